@@ -1,0 +1,14 @@
+"""hiab-sim: energy-optimal EMLA mounting for HIAB parallel-serial loader cranes."""
+
+from __future__ import annotations
+
+from importlib.metadata import PackageNotFoundError, version
+
+from hiab_sim.errors import ConfigError, HiabSimError, InvalidInputError, SolverError
+
+try:
+    __version__ = version("hiab-sim")
+except PackageNotFoundError:  # running from a source tree that is not installed
+    __version__ = "0.0.0+unknown"
+
+__all__ = ["ConfigError", "HiabSimError", "InvalidInputError", "SolverError", "__version__"]

@@ -1,0 +1,64 @@
+"""The ``hiab-sim`` console script: one argparse parser, one module per subcommand.
+
+Every subcommand module in :data:`SUBCOMMANDS` exposes ``add_parser(subparsers)`` and
+``run(args) -> int``. A :class:`~hiab_sim.errors.HiabSimError` (bad input) is printed on one
+line and the process exits with status 2, without a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from hiab_sim import __version__
+from hiab_sim.errors import HiabSimError, SolverError
+
+#: Subcommand name -> module under ``hiab_sim.cli`` that implements it.
+SUBCOMMANDS: dict[str, str] = {
+    "crane": "crane_info",
+    "mjcf": "mjcf",
+    "validate": "validate",
+    "emla-map": "emla_map",
+    "optimize": "optimize",
+    "render": "render",
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Return the top-level parser with every subcommand registered."""
+    parser = argparse.ArgumentParser(
+        prog="hiab-sim",
+        description="Energy-optimal mounting of electromechanical linear actuators on HIAB loader cranes.",
+    )
+    parser.add_argument("--version", action="version", version=f"hiab-sim {__version__}")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for module_name in SUBCOMMANDS.values():
+        module = importlib.import_module(f"hiab_sim.cli.{module_name}")
+        module.add_parser(subparsers)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; return the process exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 0
+    try:
+        return int(args.run(args))
+    except SolverError as error:
+        print(f"hiab-sim {args.command}: solver failed: {error}", file=sys.stderr)
+        return 1
+    except HiabSimError as error:
+        print(f"hiab-sim {args.command}: error: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"hiab-sim {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
