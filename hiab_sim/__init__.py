@@ -4,7 +4,11 @@ from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
-from hiab_sim.errors import ConfigError, HiabSimError, InvalidInputError, SolverError
+from hiab_sim._gl import select_gl_backend
+
+select_gl_backend()  # must run before anything imports mujoco
+
+from hiab_sim.errors import ConfigError, HiabSimError, InvalidInputError, SolverError  # noqa: E402
 
 try:
     __version__ = version("hiab-sim")

@@ -1,22 +1,56 @@
-"""``hiab-sim emla-map``: Plot an EMLA efficiency map over load force and velocity (issue 5).
-
-Not implemented yet: the subcommand is registered so that ``--help`` lists it, and it exits
-with status 2 and a message until its issue lands.
-"""
+"""``hiab-sim emla-map``: plot an EMLA efficiency map over load force and rod velocity (issue 5)."""
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
-from hiab_sim.errors import HiabSimError
+from hiab_sim.emla.config import ACTUATOR_NAMES, load_emla_set
+from hiab_sim.errors import InvalidInputError
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     """Register the subcommand."""
-    parser = subparsers.add_parser("emla-map", help="Plot an EMLA efficiency map over load force and velocity (issue 5). (not implemented yet)")
+    parser = subparsers.add_parser(
+        "emla-map",
+        help="Plot an EMLA efficiency map over load force and velocity (all four quadrants).",
+        description=(
+            "Efficiency of one EMLA over load force and rod velocity at zero acceleration, with the "
+            "feasible envelope (peak torque, rated speed, voltage) and the hydraulic cylinder it replaces."
+        ),
+    )
+    parser.add_argument("--actuator", choices=ACTUATOR_NAMES, default="lift", help="actuator (default: lift)")
+    parser.add_argument("--config", metavar="EMLA.yaml", help="EMLA parameter file (default: XS 031 preset)")
+    parser.add_argument("-o", "--output", metavar="FILE.png", help="figure path (default: emla_map_ACTUATOR.png)")
+    parser.add_argument("--csv", metavar="FILE.csv", help="also write the grid as CSV")
+    parser.add_argument("--npz", metavar="FILE.npz", help="also write the grid as NPZ")
+    parser.add_argument("--resolution", type=int, default=161, help="grid points per axis (default: 161)")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    """Report that the subcommand is not available yet."""
-    raise HiabSimError("'emla-map' is not implemented yet")
+    """Compute the map, write the requested files and print a one-line summary per file."""
+    from hiab_sim.emla.maps import efficiency_map, plot_efficiency_map, save_csv, save_npz
+
+    params = load_emla_set(args.config)[args.actuator]
+    emap = efficiency_map(params, n_force=args.resolution, n_velocity=args.resolution)
+    output = Path(args.output) if args.output else Path(f"emla_map_{args.actuator}.png")
+    targets: list[tuple[str, Path]] = [("figure", output)]
+    targets += [(kind, Path(p)) for kind, p in (("csv", args.csv), ("npz", args.npz)) if p]
+    for kind, path in targets:
+        if not path.parent.is_dir():
+            raise InvalidInputError(f"{kind} path", str(path), "its folder must exist")
+    fig = plot_efficiency_map(emap)
+    fig.savefig(output, dpi=150)
+    if args.csv:
+        save_csv(emap, args.csv)
+    if args.npz:
+        save_npz(emap, args.npz)
+    print(
+        f"{params.name}: peak force {emap.peak_force / 1e3:.1f} kN"
+        + (f" (hydraulic {params.hydraulic_push_force / 1e3:.1f} kN)" if params.hydraulic_push_force else "")
+        + f", top speed {emap.top_speed:.4f} m/s"
+    )
+    for kind, path in targets:
+        print(f"wrote {kind}: {path}")
+    return 0

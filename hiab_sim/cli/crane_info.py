@@ -1,0 +1,44 @@
+"""``hiab-sim crane``: print a summary of a crane description (chains, lengths, ranges, masses)."""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from hiab_sim.config import load_crane
+from hiab_sim.crane import mechanism
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    """Register the subcommand."""
+    parser = subparsers.add_parser("crane", help="print a summary of a crane description")
+    parser.add_argument("--crane", default="xs031", help="preset name or YAML file (default: xs031)")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print the crane summary."""
+    crane = load_crane(args.crane)
+    print(f"{crane.name}  (gravity {crane.gravity} m/s^2)")
+    print(f"source: {crane.source}")
+    for chain in crane.chains:
+        xi = chain.default_lengths
+        x_min, x_max = mechanism.stroke_bounds(chain, xi)
+        low, high = mechanism.reachable_joint_range(chain, xi)
+        work = chain.joint_range
+        print(
+            f"{chain.name:>5} chain: L = {xi.L:.4f} m, L1 = {chain.L1:.4f} m, Lc0 = {xi.Lc0:.4f} m, "
+            f"Lc = {xi.Lc:.4f} m, stroke {chain.stroke:.3f} m (usable [{x_min:.4f}, {x_max:.4f}] m)"
+        )
+        print(
+            f"       reachable theta [{low:+.4f}, {high:+.4f}] rad = [{np.degrees(low):+.1f}, {np.degrees(high):+.1f}] deg;"
+            f" working range [{work[0]:+.4f}, {work[1]:+.4f}] rad"
+        )
+    tele = crane.telescope
+    print(f"telescope: stroke {tele.stroke:.3f} m, rod {tele.rod_length:.3f} m, range {list(tele.joint_range)} m")
+    total = sum(body.mass for body in crane.bodies)
+    print(f"bodies: {len(crane.bodies)}, total mass {total:.2f} kg")
+    for body in crane.bodies:
+        print(f"  {body.name:<20} {body.mass:10.3f} kg on link {body.link}")
+    return 0

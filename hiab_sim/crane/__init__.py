@@ -1,0 +1,1 @@
+"""The crane: closed-chain mechanism math and forward kinematics (numpy only)."""

@@ -1,0 +1,96 @@
+"""Time samples exchanged by the inverse-dynamics paths, and the one entry point that picks a path.
+
+Conventions shared by both paths (issue 3, 4):
+- Independent joints, in this order: ``theta1`` [rad], ``theta2`` [rad], ``xt2`` [m] (the
+  source's Theta1, Theta2 and telescope extension, same zero and sign).
+- Actuators, in this order: ``lift`` (stroke x1), ``tilt`` (x2), ``telescope`` (xt2); strokes
+  in [m], 0 at the retracted pin-to-pin length x0.
+- Force f_x [N] is positive when it pushes the actuator apart (extends it); velocity
+  v_x = dx/dt [m/s]. f_x * v_x is the power the actuator delivers to the crane [W].
+- An optional external force at the TCP, ``tcp_force`` [N], is the force the environment
+  applies to the TCP (a payload of mass m hangs as (0, -m g, 0)), in the source world
+  frame {W} (y up), shape (3,) or (T, 3).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from hiab_sim.config import Crane, LinkLengths
+from hiab_sim.errors import InvalidInputError
+
+Array = NDArray[np.float64]
+JOINT_NAMES = ("theta1", "theta2", "xt2")
+ACTUATOR_NAMES = ("lift", "tilt", "telescope")
+IdPath = Literal["mujoco", "analytic"]
+
+
+@dataclass(frozen=True)
+class JointSamples:
+    """Samples of the independent joints: ``position``, ``velocity``, ``acceleration``, each (T, 3)."""
+
+    position: Array
+    velocity: Array
+    acceleration: Array
+
+    def __post_init__(self) -> None:
+        for name in ("position", "velocity", "acceleration"):
+            value = np.asarray(getattr(self, name), dtype=float)
+            if value.ndim != 2 or value.shape[1] != 3:
+                raise InvalidInputError(f"joints.{name}", f"shape {value.shape}", "must have shape (T, 3)")
+            if not np.all(np.isfinite(value)):
+                raise InvalidInputError(f"joints.{name}", "NaN or inf", "must be finite")
+            object.__setattr__(self, name, value)
+        if not (self.position.shape == self.velocity.shape == self.acceleration.shape):
+            raise InvalidInputError("joints", "mismatched shapes", "position, velocity, acceleration must match")
+
+    @classmethod
+    def at_rest(cls, position: ArrayLike) -> JointSamples:
+        """Static samples: the given positions (T, 3) with zero velocity and acceleration."""
+        p = np.atleast_2d(np.asarray(position, dtype=float))
+        return cls(p, np.zeros_like(p), np.zeros_like(p))
+
+    def __len__(self) -> int:
+        return int(self.position.shape[0])
+
+
+@dataclass(frozen=True)
+class ActuatorSamples:
+    """Actuator samples, each (T, 3) in the order lift, tilt, telescope.
+
+    ``force`` f_x [N], ``velocity`` v_x [m/s], ``acceleration`` dv_x/dt [m/s^2] and
+    ``stroke`` x [m].
+    """
+
+    force: Array
+    velocity: Array
+    acceleration: Array
+    stroke: Array
+
+    @property
+    def power(self) -> Array:
+        """Mechanical power delivered by each actuator, f_x v_x [W], (T, 3)."""
+        return self.force * self.velocity
+
+
+def inverse_dynamics(
+    crane: Crane,
+    lengths: LinkLengths,
+    joints: JointSamples,
+    path: IdPath = "mujoco",
+    tcp_force: ArrayLike | None = None,
+) -> ActuatorSamples:
+    """[f_x, v_x] = ID(theta, dtheta, ddtheta, robot(Xi)) (seed eq. dynamics) by the chosen path."""
+    if path == "mujoco":
+        from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
+
+        return MujocoInverseDynamics(crane, lengths)(joints, tcp_force=tcp_force)
+    if path == "analytic":
+        from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
+
+        return analytic_inverse_dynamics(crane, lengths, joints, tcp_force=tcp_force)
+    raise InvalidInputError("path", path, "must be 'mujoco' or 'analytic'")

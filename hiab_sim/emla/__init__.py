@@ -1,0 +1,70 @@
+"""The EMLA (PMSM + gearbox + screw) electromechanical model: power, losses, envelope and maps.
+
+Public API (vectorised over numpy arrays of samples):
+
+* :func:`load_emla_set` -> :class:`EmlaSet` with ``lift``, ``tilt``, ``telescope`` :class:`EmlaParams`;
+* :func:`operating_point`, :func:`electrical_power`, :func:`electrical_power_partials`;
+* :func:`envelope_margins`, :func:`envelope_margin_partials`, :data:`ENVELOPE_LIMIT_NAMES`;
+* :func:`energy_summary`, :func:`peak_force`, :func:`top_speed`;
+* Park transform in :mod:`hiab_sim.emla.park`, dq equations in :mod:`hiab_sim.emla.pmsm`,
+  efficiency maps in :mod:`hiab_sim.emla.maps` (imported on demand: it needs matplotlib).
+"""
+
+from __future__ import annotations
+
+from hiab_sim.emla.config import (
+    ACTUATOR_NAMES,
+    DEFAULT_EMLA_PRESET,
+    EmlaParams,
+    EmlaSet,
+    PmsmParams,
+    emla_set_from_mapping,
+    load_emla_set,
+)
+from hiab_sim.emla.drive import DriveState, drive_state
+from hiab_sim.emla.envelope import (
+    ENVELOPE_LIMIT_NAMES,
+    envelope_margin_partials,
+    envelope_margins,
+    within_envelope,
+)
+from hiab_sim.emla.model import (
+    OperatingPoint,
+    efficiency,
+    electrical_power,
+    electrical_power_partials,
+    energy_summary,
+    operating_point,
+    peak_force,
+    top_speed,
+)
+from hiab_sim.emla.park import abc_to_dq0, dq0_power, dq0_to_abc, line_voltage_rms, park_matrix
+
+__all__ = [
+    "ACTUATOR_NAMES",
+    "DEFAULT_EMLA_PRESET",
+    "ENVELOPE_LIMIT_NAMES",
+    "DriveState",
+    "EmlaParams",
+    "EmlaSet",
+    "OperatingPoint",
+    "PmsmParams",
+    "abc_to_dq0",
+    "dq0_power",
+    "dq0_to_abc",
+    "drive_state",
+    "efficiency",
+    "electrical_power",
+    "electrical_power_partials",
+    "emla_set_from_mapping",
+    "energy_summary",
+    "envelope_margin_partials",
+    "envelope_margins",
+    "line_voltage_rms",
+    "load_emla_set",
+    "operating_point",
+    "park_matrix",
+    "peak_force",
+    "top_speed",
+    "within_envelope",
+]

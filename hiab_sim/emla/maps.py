@@ -1,0 +1,193 @@
+"""EMLA efficiency maps over load force and rod velocity in all four quadrants (the seed's Fig. Eff).
+
+The map data are pure numpy (:func:`efficiency_map`); plotting uses matplotlib's object API with
+the Agg canvas (no pyplot, no display, no global backend switch); CSV/NPZ writers dump the grid.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from numpy.typing import ArrayLike, NDArray
+
+from hiab_sim.emla.config import EmlaParams
+from hiab_sim.emla.envelope import ENVELOPE_LIMIT_NAMES
+from hiab_sim.emla.model import operating_point, peak_force, top_speed
+from hiab_sim.errors import InvalidInputError
+
+#: Filled efficiency levels of the map; the labelled contour lines are a subset.
+EFFICIENCY_LEVELS: tuple[float, ...] = (0.0, 0.3, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.92, 0.94, 0.96, 1.0)
+LABELLED_LEVELS: tuple[float, ...] = (0.5, 0.7, 0.8, 0.85, 0.9, 0.92, 0.94)
+
+
+@dataclass(frozen=True)
+class EfficiencyMap:
+    """Efficiency and power of one EMLA on a (force, velocity) grid at zero acceleration.
+
+    Attributes:
+        actuator: Actuator name.
+        force: Load force samples f_x [N], shape ``(nf,)``.
+        velocity: Rod velocity samples v_x [m/s], shape ``(nv,)``.
+        efficiency: eta on the grid, shape ``(nf, nv)`` (see :func:`hiab_sim.emla.model.efficiency`).
+        electrical_power: P_elec [W], shape ``(nf, nv)``.
+        mechanical_power: f_x v_x [W], shape ``(nf, nv)``.
+        margins: Envelope margins, shape ``(3, nf, nv)``.
+        within_envelope: Feasibility mask, shape ``(nf, nv)``.
+        peak_force: :func:`~hiab_sim.emla.model.peak_force` [N].
+        top_speed: :func:`~hiab_sim.emla.model.top_speed` [m/s].
+        hydraulic_push_force: Push force of the replaced hydraulic cylinder [N] or None.
+        hydraulic_pull_force: Pull force of the replaced hydraulic cylinder [N] or None.
+    """
+
+    actuator: str
+    force: NDArray[np.float64]
+    velocity: NDArray[np.float64]
+    efficiency: NDArray[np.float64]
+    electrical_power: NDArray[np.float64]
+    mechanical_power: NDArray[np.float64]
+    margins: NDArray[np.float64]
+    within_envelope: NDArray[np.bool_]
+    peak_force: float
+    top_speed: float
+    hydraulic_push_force: float | None
+    hydraulic_pull_force: float | None
+
+
+def efficiency_map(
+    params: EmlaParams, n_force: int = 161, n_velocity: int = 161, span: float = 1.15
+) -> EfficiencyMap:
+    """Evaluate the EMLA on a symmetric grid covering ``span`` times its peak force and top speed.
+
+    Args:
+        params: The actuator.
+        n_force: Number of force samples (>= 3).
+        n_velocity: Number of velocity samples (>= 3).
+        span: Grid half-width as a multiple of the envelope's extent (> 1 so the envelope shows).
+    """
+    if n_force < 3:
+        raise InvalidInputError("n_force", n_force, "must be >= 3")
+    if n_velocity < 3:
+        raise InvalidInputError("n_velocity", n_velocity, "must be >= 3")
+    if not span > 1.0:
+        raise InvalidInputError("span", span, "must be > 1")
+    f_max = span * params.transmission_ratio * params.motor.peak_torque
+    v_max = span * top_speed(params)
+    force = np.linspace(-f_max, f_max, n_force)
+    velocity = np.linspace(-v_max, v_max, n_velocity)
+    ff, vv = np.meshgrid(force, velocity, indexing="ij")
+    op = operating_point(params, ff, vv, 0.0)
+    return EfficiencyMap(
+        actuator=params.name,
+        force=force,
+        velocity=velocity,
+        efficiency=op.efficiency,
+        electrical_power=op.electrical_power,
+        mechanical_power=op.mechanical_power,
+        margins=op.margins,
+        within_envelope=op.within_envelope,
+        peak_force=peak_force(params),
+        top_speed=top_speed(params),
+        hydraulic_push_force=params.hydraulic_push_force,
+        hydraulic_pull_force=params.hydraulic_pull_force,
+    )
+
+
+def plot_efficiency_map(
+    emap: EfficiencyMap,
+    operating_points: tuple[ArrayLike, ArrayLike] | None = None,
+    ax: Axes | None = None,
+) -> Figure:
+    """Draw the efficiency map: filled contours with labelled levels, the envelope and references.
+
+    Outside the envelope the map is blank. In the generating quadrants (f_x v_x < 0) the colour is
+    the generating efficiency P_elec / (f_x v_x) = |P_elec| / |f_x v_x|; grey hatching marks where
+    the drive still draws power there (losses exceed the returned power).
+
+    Args:
+        emap: Map data from :func:`efficiency_map`.
+        operating_points: Optional (f_x [N], v_x [m/s]) arrays of one shape to overlay as dots.
+        ax: Axes to draw into; a new Agg-backed figure is made when None.
+
+    Returns:
+        The figure holding the axes.
+    """
+    if ax is None:
+        fig = Figure(figsize=(7.5, 5.8), layout="constrained")
+        FigureCanvasAgg(fig)
+        ax = fig.add_subplot()
+    else:
+        fig = ax.get_figure()  # type: ignore[assignment]
+    v = emap.velocity
+    f_kn = emap.force / 1e3
+    eta = np.where(emap.within_envelope, emap.efficiency, np.nan)
+    filled = ax.contourf(v, f_kn, np.clip(eta, 0.0, 1.0), levels=list(EFFICIENCY_LEVELS), cmap="viridis")
+    lines = ax.contour(v, f_kn, eta, levels=list(LABELLED_LEVELS), colors="white", linewidths=0.7)
+    ax.clabel(lines, fmt="%.2f", fontsize=7)
+    drawing = emap.within_envelope & (emap.mechanical_power < 0) & (emap.efficiency < 0)
+    if np.any(drawing):
+        ax.contourf(
+            v, f_kn, drawing.astype(float), levels=[0.5, 1.5], colors="0.6", hatches=["///"], alpha=0.9
+        )
+    ax.contour(v, f_kn, emap.margins.min(axis=0), levels=[0.0], colors="black", linewidths=2.0)
+    ax.plot([], [], color="black", linewidth=2.0, label="envelope (" + ", ".join(ENVELOPE_LIMIT_NAMES) + ")")
+    if np.any(drawing):
+        ax.fill_between([], [], color="0.6", hatch="///", label="generating, drive still draws power")
+    if emap.hydraulic_push_force is not None:
+        ax.axhline(emap.hydraulic_push_force / 1e3, color="tab:red", linestyle="--", linewidth=1.2)
+        ax.plot([], [], color="tab:red", linestyle="--", label="hydraulic cylinder push / pull")
+    if emap.hydraulic_pull_force is not None:
+        ax.axhline(-emap.hydraulic_pull_force / 1e3, color="tab:red", linestyle="--", linewidth=1.2)
+    if operating_points is not None:
+        f_op = np.asarray(operating_points[0], dtype=float).ravel()
+        v_op = np.asarray(operating_points[1], dtype=float).ravel()
+        if f_op.shape != v_op.shape:
+            raise InvalidInputError("operating_points", f"shapes {f_op.shape}, {v_op.shape}", "must match")
+        ax.plot(v_op, f_op / 1e3, ".", color="tab:orange", markersize=3, label="operating points")
+    ax.axhline(0.0, color="0.3", linewidth=0.5)
+    ax.axvline(0.0, color="0.3", linewidth=0.5)
+    for sx, sy, text in ((1, 1, "motoring"), (-1, -1, "motoring"), (-1, 1, "generating"), (1, -1, "generating")):
+        ax.text(
+            0.5 + 0.47 * sx, 0.5 + 0.47 * sy, text, transform=ax.transAxes, fontsize=8, color="0.25",
+            ha="right" if sx > 0 else "left", va="top" if sy > 0 else "bottom",
+        )  # fmt: skip
+    ax.set_xlabel("rod velocity $v_x$ [m/s]")
+    ax.set_ylabel("load force $f_x$ [kN]")
+    ax.set_title(
+        f"EMLA efficiency, {emap.actuator}: peak {emap.peak_force / 1e3:.1f} kN, top {emap.top_speed:.3f} m/s"
+    )
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.07), ncol=2, fontsize=7, frameon=False)
+    fig.colorbar(filled, ax=ax, label="efficiency: $f_x v_x / P_{elec}$ motoring, $P_{elec} / f_x v_x$ generating")
+    return fig
+
+
+def save_csv(emap: EfficiencyMap, path: str | Path) -> None:
+    """Write the map as CSV, one row per grid point, SI units named in the header."""
+    ff, vv = np.meshgrid(emap.force, emap.velocity, indexing="ij")
+    columns = [ff, vv, emap.efficiency, emap.electrical_power, emap.mechanical_power]
+    columns += [emap.within_envelope.astype(float), *emap.margins]
+    header = "force_N,velocity_m_per_s,efficiency,electrical_power_W,mechanical_power_W,within_envelope,"
+    header += ",".join(f"margin_{name}" for name in ENVELOPE_LIMIT_NAMES)
+    table = np.column_stack([c.ravel() for c in columns])
+    np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.10g")
+
+
+def save_npz(emap: EfficiencyMap, path: str | Path) -> None:
+    """Write the map arrays to a compressed NPZ file (keys as the :class:`EfficiencyMap` fields)."""
+    np.savez_compressed(
+        path,
+        force=emap.force,
+        velocity=emap.velocity,
+        efficiency=emap.efficiency,
+        electrical_power=emap.electrical_power,
+        mechanical_power=emap.mechanical_power,
+        margins=emap.margins,
+        margin_names=np.array(ENVELOPE_LIMIT_NAMES),
+        within_envelope=emap.within_envelope,
+        peak_force=emap.peak_force,
+        top_speed=emap.top_speed,
+    )

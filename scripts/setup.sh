@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Idempotent set-up on a fresh Debian machine: system libraries (OSMesa for off-screen
+# rendering, ffmpeg for videos), a virtual environment in .venv and hiab-sim with its extras.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SUDO=""
+if [ "$(id -u)" != "0" ]; then SUDO="sudo"; fi
+need=""
+dpkg -s libosmesa6 >/dev/null 2>&1 || need="$need libosmesa6"
+command -v ffmpeg >/dev/null 2>&1 || need="$need ffmpeg"
+if [ -n "$need" ]; then
+  echo "[setup] apt-get install$need"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $need >/dev/null
+fi
+if [ ! -x .venv/bin/python ]; then
+  python3 -m venv .venv
+fi
+.venv/bin/python -m pip install -q --upgrade pip >/dev/null
+.venv/bin/python -m pip install -q -e ".[test,dev]"
