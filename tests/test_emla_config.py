@@ -65,8 +65,10 @@ def test_hydraulic_comparison_forces_match_bore_times_supply_pressure() -> None:
 
 @pytest.mark.parametrize("name", ACTUATOR_NAMES)
 def test_each_emla_pushes_at_least_as_hard_as_the_hydraulic_cylinder(name: str) -> None:
-    """Peak EMLA force >= the 190 bar cylinder it replaces (95.5 kN lift/tilt, 37.3 kN telescope),
-    and the envelope admits that force while the rod starts to move outwards."""
+    """Peak EMLA force >= the 190 bar cylinder it replaces (95.5 kN lift/tilt, 37.3 kN telescope).
+
+    The envelope also admits that force while the rod starts to move outwards.
+    """
     params = load_emla_set()[name]
     hydraulic = {"lift": 95.5e3, "tilt": 95.5e3, "telescope": 37.3e3}[name]
     assert params.hydraulic_push_force == hydraulic

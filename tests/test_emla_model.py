@@ -71,7 +71,13 @@ def test_electrical_power_equals_mechanical_power_plus_losses_to_machine_precisi
     """P_elec (electrical side) = f v + copper + rotor friction + screw viscous + inertial power."""
     f, v, a = samples(data.draw, params)
     op = operating_point(params, f, v, a)
-    terms = [op.mechanical_power, op.copper_loss, op.rotor_friction_loss, op.screw_viscous_loss, op.inertial_power]
+    terms = [
+        op.mechanical_power,
+        op.copper_loss,
+        op.rotor_friction_loss,
+        op.screw_viscous_loss,
+        op.inertial_power,
+    ]
     scale = np.sum(np.abs(terms), axis=0) + np.abs(op.electrical_power)
     residual = op.electrical_power - np.sum(terms, axis=0)
     assert np.all(np.abs(residual) <= 8 * np.finfo(float).eps * scale + 1e-300)
@@ -91,7 +97,9 @@ def test_dq_power_splits_into_copper_loss_and_air_gap_power_for_any_d_current(
     motor = params.motor
     v_d, v_q = dq_voltages(motor, i_d, i_q, omega)
     p_elec = 1.5 * (v_d * i_d + v_q * i_q)
-    expected = 1.5 * motor.stator_resistance * (i_d**2 + i_q**2) + omega * electromagnetic_torque(motor, i_d, i_q)
+    expected = 1.5 * motor.stator_resistance * (i_d**2 + i_q**2) + omega * electromagnetic_torque(
+        motor, i_d, i_q
+    )
     assert p_elec == pytest.approx(expected, rel=1e-12, abs=1e-9)
 
 
@@ -100,7 +108,7 @@ def test_dq_power_splits_into_copper_loss_and_air_gap_power_for_any_d_current(
 def test_efficiency_never_exceeds_one_unless_kinetic_energy_is_released(
     data: st.DataObject, params: EmlaParams
 ) -> None:
-    """eta <= 1 in all four quadrants, inside and outside the envelope, wherever a_x v_x >= 0."""
+    """Efficiency is <= 1 in all four quadrants, in and out of the envelope, wherever a_x v_x >= 0."""
     f, v, a = samples(data.draw, params)
     a = np.abs(a) * np.sign(v)  # a v >= 0: steady or accelerating
     op = operating_point(params, f, v, a)
@@ -114,8 +122,10 @@ def test_efficiency_never_exceeds_one_unless_kinetic_energy_is_released(
 
 
 def test_generating_drive_at_crawl_speed_and_high_load_still_draws_more_than_it_receives() -> None:
-    """|P_elec| <= |f v| in the generating quadrants only where the drive actually regenerates:
-    lowering 90 kN at 1 mm/s returns 90 W but costs about 1 kW of copper loss (P_elec > 0)."""
+    """In generating quadrants |P_elec| <= |f v| holds only where the drive actually regenerates.
+
+    Lowering 90 kN at 1 mm/s returns 90 W but costs about 1 kW of copper loss (P_elec > 0).
+    """
     op = operating_point(EMLAS.lift, 90e3, -1e-3, 0.0)
     assert op.within_envelope
     assert op.mechanical_power < 0 < op.electrical_power
@@ -124,7 +134,7 @@ def test_generating_drive_at_crawl_speed_and_high_load_still_draws_more_than_it_
 
 
 def test_lowering_a_load_at_speed_regenerates_through_the_same_model() -> None:
-    """f v < 0 at speed gives P_elec < 0 with |P_elec| = |f v| - losses (generating efficiency < 1)."""
+    """Negative f v at speed gives P_elec < 0 with |P_elec| = |f v| - losses (generating efficiency < 1)."""
     op = operating_point(EMLAS.lift, 60e3, -0.15, 0.0)
     losses = op.copper_loss + op.rotor_friction_loss + op.screw_viscous_loss
     assert op.electrical_power < 0
@@ -175,7 +185,9 @@ def test_electrical_power_matches_seed_form_f_v_over_eta_where_eta_is_defined() 
 
 @settings(max_examples=60, deadline=None)
 @given(data=st.data(), params=emla_params())
-def test_electrical_power_partials_match_central_finite_differences(data: st.DataObject, params: EmlaParams) -> None:
+def test_electrical_power_partials_match_central_finite_differences(
+    data: st.DataObject, params: EmlaParams
+) -> None:
     """Analytic dP/df, dP/dv, dP/da agree with central differences to 1e-6 relative (+ FD roundoff)."""
     f, v, a = samples(data.draw, params)
     analytic = electrical_power_partials(params, f, v, a)

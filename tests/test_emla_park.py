@@ -16,7 +16,7 @@ angles = st.floats(-20.0, 20.0, allow_nan=False)
 @settings(max_examples=100, deadline=None)
 @given(x=arrays(float, (3, 5), elements=finite), theta=arrays(float, (5,), elements=angles))
 def test_abc_to_dq0_to_abc_round_trip_is_identity(x: np.ndarray, theta: np.ndarray) -> None:
-    """abc -> dq0 -> abc and dq0 -> abc -> dq0 return the input (any values, zero sequence included)."""
+    """Transforms abc -> dq0 -> abc and dq0 -> abc -> dq0 return the input (zero sequence too)."""
     np.testing.assert_allclose(dq0_to_abc(abc_to_dq0(x, theta), theta), x, atol=1e-9)
     np.testing.assert_allclose(abc_to_dq0(dq0_to_abc(x, theta), theta), x, atol=1e-9)
 
@@ -27,7 +27,9 @@ def test_abc_to_dq0_to_abc_round_trip_is_identity(x: np.ndarray, theta: np.ndarr
     i=arrays(float, (3, 4), elements=finite),
     theta=arrays(float, (4,), elements=angles),
 )
-def test_three_phase_power_equals_three_halves_dq_power(v: np.ndarray, i: np.ndarray, theta: np.ndarray) -> None:
+def test_three_phase_power_equals_three_halves_dq_power(
+    v: np.ndarray, i: np.ndarray, theta: np.ndarray
+) -> None:
     """sum_k v_k i_k = 3/2 (v_d i_d + v_q i_q) + 3 v_0 i_0 for the amplitude-invariant transform."""
     p_abc = np.sum(v * i, axis=0)
     p_dq = dq0_power(abc_to_dq0(v, theta), abc_to_dq0(i, theta))
@@ -58,4 +60,6 @@ def test_line_voltage_rms_is_sqrt_three_halves_times_dq_magnitude() -> None:
 def test_park_matrix_rows_are_orthogonal_with_norms_three_halves_and_three_quarters() -> None:
     """P P^T = diag(3/2, 3/2, 3/4), which is why the power carries the 3/2 factor."""
     p = park_matrix(np.array([0.0, 1.3, -2.0]))
-    np.testing.assert_allclose(p @ np.swapaxes(p, -1, -2), np.broadcast_to(np.diag([1.5, 1.5, 0.75]), (3, 3, 3)), atol=1e-14)
+    np.testing.assert_allclose(
+        p @ np.swapaxes(p, -1, -2), np.broadcast_to(np.diag([1.5, 1.5, 0.75]), (3, 3, 3)), atol=1e-14
+    )

@@ -51,6 +51,7 @@ class PmsmParams:
         friction_smoothing_speed: omega_eps [rad/s] of the regularised Coulomb friction
             tau_f tanh(omega_m / omega_eps); a model choice, not a motor datum.
         label: Prefix used in error messages.
+
     """
 
     pole_pairs: int
@@ -103,7 +104,7 @@ class PmsmParams:
 
 @dataclass(frozen=True)
 class EmlaParams:
-    """One electromechanical linear actuator: PMSM, gearbox and screw (eqs. ``torque_torque``, ``torque_force``).
+    """One electromechanical linear actuator: PMSM, gearbox, screw (eqs. ``torque_torque``, ``torque_force``).
 
     Attributes:
         name: Actuator name (``lift``, ``tilt`` or ``telescope`` for the XS 031), used in messages.
@@ -116,6 +117,7 @@ class EmlaParams:
         hydraulic_pull_force: Pull force of that cylinder [N], or None.
         provenance: (parameter key, source label) pairs, e.g.
             ``("pmsm.peak_torque", "estimate: 3 x rated torque ...")``.
+
     """
 
     name: str
@@ -140,7 +142,7 @@ class EmlaParams:
 
     @property
     def transmission_ratio(self) -> float:
-        """k = 2 pi G / rho [rad/m]: motor angle per metre of rod travel (eq. ``torque_force``)."""
+        """Transmission ratio k = 2 pi G / rho [rad/m]: motor angle per rod metre (eq. ``torque_force``)."""
         return 2.0 * math.pi * self.gear_ratio / self.screw_lead
 
     def source_of(self, key: str) -> str:
@@ -186,6 +188,7 @@ def load_emla_set(path: str | Path | None = None) -> EmlaSet:
     Raises:
         ConfigError: The file is missing, is not YAML, or has unknown, missing or non-numeric keys.
         InvalidInputError: A value is out of range (the message names field, value and range).
+
     """
     file = DEFAULT_EMLA_PRESET if path is None else Path(path)
     try:
@@ -212,7 +215,9 @@ def emla_set_from_mapping(document: object, where: str = "<mapping>") -> EmlaSet
     for name in ACTUATOR_NAMES:
         section = f"actuators.{name}"
         node = _mapping(actuators[name], where, section)
-        _check_keys(node, required=_ACTUATOR_REQUIRED, optional=_ACTUATOR_OPTIONAL, where=where, section=section)
+        _check_keys(
+            node, required=_ACTUATOR_REQUIRED, optional=_ACTUATOR_OPTIONAL, where=where, section=section
+        )
         override = _mapping(node.get("pmsm", {}), where, f"{section}.pmsm")
         _check_keys(override, required=(), optional=_PMSM_KEYS, where=where, section=f"{section}.pmsm")
         provenance: list[tuple[str, str]] = []

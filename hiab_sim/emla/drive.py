@@ -45,6 +45,7 @@ class DriveState:
         d_i_q: Partials of i_q.
         d_v_d: Partials of v_d.
         d_v_q: Partials of v_q.
+
     """
 
     motor_speed: Array
@@ -64,15 +65,21 @@ class DriveState:
     d_v_q: Partials
 
 
-def broadcast_inputs(force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike) -> tuple[Array, Array, Array]:
+def broadcast_inputs(
+    force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
+) -> tuple[Array, Array, Array]:
     """Return force [N], velocity [m/s] and acceleration [m/s^2] as float arrays of one shape."""
     f, v, a = np.broadcast_arrays(
-        np.asarray(force, dtype=float), np.asarray(velocity, dtype=float), np.asarray(acceleration, dtype=float)
+        np.asarray(force, dtype=float),
+        np.asarray(velocity, dtype=float),
+        np.asarray(acceleration, dtype=float),
     )
     return f, v, a
 
 
-def drive_state(params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike) -> DriveState:
+def drive_state(
+    params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
+) -> DriveState:
     """Map load-side force [N], velocity [m/s] and acceleration [m/s^2] to the motor and its dq quantities.
 
     Args:
@@ -80,6 +87,7 @@ def drive_state(params: EmlaParams, force: ArrayLike, velocity: ArrayLike, accel
         force: Load force f_x [N], positive when the actuator pushes.
         velocity: Rod velocity v_x [m/s], positive when extending.
         acceleration: Rod acceleration dv_x/dt [m/s^2].
+
     """
     f, v, a = broadcast_inputs(force, velocity, acceleration)
     motor = params.motor
@@ -99,7 +107,8 @@ def drive_state(params: EmlaParams, force: ArrayLike, velocity: ArrayLike, accel
     d_omega: Partials = (zeros, k * ones, zeros)
     d_tau: Partials = (
         ones / k,
-        params.viscous_friction / k + motor.rotor_coulomb_friction * sech2 * k / motor.friction_smoothing_speed,
+        params.viscous_friction / k
+        + motor.rotor_coulomb_friction * sech2 * k / motor.friction_smoothing_speed,
         (params.screw_moving_mass / k + motor.rotor_inertia * k) * ones,
     )
 

@@ -48,6 +48,7 @@ def envelope_margins(
     Returns:
         Dimensionless array of shape ``(len(ENVELOPE_LIMIT_NAMES),) + shape`` (rows in the order of
         :data:`ENVELOPE_LIMIT_NAMES`).
+
     """
     return margins_from_state(params, drive_state(params, force, velocity, acceleration))
 
@@ -55,7 +56,7 @@ def envelope_margins(
 def envelope_margin_partials(
     params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """Return the analytic partials (dg/df_x [1/N], dg/dv_x [s/m], dg/da_x [s^2/m]) of :func:`envelope_margins`.
+    """Return the analytic partials (dg/df_x [1/N], dg/dv_x [s/m], dg/da_x [s^2/m]) of the margins.
 
     Each array has the shape of :func:`envelope_margins`' result.
     """

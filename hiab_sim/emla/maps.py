@@ -42,6 +42,7 @@ class EfficiencyMap:
         top_speed: :func:`~hiab_sim.emla.model.top_speed` [m/s].
         hydraulic_push_force: Push force of the replaced hydraulic cylinder [N] or None.
         hydraulic_pull_force: Pull force of the replaced hydraulic cylinder [N] or None.
+
     """
 
     actuator: str
@@ -68,6 +69,7 @@ def efficiency_map(
         n_force: Number of force samples (>= 3).
         n_velocity: Number of velocity samples (>= 3).
         span: Grid half-width as a multiple of the envelope's extent (> 1 so the envelope shows).
+
     """
     if n_force < 3:
         raise InvalidInputError("n_force", n_force, "must be >= 3")
@@ -115,6 +117,7 @@ def plot_efficiency_map(
 
     Returns:
         The figure holding the axes.
+
     """
     if ax is None:
         fig = Figure(figsize=(7.5, 5.8), layout="constrained")
@@ -150,7 +153,12 @@ def plot_efficiency_map(
         ax.plot(v_op, f_op / 1e3, ".", color="tab:orange", markersize=3, label="operating points")
     ax.axhline(0.0, color="0.3", linewidth=0.5)
     ax.axvline(0.0, color="0.3", linewidth=0.5)
-    for sx, sy, text in ((1, 1, "motoring"), (-1, -1, "motoring"), (-1, 1, "generating"), (1, -1, "generating")):
+    for sx, sy, text in (
+        (1, 1, "motoring"),
+        (-1, -1, "motoring"),
+        (-1, 1, "generating"),
+        (1, -1, "generating"),
+    ):
         ax.text(
             0.5 + 0.47 * sx, 0.5 + 0.47 * sy, text, transform=ax.transAxes, fontsize=8, color="0.25",
             ha="right" if sx > 0 else "left", va="top" if sy > 0 else "bottom",
@@ -161,7 +169,9 @@ def plot_efficiency_map(
         f"EMLA efficiency, {emap.actuator}: peak {emap.peak_force / 1e3:.1f} kN, top {emap.top_speed:.3f} m/s"
     )
     ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.07), ncol=2, fontsize=7, frameon=False)
-    fig.colorbar(filled, ax=ax, label="efficiency: $f_x v_x / P_{elec}$ motoring, $P_{elec} / f_x v_x$ generating")
+    fig.colorbar(
+        filled, ax=ax, label="efficiency: $f_x v_x / P_{elec}$ motoring, $P_{elec} / f_x v_x$ generating"
+    )
     return fig
 
 

@@ -46,6 +46,7 @@ class OperatingPoint:
         efficiency: See :func:`efficiency`; NaN where undefined.
         margins: Envelope margins, shape ``(3,) + shape`` (see :mod:`hiab_sim.emla.envelope`).
         within_envelope: True where every margin is >= 0.
+
     """
 
     motor_speed: Array
@@ -93,14 +94,18 @@ def operating_point(
         copper_loss=1.5 * motor.stator_resistance * (s.i_d**2 + s.i_q**2),
         rotor_friction_loss=s.friction_torque * s.motor_speed,
         screw_viscous_loss=params.viscous_friction * v * v,
-        inertial_power=(params.screw_moving_mass + motor.rotor_inertia * params.transmission_ratio**2) * a * v,
+        inertial_power=(params.screw_moving_mass + motor.rotor_inertia * params.transmission_ratio**2)
+        * a
+        * v,
         efficiency=efficiency(p_mech, p_elec),
         margins=margins,
         within_envelope=np.all(margins >= 0.0, axis=0),
     )
 
 
-def electrical_power(params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike) -> Array:
+def electrical_power(
+    params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
+) -> Array:
     """Return P_elec = 3/2 (V_d i_d + V_q i_q) [W] at load force [N], velocity [m/s], acceleration [m/s^2].
 
     This replaces f_x v_x / eta_EMLA in the seed's cost (eq. ``costf2``): equal where eta is
@@ -113,7 +118,7 @@ def electrical_power(params: EmlaParams, force: ArrayLike, velocity: ArrayLike, 
 def electrical_power_partials(
     params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
 ) -> tuple[Array, Array, Array]:
-    """Return the analytic partials (dP/df_x [m/s], dP/dv_x [N], dP/da_x [kg m/s]) of :func:`electrical_power`.
+    """Return the analytic partials (dP/df_x [m/s], dP/dv_x [N], dP/da_x [kg m/s]) of P_elec.
 
     With i_d = 0, P_elec = 3/2 V_q i_q, so dP = 3/2 (dV_q i_q + V_q di_q).
     """
@@ -138,8 +143,11 @@ def efficiency(mechanical_power: ArrayLike, electrical_power: ArrayLike) -> Arra
     Args:
         mechanical_power: f_x v_x [W].
         electrical_power: P_elec [W].
+
     """
-    pm, pe = np.broadcast_arrays(np.asarray(mechanical_power, dtype=float), np.asarray(electrical_power, dtype=float))
+    pm, pe = np.broadcast_arrays(
+        np.asarray(mechanical_power, dtype=float), np.asarray(electrical_power, dtype=float)
+    )
     eta = np.full(pm.shape, np.nan)
     motoring = (pm > 0) & (pe > 0)
     generating = pm < 0
@@ -162,6 +170,7 @@ def energy_summary(time: ArrayLike, electrical_power: ArrayLike) -> tuple[Array,
 
     Returns:
         Two arrays of shape ``(...)`` (0-d for a single history).
+
     """
     t = np.asarray(time, dtype=float)
     p = np.asarray(electrical_power, dtype=float)

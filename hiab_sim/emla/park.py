@@ -22,6 +22,7 @@ def park_matrix(theta_e: ArrayLike) -> NDArray[np.float64]:
 
     Returns:
         Array of shape ``S + (3, 3)``; rows d, q, 0 and columns a, b, c.
+
     """
     angle = np.asarray(theta_e, dtype=float)[..., None] + _SHIFTS
     zero_row = np.full(angle.shape, 0.5)
@@ -37,6 +38,7 @@ def abc_to_dq0(x_abc: ArrayLike, theta_e: ArrayLike) -> NDArray[np.float64]:
 
     Returns:
         ``(d, q, 0)`` components, shape ``(3,) + S``.
+
     """
     x = np.moveaxis(np.asarray(x_abc, dtype=float), 0, -1)
     p = park_matrix(theta_e)
@@ -55,6 +57,7 @@ def dq0_to_abc(x_dq0: ArrayLike, theta_e: ArrayLike) -> NDArray[np.float64]:
 
     Returns:
         Phase values, shape ``(3,) + S``.
+
     """
     x = np.moveaxis(np.asarray(x_dq0, dtype=float), 0, -1)
     p = park_matrix(theta_e)

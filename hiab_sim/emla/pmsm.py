@@ -28,6 +28,7 @@ def dq_voltages(
         motor_speed: Mechanical rotor speed omega_m [rad/s].
         di_d: d-axis current rate [A/s] (0 in steady state).
         di_q: q-axis current rate [A/s] (0 in steady state).
+
     """
     i_d = np.asarray(i_d, dtype=float)
     i_q = np.asarray(i_q, dtype=float)
@@ -62,5 +63,7 @@ def current_derivatives(
     omega_e = motor.pole_pairs * np.asarray(motor_speed, dtype=float)
     r = motor.stator_resistance
     di_d = (np.asarray(v_d, dtype=float) - r * i_d + omega_e * motor.Lq * i_q) / motor.Ld
-    di_q = (np.asarray(v_q, dtype=float) - r * i_q - omega_e * (motor.Ld * i_d + motor.flux_linkage)) / motor.Lq
+    di_q = (
+        np.asarray(v_q, dtype=float) - r * i_q - omega_e * (motor.Ld * i_d + motor.flux_linkage)
+    ) / motor.Lq
     return di_d, di_q
