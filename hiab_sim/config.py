@@ -309,12 +309,11 @@ def load_crane(source: str | Path = "xs031") -> Crane:
     Raises:
         ConfigError: unknown preset or file, malformed YAML, unknown or missing keys.
         InvalidInputError: a value out of its allowed range (the field is named).
+
     """
     path = CRANE_PRESETS.get(str(source), Path(source))
     if not path.is_file():
-        raise ConfigError(
-            f"crane '{source}' is neither a preset ({', '.join(CRANE_PRESETS)}) nor a readable YAML file"
-        )
+        raise ConfigError(f"crane '{source}' is neither a preset ({', '.join(CRANE_PRESETS)}) nor a readable YAML file")
     try:
         data = yaml.safe_load(path.read_text())
     except yaml.YAMLError as error:
@@ -384,7 +383,11 @@ def _vector(value: Any, where: str) -> Vector3:
 def _matrix(value: Any, where: str) -> Matrix3:
     if not isinstance(value, list | tuple) or len(value) != 3:
         raise ConfigError(f"{where}: expected a 3x3 nested list, got {value!r}")
-    return (_vector(value[0], f"{where}[0]"), _vector(value[1], f"{where}[1]"), _vector(value[2], f"{where}[2]"))
+    return (
+        _vector(value[0], f"{where}[0]"),
+        _vector(value[1], f"{where}[1]"),
+        _vector(value[2], f"{where}[2]"),
+    )
 
 
 def _range(value: Any, where: str, unit: str) -> tuple[float, float]:
@@ -436,7 +439,10 @@ def _telescope(data: Any) -> Telescope:
     joint_range = _range(tele["joint_range"], "telescope.joint_range", "m")
     if joint_range[0] < 0.0 or joint_range[1] > stroke:
         raise InvalidInputError(
-            "telescope.joint_range", f"{list(joint_range)}", f"must lie in [0, stroke] = [0, {stroke:.6g}]", "m"
+            "telescope.joint_range",
+            f"{list(joint_range)}",
+            f"must lie in [0, stroke] = [0, {stroke:.6g}]",
+            "m",
         )
     return Telescope(
         parent=str(tele["parent"]),

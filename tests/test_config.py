@@ -29,8 +29,19 @@ RAW = yaml.safe_load(CRANE_PRESETS["xs031"].read_text())
 
 def test_preset_keeps_every_source_mass(crane: Crane) -> None:
     """The 11 published bodies and their total mass (1062.93 kg) are all there."""
-    published = [307.29601379, 25.52660174, 54.58702836, 17.36281648, 10.34519231, 33.92850233,
-                 17.36281648, 10.34519231, 9.26136143, 6.73059863, 570.18877059]
+    published = [
+        307.29601379,
+        25.52660174,
+        54.58702836,
+        17.36281648,
+        10.34519231,
+        33.92850233,
+        17.36281648,
+        10.34519231,
+        9.26136143,
+        6.73059863,
+        570.18877059,
+    ]
     assert len(crane.bodies) == 11
     assert sum(b.mass for b in crane.bodies) == pytest.approx(sum(published), abs=1e-9)
 
@@ -76,7 +87,7 @@ def test_non_positive_or_nan_length_names_the_field(crane: Crane, key: str, valu
 
 
 def test_stroke_longer_than_rod_is_rejected(crane: Crane) -> None:
-    """stroke outside [0, Lc] (const_j) names the stroke and the allowed interval."""
+    """Stroke outside [0, Lc] (const_j) names the stroke and the allowed interval."""
     lengths = LinkLengths(crane.default_lengths.lift, ChainLengths(1.132185817991, 0.3, 0.5))
     with pytest.raises(InvalidInputError, match=r"tilt\.stroke = 0\.59 m .* \[0, Lc\] = \[0, 0\.5\]"):
         check_lengths(crane, lengths)
@@ -90,7 +101,7 @@ def test_chain_longer_than_upper_links_in_working_stroke_is_rejected(crane: Cran
 
 
 def test_joint_sample_at_flat_triangle_is_rejected(crane: Crane) -> None:
-    """theta with sin q = 0 (k of eq. k1_3 undefined) is rejected with the reachable range."""
+    """Theta with sin q = 0 (k of eq. k1_3 undefined) is rejected with the reachable range."""
     chain = crane.lift
     with pytest.raises(InvalidInputError, match=r"theta1 = 2\.0735.* rad is out of range: must lie in \[-0\.161"):
         mechanism.check_joint_samples(chain, chain.default_lengths, np.array([0.5, chain.joint_offset]), "theta1")
@@ -149,7 +160,10 @@ def test_cli_bad_crane_file_exits_2_without_traceback(tmp_path: Path) -> None:
     bad = tmp_path / "bad.yaml"
     bad.write_text(yaml.safe_dump(_mutated(["chains", "tilt", "L"], -2.0)))
     result = subprocess.run(
-        [sys.executable, "-m", "hiab_sim", "crane", "--crane", str(bad)], capture_output=True, text=True, check=False
+        [sys.executable, "-m", "hiab_sim", "crane", "--crane", str(bad)],
+        capture_output=True,
+        text=True,
+        check=False,
     )
     assert result.returncode == 2
     assert "tilt.L = -2 m is out of range" in result.stderr
@@ -161,5 +175,7 @@ def test_cli_help_lists_subcommands_and_version() -> None:
     result = subprocess.run([sys.executable, "-m", "hiab_sim", "--help"], capture_output=True, text=True, check=True)
     for name in ("crane", "mjcf", "validate", "emla-map", "optimize", "render"):
         assert name in result.stdout
-    version = subprocess.run([sys.executable, "-m", "hiab_sim", "--version"], capture_output=True, text=True, check=True)
+    version = subprocess.run(
+        [sys.executable, "-m", "hiab_sim", "--version"], capture_output=True, text=True, check=True
+    )
     assert version.stdout.startswith("hiab-sim ")

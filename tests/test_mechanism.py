@@ -24,7 +24,7 @@ def _working_theta(name: str, fraction: float) -> float:
 @settings(max_examples=200, deadline=None)
 @given(chain_names, fractions)
 def test_theta_to_stroke_to_theta_round_trip(name: str, fraction: float) -> None:
-    """theta -> x -> theta returns theta to 1e-12 rad over the working range."""
+    """Theta -> x -> theta returns theta to 1e-12 rad over the working range."""
     chain = CHAINS[name]
     theta = _working_theta(name, fraction)
     x = mechanism.joint_to_stroke(chain, chain.default_lengths, theta)
@@ -34,7 +34,7 @@ def test_theta_to_stroke_to_theta_round_trip(name: str, fraction: float) -> None
 @settings(max_examples=200, deadline=None)
 @given(chain_names, st.floats(min_value=0.001, max_value=0.999))
 def test_stroke_to_theta_to_stroke_round_trip(name: str, fraction: float) -> None:
-    """x -> theta -> x returns x to 1e-12 m inside the usable stroke."""
+    """X -> theta -> x returns x to 1e-12 m inside the usable stroke."""
     chain = CHAINS[name]
     x_min, x_max = mechanism.stroke_bounds(chain, chain.default_lengths)
     x = x_min + fraction * (x_max - x_min)
@@ -43,11 +43,9 @@ def test_stroke_to_theta_to_stroke_round_trip(name: str, fraction: float) -> Non
 
 
 @settings(max_examples=200, deadline=None)
-@given(
-    st.floats(0.3, 2.0), st.floats(0.2, 1.0), st.floats(0.5, 1.5), st.floats(0.01, 0.99)
-)
+@given(st.floats(0.3, 2.0), st.floats(0.2, 1.0), st.floats(0.5, 1.5), st.floats(0.01, 0.99))
 def test_internal_angles_satisfy_triangle_property(L: float, L1: float, x0: float, fraction: float) -> None:
-    """q + q1 + q2 = -pi (eq. triangle, const_l) for any non-degenerate triangle."""
+    """Q + q1 + q2 = -pi (eq. triangle, const_l) for any non-degenerate triangle."""
     s_min, s_max = abs(L - L1), L + L1
     s = s_min + fraction * (s_max - s_min)
     q, q1, q2 = mechanism.triangle_angles(s - x0, L, L1, x0)
@@ -109,9 +107,7 @@ def test_actuator_motion_matches_differentiated_joint_motion(name: str) -> None:
     mid, amp, w = 0.5 * (low + high), 0.3 * (high - low), 0.9
     t, h = np.linspace(0.0, 4.0, 21), 1e-4
     theta = lambda time: mid + amp * np.sin(w * time)  # noqa: E731
-    x, dx, ddx = mechanism.joint_to_actuator(
-        chain, xi, theta(t), amp * w * np.cos(w * t), -amp * w * w * np.sin(w * t)
-    )
+    x, dx, ddx = mechanism.joint_to_actuator(chain, xi, theta(t), amp * w * np.cos(w * t), -amp * w * w * np.sin(w * t))
     x_plus = mechanism.joint_to_stroke(chain, xi, theta(t + h))
     x_minus = mechanism.joint_to_stroke(chain, xi, theta(t - h))
     np.testing.assert_allclose(dx, (x_plus - x_minus) / (2 * h), rtol=1e-6, atol=1e-9)
@@ -127,7 +123,9 @@ def test_xs031_joint_to_triangle_relations_use_the_source_betas() -> None:
     beta1, beta2 = np.arctan2(374.261, 935), np.arctan2(45.757, 373.313)
     beta3, beta4 = np.arctan2(139.50, 1132.19), np.arctan2(88.061, 296.198)
     theta = np.array([0.3, 0.7])
-    np.testing.assert_allclose(mechanism.boom_rotation(CRANE.lift, theta), theta - np.pi / 2 - beta1 - beta2, atol=1e-12)
+    np.testing.assert_allclose(
+        mechanism.boom_rotation(CRANE.lift, theta), theta - np.pi / 2 - beta1 - beta2, atol=1e-12
+    )
     np.testing.assert_allclose(mechanism.boom_rotation(CRANE.tilt, theta), theta - beta3 - beta4, atol=1e-12)
 
 
@@ -161,6 +159,8 @@ def test_xs031_reachable_ranges_from_the_0p59_m_stroke(name: str, expected_degre
 def test_stroke_bounds_follow_stroke_rod_length_and_triangle() -> None:
     """Usable stroke is [0, min(stroke, Lc, L + L1 - x0)]."""
     chain = CRANE.lift
-    assert mechanism.stroke_bounds(chain, chain.default_lengths) == pytest.approx((0.0, 1.0071227324212 + 0.37610632101293 - 0.83))
+    assert mechanism.stroke_bounds(chain, chain.default_lengths) == pytest.approx(
+        (0.0, 1.0071227324212 + 0.37610632101293 - 0.83)
+    )
     short_rod = ChainLengths(L=1.2, Lc0=0.1, Lc=0.5)
     assert mechanism.stroke_bounds(chain, short_rod)[1] == pytest.approx(0.5)

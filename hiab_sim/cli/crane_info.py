@@ -10,7 +10,7 @@ from hiab_sim.config import load_crane
 from hiab_sim.crane import mechanism
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register the subcommand."""
     parser = subparsers.add_parser("crane", help="print a summary of a crane description")
     parser.add_argument("--crane", default="xs031", help="preset name or YAML file (default: xs031)")
@@ -32,7 +32,8 @@ def run(args: argparse.Namespace) -> int:
             f"Lc = {xi.Lc:.4f} m, stroke {chain.stroke:.3f} m (usable [{x_min:.4f}, {x_max:.4f}] m)"
         )
         print(
-            f"       reachable theta [{low:+.4f}, {high:+.4f}] rad = [{np.degrees(low):+.1f}, {np.degrees(high):+.1f}] deg;"
+            f"       reachable theta [{low:+.4f}, {high:+.4f}] rad"
+            f" = [{np.degrees(low):+.1f}, {np.degrees(high):+.1f}] deg;"
             f" working range [{work[0]:+.4f}, {work[1]:+.4f}] rad"
         )
     tele = crane.telescope

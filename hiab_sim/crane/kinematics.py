@@ -52,11 +52,23 @@ def _add_chain(frames: Frames, chain: ClosedChain, lengths: LinkLengths, theta: 
     frames.stroke[chain.name] = x
     hinge = np.broadcast_to(chain.boom_hinge, (*n, 3))
     pivot = np.broadcast_to(chain.base_pivot(xi), (*n, 3))
-    _compose(frames, chain.parent, f"{chain.name}_boom", _rz(chain.base_axis_angle + theta - chain.joint_offset), hinge)
+    _compose(
+        frames,
+        chain.parent,
+        f"{chain.name}_boom",
+        _rz(chain.base_axis_angle + theta - chain.joint_offset),
+        hinge,
+    )
     _compose(frames, chain.parent, f"{chain.name}_cylinder", _rz(chain.base_axis_angle + q1), pivot)
     rod_offset = np.zeros((*n, 3))
     rod_offset[..., 0] = xi.Lc0 + x
-    _compose(frames, f"{chain.name}_cylinder", f"{chain.name}_rod", np.broadcast_to(np.eye(3), (*n, 3, 3)), rod_offset)
+    _compose(
+        frames,
+        f"{chain.name}_cylinder",
+        f"{chain.name}_rod",
+        np.broadcast_to(np.eye(3), (*n, 3, 3)),
+        rod_offset,
+    )
 
 
 def forward_kinematics(
@@ -74,8 +86,13 @@ def forward_kinematics(
     _add_chain(frames, crane.tilt, lengths, theta2)
     tele = crane.telescope
     cyl = tele.cylinder_frame
-    _compose(frames, tele.parent, "telescope_cylinder", np.broadcast_to(np.asarray(cyl.rotation), (*n, 3, 3)),
-             np.broadcast_to(np.asarray(cyl.position), (*n, 3)))
+    _compose(
+        frames,
+        tele.parent,
+        "telescope_cylinder",
+        np.broadcast_to(np.asarray(cyl.rotation), (*n, 3, 3)),
+        np.broadcast_to(np.asarray(cyl.position), (*n, 3)),
+    )
     slide = np.zeros((*n, 3))
     slide[..., 0] = tele.rod_offset + xt2
     _compose(frames, "telescope_cylinder", "telescope_rod", np.broadcast_to(np.eye(3), (*n, 3, 3)), slide)
@@ -84,8 +101,13 @@ def forward_kinematics(
 
 
 def _attach(frames: Frames, parent: str, child: str, pose: Pose, n: tuple[int, ...]) -> None:
-    _compose(frames, parent, child, np.broadcast_to(np.asarray(pose.rotation), (*n, 3, 3)),
-             np.broadcast_to(np.asarray(pose.position), (*n, 3)))
+    _compose(
+        frames,
+        parent,
+        child,
+        np.broadcast_to(np.asarray(pose.rotation), (*n, 3, 3)),
+        np.broadcast_to(np.asarray(pose.position), (*n, 3)),
+    )
 
 
 def tcp_position(crane: Crane, theta1: ArrayLike, theta2: ArrayLike, xt2: ArrayLike) -> Array:

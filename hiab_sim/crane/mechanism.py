@@ -71,9 +71,7 @@ def velocity_ratios(x: ArrayLike, L: float, L1: float, x0: float) -> tuple[Array
     return k1, k2, k3
 
 
-def velocity_ratio_rates(
-    x: ArrayLike, dx: ArrayLike, L: float, L1: float, x0: float
-) -> tuple[Array, Array, Array]:
+def velocity_ratio_rates(x: ArrayLike, dx: ArrayLike, L: float, L1: float, x0: float) -> tuple[Array, Array, Array]:
     """Time derivatives (dk1, dk2, dk3) of the velocity ratios (used in eq. 04) [rad/(m s)].
 
     Each is dk/dt = (dk/dx) dx, with dk/dx from differentiating eq. k1_3 and using
@@ -182,9 +180,7 @@ def reachable_joint_range(chain: ClosedChain, lengths: ChainLengths) -> tuple[fl
     return float(theta[0]), float(theta[1])
 
 
-def check_joint_samples(
-    chain: ClosedChain, lengths: ChainLengths, theta: ArrayLike, field: str | None = None
-) -> None:
+def check_joint_samples(chain: ClosedChain, lengths: ChainLengths, theta: ArrayLike, field: str | None = None) -> None:
     """Raise :class:`InvalidInputError` if any joint sample leaves the chain's usable stroke.
 
     A sample is valid when q lies strictly inside (-pi, 0) (the triangle is not flat, so the
