@@ -1,0 +1,447 @@
+"""Cross-validation of the MuJoCo and analytic inverse dynamics (issue 4), behind ``hiab-sim validate``.
+
+Cases (``validate/cases.yaml``), each run without and with a TCP payload force:
+
+- ``random_states``: random loop-consistent states over each joint's full working range;
+- ``trajectory``: a smooth trajectory sweeping each joint's range;
+- ``random_lengths``: random states on >= 20 random feasible link-length sets;
+- ``static``: gravity-only static poses.
+
+For each case: the maximum absolute and relative error of the actuator forces (relative to
+each actuator's peak |f| over the case) and the maximum absolute error of the velocities
+between the two paths, and the energy balance of each path: the power balance
+``sum f v + F_tcp . v_tcp = dE/dt`` (relative to the peak power) for moving samples, the
+virtual-work balance ``f_j = d(U - F_tcp . p_tcp)/dx_j`` (relative to the peak force) for
+static ones. The math lives here; file output is in :func:`write_report`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from numpy.typing import NDArray
+
+from hiab_sim.config import ChainLengths, Crane, LinkLengths, check_lengths
+from hiab_sim.crane import kinematics, mechanism
+from hiab_sim.dynamics.analytic_id import (
+    analytic_inverse_dynamics,
+    energy_rate,
+    mechanical_energy,
+    tcp_velocity,
+)
+from hiab_sim.dynamics.samples import ACTUATOR_NAMES, ActuatorSamples, JointSamples
+from hiab_sim.errors import ConfigError, InvalidInputError
+
+Array = NDArray[np.float64]
+IdFunction = Callable[[LinkLengths, JointSamples, Array], ActuatorSamples]
+
+#: The case file shipped with the repository.
+DEFAULT_CASES = Path(__file__).resolve().parents[1] / "validate" / "cases.yaml"
+CASE_KINDS = ("random_states", "trajectory", "random_lengths", "static")
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Pass thresholds: forces relative to each actuator's peak |f| [-], velocities [m/s], balance [-]."""
+
+    force_relative: float = 1e-6
+    velocity_absolute: float = 1e-9
+    balance_relative: float = 1e-6
+
+
+@dataclass(frozen=True)
+class CaseSpec:
+    """One validation case as read from the case file."""
+
+    name: str
+    kind: str
+    samples: int
+    seed: int = 0
+    payload: tuple[float, float, float] | None = None  # TCP force in {W} [N]
+    length_sets: int = 1
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class CaseResult:
+    """Errors of one case; arrays are per actuator (lift, tilt, telescope)."""
+
+    name: str
+    kind: str
+    description: str
+    samples: int
+    length_sets: int
+    payload: tuple[float, float, float] | None
+    peak_force: list[float]
+    force_abs_error: list[float]
+    force_rel_error: list[float]
+    velocity_abs_error: list[float]
+    balance_kind: str  # "power" or "virtual work"
+    balance_analytic: float
+    balance_mujoco: float
+    passed: bool
+    traces: dict[str, Any] = field(repr=False, default_factory=dict)
+
+
+# ---------------------------------------------------------------------------------------------
+# Inputs: link lengths and joint samples
+# ---------------------------------------------------------------------------------------------
+
+
+def lengths_from_fractions(crane: Crane, fractions: Array, spread: float = 0.2) -> LinkLengths | None:
+    """A link-length set that serves both working joint ranges, from fractions in [0, 1]^(2x3).
+
+    Per chain: L = L_default (1 - spread + 2 spread u0); the pin-to-pin length x0 in the window
+    [s_high - stroke, s_low] that keeps the stroke inside [0, stroke] over the joint range
+    (s: the triangle side {Bc}-{Tc} at the range ends), at fraction u1; Lc in
+    [max(stroke, s_high - x0), x0) at fraction u2 (const_j), Lc0 = x0 - Lc. Returns None when the
+    window is empty for this L. The result passes :func:`hiab_sim.config.check_lengths`.
+    """
+    chains = []
+    for chain, u in zip(crane.chains, np.asarray(fractions, dtype=float).reshape(2, 3), strict=True):
+        L = chain.default_lengths.L * (1.0 - spread + 2.0 * spread * u[0])
+        ends = mechanism.hinge_angle(chain, np.asarray(chain.joint_range))
+        s_low, s_high = mechanism.stroke_from_hinge_angle(ends, L, chain.L1, 0.0)
+        margin = 1e-9
+        x0_low, x0_high = max(s_high - chain.stroke, chain.stroke) + margin, s_low - margin
+        if not x0_low < x0_high:
+            return None
+        x0 = x0_low + u[1] * (x0_high - x0_low)
+        lc_low, lc_high = max(chain.stroke, s_high - x0) + margin, 0.95 * x0
+        if not lc_low < lc_high:
+            return None
+        Lc = lc_low + u[2] * (lc_high - lc_low)
+        chains.append(ChainLengths(L=float(L), Lc0=float(x0 - Lc), Lc=float(Lc)))
+    lengths = LinkLengths(*chains)
+    check_lengths(crane, lengths)
+    return lengths
+
+
+def random_link_lengths(crane: Crane, rng: np.random.Generator, count: int, spread: float = 0.2) -> list[LinkLengths]:
+    """``count`` random feasible link-length sets (see :func:`lengths_from_fractions`)."""
+    out: list[LinkLengths] = []
+    while len(out) < count:
+        lengths = lengths_from_fractions(crane, rng.uniform(0.0, 1.0, (2, 3)), spread)
+        if lengths is not None:
+            out.append(lengths)
+    return out
+
+
+def joint_ranges(crane: Crane) -> Array:
+    """Working ranges (3, 2) of theta1 [rad], theta2 [rad], xt2 [m]."""
+    return np.array([crane.lift.joint_range, crane.tilt.joint_range, crane.telescope.joint_range])
+
+
+def random_states(crane: Crane, rng: np.random.Generator, n: int) -> JointSamples:
+    """Random states over each joint's full working range, the range ends included.
+
+    Positions uniform; velocities ~ N(0, 0.3) rad/s or m/s; accelerations ~ N(0, 1) rad/s^2 or m/s^2.
+    """
+    ranges = joint_ranges(crane)
+    fraction = rng.uniform(0.0, 1.0, (n, 3))
+    if n >= 4:  # the range ends themselves
+        fraction[:2] = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 1.0]])
+    position = ranges[:, 0] + fraction * (ranges[:, 1] - ranges[:, 0])
+    return JointSamples(position, rng.normal(0.0, 0.3, (n, 3)), rng.normal(0.0, 1.0, (n, 3)))
+
+
+def smooth_trajectory(crane: Crane, n: int, duration: float = 10.0) -> tuple[Array, JointSamples]:
+    """Sinusoids sweeping 5 %..95 % of each joint's range over ``duration`` [s]: (t, samples)."""
+    ranges = joint_ranges(crane)
+    mid, amp = ranges.mean(axis=1), 0.45 * (ranges[:, 1] - ranges[:, 0])
+    w = 2.0 * np.pi / duration * np.array([1.0, 1.5, 2.0])
+    t = np.linspace(0.0, duration, n)
+    arg = w * t[:, None] + np.array([0.0, 0.7, 1.9])
+    return t, JointSamples(mid + amp * np.sin(arg), amp * w * np.cos(arg), -amp * w**2 * np.sin(arg))
+
+
+# ---------------------------------------------------------------------------------------------
+# Balances
+# ---------------------------------------------------------------------------------------------
+
+
+def _payload_array(payload: tuple[float, float, float] | None) -> Array:
+    return np.zeros(3) if payload is None else np.asarray(payload, dtype=float)
+
+
+def power_residual(
+    crane: Crane, lengths: LinkLengths, joints: JointSamples, out: ActuatorSamples, payload: Array
+) -> tuple[Array, Array]:
+    """(sum f v + F_tcp . v_tcp - dE/dt, sum f v + F_tcp . v_tcp) per sample [W]."""
+    power = out.power.sum(axis=1) + tcp_velocity(crane, lengths, joints) @ payload
+    return power - energy_rate(crane, lengths, joints), power
+
+
+def virtual_work_residual(
+    crane: Crane, lengths: LinkLengths, joints: JointSamples, out: ActuatorSamples, payload: Array, step: float = 1e-6
+) -> Array:
+    """f_j - d(U - F_tcp . p_tcp)/dx_j at static samples (T, 3) [N], central differences in x."""
+    residual = out.force.copy()
+    for j in range(3):
+        shift = np.zeros(3)
+        shift[j] = step
+        value = []
+        for sign in (1.0, -1.0):
+            x = out.stroke + sign * shift
+            theta1 = mechanism.stroke_to_joint(crane.lift, lengths.lift, x[:, 0])
+            theta2 = mechanism.stroke_to_joint(crane.tilt, lengths.tilt, x[:, 1])
+            position = np.stack([theta1, theta2, x[:, 2]], axis=1)
+            potential = mechanical_energy(crane, lengths, JointSamples.at_rest(position)).potential
+            tcp = kinematics.tcp_position(crane, theta1, theta2, x[:, 2])
+            value.append(potential - tcp @ payload)
+        residual[:, j] -= (value[0] - value[1]) / (2.0 * step)
+    return residual
+
+
+# ---------------------------------------------------------------------------------------------
+# Cases
+# ---------------------------------------------------------------------------------------------
+
+
+def _case_inputs(crane: Crane, spec: CaseSpec) -> tuple[list[tuple[LinkLengths, JointSamples]], Array | None]:
+    """(lengths, samples) groups of a case, and its time axis if it has one."""
+    rng = np.random.default_rng(spec.seed)
+    default = crane.default_lengths
+    if spec.kind == "random_states":
+        return [(default, random_states(crane, rng, spec.samples))], None
+    if spec.kind == "trajectory":
+        t, joints = smooth_trajectory(crane, spec.samples)
+        return [(default, joints)], t
+    if spec.kind == "static":
+        return [(default, JointSamples.at_rest(random_states(crane, rng, spec.samples).position))], None
+    if spec.kind == "random_lengths":
+        per_set = max(1, spec.samples // spec.length_sets)
+        return [
+            (xi, random_states(crane, rng, per_set)) for xi in random_link_lengths(crane, rng, spec.length_sets)
+        ], None
+    raise ConfigError(f"case {spec.name}: unknown kind {spec.kind!r}; allowed: {list(CASE_KINDS)}")
+
+
+def run_case(crane: Crane, spec: CaseSpec, mujoco: IdFunction, tolerances: Tolerances) -> CaseResult:
+    """Run one case through both paths and measure the errors (see the module docstring)."""
+    groups, time = _case_inputs(crane, spec)
+    payload = _payload_array(spec.payload)
+    static = spec.kind == "static"
+    f_an, f_mj, v_an, v_mj, res_an, res_mj, scale = [], [], [], [], [], [], []
+    for lengths, joints in groups:
+        analytic = analytic_inverse_dynamics(crane, lengths, joints, tcp_force=payload)
+        reference = mujoco(lengths, joints, payload)
+        f_an.append(analytic.force)
+        f_mj.append(reference.force)
+        v_an.append(analytic.velocity)
+        v_mj.append(reference.velocity)
+        if static:
+            res_an.append(virtual_work_residual(crane, lengths, joints, analytic, payload))
+            res_mj.append(virtual_work_residual(crane, lengths, joints, reference, payload))
+        else:
+            residual, power = power_residual(crane, lengths, joints, analytic, payload)
+            res_an.append(residual)
+            res_mj.append(power_residual(crane, lengths, joints, reference, payload)[0])
+            scale.append(power)
+    fa, fm, va, vm = (np.concatenate(a) for a in (f_an, f_mj, v_an, v_mj))
+    peak = np.max(np.abs(fa), axis=0)
+    force_abs = np.max(np.abs(fm - fa), axis=0)
+    force_rel = force_abs / np.maximum(peak, np.finfo(float).tiny)
+    velocity_abs = np.max(np.abs(vm - va), axis=0)
+    if static:
+        norm = float(np.max(peak))
+        balance_an = float(np.max(np.abs(np.concatenate(res_an)))) / norm
+        balance_mj = float(np.max(np.abs(np.concatenate(res_mj)))) / norm
+    else:
+        norm = float(np.max(np.abs(np.concatenate(scale))))
+        balance_an = float(np.max(np.abs(np.concatenate(res_an)))) / norm
+        balance_mj = float(np.max(np.abs(np.concatenate(res_mj)))) / norm
+    passed = bool(
+        np.all(force_rel <= tolerances.force_relative)
+        and np.all(velocity_abs <= tolerances.velocity_absolute)
+        and balance_an <= tolerances.balance_relative
+    )
+    axis = time if time is not None else np.arange(fa.shape[0], dtype=float)
+    return CaseResult(
+        name=spec.name,
+        kind=spec.kind,
+        description=spec.description,
+        samples=int(fa.shape[0]),
+        length_sets=len(groups),
+        payload=spec.payload,
+        peak_force=peak.tolist(),
+        force_abs_error=force_abs.tolist(),
+        force_rel_error=force_rel.tolist(),
+        velocity_abs_error=velocity_abs.tolist(),
+        balance_kind="virtual work" if static else "power",
+        balance_analytic=balance_an,
+        balance_mujoco=balance_mj,
+        passed=passed,
+        traces={"axis": axis, "time": time is not None, "analytic": fa, "mujoco": fm},
+    )
+
+
+def mujoco_path(crane: Crane) -> IdFunction:
+    """The MuJoCo inverse dynamics as an :data:`IdFunction`, one model per link-length set."""
+    from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
+
+    cache: dict[tuple[float, ...], Any] = {}
+
+    def run(lengths: LinkLengths, joints: JointSamples, payload: Array) -> ActuatorSamples:
+        key = tuple(lengths.as_array().tolist())
+        if key not in cache:
+            cache[key] = MujocoInverseDynamics(crane, lengths)
+        result: ActuatorSamples = cache[key](joints, tcp_force=payload)
+        return result
+
+    return run
+
+
+# ---------------------------------------------------------------------------------------------
+# Case file
+# ---------------------------------------------------------------------------------------------
+
+_CASE_KEYS = {"name", "kind", "samples", "seed", "payload", "length_sets", "description"}
+
+
+def load_cases(path: str | Path = DEFAULT_CASES) -> tuple[Tolerances, list[CaseSpec]]:
+    """Read the tolerances and cases; each case with ``payload: both`` becomes two cases."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"case file {path} not found (pass --cases FILE)")
+    data = yaml.safe_load(path.read_text())
+    if not isinstance(data, dict) or not isinstance(data.get("cases"), list):
+        raise ConfigError(f"{path}: expected a mapping with a 'cases' list")
+    tolerances = Tolerances(**data.get("tolerances", {}))
+    payload = tuple(float(v) for v in data.get("payload_force", (0.0, -2452.0, 0.0)))
+    specs = []
+    for entry in data["cases"]:
+        unknown = set(entry) - _CASE_KEYS
+        if unknown:
+            raise ConfigError(f"{path}: case {entry.get('name')}: unknown key(s) {sorted(unknown)}")
+        choices: dict[str, list[tuple[float, ...] | None]] = {
+            "none": [None],
+            "payload": [payload],
+            "both": [None, payload],
+        }
+        variants = choices.get(str(entry.get("payload", "both")))
+        if variants is None:
+            raise ConfigError(f"{path}: case {entry.get('name')}: payload must be none, payload or both")
+        for force in variants:
+            spec = {k: v for k, v in entry.items() if k != "payload"}
+            spec["name"] = f"{entry['name']}{'' if force is None else '+payload'}"
+            specs.append(CaseSpec(**spec, payload=force))  # type: ignore[arg-type]
+    return tolerances, specs
+
+
+def with_samples(specs: list[CaseSpec], samples: int) -> list[CaseSpec]:
+    """The same cases with ``samples`` samples each (random_lengths: at least one per set)."""
+    if samples < 1:
+        raise InvalidInputError("samples", samples, "must be >= 1")
+    out = []
+    for spec in specs:
+        n = (
+            max(samples, spec.length_sets)
+            if spec.kind == "random_lengths"
+            else max(samples, 4 if spec.kind != "trajectory" else 8)
+        )
+        out.append(CaseSpec(**{**asdict(spec), "samples": n}))
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# Report
+# ---------------------------------------------------------------------------------------------
+
+
+def markdown_table(results: list[CaseResult], tolerances: Tolerances) -> str:
+    """The validation table (markdown), as inserted in the README."""
+    lines = [
+        "| case | samples | length sets | max abs force error [N] | max rel force error | "
+        "max abs velocity error [m/s] | balance (analytic) | balance (MuJoCo) | pass |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|:---:|",
+    ]
+    for r in results:
+        lines.append(
+            f"| {r.name} | {r.samples} | {r.length_sets} | {max(r.force_abs_error):.2e} | "
+            f"{max(r.force_rel_error):.2e} | {max(r.velocity_abs_error):.2e} | "
+            f"{r.balance_analytic:.2e} ({r.balance_kind}) | {r.balance_mujoco:.2e} | {'yes' if r.passed else 'NO'} |"
+        )
+    lines.append("")
+    lines.append(
+        f"Tolerances: force error <= {tolerances.force_relative:g} of each actuator's peak |f| over the case, "
+        f"velocity error <= {tolerances.velocity_absolute:g} m/s, analytic balance <= {tolerances.balance_relative:g} "
+        "(power: of the peak power; virtual work: of the peak force)."
+    )
+    return "\n".join(lines) + "\n"
+
+
+def report_dict(crane: Crane, results: list[CaseResult], tolerances: Tolerances) -> dict[str, Any]:
+    """JSON-ready report."""
+    cases = []
+    for r in results:
+        entry = asdict(r)
+        entry.pop("traces")
+        entry["actuators"] = list(ACTUATOR_NAMES)
+        cases.append(entry)
+    return {
+        "crane": crane.name,
+        "tolerances": asdict(tolerances),
+        "passed": all(r.passed for r in results),
+        "cases": cases,
+    }
+
+
+def _atomic_write(path: Path, write: Callable[[Path], None]) -> None:
+    """Write via a temporary file in the same folder, then os.replace (no torn files)."""
+    handle, temp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+    os.close(handle)
+    try:
+        write(Path(temp))
+        os.replace(temp, path)
+    except BaseException:
+        Path(temp).unlink(missing_ok=True)
+        raise
+
+
+def plot_case(result: CaseResult) -> Any:
+    """Figure: both force traces (top) and their difference (bottom) for each actuator."""
+    from matplotlib.figure import Figure
+
+    traces = result.traces
+    fig = Figure(figsize=(12, 6), layout="constrained")
+    axes = fig.subplots(2, 3, sharex=True)
+    style = {"linestyle": "-"} if traces["time"] else {"linestyle": "none", "marker": "."}
+    for j, name in enumerate(ACTUATOR_NAMES):
+        top, bottom = axes[0, j], axes[1, j]
+        top.plot(traces["axis"], traces["analytic"][:, j] / 1e3, label="analytic", color="C0", **style)
+        top.plot(traces["axis"], traces["mujoco"][:, j] / 1e3, label="MuJoCo", color="C1", linestyle="--")
+        top.set_title(f"{name}")
+        top.set_ylabel("f_x [kN]")
+        bottom.plot(traces["axis"], traces["mujoco"][:, j] - traces["analytic"][:, j], color="C3", **style)
+        bottom.set_ylabel("MuJoCo - analytic [N]")
+        bottom.set_xlabel("t [s]" if traces["time"] else "sample")
+    axes[0, 0].legend()
+    fig.suptitle(f"{result.name}: actuator forces, MuJoCo vs analytic")
+    return fig
+
+
+def write_report(out_dir: Path, crane: Crane, results: list[CaseResult], tolerances: Tolerances) -> list[Path]:
+    """Write report.json, table.md and forces_<case>.png into ``out_dir``, atomically."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    report = json.dumps(report_dict(crane, results, tolerances), indent=2)
+    table = markdown_table(results, tolerances)
+    for name, text in (("report.json", report), ("table.md", table)):
+        path = out_dir / name
+        _atomic_write(path, lambda temp, text=text: temp.write_text(text))  # type: ignore[misc]
+        written.append(path)
+    for result in results:
+        path = out_dir / f"forces_{result.name.replace('+', '_')}.png"
+        fig = plot_case(result)
+        _atomic_write(path, lambda temp, fig=fig: fig.savefig(temp, dpi=110, format="png"))  # type: ignore[misc]
+        written.append(path)
+    return written
