@@ -1,0 +1,5 @@
+"""The MJCF crane model, regenerated per link-length set (issue 3)."""
+
+from hiab_sim.model.mjcf import build_model, build_spec, to_xml
+
+__all__ = ["build_model", "build_spec", "to_xml"]
