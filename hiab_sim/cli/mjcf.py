@@ -1,22 +1,82 @@
-"""``hiab-sim mjcf``: Write the MJCF crane model for a link-length set (issue 3).
+"""``hiab-sim mjcf``: write the MJCF crane model for a link-length set (issue 3).
 
-Not implemented yet: the subcommand is registered so that ``--help`` lists it, and it exits
-with status 2 and a message until its issue lands.
+``--lengths`` takes six numbers in metres, comma-separated, lift chain first:
+``L,Lc0,Lc,L,Lc0,Lc`` (seed eq. Xi). The file is written atomically (a temporary file in the
+target folder, then ``os.replace``), loads with ``mujoco.MjModel.from_xml_path`` and opens in
+``python -m mujoco.viewer --mjcf=FILE``.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
+import os
+import tempfile
+from pathlib import Path
 
-from hiab_sim.errors import HiabSimError
+from hiab_sim.config import LinkLengths, load_crane
+from hiab_sim.errors import InvalidInputError
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register the subcommand."""
-    parser = subparsers.add_parser("mjcf", help="Write the MJCF crane model for a link-length set (issue 3). (not implemented yet)")
+    parser = subparsers.add_parser(
+        "mjcf",
+        help="write the MJCF crane model for a link-length set",
+        description="Write the MuJoCo MJCF model of the crane (closed chains as connect equalities).",
+    )
+    parser.add_argument("--crane", default="xs031", help="preset name or YAML file (default: xs031)")
+    parser.add_argument(
+        "--lengths",
+        metavar="L,Lc0,Lc,L,Lc0,Lc",
+        help="link lengths [m], lift chain then tilt chain (default: the crane's own)",
+    )
+    parser.add_argument("-o", "--output", default="crane.xml", metavar="FILE.xml", help="default: crane.xml")
     parser.set_defaults(run=run)
 
 
+def parse_lengths(text: str) -> LinkLengths:
+    """Parse ``L,Lc0,Lc,L,Lc0,Lc`` (lift, then tilt) in metres.
+
+    Raises:
+        InvalidInputError: not six finite numbers (field ``--lengths``).
+
+    """
+    parts = [p.strip() for p in text.split(",")]
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        raise InvalidInputError("--lengths", text, "must be six numbers L,Lc0,Lc,L,Lc0,Lc (lift, tilt)", "m") from None
+    if len(values) != 6 or not all(math.isfinite(v) for v in values):
+        raise InvalidInputError("--lengths", text, "must be six finite numbers L,Lc0,Lc,L,Lc0,Lc (lift, tilt)", "m")
+    return LinkLengths.from_array(values)
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file in the same folder and ``os.replace``."""
+    if not path.parent.is_dir():
+        raise InvalidInputError("--output", str(path), "its folder must exist")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w") as handle:
+            handle.write(text)
+        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a model file is meant to be shared
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
 def run(args: argparse.Namespace) -> int:
-    """Report that the subcommand is not available yet."""
-    raise HiabSimError("'mjcf' is not implemented yet")
+    """Build the model, write it and print a one-line summary."""
+    from hiab_sim.model.mjcf import build_spec
+
+    crane = load_crane(args.crane)
+    lengths = parse_lengths(args.lengths) if args.lengths else crane.default_lengths
+    spec = build_spec(crane, lengths)
+    model = spec.compile()
+    output = Path(args.output)
+    write_atomic(output, spec.to_xml())
+    xi = ", ".join(f"{v:.4g}" for v in lengths.as_array())
+    print(f"wrote {output}: {crane.name}, Xi = [{xi}] m, {model.nbody - 1} bodies, {model.nv} dofs")
+    return 0
