@@ -34,7 +34,7 @@ from hiab_sim.crane import kinematics, mechanism
 from hiab_sim.dynamics.analytic_id import (
     analytic_inverse_dynamics,
     energy_rate,
-    mechanical_energy,
+    state_energy,
     tcp_velocity,
 )
 from hiab_sim.dynamics.samples import ACTUATOR_NAMES, ActuatorSamples, JointSamples
@@ -181,23 +181,27 @@ def power_residual(
 
 
 def virtual_work_residual(
-    crane: Crane, lengths: LinkLengths, joints: JointSamples, out: ActuatorSamples, payload: Array, step: float = 1e-6
+    crane: Crane,
+    lengths: LinkLengths,
+    joints: JointSamples,
+    out: ActuatorSamples,
+    payload: Array,
+    step: float = 1e-5,
 ) -> Array:
-    """f_j - d(U - F_tcp . p_tcp)/dx_j at static samples (T, 3) [N], central differences in x."""
+    """f_j - d(U - F_tcp . p_tcp)/dx_j at static samples (T, 3) [N], 5-point stencils in x."""
     residual = out.force.copy()
     for j in range(3):
-        shift = np.zeros(3)
-        shift[j] = step
         value = []
-        for sign in (1.0, -1.0):
-            x = out.stroke + sign * shift
+        for k in (-2, -1, 1, 2):
+            x = out.stroke.copy()
+            x[:, j] += k * step
             theta1 = mechanism.stroke_to_joint(crane.lift, lengths.lift, x[:, 0])
             theta2 = mechanism.stroke_to_joint(crane.tilt, lengths.tilt, x[:, 1])
             position = np.stack([theta1, theta2, x[:, 2]], axis=1)
-            potential = mechanical_energy(crane, lengths, JointSamples.at_rest(position)).potential
+            potential = state_energy(crane, lengths, position, np.zeros_like(position)).potential
             tcp = kinematics.tcp_position(crane, theta1, theta2, x[:, 2])
             value.append(potential - tcp @ payload)
-        residual[:, j] -= (value[0] - value[1]) / (2.0 * step)
+        residual[:, j] -= (value[0] - 8.0 * value[1] + 8.0 * value[2] - value[3]) / (12.0 * step)
     return residual
 
 

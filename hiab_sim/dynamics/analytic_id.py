@@ -192,10 +192,15 @@ def mechanical_energy(crane: Crane, lengths: LinkLengths, joints: JointSamples) 
     inverse-dynamics paths. Inputs are validated like :func:`analytic_inverse_dynamics`.
     """
     check_analytic_inputs(crane, lengths, joints)
-    return _energy(crane, lengths, joints.position, joints.velocity)
+    return state_energy(crane, lengths, joints.position, joints.velocity)
 
 
-def _energy(crane: Crane, lengths: LinkLengths, position: Array, velocity: Array) -> MechanicalEnergy:
+def state_energy(crane: Crane, lengths: LinkLengths, position: Array, velocity: Array) -> MechanicalEnergy:
+    """Energy of joint states (T, 3) without range checks, for finite-difference stencils [J].
+
+    A stencil around a state at the end of a joint's working range steps slightly outside it;
+    the trigonometry stays valid there as long as the chain's triangle is not flat.
+    """
     motion = crane_motion(crane, lengths, position, velocity, np.zeros_like(position))
     kinetic = np.zeros(position.shape[0])
     potential = np.zeros(position.shape[0])
@@ -217,7 +222,7 @@ def energy_rate(crane: Crane, lengths: LinkLengths, joints: JointSamples, step: 
     check_analytic_inputs(crane, lengths, joints)
     q, dq, ddq = joints.position, joints.velocity, joints.acceleration
     total = [
-        _energy(crane, lengths, q + dq * (k * step) + 0.5 * ddq * (k * step) ** 2, dq + ddq * (k * step)).total
+        state_energy(crane, lengths, q + dq * (k * step) + 0.5 * ddq * (k * step) ** 2, dq + ddq * (k * step)).total
         for k in (-2, -1, 1, 2)
     ]
     return (total[0] - 8.0 * total[1] + 8.0 * total[2] - total[3]) / (12.0 * step)
