@@ -1,22 +1,78 @@
-"""``hiab-sim render``: Render a playback video of an optimisation result off-screen (issue 7).
+"""``hiab-sim render``: a playback video of an optimisation result, rendered off-screen (issue 7).
 
-Not implemented yet: the subcommand is registered so that ``--help`` lists it, and it exits
-with status 2 and a message until its issue lands.
+Needs an OpenGL backend (OSMesa on CPU: ``apt-get install libosmesa6``) and an ffmpeg binary
+(``apt-get install ffmpeg`` or ``pip install imageio-ffmpeg``); a missing one is reported on one
+line with exit status 2, and no half-written file is left behind.
 """
 
 from __future__ import annotations
 
 import argparse
+import re
+import time
+from pathlib import Path
 
-from hiab_sim.errors import HiabSimError
+from hiab_sim.errors import InvalidInputError
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def _size(text: str) -> tuple[int, int]:
+    match = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
+    if not match:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT in pixels, e.g. 640x480, got {text!r}")
+    return int(match.group(1)), int(match.group(2))
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register the subcommand."""
-    parser = subparsers.add_parser("render", help="Render a playback video of an optimisation result off-screen (issue 7). (not implemented yet)")
+    parser = subparsers.add_parser(
+        "render",
+        help="Render a playback video of an optimisation result off-screen (initial vs optimal design).",
+        description=(
+            "Render the crane following the study's trajectory with the initial and the optimal link "
+            "lengths, the reference TCP curve (grey) and each design's TCP trail, off-screen through "
+            "OSMesa (MUJOCO_GL=osmesa, selected automatically; MUJOCO_GL=egl is honoured)."
+        ),
+    )
+    parser.add_argument("result_dir", metavar="RESULT_DIR", help="folder written by 'hiab-sim optimize'")
+    parser.add_argument(
+        "-o", "--output", metavar="VIDEO", help="video path, .mp4 or .gif (default: RESULT_DIR/playback.mp4)"
+    )
+    parser.add_argument("--fps", type=float, default=30.0, help="frames per second, real-time playback (default: 30)")
+    parser.add_argument("--size", type=_size, default=(640, 480), metavar="WxH", help="frame size (default: 640x480)")
+    parser.add_argument(
+        "--mode",
+        choices=("kinematic", "simulate"),
+        default="kinematic",
+        help="kinematic: the planned states; simulate: a forward simulation driven by the computed "
+        "actuator forces (default: kinematic)",
+    )
+    parser.add_argument(
+        "--layout",
+        choices=("side-by-side", "overlay"),
+        default="side-by-side",
+        help="designs in two viewports, or overlaid (initial translucent) (default: side-by-side)",
+    )
+    parser.add_argument(
+        "--still",
+        metavar="FILE.png",
+        help="write only one frame (kinematic) as a PNG instead of a video (see --at)",
+    )
+    parser.add_argument("--at", type=float, metavar="SECONDS", help="time of the --still frame (default: the end)")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    """Report that the subcommand is not available yet."""
-    raise HiabSimError("'render' is not implemented yet")
+    """Render the video (or the still frame) and print where it was written."""
+    from hiab_sim.render import render_result, render_still  # checks the OpenGL backend on import
+
+    if not args.fps > 0:
+        raise InvalidInputError("--fps", args.fps, "must be > 0", "1/s")
+    start = time.perf_counter()
+    if args.still:
+        path = render_still(args.result_dir, args.still, at_time=args.at, size=args.size, layout=args.layout)
+        print(f"wrote still frame: {path}")
+        return 0
+    output = Path(args.output) if args.output else None
+    path = render_result(args.result_dir, output, fps=args.fps, size=args.size, mode=args.mode, layout=args.layout)
+    print(f"wrote {args.mode} playback: {path} ({time.perf_counter() - start:.1f} s)")
+    return 0

@@ -1,0 +1,186 @@
+"""System back ends of rendering: the off-screen OpenGL context and the ffmpeg video writer.
+
+Everything that can be missing on a headless machine is checked here and reported as a
+:class:`~hiab_sim.errors.BackendUnavailableError` whose one-line message says how to install it:
+
+- OpenGL: MuJoCo picks its backend from ``MUJOCO_GL`` when ``mujoco`` is first imported;
+  :mod:`hiab_sim._gl` selects ``osmesa`` (CPU, ``apt-get install libosmesa6``) when unset, and a
+  user's ``MUJOCO_GL=egl`` (GPU) is honoured.
+- ffmpeg: mediapy pipes raw frames into an ``ffmpeg`` binary: Debian's ``ffmpeg``, else the
+  binary of the ``imageio-ffmpeg`` wheel (it writes videos; mediapy cannot read them back with it).
+
+Videos and images are written to a temporary name in the target folder and moved into place with
+:func:`os.replace`, so a failed render never leaves a half-written file behind.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes.util
+import os
+import shutil
+import tempfile
+import warnings
+from collections.abc import Iterator
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiab_sim.errors import BackendUnavailableError, HiabSimError, InvalidInputError
+
+if TYPE_CHECKING:
+    import mujoco
+
+INSTALL_OSMESA = "apt-get install libosmesa6"
+INSTALL_FFMPEG = "apt-get install ffmpeg (or pip install imageio-ffmpeg)"
+
+#: Video containers written by :func:`video_sink`: suffix -> mediapy codec.
+VIDEO_CODECS = {".mp4": "h264", ".gif": "gif"}
+
+
+def import_mujoco() -> Any:
+    """Import ``mujoco`` for rendering, turning a broken OpenGL set-up into a one-line error.
+
+    With ``MUJOCO_GL=osmesa`` but no libOSMesa, ``import mujoco`` itself fails deep inside
+    PyOpenGL (``'NoneType' object has no attribute 'glGetError'``); it is checked first.
+    """
+    check_gl_backend()
+    try:
+        import mujoco
+    except (AttributeError, ImportError, OSError, RuntimeError) as error:
+        backend = os.environ.get("MUJOCO_GL", "default")
+        raise BackendUnavailableError(
+            f"cannot load MuJoCo's OpenGL backend MUJOCO_GL={backend} ({error}); "
+            f"for CPU rendering: {INSTALL_OSMESA} and MUJOCO_GL=osmesa"
+        ) from None
+    return mujoco
+
+
+def check_gl_backend() -> str:
+    """Return the OpenGL backend in force; raise if it is OSMesa and libOSMesa is missing."""
+    backend = os.environ.get("MUJOCO_GL", "").strip().lower()
+    if backend == "osmesa" and not ctypes.util.find_library("OSMesa"):
+        raise BackendUnavailableError(f"MUJOCO_GL=osmesa but libOSMesa is not installed: {INSTALL_OSMESA}")
+    return backend or "default"
+
+
+def open_renderer(model: mujoco.MjModel, width: int, height: int, max_geom: int) -> mujoco.Renderer:
+    """Create an off-screen :class:`mujoco.Renderer`, growing the model's framebuffer if needed.
+
+    Raises:
+        BackendUnavailableError: no OpenGL context can be created (no OSMesa, no display).
+
+    """
+    mujoco = import_mujoco()
+    model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
+    model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
+    try:
+        with warnings.catch_warnings():  # GLFW warns about a missing display before it fails
+            warnings.simplefilter("ignore")
+            return mujoco.Renderer(model, height=height, width=width, max_geom=max_geom)
+    except (mujoco.FatalError, ImportError, RuntimeError, AttributeError) as error:
+        backend = check_gl_backend()
+        first_line = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+        raise BackendUnavailableError(
+            f"no off-screen OpenGL context (MUJOCO_GL={backend}: {first_line}); "
+            f"install OSMesa with {INSTALL_OSMESA} and set MUJOCO_GL=osmesa, or use MUJOCO_GL=egl on a GPU"
+        ) from None
+
+
+def ffmpeg_path() -> str:
+    """Path of the ffmpeg binary mediapy will use: Debian's ``ffmpeg``, else imageio-ffmpeg's.
+
+    Raises:
+        BackendUnavailableError: neither is installed.
+
+    """
+    import mediapy
+
+    found = shutil.which("ffmpeg")
+    if found:
+        return found
+    try:
+        import imageio_ffmpeg
+
+        found = str(imageio_ffmpeg.get_ffmpeg_exe())
+    except (ImportError, RuntimeError):
+        raise BackendUnavailableError(f"ffmpeg is not installed: {INSTALL_FFMPEG}") from None
+    mediapy.set_ffmpeg(found)
+    return found
+
+
+def check_output_path(path: Path, suffixes: tuple[str, ...], what: str) -> Path:
+    """Validate an output file path: known suffix, existing writable folder; return it resolved."""
+    path = Path(path)
+    if path.suffix.lower() not in suffixes:
+        raise InvalidInputError(f"{what} path", str(path), f"must end with {' or '.join(suffixes)}")
+    folder = path.parent
+    if not folder.is_dir():
+        raise HiabSimError(f"cannot write the {what} {path}: folder {folder} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise HiabSimError(f"cannot write the {what} {path}: folder {folder} is not writable")
+    if path.is_dir():
+        raise HiabSimError(f"cannot write the {what} {path}: it is a folder")
+    return path
+
+
+@contextlib.contextmanager
+def _atomic_target(path: Path) -> Iterator[Path]:
+    """Yield a temporary path next to ``path`` (same suffix); move it onto ``path`` on success."""
+    handle, name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}", dir=path.parent)
+    os.close(handle)
+    temporary = Path(name)
+    try:
+        yield temporary
+        os.chmod(temporary, 0o644)
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)
+
+
+class VideoSink:
+    """An open video file: :meth:`add` frames one by one; the file appears when the sink closes."""
+
+    def __init__(self, writer: Any) -> None:
+        self._writer = writer
+        self.frames = 0
+
+    def add(self, frame: NDArray[np.uint8]) -> None:
+        """Append one RGB frame (H, W, 3) uint8."""
+        self._writer.add_image(frame)
+        self.frames += 1
+
+
+@contextlib.contextmanager
+def video_sink(path: Path, size: tuple[int, int], fps: float) -> Iterator[VideoSink]:
+    """Open ``path`` (.mp4 H.264 or .gif) for frames of ``size`` = (width, height) at ``fps``.
+
+    The video is encoded by ffmpeg while frames arrive; on any error nothing is left at ``path``.
+    """
+    import mediapy
+
+    path = check_output_path(path, tuple(VIDEO_CODECS), "video")
+    ffmpeg_path()
+    width, height = size
+    with _atomic_target(path) as temporary:
+        writer = mediapy.VideoWriter(temporary, (height, width), codec=VIDEO_CODECS[path.suffix.lower()], fps=fps)
+        try:
+            with writer:
+                yield VideoSink(writer)
+        except RuntimeError as error:
+            if "Error writing" not in str(error):
+                raise
+            detail = str(error).strip().splitlines()[-1]
+            raise BackendUnavailableError(f"ffmpeg could not write {path}: {detail}") from None
+
+
+def write_image(path: Path, image: NDArray[np.uint8]) -> Path:
+    """Write an RGB image (PNG) atomically."""
+    import mediapy
+
+    path = check_output_path(path, (".png",), "image")
+    with _atomic_target(path) as temporary:
+        mediapy.write_image(temporary, image)
+    return path

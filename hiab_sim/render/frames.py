@@ -1,0 +1,204 @@
+"""Frames of one or two crane designs moving through qpos sequences, rendered off-screen.
+
+A :class:`PlaybackRenderer` draws each :class:`Design` either side by side (one viewport each)
+or overlaid in one viewport (the later designs as translucent ghosts showing only the parts
+that differ), with the reference TCP curve and each design's TCP trail as line geoms and the
+design's name as a caption. One free camera, fitted once to the whole motion of all designs
+(:func:`~hiab_sim.render.camera.fit_camera`), looks onto the crane's x-z plane of motion.
+
+Visuals are chosen for CPU rendering through OSMesa (:func:`~hiab_sim.render.decor.set_fast_visuals`):
+no shadows, reflections, skybox or multisampling; a self-lit backdrop instead of a sky.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.render import decor
+from hiab_sim.render.backend import open_renderer
+from hiab_sim.render.camera import camera_axes, fit_camera, geom_corners
+from hiab_sim.render.labels import caption_bitmap, stamp
+
+Array = NDArray[np.float64]
+Image = NDArray[np.uint8]
+Layout = Literal["side-by-side", "overlay"]
+LAYOUTS: tuple[str, ...] = ("side-by-side", "overlay")
+GHOST_ALPHA = 0.5
+
+
+@dataclass(frozen=True)
+class Design:
+    """One crane design to play back: its model, qpos per frame (N, nq), colour and caption.
+
+    The renderer adjusts the model's render settings (:func:`~hiab_sim.render.decor.prepare_model`),
+    so pass a model built for rendering.
+    """
+
+    name: str
+    model: mujoco.MjModel
+    qpos: Array
+    rgba: tuple[float, float, float, float]
+    caption: str | None = None  # top-left of the design's viewport; default: the name
+    tcp_site: str = "tcp"
+    #: TCP position per frame (N, 3) in the MuJoCo world [m], computed from ``qpos``.
+    tcp: Array = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        qpos = np.asarray(self.qpos, dtype=float)
+        if qpos.ndim != 2 or qpos.shape[1] != self.model.nq or len(qpos) == 0:
+            raise InvalidInputError(
+                f"{self.name}.qpos", f"shape {qpos.shape}", f"must have shape (N >= 1, nq = {self.model.nq})"
+            )
+        site = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, self.tcp_site)
+        if site < 0:
+            raise InvalidInputError(f"{self.name}.tcp_site", self.tcp_site, "must name a site of the model")
+        data = mujoco.MjData(self.model)
+        tcp = np.empty((len(qpos), 3))
+        for k, q in enumerate(qpos):
+            data.qpos[:] = q
+            mujoco.mj_kinematics(self.model, data)
+            tcp[k] = data.site_xpos[site]
+        object.__setattr__(self, "qpos", qpos)
+        object.__setattr__(self, "tcp", tcp)
+
+    def __len__(self) -> int:
+        return int(self.qpos.shape[0])
+
+
+class PlaybackRenderer:
+    """Render frames of one or more designs; a context manager that frees its OpenGL contexts.
+
+    Args:
+        designs: the designs, all with the same number of frames (side by side: left to right;
+            overlaid: the first opaque, the others translucent).
+        reference: the reference TCP curve (M, 3) in the MuJoCo world [m], or None.
+        size: image (width, height) [px]; side by side each design gets width / len(designs).
+        layout: ``"side-by-side"`` or ``"overlay"``.
+        shadows: draw shadows and reflections (several times slower on CPU; for comparison).
+
+    """
+
+    def __init__(
+        self,
+        designs: Sequence[Design],
+        reference: Array | None = None,
+        size: tuple[int, int] = (640, 480),
+        layout: Layout = "side-by-side",
+        shadows: bool = False,
+    ) -> None:
+        if not designs:
+            raise InvalidInputError("designs", "[]", "at least one design is needed")
+        if layout not in LAYOUTS:
+            raise InvalidInputError("layout", layout, f"must be one of {', '.join(LAYOUTS)}")
+        if len({len(d) for d in designs}) != 1:
+            raise InvalidInputError("designs", [len(d) for d in designs], "must all have the same number of frames")
+        width, height = size
+        panels = len(designs) if layout == "side-by-side" else 1
+        if width % panels or width < 16 * panels or height < 16:
+            raise InvalidInputError("size", f"{width}x{height}", f"width must split into {panels} panels >= 16 px")
+        self.designs = tuple(designs)
+        self.reference = None if reference is None else np.asarray(reference, dtype=float).reshape(-1, 3)
+        self.size = (width, height)
+        self.layout = layout
+        self._data = [mujoco.MjData(d.model) for d in self.designs]
+        self._option = mujoco.MjvOption()
+        self._perturb = mujoco.MjvPerturb()
+        panel_width = width // panels
+        max_geom = sum(d.model.ngeom for d in self.designs) + decor.MAX_SEGMENTS * (len(self.designs) + 1) + 16
+        self._renderers: list[mujoco.Renderer] = []
+        try:
+            for design in self.designs if layout == "side-by-side" else self.designs[:1]:
+                decor.prepare_model(design.model)
+                renderer = open_renderer(design.model, panel_width, height, max_geom=max_geom)
+                decor.set_fast_visuals(renderer.scene, shadows)
+                self._renderers.append(renderer)
+        except BaseException:
+            self.close()
+            raise
+        points = self._motion_points()
+        fovy = float(self.designs[0].model.vis.global_.fovy)
+        self.camera = fit_camera(points, aspect=panel_width / height, fovy=fovy)
+        forward, _, _ = camera_axes(float(self.camera.azimuth), float(self.camera.elevation))
+        depth = float(np.max((points - self.camera.lookat) @ forward)) + 1.0
+        self._backdrop = (depth, 4.0 * (self.camera.distance + depth) * np.tan(np.radians(fovy)) * width / height)
+        line = max(12, height // 26)
+        self._captions = [caption_bitmap(d.caption or d.name, d.rgba[:3], line) for d in self.designs]
+
+    def __len__(self) -> int:
+        return len(self.designs[0])
+
+    def _motion_points(self, samples: int = 40) -> Array:
+        """Geom bounding-box corners of every design over ``samples`` frames, and the reference."""
+        points = [] if self.reference is None else [self.reference]
+        for design, data in zip(self.designs, self._data, strict=True):
+            for k in np.unique(np.linspace(0, len(design) - 1, samples).round().astype(int)):
+                data.qpos[:] = design.qpos[k]
+                mujoco.mj_kinematics(design.model, data)
+                points.append(geom_corners(design.model, data))
+            points.append(design.tcp)
+        return np.concatenate(points)
+
+    def _decorate(self, scene: mujoco.MjvScene, designs: Sequence[Design], index: int) -> None:
+        decor.add_backdrop(scene, self.camera, *self._backdrop)
+        if self.reference is not None:
+            decor.add_polyline(scene, self.reference, decor.REFERENCE_RGBA, width=decor.LINE_WIDTH - 1.0)
+        for design in designs:
+            decor.add_polyline(scene, design.tcp[: index + 1], design.rgba)
+
+    def frame(self, index: int) -> Image:
+        """The RGB image (height, width, 3) uint8 of frame ``index``."""
+        if not 0 <= index < len(self):
+            raise InvalidInputError("frame index", index, f"must lie in [0, {len(self) - 1}]")
+        for design, data in zip(self.designs, self._data, strict=True):
+            data.qpos[:] = design.qpos[index]
+            mujoco.mj_kinematics(design.model, data)
+        if self.layout == "overlay":
+            return self._overlay_frame(index)
+        images = []
+        for renderer, design, data, caption in zip(
+            self._renderers, self.designs, self._data, self._captions, strict=True
+        ):
+            renderer.update_scene(data, camera=self.camera, scene_option=self._option)
+            decor.tint_geoms(renderer.scene, 0, design.rgba)
+            self._decorate(renderer.scene, [design], index)
+            image = renderer.render()
+            stamp(image, caption)
+            images.append(image)
+        return np.concatenate(images, axis=1)
+
+    def _overlay_frame(self, index: int) -> Image:
+        renderer = self._renderers[0]
+        renderer.update_scene(self._data[0], camera=self.camera, scene_option=self._option)
+        scene = renderer.scene
+        decor.tint_geoms(scene, 0, self.designs[0].rgba)
+        for design, data in zip(self.designs[1:], self._data[1:], strict=True):
+            start = scene.ngeom
+            mujoco.mjv_addGeoms(design.model, data, self._option, self._perturb, mujoco.mjtCatBit.mjCAT_DYNAMIC, scene)
+            decor.drop_coincident(scene, start)
+            decor.tint_geoms(scene, start, (*design.rgba[:3], GHOST_ALPHA), weight=0.8)
+        self._decorate(scene, self.designs, index)
+        image = renderer.render()
+        top = 8
+        for caption in self._captions:
+            stamp(image, caption, top=top)
+            top += caption.shape[0] + 6
+        return image
+
+    def close(self) -> None:
+        """Free the OpenGL contexts (idempotent); left to the garbage collector, OSMesa may complain at exit."""
+        for renderer in self._renderers:
+            renderer.close()
+        self._renderers = []
+
+    def __enter__(self) -> PlaybackRenderer:
+        return self
+
+    def __exit__(self, *_: object) -> None:
+        self.close()

@@ -1,0 +1,197 @@
+"""Playback of an optimisation result: read the result folder, build the states, render the video.
+
+A result folder (written by ``hiab-sim optimize``, issue 6) holds ``result.json`` with the crane
+(``crane``: preset name or YAML path) and the link lengths of the ``initial`` and ``optimal``
+designs, and ``trajectory.npz`` with ``time`` (K,), ``reference_tcp`` (K, 3) in the source world
+{W} (y up) and, per design d, ``{d}_position``, ``{d}_velocity``, ``{d}_acceleration`` (K, 3) of
+(theta1, theta2, xt2).
+
+Two playback modes:
+
+- ``kinematic``: the planned states, the closed chains solved by the MuJoCo inverse-dynamics
+  module (:meth:`~hiab_sim.dynamics.mujoco_id.MujocoInverseDynamics.state`).
+- ``simulate``: a forward simulation of the MJCF model driven by the actuator forces that the
+  MuJoCo inverse dynamics computes for the planned motion (:mod:`hiab_sim.dynamics.replay`), so
+  the video shows that those forces really move the crane along the reference.
+
+Both are resampled to the video's frame rate, in real time.
+"""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiab_sim.config import ChainLengths, Crane, LinkLengths, load_crane
+from hiab_sim.dynamics.samples import JointSamples
+from hiab_sim.errors import ConfigError, InvalidInputError
+
+Array = NDArray[np.float64]
+Mode = Literal["kinematic", "simulate"]
+MODES: tuple[str, ...] = ("kinematic", "simulate")
+DESIGNS = ("initial", "optimal")
+RESULT_FILE = "result.json"
+TRAJECTORY_FILE = "trajectory.npz"
+_HINT = "write one with 'hiab-sim optimize'"
+#: Spacing of the force samples of a simulated playback [s]: the replay's integrator step.
+SIMULATION_STEP = 1e-3
+
+
+@dataclass(frozen=True)
+class DesignMotion:
+    """One design of a result: its link lengths and planned joint samples at ``PlaybackData.time``."""
+
+    name: str
+    lengths: LinkLengths
+    joints: JointSamples
+
+
+@dataclass(frozen=True)
+class PlaybackData:
+    """What a playback needs from a result folder."""
+
+    crane: Crane
+    time: Array  # (K,) [s], increasing
+    reference_tcp: Array  # (K, 3) in the source world {W} [m]
+    designs: tuple[DesignMotion, ...]
+
+
+def load_playback(result_dir: str | Path) -> PlaybackData:
+    """Read ``result.json`` and ``trajectory.npz`` of a result folder.
+
+    Raises:
+        ConfigError: the folder or one of its files is missing or corrupt (not JSON / NPZ,
+            missing keys, wrong shapes).
+
+    """
+    folder = Path(result_dir)
+    if not folder.is_dir():
+        raise ConfigError(f"result folder {folder} does not exist ({_HINT})")
+    for name in (RESULT_FILE, TRAJECTORY_FILE):
+        if not (folder / name).is_file():
+            raise ConfigError(f"result folder {folder} has no {name} ({_HINT})")
+    try:
+        result = json.loads((folder / RESULT_FILE).read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise ConfigError(f"{folder / RESULT_FILE}: not valid JSON: {error}") from None
+    if not isinstance(result, dict) or "crane" not in result:
+        raise ConfigError(f"{folder / RESULT_FILE}: missing key 'crane'")
+    crane_source = str(result["crane"])
+    if not crane_source.endswith((".yaml", ".yml")) or Path(crane_source).is_absolute():
+        crane = load_crane(crane_source)
+    else:  # a relative YAML path: relative to the result folder if it is there
+        local = folder / crane_source
+        crane = load_crane(local if local.is_file() else crane_source)
+    arrays = _read_npz(folder / TRAJECTORY_FILE)
+    time = _array(arrays, "time", 1, folder)
+    if len(time) < 2 or not np.all(np.diff(time) > 0):
+        raise ConfigError(f"{folder / TRAJECTORY_FILE}: 'time' must hold at least 2 increasing samples")
+    reference = _array(arrays, "reference_tcp", 2, folder, len(time))
+    designs = []
+    for name in DESIGNS:
+        joints = JointSamples(*(_array(arrays, f"{name}_{kind}", 2, folder, len(time)) for kind in _KINDS))
+        designs.append(DesignMotion(name, _lengths(result, name, folder / RESULT_FILE), joints))
+    return PlaybackData(crane, time, reference, tuple(designs))
+
+
+_KINDS = ("position", "velocity", "acceleration")
+
+
+def _read_npz(path: Path) -> dict[str, Array]:
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            return {key: np.asarray(npz[key]) for key in npz.files}
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as error:
+        raise ConfigError(f"{path}: not a valid .npz archive: {error}") from None
+
+
+def _array(arrays: dict[str, Array], key: str, ndim: int, folder: Path, rows: int | None = None) -> Array:
+    where = folder / TRAJECTORY_FILE
+    if key not in arrays:
+        raise ConfigError(f"{where}: missing array '{key}'")
+    value = arrays[key]
+    shape_ok = value.ndim == ndim and (ndim == 1 or value.shape[1] == 3) and (rows is None or len(value) == rows)
+    if not shape_ok or not np.issubdtype(value.dtype, np.number):
+        expected = "(K,)" if ndim == 1 else "(K, 3)"
+        raise ConfigError(f"{where}: array '{key}' has shape {value.shape}, expected {expected} numbers")
+    if not np.all(np.isfinite(value)):
+        raise ConfigError(f"{where}: array '{key}' holds NaN or inf")
+    return value.astype(float)
+
+
+def _lengths(result: dict[str, Any], design: str, where: Path) -> LinkLengths:
+    try:
+        chains = result[design]["lengths"]
+        return LinkLengths(
+            *(ChainLengths(*(float(chains[c][k]) for k in ("L", "Lc0", "Lc"))) for c in ("lift", "tilt"))
+        )
+    except (KeyError, TypeError, ValueError):
+        raise ConfigError(f"{where}: '{design}.lengths' must map lift and tilt to numbers L, Lc0, Lc [m]") from None
+
+
+def frame_times(time: Array, fps: float) -> Array:
+    """Frame instants t0, t0 + 1/fps, ... up to the last sample [s]: real-time playback."""
+    if not fps > 0:
+        raise InvalidInputError("fps", fps, "must be > 0", "1/s")
+    count = int(np.floor((time[-1] - time[0]) * fps + 1e-9)) + 1
+    return time[0] + np.arange(count) / fps
+
+
+def resample(time: Array, values: Array, at: Array) -> Array:
+    """Linear interpolation of ``values`` (K, n) sampled at ``time`` onto the instants ``at``."""
+    return np.stack([np.interp(at, time, column) for column in np.asarray(values).T], axis=1)
+
+
+def planned_qpos(crane: Crane, lengths: LinkLengths, position: Array) -> Array:
+    """Loop-consistent qpos (N, nq) of the MJCF model for joint positions (theta1, theta2, xt2) (N, 3).
+
+    The closed chains are solved by :meth:`MujocoInverseDynamics.state
+    <hiab_sim.dynamics.mujoco_id.MujocoInverseDynamics.state>`, which also checks the joint ranges.
+    """
+    from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
+
+    qpos, _, _ = MujocoInverseDynamics(crane, lengths).state(JointSamples.at_rest(position))
+    return qpos
+
+
+def densify(time: Array, joints: JointSamples, step: float = SIMULATION_STEP) -> tuple[Array, JointSamples]:
+    """Joint samples on a grid of spacing <= ``step`` [s]: quintic Hermite through (p, v, a) of each sample.
+
+    The interpolant matches position, velocity and acceleration at every given sample, so the
+    dense samples stay consistent (v = dp/dt, a = dv/dt) between them.
+    """
+    from scipy.interpolate import BPoly
+
+    count = int(np.ceil((time[-1] - time[0]) / step - 1e-9)) + 1
+    fine = np.linspace(time[0], time[-1], max(count, len(time)))
+    columns: list[list[Array]] = [[], [], []]
+    for j in range(3):
+        knots = np.stack([joints.position[:, j], joints.velocity[:, j], joints.acceleration[:, j]], axis=1)
+        poly = BPoly.from_derivatives(time, knots)
+        for order in range(3):
+            columns[order].append(poly.derivative(order)(fine) if order else poly(fine))
+    position, velocity, acceleration = (np.stack(c, axis=1) for c in columns)
+    return fine, JointSamples(position, velocity, acceleration)
+
+
+def simulated_qpos(crane: Crane, lengths: LinkLengths, time: Array, joints: JointSamples) -> tuple[Array, Array]:
+    """A forward simulation driven by the inverse-dynamics forces: (time (T,), qpos (T, nq)).
+
+    The planned joints are first densified to the simulation step (:func:`densify`): forces are
+    interpolated linearly between their samples, and from samples tens of milliseconds apart
+    that error alone lets the open-loop replay drift off the plan. The forces f_x of
+    :class:`~hiab_sim.dynamics.mujoco_id.MujocoInverseDynamics` then drive the model's motors
+    from the first planned state, without feedback (:func:`hiab_sim.dynamics.replay.replay`).
+    """
+    from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
+    from hiab_sim.dynamics.replay import replay
+
+    fine, dense = densify(time, joints)
+    forces = MujocoInverseDynamics(crane, lengths)(dense).force
+    return fine, replay(crane, lengths, fine, dense, forces).qpos

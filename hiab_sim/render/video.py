@@ -1,0 +1,128 @@
+"""``render_result``: a playback video (or a still frame) of an optimisation result folder."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.model.mjcf import build_model, source_to_world
+from hiab_sim.render.backend import check_output_path, ffmpeg_path, video_sink, write_image
+from hiab_sim.render.decor import INITIAL_RGBA, OPTIMAL_RGBA
+from hiab_sim.render.frames import LAYOUTS, Design, Layout, PlaybackRenderer
+from hiab_sim.render.playback import (
+    MODES,
+    Mode,
+    PlaybackData,
+    frame_times,
+    load_playback,
+    planned_qpos,
+    resample,
+    simulated_qpos,
+)
+
+#: Default file name of the playback video inside a result folder.
+VIDEO_NAME = "playback.mp4"
+_COLOURS = {"initial": INITIAL_RGBA, "optimal": OPTIMAL_RGBA}
+
+
+def playback_renderer(
+    data: PlaybackData,
+    fps: float = 30.0,
+    size: tuple[int, int] = (640, 480),
+    mode: Mode = "kinematic",
+    layout: Layout = "side-by-side",
+    shadows: bool = False,
+) -> PlaybackRenderer:
+    """A :class:`~hiab_sim.render.scene.PlaybackRenderer` of both designs of ``data`` at ``fps``.
+
+    Side by side, the initial design is on the left; overlaid, the initial design is drawn
+    translucent over the optimal one.
+    """
+    if mode not in MODES:
+        raise InvalidInputError("mode", mode, f"must be one of {', '.join(MODES)}")
+    if layout not in LAYOUTS:
+        raise InvalidInputError("layout", layout, f"must be one of {', '.join(LAYOUTS)}")
+    at = frame_times(data.time, fps)
+    designs = []
+    for motion in data.designs:
+        model = build_model(data.crane, motion.lengths)
+        if mode == "kinematic":
+            qpos = planned_qpos(data.crane, motion.lengths, resample(data.time, motion.joints.position, at))
+        else:
+            qpos = resample(*simulated_qpos(data.crane, motion.lengths, data.time, motion.joints), at)
+        caption = f"{motion.name} ({mode})"
+        if layout == "overlay" and motion.name == "initial":
+            caption = f"{motion.name} (translucent, {mode})"
+        designs.append(Design(motion.name, model, qpos, _COLOURS.get(motion.name, OPTIMAL_RGBA), caption))
+    if layout == "overlay":
+        designs.reverse()  # the optimal design opaque, the initial one as a translucent ghost
+    return PlaybackRenderer(designs, source_to_world(data.reference_tcp), size, layout=layout, shadows=shadows)
+
+
+def render_result(
+    result_dir: str | Path,
+    output: str | Path | None = None,
+    fps: float = 30.0,
+    size: tuple[int, int] = (640, 480),
+    mode: Mode = "kinematic",
+    layout: Layout = "side-by-side",
+    progress: Callable[[int, int], None] | None = None,
+) -> Path:
+    """Render the playback video (.mp4, or .gif) of a result folder; return its path.
+
+    Args:
+        result_dir: folder written by ``hiab-sim optimize`` (``result.json``, ``trajectory.npz``).
+        output: video path (default ``result_dir/playback.mp4``); written atomically.
+        fps: frames per second; the video plays in real time.
+        size: (width, height) [px], both even for H.264.
+        mode: ``"kinematic"`` (planned states) or ``"simulate"`` (forward simulation under the
+            inverse-dynamics forces).
+        layout: ``"side-by-side"`` or ``"overlay"``.
+        progress: called with (frames done, frames in all) after each frame.
+
+    Raises:
+        HiabSimError: bad result folder or output path, no OpenGL backend, no ffmpeg.
+
+    """
+    data = load_playback(result_dir)
+    output = Path(result_dir) / VIDEO_NAME if output is None else Path(output)
+    _check_size(size, even=output.suffix.lower() == ".mp4")
+    check_output_path(output, (".mp4", ".gif"), "video")
+    ffmpeg_path()
+    with (
+        playback_renderer(data, fps, size, mode, layout) as renderer,
+        video_sink(output, size, fps) as sink,
+    ):
+        for index in range(len(renderer)):
+            sink.add(renderer.frame(index))
+            if progress is not None:
+                progress(index + 1, len(renderer))
+    return output
+
+
+def render_still(
+    result_dir: str | Path,
+    output: str | Path,
+    at_time: float | None = None,
+    size: tuple[int, int] = (640, 480),
+    layout: Layout = "side-by-side",
+) -> Path:
+    """Render one frame (.png) of the kinematic playback at ``at_time`` [s] (default: the end)."""
+    data = load_playback(result_dir)
+    _check_size(size, even=False)
+    output = check_output_path(Path(output), (".png",), "image")
+    fps = 30.0
+    with playback_renderer(data, fps, size, "kinematic", layout) as renderer:
+        last = len(renderer) - 1
+        index = last if at_time is None else int(np.clip(round((at_time - data.time[0]) * fps), 0, last))
+        return write_image(output, renderer.frame(index))
+
+
+def _check_size(size: tuple[int, int], even: bool) -> None:
+    width, height = size
+    if width < 32 or height < 32 or width > 4096 or height > 4096 or (even and (width % 4 or height % 2)):
+        allowed = "width and height in [32, 4096] px" + (", width a multiple of 4, height even" if even else "")
+        raise InvalidInputError("size", f"{width}x{height}", allowed)
