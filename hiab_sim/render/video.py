@@ -9,7 +9,7 @@ import numpy as np
 
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.model.mjcf import build_model, source_to_world
-from hiab_sim.render.backend import check_output_path, ffmpeg_path, video_sink, write_image
+from hiab_sim.render.backend import check_gl_backend, check_output_path, ffmpeg_path, video_sink, write_image
 from hiab_sim.render.decor import INITIAL_RGBA, OPTIMAL_RGBA
 from hiab_sim.render.frames import LAYOUTS, Design, Layout, PlaybackRenderer
 from hiab_sim.render.playback import (
@@ -87,6 +87,7 @@ def render_result(
         HiabSimError: bad result folder or output path, no OpenGL backend, no ffmpeg.
 
     """
+    check_gl_backend()
     data = load_playback(result_dir)
     output = Path(result_dir) / VIDEO_NAME if output is None else Path(output)
     _check_size(size, even=output.suffix.lower() == ".mp4")
@@ -111,6 +112,7 @@ def render_still(
     layout: Layout = "side-by-side",
 ) -> Path:
     """Render one frame (.png) of the kinematic playback at ``at_time`` [s] (default: the end)."""
+    check_gl_backend()
     data = load_playback(result_dir)
     _check_size(size, even=False)
     output = check_output_path(Path(output), (".png",), "image")

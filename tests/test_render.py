@@ -1,0 +1,275 @@
+"""Off-screen playback rendering (issue 7): frames, camera, video files and one-line errors.
+
+Renders through the OpenGL backend that hiab_sim selects (OSMesa on CI, MUJOCO_GL=osmesa) from a
+fabricated result folder that follows the ``hiab-sim optimize`` contract: a smooth joint
+trajectory inside the working ranges and two feasible link-length sets.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hiab_sim.cli import main
+from hiab_sim.config import Crane, LinkLengths, check_lengths
+from hiab_sim.crane.kinematics import tcp_position
+from hiab_sim.model.mjcf import source_to_world
+from hiab_sim.render import backend as render_backend
+from hiab_sim.render import (
+    fit_camera,
+    frame_times,
+    load_playback,
+    playback_renderer,
+    render_result,
+    render_still,
+)
+from hiab_sim.render.frames import PlaybackRenderer
+
+DURATION = 1.0  # [s] of the fabricated study
+FPS = 12.0
+SIZE = (320, 240)
+FRAMES = int(DURATION * FPS) + 1
+
+
+def _motion(time: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(theta1, theta2, xt2) around (0.6, -1.3, 0.4) with exact rates and accelerations."""
+    w = 2.0 * np.pi / DURATION
+    amp = np.array([0.25, 0.3, 0.3])
+    freq = np.array([1.0, 1.0, 2.0])
+    phase = np.array([0.0, 1.0, 0.0])
+    arg = w * freq * time[:, None] + phase
+    centre = np.array([0.6, -1.3, 0.4])
+    return centre + amp * np.sin(arg), amp * w * freq * np.cos(arg), -amp * (w * freq) ** 2 * np.sin(arg)
+
+
+def write_result(folder: Path, crane: Crane, samples: int = 201) -> Path:
+    """A result folder as ``hiab-sim optimize`` writes it (issue 6 contract)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    initial = crane.default_lengths
+    optimal = LinkLengths.from_array(initial.as_array() * np.array([1.03, 1.2, 1.0, 1.0, 1.0, 1.0]))
+    check_lengths(crane, optimal)
+    time = np.linspace(0.0, DURATION, samples)
+    p, v, a = _motion(time)
+
+    def lengths(xi: LinkLengths) -> dict[str, dict[str, float]]:
+        return {name: {"L": c.L, "Lc0": c.Lc0, "Lc": c.Lc} for name, c in zip(("lift", "tilt"), xi, strict=True)}
+
+    result = {"crane": "xs031", "study": "test", "initial": {"lengths": lengths(initial)}}
+    result["optimal"] = {"lengths": lengths(optimal)}
+    (folder / "result.json").write_text(json.dumps(result))
+    arrays = {"time": time, "reference_tcp": tcp_position(crane, p[:, 0], p[:, 1], p[:, 2])}
+    for design in ("initial", "optimal"):
+        arrays |= {f"{design}_position": p, f"{design}_velocity": v, f"{design}_acceleration": a}
+    np.savez(folder / "trajectory.npz", **arrays)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def result_dir(tmp_path_factory: pytest.TempPathFactory, crane: Crane) -> Path:
+    return write_result(tmp_path_factory.mktemp("render") / "result", crane)
+
+
+@pytest.fixture(scope="module")
+def frames(result_dir: Path) -> np.ndarray:
+    with playback_renderer(load_playback(result_dir), fps=FPS, size=SIZE) as renderer:
+        return np.stack([renderer.frame(i) for i in range(len(renderer))])
+
+
+def _saturated(image: np.ndarray) -> np.ndarray:
+    """Mask of strongly coloured pixels: the tinted crane (floor, backdrop and sky are grey)."""
+    rgb = image.astype(int)
+    return (rgb.max(axis=-1) - rgb.min(axis=-1)) > 60
+
+
+def test_clip_has_one_frame_per_tick_at_the_video_size(frames: np.ndarray) -> None:
+    """A 1 s study at 12 fps gives 13 RGB frames of 320x240 (real-time playback)."""
+    assert frames.shape == (FRAMES, SIZE[1], SIZE[0], 3)
+    assert frames.dtype == np.uint8
+    assert len(frame_times(np.array([0.0, DURATION]), FPS)) == FRAMES
+
+
+def test_frames_show_both_cranes(frames: np.ndarray) -> None:
+    """Every frame is lit (not black); each half holds crane pixels, the right half's tinted blue."""
+    half = SIZE[0] // 2
+    for image in frames:
+        assert image.mean() > 60
+        body = image[30:]  # below the captions
+        assert _saturated(body[:, :half]).sum() > 300  # initial design, orange
+        assert _saturated(body[:, half:]).sum() > 300  # optimal design, blue
+        left, right = body[:, :half][_saturated(body[:, :half])], body[:, half:][_saturated(body[:, half:])]
+        blue_over_red = [int(p[:, 2].sum()) - int(p[:, 0].sum()) for p in (left, right)]
+        assert blue_over_red[1] - blue_over_red[0] > 30 * 300  # the right crane is the blue one
+
+
+def test_consecutive_frames_differ_where_the_crane_moves(frames: np.ndarray) -> None:
+    """The crane moves all along the trajectory, so every frame changes many pixels."""
+    changed = np.any(frames[1:] != frames[:-1], axis=-1).sum(axis=(1, 2))
+    assert np.all(changed > 200), changed
+
+
+def test_trail_follows_the_reference_in_mujoco_world(result_dir: Path) -> None:
+    """The model's TCP site over the kinematic playback lies on the reference mapped (x, y, z) -> (x, -z, y)."""
+    data = load_playback(result_dir)
+    with playback_renderer(data, fps=FPS, size=SIZE) as renderer:
+        at = frame_times(data.time, FPS)
+        reference = np.stack([np.interp(at, data.time, c) for c in source_to_world(data.reference_tcp).T], axis=1)
+        for design in renderer.designs:
+            assert np.max(np.abs(design.tcp - reference)) < 2e-3
+
+
+def test_simulated_playback_tracks_the_plan(result_dir: Path) -> None:
+    """Forward simulation under the inverse-dynamics forces keeps the TCP within 5 mm of the plan."""
+    data = load_playback(result_dir)
+    with playback_renderer(data, fps=FPS, size=SIZE, mode="simulate") as renderer:
+        kinematic = playback_renderer(data, fps=FPS, size=SIZE)
+        with kinematic:
+            for simulated, planned in zip(renderer.designs, kinematic.designs, strict=True):
+                assert np.max(np.linalg.norm(simulated.tcp - planned.tcp, axis=1)) < 5e-3
+
+
+def test_overlay_draws_both_designs_in_one_view(result_dir: Path) -> None:
+    """Overlaid, one full-width view holds the opaque optimal crane and the ghost of the initial one."""
+    with playback_renderer(load_playback(result_dir), fps=FPS, size=SIZE, layout="overlay") as renderer:
+        assert [d.name for d in renderer.designs] == ["optimal", "initial"]
+        image = renderer.frame(0)
+    assert image.shape == (SIZE[1], SIZE[0], 3)
+    assert _saturated(image[30:]).sum() > 600
+
+
+def test_fitted_camera_sees_every_point() -> None:
+    """Every point projects inside the viewport and the extreme ones nearly touch its border."""
+    rng = np.random.default_rng(1)
+    points = rng.uniform([-1.0, -0.3, 0.0], [3.0, 0.3, 2.0], size=(200, 3))
+    aspect, fovy = 4 / 3, 45.0
+    camera = fit_camera(points, aspect, fovy, margin=1.0)
+    az, el = np.radians(camera.azimuth), np.radians(camera.elevation)
+    forward = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    eye = np.asarray(camera.lookat) - camera.distance * forward
+    v = points - eye
+    depth = v @ forward
+    x = (v @ right) / (depth * np.tan(np.radians(fovy) / 2) * aspect)
+    y = (v @ up) / (depth * np.tan(np.radians(fovy) / 2))
+    assert np.all(depth > 0)
+    assert np.max(np.maximum(np.abs(x), np.abs(y))) == pytest.approx(1.0, abs=1e-6)
+
+
+def _count_frames(path: Path) -> int:
+    if shutil.which("ffprobe"):
+        out = subprocess.run(
+            ["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+             "stream=nb_read_frames,width,height", "-of", "csv=p=0", str(path)],
+            check=True, capture_output=True, text=True,
+        ).stdout  # fmt: skip
+        width, height, count = (int(v) for v in out.strip().split(","))
+        assert (width, height) == SIZE
+        return count
+    import mediapy
+
+    return len(mediapy.read_video(path))
+
+
+@pytest.mark.skipif(shutil.which("ffmpeg") is None, reason="needs Debian ffmpeg (scripts/setup.sh installs it)")
+def test_mp4_holds_every_frame_and_no_temporary_file(result_dir: Path, tmp_path: Path) -> None:
+    """render_result writes an H.264 mp4 with one frame per tick and leaves nothing else behind."""
+    output = render_result(result_dir, tmp_path / "clip.mp4", fps=FPS, size=SIZE)
+    assert output == tmp_path / "clip.mp4"
+    assert _count_frames(output) == FRAMES
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["clip.mp4"]
+
+
+def test_still_frame_is_a_png_of_the_requested_size(result_dir: Path, tmp_path: Path) -> None:
+    """--still writes one PNG frame."""
+    import mediapy
+
+    path = render_still(result_dir, tmp_path / "still.png", at_time=0.5, size=SIZE)
+    assert mediapy.read_image(path).shape == (SIZE[1], SIZE[0], 3)
+
+
+def test_failed_render_leaves_no_video(result_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """An error while frames are written removes the partial file: the output never exists half-written."""
+
+    def broken(self: PlaybackRenderer, index: int) -> np.ndarray:
+        if index == 3:
+            raise RuntimeError("boom")
+        return np.zeros((SIZE[1], SIZE[0], 3), dtype=np.uint8)
+
+    monkeypatch.setattr(PlaybackRenderer, "frame", broken)
+    with pytest.raises(RuntimeError, match="boom"):
+        render_result(result_dir, tmp_path / "clip.mp4", fps=FPS, size=SIZE)
+    assert list(tmp_path.iterdir()) == []
+
+
+# ---------------------------------------------------------------------------------------------
+# Bad input: one line on stderr, exit status 2, no traceback, no file
+# ---------------------------------------------------------------------------------------------
+
+
+def _cli_error(capsys: pytest.CaptureFixture[str], argv: list[str]) -> str:
+    assert main(["render", *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    return err
+
+
+def test_missing_result_folder_is_one_line(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    """A folder that does not exist is named, with how to make one."""
+    err = _cli_error(capsys, [str(tmp_path / "nope")])
+    assert "does not exist" in err and "hiab-sim optimize" in err
+
+
+@pytest.mark.parametrize(
+    ("damage", "message"),
+    [
+        (lambda f: (f / "result.json").write_text("{not json"), "not valid JSON"),
+        (lambda f: (f / "trajectory.npz").write_bytes(b"garbage"), "not a valid .npz"),
+        (lambda f: (f / "trajectory.npz").unlink(), "has no trajectory.npz"),
+        (lambda f: (f / "result.json").write_text('{"crane": "xs031", "initial": {}}'), "initial.lengths"),
+    ],
+)
+def test_corrupt_result_folder_is_one_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, crane: Crane, damage: object, message: str
+) -> None:
+    """A corrupt result.json or trajectory.npz is named on one line."""
+    folder = write_result(tmp_path / "result", crane, samples=11)
+    damage(folder)  # type: ignore[operator]
+    assert message in _cli_error(capsys, [str(folder), "-o", str(tmp_path / "v.mp4")])
+    assert not (tmp_path / "v.mp4").exists()
+
+
+def test_unwritable_output_is_one_line(capsys: pytest.CaptureFixture[str], result_dir: Path, tmp_path: Path) -> None:
+    """An output folder that does not exist, a folder as output, or a wrong suffix is refused up front."""
+    assert "does not exist" in _cli_error(capsys, [str(result_dir), "-o", str(tmp_path / "no" / "v.mp4")])
+    (tmp_path / "d.mp4").mkdir()
+    assert "is a folder" in _cli_error(capsys, [str(result_dir), "-o", str(tmp_path / "d.mp4")])
+    assert ".mp4 or .gif" in _cli_error(capsys, [str(result_dir), "-o", str(tmp_path / "v.avi")])
+
+
+def test_missing_osmesa_is_one_line(
+    capsys: pytest.CaptureFixture[str], result_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """MUJOCO_GL=osmesa without libOSMesa says to apt-get install libosmesa6."""
+    monkeypatch.setenv("MUJOCO_GL", "osmesa")
+    monkeypatch.setattr(render_backend.ctypes.util, "find_library", lambda name: None)
+    err = _cli_error(capsys, [str(result_dir), "-o", str(tmp_path / "v.mp4")])
+    assert "apt-get install libosmesa6" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_missing_ffmpeg_is_one_line(
+    capsys: pytest.CaptureFixture[str], result_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Without Debian ffmpeg or imageio-ffmpeg the error says how to install either."""
+    monkeypatch.setattr(render_backend.shutil, "which", lambda name: None)
+    monkeypatch.setitem(sys.modules, "imageio_ffmpeg", None)
+    err = _cli_error(capsys, [str(result_dir), "-o", str(tmp_path / "v.mp4")])
+    assert "apt-get install ffmpeg" in err and "pip install imageio-ffmpeg" in err
+    assert list(tmp_path.iterdir()) == []
