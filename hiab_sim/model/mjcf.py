@@ -58,6 +58,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from xml.etree import ElementTree
 
 import mujoco
 import numpy as np
@@ -245,7 +246,44 @@ def build_model(crane: Crane, lengths: LinkLengths | None = None) -> mujoco.MjMo
 
 
 def to_xml(crane: Crane, lengths: LinkLengths | None = None) -> str:
-    """MJCF text of the crane for link lengths Xi; loads with ``mujoco.MjModel.from_xml_string``."""
+    """MJCF text of the crane for link lengths Xi; loads with ``mujoco.MjModel.from_xml_string``.
+
+    MuJoCo's XML writer keeps 6 significant digits, which would open the closed loops by ~1e-6 m
+    and round masses; every body, inertial, geom and site placement is therefore rewritten
+    from the compiled model at full double precision (``repr``), so the file reloads to the
+    same model to round-off.
+    """
     spec = build_spec(crane, lengths)
-    spec.compile()
-    return str(spec.to_xml())
+    model = spec.compile()
+    root = ElementTree.fromstring(spec.to_xml())
+    world = root.find("worldbody")
+    if world is None:
+        raise AssertionError("MuJoCo wrote no worldbody")
+    for body_id, body in enumerate(world.iter("body"), start=1):  # depth-first, as MuJoCo numbers them
+        _set(body, pos=model.body_pos[body_id], quat=model.body_quat[body_id])
+        inertial = body.find("inertial")
+        if inertial is not None:
+            _set(
+                inertial,
+                pos=model.body_ipos[body_id],
+                quat=model.body_iquat[body_id],
+                mass=[model.body_mass[body_id]],
+                diaginertia=model.body_inertia[body_id],
+            )
+    for geom_id, geom in enumerate(world.iter("geom")):
+        _set(geom, pos=model.geom_pos[geom_id], quat=model.geom_quat[geom_id])
+        if geom.get("type", "") != "plane":
+            geom.set("size", _text(model.geom_size[geom_id][: len(geom.get("size", "0 0").split())]))
+    for site in world.iter("site"):
+        site_id = model.site(site.get("name", "")).id
+        _set(site, pos=model.site_pos[site_id], quat=model.site_quat[site_id])
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+def _text(values: np.ndarray) -> str:
+    return " ".join(repr(float(v)) for v in values)
+
+
+def _set(element: ElementTree.Element, **attributes: np.ndarray | list[float]) -> None:
+    for key, values in attributes.items():
+        element.set(key, _text(np.asarray(values)))
