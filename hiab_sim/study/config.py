@@ -99,12 +99,15 @@ class Tracking:
         position: |x_r - G_tcp(theta)| per coordinate [m] (xt2 in [m] too).
         velocity: [m/s].
         acceleration: [m/s^2].
+        collocation_fraction: The optimiser holds the bands times this fraction at the
+            collocation points, so the full bands hold between them (checked on the fine grid).
 
     """
 
     position: float = 1e-3
     velocity: float = 5e-3
     acceleration: float = 5e-2
+    collocation_fraction: float = 0.5
 
 
 @dataclass(frozen=True)
@@ -117,6 +120,10 @@ class Bounds:
         joint_velocity: |dtheta1|, |dtheta2| [rad/s], |dxt2| [m/s] limits (const_i).
         triangle_margin: Smallest interior angle of each chain's triangle at the boom hinge
             and its supplement, [rad] (const_k with a margin from the flat triangle).
+        working_margin: The design must serve the reference's joint range widened by this
+            much at both ends [rad] (const_j there), so it does not fit the spiral only.
+        envelope_margin: The optimiser keeps the EMLA envelope margins >= this at the
+            collocation points, so they stay >= 0 between them (checked on the fine grid).
 
     """
 
@@ -124,6 +131,8 @@ class Bounds:
     xi_up: tuple[float, ...]
     joint_velocity: tuple[float, float, float] = (0.6, 0.6, 0.5)
     triangle_margin: float = math.radians(10.0)
+    working_margin: float = math.radians(3.0)
+    envelope_margin: float = 0.02
 
 
 @dataclass(frozen=True)
@@ -243,12 +252,16 @@ def study_from_dict(data: Any, file: str | Path = "<study>") -> Study:
         fine_factor=_integer(grid_d.get("fine_factor", 10), "grid.fine_factor", 1),
     )
     reference = _reference(top["reference"])
-    track_d = _mapping(top.get("tracking", {}), "tracking", {"position", "velocity", "acceleration"}, set())
+    track_keys = {"position", "velocity", "acceleration", "collocation_fraction"}
+    track_d = _mapping(top.get("tracking", {}), "tracking", track_keys, set())
     tracking = Tracking(
         position=_positive(track_d.get("position", 1e-3), "tracking.position", "m"),
         velocity=_positive(track_d.get("velocity", 5e-3), "tracking.velocity", "m/s"),
         acceleration=_positive(track_d.get("acceleration", 5e-2), "tracking.acceleration", "m/s^2"),
+        collocation_fraction=_positive(track_d.get("collocation_fraction", 0.5), "tracking.collocation_fraction"),
     )
+    if tracking.collocation_fraction > 1.0:
+        raise InvalidInputError("tracking.collocation_fraction", tracking.collocation_fraction, "must lie in (0, 1]")
     bounds = _bounds(top["bounds"], initial)
     solver_d = _mapping(top.get("solver", {}), "solver", {"maxiter", "ftol", "id_path", "fd_step"}, set())
     id_path = str(solver_d.get("id_path", "mujoco"))
@@ -340,7 +353,7 @@ def _reference(data: Any) -> SpiralReference:
 
 
 def _bounds(data: Any, initial: LinkLengths) -> Bounds:
-    keys = {"lift", "tilt", "joint_velocity", "triangle_margin_deg"}
+    keys = {"lift", "tilt", "joint_velocity", "triangle_margin_deg", "working_margin_deg", "envelope_margin"}
     d = _mapping(data, "bounds", keys, {"lift", "tilt"})
     low: list[float] = []
     up: list[float] = []
@@ -366,7 +379,20 @@ def _bounds(data: Any, initial: LinkLengths) -> Bounds:
     margin = _number(d.get("triangle_margin_deg", 10.0), "bounds.triangle_margin_deg")
     if not 0.0 <= margin < 60.0:
         raise InvalidInputError("bounds.triangle_margin_deg", margin, "must lie in [0, 60)", "deg")
-    return Bounds(tuple(low), tuple(up), (velocity[0], velocity[1], velocity[2]), math.radians(margin))
+    working = _number(d.get("working_margin_deg", 3.0), "bounds.working_margin_deg")
+    if not 0.0 <= working <= 30.0:
+        raise InvalidInputError("bounds.working_margin_deg", working, "must lie in [0, 30]", "deg")
+    envelope = _number(d.get("envelope_margin", 0.02), "bounds.envelope_margin")
+    if not 0.0 <= envelope < 0.5:
+        raise InvalidInputError("bounds.envelope_margin", envelope, "must lie in [0, 0.5)")
+    return Bounds(
+        tuple(low),
+        tuple(up),
+        (velocity[0], velocity[1], velocity[2]),
+        math.radians(margin),
+        math.radians(working),
+        envelope,
+    )
 
 
 def _mapping(data: Any, where: str, keys: set[str], required: set[str]) -> Mapping[str, Any]:

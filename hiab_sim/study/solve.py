@@ -1,0 +1,270 @@
+"""SQP driver: scipy SLSQP with exact gradients, per-iteration history, atomic checkpoints, resume, multi-start.
+
+Every SQP iteration appends (cost, scaled cost, max constraint violation, Xi) to the history and
+rewrites ``checkpoint_<k>.json`` in the output folder atomically (temp file + ``os.replace``),
+so a killed run continues from its last iterate with ``resume=True`` (the quasi-Newton Hessian
+restarts from the identity there).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import minimize
+
+from hiab_sim.config import CHAIN_NAMES, LinkLengths
+from hiab_sim.errors import HiabSimError, InvalidInputError, SolverError
+from hiab_sim.study.problem import LinkLengthProblem
+
+Array = NDArray[np.float64]
+#: Largest violation [scaled units] a start may have.
+START_TOLERANCE = 1e-9
+
+
+@dataclass
+class Iterate:
+    """One row of the history: SQP iteration, cost [W^2 s], scaled cost, max violation, Xi [m]."""
+
+    iteration: int
+    cost: float
+    scaled_cost: float
+    max_violation: float
+    xi: list[float]
+    wall_time: float
+
+
+@dataclass
+class SolveResult:
+    """Outcome of one start."""
+
+    start: int
+    initial_lengths: LinkLengths
+    z0: Array
+    z: Array
+    history: list[Iterate] = field(default_factory=list)
+    success: bool = False
+    status: int = -1
+    message: str = ""
+    iterations: int = 0
+    wall_time: float = 0.0
+    n_evaluations: int = 0
+    n_gradients: int = 0
+
+
+def write_atomic(path: Path, text: str | bytes) -> None:
+    """Write a file atomically: a temp file in the same folder, then ``os.replace``."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(text.encode() if isinstance(text, str) else text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def check_start(problem: LinkLengthProblem, z: Array, label: str = "initial_lengths") -> None:
+    """Raise :class:`InvalidInputError` naming the worst violated constraint at a start point."""
+    ev = problem.evaluate(z)
+    worst = int(np.argmin(ev.constraints))
+    if ev.constraints[worst] < -START_TOLERANCE:
+        raise InvalidInputError(
+            f"{label} (constraint {problem.constraint_names[worst]})",
+            float(ev.constraints[worst]),
+            "the start must satisfy every constraint (scaled margin >= 0)",
+        )
+
+
+def start_points(problem: LinkLengthProblem, count: int, seed: int = 6) -> list[LinkLengths]:
+    """The study's start and ``count - 1`` other feasible starts, drawn in the Xi bounds.
+
+    Candidates perturb the study's start by up to 15 % per length (clipped to the bounds); the
+    first ones that satisfy every constraint with the inverse-kinematics coefficients are kept.
+    """
+    base = problem.study.initial_lengths.as_array()
+    low, up = np.asarray(problem.study.bounds.xi_low), np.asarray(problem.study.bounds.xi_up)
+    starts = [problem.study.initial_lengths]
+    rng = np.random.default_rng(seed)
+    for _ in range(400):
+        if len(starts) >= count:
+            break
+        xi = np.clip(base * (1.0 + rng.uniform(-0.15, 0.15, 6)), low, up)
+        lengths = LinkLengths.from_array(xi)
+        try:
+            z = problem.initial_point(lengths)
+            if problem.evaluate(z).constraints.min() >= 0.0:
+                starts.append(lengths)
+        except HiabSimError:
+            continue
+    if len(starts) < count:
+        raise InvalidInputError("starts", count, f"only {len(starts)} feasible starts found in the bounds")
+    return starts
+
+
+def _checkpoint_path(out: Path, start: int) -> Path:
+    return out / f"checkpoint_{start}.json"
+
+
+def _save_checkpoint(out: Path, result: SolveResult, z: Array, done: bool) -> None:
+    data = {
+        "start": result.start,
+        "initial_xi": result.initial_lengths.as_array().tolist(),
+        "z0": result.z0.tolist(),
+        "z": np.asarray(z).tolist(),
+        "history": [vars(h) for h in result.history],
+        "done": done,
+        "success": result.success,
+        "status": result.status,
+        "message": result.message,
+        "wall_time": result.wall_time,
+    }
+    write_atomic(_checkpoint_path(out, result.start), json.dumps(data))
+
+
+def load_checkpoint(out: Path, start: int) -> dict[str, Any] | None:
+    """The checkpoint of a start, or None."""
+    path = _checkpoint_path(out, start)
+    if not path.is_file():
+        return None
+    try:
+        data: dict[str, Any] = json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError):
+        return None
+    return data
+
+
+def solve(
+    problem: LinkLengthProblem,
+    initial: LinkLengths,
+    start: int = 0,
+    out: Path | None = None,
+    resume: bool = False,
+    progress: TextIO | None = sys.stderr,
+    maxiter: int | None = None,
+    use_gradients: bool = True,
+    on_iterate: Callable[[Iterate], None] | None = None,
+) -> SolveResult:
+    """Solve the NLP from ``initial`` with SLSQP; checkpoint into ``out`` after every iteration.
+
+    Args:
+        problem: The scaled NLP.
+        initial: Start link lengths (coefficients from inverse kinematics).
+        start: Index of this start (names its checkpoint).
+        out: Output folder for checkpoints, or None.
+        resume: Continue from ``out``'s checkpoint of this start if there is one.
+        progress: Stream for one line per iteration, or None (quiet).
+        maxiter: Iteration limit (default: the study's).
+        use_gradients: False uses scipy's finite-difference jacobians (the benchmark's baseline).
+        on_iterate: Called with each new history row.
+
+    Raises:
+        InvalidInputError: The start violates a constraint (named).
+        SolverError: SLSQP did not report success; the checkpoint keeps the partial history.
+
+    """
+    z0 = problem.initial_point(initial)
+    check_start(problem, z0)
+    result = SolveResult(start=start, initial_lengths=initial, z0=z0, z=z0.copy())
+    z_begin = z0
+    previous_wall = 0.0
+    if resume and out is not None:
+        data = load_checkpoint(out, start)
+        if data is not None:
+            result.history = [Iterate(**h) for h in data["history"]]
+            z_begin = np.asarray(data["z"], dtype=float)
+            previous_wall = float(data.get("wall_time", 0.0))
+            if data.get("done"):
+                result.z = z_begin
+                result.success, result.status, result.message = data["success"], data["status"], data["message"]
+                result.iterations = len(result.history) - 1
+                result.wall_time = previous_wall
+                return result
+    limit = maxiter or problem.study.solver.maxiter
+    limit = max(1, limit - max(0, len(result.history) - 1))
+    t0 = time.perf_counter()
+
+    def record(z: Array) -> None:
+        ev = problem.evaluate(z)
+        row = Iterate(
+            iteration=len(result.history),
+            cost=ev.cost,
+            scaled_cost=ev.cost / problem.cost_scale,
+            max_violation=problem.max_violation(z),
+            xi=ev.lengths.as_array().tolist(),
+            wall_time=previous_wall + time.perf_counter() - t0,
+        )
+        result.history.append(row)
+        result.z = np.array(z, dtype=float)
+        result.wall_time = row.wall_time
+        if out is not None:
+            _save_checkpoint(out, result, z, done=False)
+        if progress is not None:
+            xi = " ".join(f"{v:.4f}" for v in row.xi)
+            progress.write(
+                f"[start {start}] iter {row.iteration:3d}  cost {row.cost:.6e} W^2 s ({row.scaled_cost:.6f})"
+                f"  viol {row.max_violation:.1e}  Xi [{xi}] m  {row.wall_time:.1f} s\n"
+            )
+            progress.flush()
+        if on_iterate is not None:
+            on_iterate(row)
+
+    if not result.history:
+        record(z_begin)
+    ineq: dict[str, Any] = {"type": "ineq", "fun": problem.constraints}
+    eq: dict[str, Any] = {"type": "eq", "fun": problem.equalities}
+    if use_gradients:
+        ineq["jac"] = problem.constraints_jacobian
+        eq["jac"] = problem.equalities_jacobian
+    bounds = list(zip(problem.lower, problem.upper, strict=True))
+    bounds = [(lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None) for lo, hi in bounds]
+    try:
+        res = minimize(
+            problem.cost,
+            z_begin,
+            jac=problem.cost_gradient if use_gradients else None,
+            method="SLSQP",
+            bounds=bounds,
+            constraints=[eq, ineq],
+            callback=record,
+            options={"maxiter": limit, "ftol": problem.study.solver.ftol},
+        )
+    except HiabSimError as error:
+        result.message = f"a trial point left the model's domain: {error}"
+        if out is not None:
+            _save_checkpoint(out, result, result.z, done=False)
+        raise SolverError(f"start {start}: {result.message} (partial history kept)") from error
+    result.z = np.asarray(res.x, dtype=float)
+    result.success = bool(res.success)
+    result.status = int(res.status)
+    result.message = str(res.message)
+    result.iterations = len(result.history) - 1
+    result.wall_time = previous_wall + time.perf_counter() - t0
+    result.n_evaluations = problem.n_evaluations
+    result.n_gradients = problem.n_gradients
+    if result.history and not np.array_equal(np.asarray(result.history[-1].xi), problem.unpack(result.z)[0].as_array()):
+        record(result.z)
+        result.iterations = len(result.history) - 1
+    if out is not None:
+        _save_checkpoint(out, result, result.z, done=True)
+    if not result.success:
+        raise SolverError(
+            f"start {start}: SLSQP status {result.status}: {result.message} after {result.iterations} iterations "
+            "(partial history kept in the output folder)"
+        )
+    return result
+
+
+def xi_table(lengths: LinkLengths) -> dict[str, dict[str, float]]:
+    """{"lift": {"L":..,"Lc0":..,"Lc":..}, "tilt": {...}} [m]."""
+    return {name: {k: float(getattr(getattr(lengths, name), k)) for k in ("L", "Lc0", "Lc")} for name in CHAIN_NAMES}
