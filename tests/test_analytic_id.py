@@ -13,6 +13,7 @@ from hiab_sim.dynamics.analytic_id import (
     analytic_inverse_dynamics,
     link_wrenches,
     mechanical_energy,
+    spatial_inverse_dynamics,
     tcp_velocity,
 )
 from hiab_sim.dynamics.analytic_kinematics import crane_motion
@@ -52,18 +53,26 @@ def _energy_rate(lengths: LinkLengths, joints: JointSamples, h: float = 1e-3) ->
     return (energies[0] - 8 * energies[1] + 8 * energies[2] - energies[3]) / (12 * h)
 
 
-def _power_residual(lengths: LinkLengths, joints: JointSamples, tcp_force: np.ndarray | None) -> float:
-    out = analytic_inverse_dynamics(CRANE, lengths, joints, tcp_force=tcp_force)
+IMPLEMENTATIONS = pytest.mark.parametrize(
+    "inverse_dynamics", [analytic_inverse_dynamics, spatial_inverse_dynamics], ids=["planar", "spatial"]
+)
+
+
+def _power_residual(
+    lengths: LinkLengths, joints: JointSamples, tcp_force: np.ndarray | None, inverse_dynamics=analytic_inverse_dynamics
+) -> float:
+    out = inverse_dynamics(CRANE, lengths, joints, tcp_force=tcp_force)
     power = out.power.sum(axis=1)
     if tcp_force is not None:
         power = power + tcp_velocity(CRANE, lengths, joints) @ tcp_force
     return float(np.max(np.abs(power - _energy_rate(lengths, joints))) / np.max(np.abs(power)))
 
 
+@IMPLEMENTATIONS
 @pytest.mark.parametrize("tcp_force", [None, PAYLOAD], ids=["free", "payload"])
-def test_actuator_power_equals_rate_of_mechanical_energy(tcp_force: np.ndarray | None) -> None:
+def test_actuator_power_equals_rate_of_mechanical_energy(inverse_dynamics, tcp_force: np.ndarray | None) -> None:
     """Power balance: sum f_x v_x + F_tcp . v_tcp = dE/dt along a smooth trajectory, to 1e-6 of the peak power."""
-    assert _power_residual(DEFAULT, _trajectory(np.linspace(0.0, 9.0, 60)), tcp_force) <= 1e-6
+    assert _power_residual(DEFAULT, _trajectory(np.linspace(0.0, 9.0, 60)), tcp_force, inverse_dynamics) <= 1e-6
 
 
 def _stroke_samples(x: np.ndarray, lengths: LinkLengths) -> np.ndarray:
@@ -77,12 +86,13 @@ def _potential(x: np.ndarray, lengths: LinkLengths) -> np.ndarray:
     return mechanical_energy(CRANE, lengths, JointSamples.at_rest(_stroke_samples(x, lengths))).potential
 
 
-def test_static_forces_equal_the_gradient_of_potential_energy() -> None:
+@IMPLEMENTATIONS
+def test_static_forces_equal_the_gradient_of_potential_energy(inverse_dynamics) -> None:
     """Gravity only, at rest: f_j = dU/dx_j (virtual work), to 1e-7 of the largest force."""
     rng = np.random.default_rng(3)
     joints = _random_states(rng, 12)
     static = JointSamples.at_rest(joints.position)
-    out = analytic_inverse_dynamics(CRANE, DEFAULT, static)
+    out = inverse_dynamics(CRANE, DEFAULT, static)
     h = 1e-5
     for j in range(3):
         step = np.zeros(3)
@@ -115,11 +125,12 @@ def _mass_matrix(x: np.ndarray, lengths: LinkLengths) -> np.ndarray:
     return M
 
 
-def test_forces_satisfy_lagranges_equations_in_actuator_coordinates() -> None:
+@IMPLEMENTATIONS
+def test_forces_satisfy_lagranges_equations_in_actuator_coordinates(inverse_dynamics) -> None:
     """Lagrange: f = M(x) ddx + dM/dt dx - d(dx^T M dx / 2)/dx + dU/dx, with M from the energy function alone."""
     rng = np.random.default_rng(11)
     joints = _random_states(rng, 8)
-    out = analytic_inverse_dynamics(CRANE, DEFAULT, joints)
+    out = inverse_dynamics(CRANE, DEFAULT, joints)
     x, dx, ddx = out.stroke, out.velocity, out.acceleration
     h = 1e-5
     expected = np.einsum("tij,tj->ti", _mass_matrix(x, DEFAULT), ddx)
@@ -133,11 +144,12 @@ def test_forces_satisfy_lagranges_equations_in_actuator_coordinates() -> None:
     np.testing.assert_allclose(out.force, expected, atol=1e-6 * np.max(np.abs(out.force)))
 
 
-def test_forces_equal_virtual_power_of_link_wrenches() -> None:
+@IMPLEMENTATIONS
+def test_forces_equal_virtual_power_of_link_wrenches(inverse_dynamics) -> None:
     """Virtual power: f_j = sum_i F_i . dV_i/dv_j: the partial twists' virtual power equals the tip-to-base solve."""
     rng = np.random.default_rng(5)
     joints = _random_states(rng, 10)
-    out = analytic_inverse_dynamics(CRANE, DEFAULT, joints, tcp_force=PAYLOAD)
+    out = inverse_dynamics(CRANE, DEFAULT, joints, tcp_force=PAYLOAD)
     wrenches = link_wrenches(
         CRANE, DEFAULT, crane_motion(CRANE, DEFAULT, joints.position, joints.velocity, joints.acceleration)
     )
@@ -186,16 +198,20 @@ def test_link_poses_match_forward_kinematics_and_twists_its_time_derivative() ->
 @settings(max_examples=25, deadline=None)
 @given(st.lists(st.floats(0.0, 1.0), min_size=6, max_size=6), st.integers(0, 2**31))
 def test_power_balance_holds_for_other_lengths_and_states(fractions: list[float], seed: int) -> None:
-    """Power balance to 1e-6 for random feasible link lengths, joint states and a payload."""
+    """Power balance to 1e-6 for random feasible lengths, states and a payload; planar = 6D to round-off."""
     lengths = lengths_from_fractions(CRANE, np.array(fractions))
     assume(lengths is not None)
     assert lengths is not None
     joints = _random_states(np.random.default_rng(seed), 6)
     assert _power_residual(lengths, joints, PAYLOAD) <= 1e-6
+    planar = analytic_inverse_dynamics(CRANE, lengths, joints, tcp_force=PAYLOAD)
+    spatial = spatial_inverse_dynamics(CRANE, lengths, joints, tcp_force=PAYLOAD)
+    np.testing.assert_allclose(planar.force, spatial.force, rtol=0, atol=1e-12 * np.max(np.abs(spatial.force)))
+    np.testing.assert_allclose(planar.velocity, spatial.velocity, rtol=0, atol=1e-13)
 
 
-def test_static_hold_of_the_payload_costs_its_weight_times_the_lever() -> None:
-    """Adding a TCP force changes the static forces by exactly J^T-type virtual work: df . dx = F . dp_tcp."""
+def test_tcp_force_adds_its_virtual_work_to_the_static_forces() -> None:
+    """A TCP force F changes the static forces by df_j = -F . dp_tcp/dx_j (virtual work of F)."""
     position = _random_states(np.random.default_rng(2), 5).position
     static = JointSamples.at_rest(position)
     free = analytic_inverse_dynamics(CRANE, DEFAULT, static)
@@ -214,23 +230,27 @@ def test_static_hold_of_the_payload_costs_its_weight_times_the_lever() -> None:
     ("column", "value", "field"),
     [(0, 2.5, "theta1"), (1, 0.5, "theta2"), (2, 1.5, "xt2"), (2, -0.1, "xt2")],
 )
-def test_joint_sample_outside_its_range_names_the_field(column: int, value: float, field: str) -> None:
+@IMPLEMENTATIONS
+def test_joint_sample_outside_its_range_names_the_field(
+    inverse_dynamics, column: int, value: float, field: str
+) -> None:
     """A joint sample outside the usable range raises InvalidInputError naming the joint."""
     position = _trajectory(np.linspace(0, 1, 4)).position.copy()
     position[2, column] = value
     with pytest.raises(InvalidInputError) as info:
-        analytic_inverse_dynamics(CRANE, DEFAULT, JointSamples.at_rest(position))
+        inverse_dynamics(CRANE, DEFAULT, JointSamples.at_rest(position))
     assert info.value.field == field
 
 
-def test_bad_lengths_and_tcp_force_name_the_field() -> None:
+@IMPLEMENTATIONS
+def test_bad_lengths_and_tcp_force_name_the_field(inverse_dynamics) -> None:
     """Non-positive lengths and a wrongly shaped TCP force are rejected with the field named."""
     joints = _trajectory(np.linspace(0, 1, 4))
     bad = LinkLengths(ChainLengths(DEFAULT.lift.L, DEFAULT.lift.Lc0, -0.1), DEFAULT.tilt)
     with pytest.raises(InvalidInputError, match=r"lift\.Lc"):
-        analytic_inverse_dynamics(CRANE, bad, joints)
+        inverse_dynamics(CRANE, bad, joints)
     with pytest.raises(InvalidInputError) as info:
-        analytic_inverse_dynamics(CRANE, DEFAULT, joints, tcp_force=np.ones(2))
+        inverse_dynamics(CRANE, DEFAULT, joints, tcp_force=np.ones(2))
     assert info.value.field == "tcp_force"
 
 
