@@ -13,7 +13,7 @@ import time
 import numpy as np
 
 from hiab_sim.config import load_crane
-from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
+from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics, spatial_inverse_dynamics
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.validation import random_states
 
@@ -41,11 +41,15 @@ def main() -> None:
     mujoco_out = mujoco(joints, tcp_force=payload)
     error = np.max(np.abs(analytic_out.force - mujoco_out.force) / np.max(np.abs(analytic_out.force), axis=0))
     t_analytic = best_time(lambda: analytic_inverse_dynamics(crane, lengths, joints, tcp_force=payload), args.repeats)
+    t_spatial = best_time(lambda: spatial_inverse_dynamics(crane, lengths, joints, tcp_force=payload), args.repeats)
     t_mujoco = best_time(lambda: mujoco(joints, tcp_force=payload), args.repeats)
+    t_build = best_time(lambda: MujocoInverseDynamics(crane, lengths), args.repeats)
     n = args.samples
     print(f"samples: {n} (random states over the working ranges, 250 kg payload), best of {args.repeats}")
     print(f"analytic ID: {t_analytic * 1e3:8.2f} ms total, {t_analytic / n * 1e6:7.2f} us/sample")
+    print(f"6D form:     {t_spatial * 1e3:8.2f} ms total, {t_spatial / n * 1e6:7.2f} us/sample (reference)")
     print(f"MuJoCo ID:   {t_mujoco * 1e3:8.2f} ms total, {t_mujoco / n * 1e6:7.2f} us/sample")
+    print(f"MuJoCo model build per link-length set: {t_build * 1e3:.2f} ms (not in the per-sample times)")
     print(f"ratio MuJoCo / analytic: {t_mujoco / t_analytic:.1f}x (goal >= 10x)")
     print(f"max relative force difference: {error:.1e}")
 
