@@ -67,15 +67,16 @@ def check_gl_backend() -> str:
 
 
 def open_renderer(model: mujoco.MjModel, width: int, height: int, max_geom: int) -> mujoco.Renderer:
-    """Create an off-screen :class:`mujoco.Renderer`, growing the model's framebuffer if needed.
+    """Create an off-screen :class:`mujoco.Renderer`; sets the model's framebuffer to the image size.
 
     Raises:
         BackendUnavailableError: no OpenGL context can be created (no OSMesa, no display).
 
     """
     mujoco = import_mujoco()
-    model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
-    model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
+    # The off-screen framebuffer exactly the image size: OSMesa clears and reads all of it.
+    model.vis.global_.offwidth = width
+    model.vis.global_.offheight = height
     try:
         with warnings.catch_warnings():  # GLFW warns about a missing display before it fails
             warnings.simplefilter("ignore")
