@@ -273,3 +273,17 @@ def test_missing_ffmpeg_is_one_line(
     err = _cli_error(capsys, [str(result_dir), "-o", str(tmp_path / "v.mp4")])
     assert "apt-get install ffmpeg" in err and "pip install imageio-ffmpeg" in err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_cli_prints_nothing_at_exit(result_dir: Path, tmp_path: Path) -> None:
+    """The GL contexts are freed before exit: the process's stderr stays empty (CI: MUJOCO_GL=osmesa)."""
+    output = tmp_path / "still.png"
+    done = subprocess.run(
+        [sys.executable, "-m", "hiab_sim", "render", str(result_dir), "--still", str(output), "--size", "160x120"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == ""
+    assert done.stdout.strip() == f"wrote still frame: {output}"
