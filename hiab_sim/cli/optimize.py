@@ -1,22 +1,88 @@
-"""``hiab-sim optimize``: Optimise the link lengths of both closed chains for least EMLA energy (issue 6).
+"""``hiab-sim optimize``: energy-optimal link lengths of both closed chains (issue 6).
 
-Not implemented yet: the subcommand is registered so that ``--help`` lists it, and it exits
-with status 2 and a message until its issue lands.
+Runs a study (default ``optimize/xs031_spiral.yaml``) with SQP, prints one line per iteration to
+stderr, and writes ``result.json``, ``trajectory.npz``, the figures and the playback video into
+the output folder. Bad input exits 2 before anything is written; a solver failure exits 1 and
+keeps the partial history (``checkpoint_<k>.json``) for ``--resume``.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
+from pathlib import Path
 
-from hiab_sim.errors import HiabSimError
+from hiab_sim.errors import BackendUnavailableError, InvalidInputError
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     """Register the subcommand."""
-    parser = subparsers.add_parser("optimize", help="Optimise the link lengths of both closed chains for least EMLA energy (issue 6). (not implemented yet)")
+    parser = subparsers.add_parser(
+        "optimize",
+        help="Optimise the link lengths of both closed chains for least EMLA energy.",
+        description=(
+            "Minimise the seed's cost (eq. costf2: 1/2 Dt sum (sum_i P_i)^2 with EMLA electrical power) over "
+            "both chains' link lengths and the B-spline joint trajectory, subject to inverse dynamics, TCP "
+            "tracking of a spiral, the EMLA envelope, stroke, triangle and joint limits (SLSQP)."
+        ),
+    )
+    parser.add_argument("study", nargs="?", metavar="STUDY.yaml", help="study file (default: optimize/xs031_spiral.yaml)")
+    parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<study name>)")
+    parser.add_argument("--resume", action="store_true", help="continue from the output folder's last checkpoint")
+    parser.add_argument("--starts", type=int, default=1, metavar="K", help="number of feasible starts (default: 1)")
+    parser.add_argument("--id", choices=("mujoco", "analytic"), help="inverse-dynamics path (default: the study's)")
+    parser.add_argument("--no-video", action="store_true", help="do not render the playback video")
+    parser.add_argument("--quiet", action="store_true", help="no per-iteration progress lines")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    """Report that the subcommand is not available yet."""
-    raise HiabSimError("'optimize' is not implemented yet")
+    """Run the study and print a summary; return the exit status."""
+    from hiab_sim.study.config import DEFAULT_STUDY, load_study
+    from hiab_sim.study.run import run_study
+
+    if args.starts < 1:
+        raise InvalidInputError("--starts", args.starts, "must be >= 1")
+    study = load_study(args.study or DEFAULT_STUDY)
+    out = Path(args.out) if args.out else Path("runs") / study.name
+    output = run_study(
+        study, out, starts=args.starts, resume=args.resume, id_path=args.id, progress=None if args.quiet else sys.stderr
+    )
+    r = output.result
+    ini, opt, sol, rc = r["initial"], r["optimal"], r["solver"], r["recheck"]
+    for name, entry in (("initial", ini), ("optimal", opt)):
+        xi = entry["lengths"]
+        print(
+            f"{name:8s} lift L={xi['lift']['L']:.4f} Lc0={xi['lift']['Lc0']:.4f} Lc={xi['lift']['Lc']:.4f}  "
+            f"tilt L={xi['tilt']['L']:.4f} Lc0={xi['tilt']['Lc0']:.4f} Lc={xi['tilt']['Lc']:.4f} m  "
+            f"net energy {entry['net_electrical_energy_J'] / 1e3:.3f} kJ  "
+            f"drawn {entry['drawn_energy_without_regeneration_J'] / 1e3:.3f} kJ"
+        )
+    print(
+        f"SLSQP: {sol['message']} ({sol['iterations']} iterations, {sol['wall_time_s']:.1f} s, "
+        f"max violation {sol['max_violation_scaled']:.1e}); cost ratio {r['improvement']['cost_ratio']:.4f}, "
+        f"net energy -{r['improvement']['net_energy_saved_percent']:.2f} %"
+    )
+    print(
+        f"re-check ({rc['id_path']}, {rc['grid_points']} points): max violation {rc['max_violation_scaled']:.1e}, "
+        f"TCP tracking error {rc['tracking_error']['position_m'] * 1e3:.3f} mm"
+    )
+    ms = r["multistart"]
+    if len(ms["starts"]) > 1:
+        if ms["same_optimum"]:
+            print(f"multi-start: all {len(ms['starts'])} starts reach the same optimum within {ms['tolerance_m']} m")
+        else:
+            print(f"multi-start: {len(ms['distinct_optima'])} distinct local optima:")
+            for d in ms["distinct_optima"]:
+                xi = " ".join(f"{v:.4f}" for v in d["xi"])
+                print(f"  Xi [{xi}] m  net energy {d['net_electrical_energy_J'] / 1e3:.3f} kJ  starts {d['starts']}")
+    print(f"wrote {output.folder}/result.json, trajectory.npz and {len(output.figures)} figures")
+    if not args.no_video:
+        try:
+            from hiab_sim.render import render_result
+
+            video = render_result(output.folder, output.folder / "playback.mp4")
+            print(f"wrote video: {video}")
+        except BackendUnavailableError as error:
+            print(f"hiab-sim optimize: no video: {error}", file=sys.stderr)
+    return 0

@@ -120,8 +120,9 @@ class Bounds:
         joint_velocity: |dtheta1|, |dtheta2| [rad/s], |dxt2| [m/s] limits (const_i).
         triangle_margin: Smallest interior angle of each chain's triangle at the boom hinge
             and its supplement, [rad] (const_k with a margin from the flat triangle).
-        working_margin: The design must serve the reference's joint range widened by this
-            much at both ends [rad] (const_j there), so it does not fit the spiral only.
+        working_range: ``crane``: the design must serve the crane's full joint range (const_j at
+            its ends), i.e. keep the crane's workspace; ``reference``: only the reference's joint
+            range widened by ``working_margin`` [rad] at both ends.
         envelope_margin: The optimiser keeps the EMLA envelope margins >= this at the
             collocation points, so they stay >= 0 between them (checked on the fine grid).
 
@@ -133,6 +134,7 @@ class Bounds:
     triangle_margin: float = math.radians(10.0)
     working_margin: float = math.radians(3.0)
     envelope_margin: float = 0.02
+    working_range: str = "crane"
 
 
 @dataclass(frozen=True)
@@ -353,7 +355,15 @@ def _reference(data: Any) -> SpiralReference:
 
 
 def _bounds(data: Any, initial: LinkLengths) -> Bounds:
-    keys = {"lift", "tilt", "joint_velocity", "triangle_margin_deg", "working_margin_deg", "envelope_margin"}
+    keys = {
+        "lift",
+        "tilt",
+        "joint_velocity",
+        "triangle_margin_deg",
+        "working_range",
+        "working_margin_deg",
+        "envelope_margin",
+    }
     d = _mapping(data, "bounds", keys, {"lift", "tilt"})
     low: list[float] = []
     up: list[float] = []
@@ -382,6 +392,9 @@ def _bounds(data: Any, initial: LinkLengths) -> Bounds:
     working = _number(d.get("working_margin_deg", 3.0), "bounds.working_margin_deg")
     if not 0.0 <= working <= 30.0:
         raise InvalidInputError("bounds.working_margin_deg", working, "must lie in [0, 30]", "deg")
+    working_range = str(d.get("working_range", "crane"))
+    if working_range not in ("crane", "reference"):
+        raise InvalidInputError("bounds.working_range", working_range, "must be 'crane' or 'reference'")
     envelope = _number(d.get("envelope_margin", 0.02), "bounds.envelope_margin")
     if not 0.0 <= envelope < 0.5:
         raise InvalidInputError("bounds.envelope_margin", envelope, "must lie in [0, 0.5)")
@@ -392,6 +405,7 @@ def _bounds(data: Any, initial: LinkLengths) -> Bounds:
         math.radians(margin),
         math.radians(working),
         envelope,
+        working_range,
     )
 
 

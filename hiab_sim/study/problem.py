@@ -60,6 +60,10 @@ C_SCALE = 0.1
 #: Scale of the stroke constraints [m per unit].
 STROKE_SCALE = 0.1
 ACTUATORS = ("lift", "tilt", "telescope")
+#: The ID's input check uses the working range shrunk by this much at both ends [rad].
+ID_SLACK = 0.02
+#: const_j at the ends of the working range holds with this clearance [m] (exact, not round-off).
+WORKING_CLEARANCE = 1e-6
 
 
 def make_id(crane: Crane, lengths: LinkLengths, path: str, tcp_force: Array | None) -> IdFunction:
@@ -154,11 +158,17 @@ class LinkLengthProblem:
             self.theta_low[j] = max(lo, chain.joint_offset - math.pi + margin)
             self.theta_up[j] = min(hi, chain.joint_offset - margin)
         self.theta_low[2], self.theta_up[2] = study.crane.telescope.joint_range
-        # working range the design must serve (const_j at its ends); the ID's input checks use a
-        # slightly narrower range so that trial points of the line search stay evaluable
+        # working range the design must serve (const_j at its ends): the crane's full joint range
+        # (so the redesigned crane keeps its workspace, as every ID path's input check demands) or
+        # the reference's range widened by a margin. The ID sees a slightly narrower range, so trial
+        # points of the line search that violate const_j by a second-order amount stay evaluable.
         wr_margin = study.bounds.working_margin
-        self.working = working_range(study.crane, ik.position, wr_margin)
-        inner = working_range(study.crane, ik.position, 0.5 * wr_margin)
+        if study.bounds.working_range == "crane":
+            self.working = tuple(chain.joint_range for chain in study.crane.chains)
+            inner = tuple((lo + ID_SLACK, hi - ID_SLACK) for lo, hi in self.working)
+        else:
+            self.working = working_range(study.crane, ik.position, wr_margin)
+            inner = working_range(study.crane, ik.position, 0.5 * wr_margin)
         self.crane = replace(
             study.crane,
             lift=replace(study.crane.lift, joint_range=inner[0]),
@@ -291,7 +301,7 @@ class LinkLengthProblem:
         dth = joints.velocity / vmax
         blocks.append((np.concatenate([1.0 - dth, 1.0 + dth], axis=1).ravel(), "joint_velocity"))
         xw = self._strokes(lengths, np.array([[w[0] for w in self.working], [w[1] for w in self.working]]))
-        blocks.append((self._stroke_rows(lengths, xw).ravel(), "working_range"))
+        blocks.append((self._stroke_rows(lengths, xw).ravel() - WORKING_CLEARANCE / STROKE_SCALE, "working_range"))
         return blocks
 
     def _strokes(self, lengths: LinkLengths, theta: Array) -> Array:

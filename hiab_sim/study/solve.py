@@ -27,8 +27,9 @@ from hiab_sim.errors import HiabSimError, InvalidInputError, SolverError
 from hiab_sim.study.problem import LinkLengthProblem
 
 Array = NDArray[np.float64]
-#: Largest violation [scaled units] a start may have.
-START_TOLERANCE = 1e-9
+#: Largest violation [scaled units] a start may have: the working-range clearance, so that the built
+#: crane, whose strokes reach exactly 0 at the ends of its joint range, is a valid start.
+START_TOLERANCE = 1.01e-5
 
 
 @dataclass
@@ -89,21 +90,36 @@ def check_start(problem: LinkLengthProblem, z: Array, label: str = "initial_leng
 def start_points(problem: LinkLengthProblem, count: int, seed: int = 6) -> list[LinkLengths]:
     """The study's start and ``count - 1`` other feasible starts, drawn in the Xi bounds.
 
-    Candidates perturb the study's start by up to 15 % per length (clipped to the bounds); the
-    first ones that satisfy every constraint with the inverse-kinematics coefficients are kept.
+    Per chain: L uniform in its bounds, the retracted length x0 = Lc0 + Lc so that the stroke is
+    >= 0 at the low end of the working range and within the stroke at its high end, Lc just
+    above the largest stroke; kept when every constraint holds with the inverse-kinematics
+    coefficients.
     """
-    base = problem.study.initial_lengths.as_array()
+    from hiab_sim.crane import mechanism
+
     low, up = np.asarray(problem.study.bounds.xi_low), np.asarray(problem.study.bounds.xi_up)
     starts = [problem.study.initial_lengths]
     rng = np.random.default_rng(seed)
-    for _ in range(400):
+    for _ in range(2000):
         if len(starts) >= count:
             break
-        xi = np.clip(base * (1.0 + rng.uniform(-0.15, 0.15, 6)), low, up)
+        xi = np.zeros(6)
+        for j, chain in enumerate(problem.crane.chains):
+            L = rng.uniform(low[3 * j], up[3 * j])
+            lo, hi = problem.working[j]
+            q = mechanism.hinge_angle(chain, np.array([lo, hi]))
+            s_lo, s_hi = mechanism.stroke_from_hinge_angle(q, L, chain.L1, 0.0)
+            slack = chain.stroke - (s_hi - s_lo)
+            if slack <= 0.0:
+                continue
+            x0 = s_lo - rng.uniform(0.0, 0.5) * slack
+            Lc = max(low[3 * j + 2], s_hi - x0) + rng.uniform(0.0, 0.05)
+            xi[3 * j : 3 * j + 3] = (L, x0 - Lc, Lc)
+        if np.any(xi == 0.0) or np.any(xi < low) or np.any(xi > up):
+            continue
         lengths = LinkLengths.from_array(xi)
         try:
-            z = problem.initial_point(lengths)
-            if problem.evaluate(z).constraints.min() >= 0.0:
+            if problem.evaluate(problem.initial_point(lengths)).constraints.min() >= 0.0:
                 starts.append(lengths)
         except HiabSimError:
             continue

@@ -1,0 +1,254 @@
+"""Result folder of an optimisation: ``result.json``, ``trajectory.npz`` and the design summaries.
+
+Contract with the renderer (issue 7): ``result.json`` has top-level ``crane`` (preset name or
+path as given in the study), ``study`` (path), ``initial`` and ``optimal``, each with
+``lengths`` = {"lift": {"L", "Lc0", "Lc"}, "tilt": {...}}; ``trajectory.npz`` has ``time`` (K,)
+on the fine grid, ``reference_tcp`` (K, 3) in {W} and ``{initial,optimal}_{position,velocity,
+acceleration}`` (K, 3) = (theta1, theta2, xt2). Every file is written atomically.
+
+Energies are integrated on the fine grid (10x the collocation grid): the cost of eq. ``costf2``
+is 1/2 Dt sum (sum_i P_i)^2 [W^2 s], a squared-power integral, not an energy, so the net
+electrical energy (regeneration credited) and the energy drawn without regeneration are
+reported separately, with the loss breakdown of :func:`hiab_sim.emla.operating_point`.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiab_sim.emla import energy_summary, operating_point
+from hiab_sim.study.problem import ACTUATORS, Evaluation, LinkLengthProblem
+from hiab_sim.study.solve import SolveResult, write_atomic, xi_table
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class DesignCheck:
+    """A design evaluated on the fine grid by one ID path, with its summary as JSON-ready dict."""
+
+    evaluation: Evaluation
+    summary: dict[str, Any]
+
+
+def _trapezoid(y: Array, t: Array) -> float:
+    return float(0.5 * np.sum((y[1:] + y[:-1]) * np.diff(t)))
+
+
+def design_summary(problem: LinkLengthProblem, z: Array) -> DesignCheck:
+    """Evaluate z on ``problem``'s grid (the fine grid, nominal bands): energies, peaks, violations."""
+    ev = problem.evaluate(z)
+    t = problem.times
+    act = ev.actuators
+    net, drawn = energy_summary(t, ev.power.T)
+    breakdown = {k: 0.0 for k in ("mechanical", "copper", "rotor_friction", "screw_viscous", "inertial", "electrical")}
+    per_actuator: dict[str, Any] = {}
+    for i, (name, params) in enumerate(zip(ACTUATORS, problem.emlas, strict=True)):
+        op = operating_point(params, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
+        parts = {
+            "mechanical": _trapezoid(op.mechanical_power, t),
+            "copper": _trapezoid(op.copper_loss, t),
+            "rotor_friction": _trapezoid(op.rotor_friction_loss, t),
+            "screw_viscous": _trapezoid(op.screw_viscous_loss, t),
+            "inertial": _trapezoid(op.inertial_power, t),
+            "electrical": _trapezoid(op.electrical_power, t),
+        }
+        for k, v in parts.items():
+            breakdown[k] += v
+        per_actuator[name] = {
+            "peak_force_N": float(np.max(np.abs(act.force[:, i]))),
+            "peak_velocity_m_per_s": float(np.max(np.abs(act.velocity[:, i]))),
+            "peak_electrical_power_W": float(np.max(ev.power[:, i])),
+            "min_envelope_margin": float(op.margins.min()),
+            "net_energy_J": float(net[i]),
+            "drawn_energy_J": float(drawn[i]),
+            "energy_J": parts,
+        }
+    total_power = ev.power.sum(axis=1)
+    net_total, drawn_total = energy_summary(t, total_power)
+    ref = problem.reference
+    err = {
+        "position_m": float(np.max(np.abs(ev.tcp.position[:, :2] - ref.position[:, :2]))),
+        "velocity_m_per_s": float(np.max(np.abs(ev.tcp.velocity[:, :2] - ref.velocity[:, :2]))),
+        "acceleration_m_per_s2": float(np.max(np.abs(ev.tcp.acceleration[:, :2] - ref.acceleration[:, :2]))),
+        "telescope_m": float(np.max(np.abs(ev.tcp.position[:, 2] - ref.position[:, 2]))),
+    }
+    worst = int(np.argmin(ev.constraints))
+    summary = {
+        "lengths": xi_table(ev.lengths),
+        "id_path": problem.id_path,
+        "grid_points": len(t),
+        "cost_W2s": ev.cost,
+        "cost_note": "1/2 Dt sum_k (sum_i P_i(t_k))^2 on this grid: a squared-power integral, not an energy",
+        "net_electrical_energy_J": float(net_total),
+        "drawn_energy_without_regeneration_J": float(drawn_total),
+        "drawn_energy_sum_of_actuators_J": float(np.sum(drawn)),
+        "energy_breakdown_J": breakdown,
+        "actuators": per_actuator,
+        "max_violation": problem.max_violation(z),
+        "worst_constraint": {"name": problem.constraint_names[worst], "scaled_margin": float(ev.constraints[worst])},
+        "tracking_error": err,
+    }
+    return DesignCheck(ev, summary)
+
+
+def fine_problem(problem: LinkLengthProblem, id_path: str | None = None) -> LinkLengthProblem:
+    """The same study on the fine grid with nominal bands (for reports and the re-check)."""
+    return LinkLengthProblem(
+        problem.study,
+        emlas=problem.emlas,
+        id_path=id_path or problem.id_path,
+        times=problem.study.grid.fine_times(),
+        cost_scale=problem.cost_scale,
+        tightened=False,
+    )
+
+
+def other_path(path: str) -> str:
+    """The other inverse-dynamics path."""
+    return "analytic" if path == "mujoco" else "mujoco"
+
+
+def build_result(
+    problem: LinkLengthProblem, results: list[SolveResult], wall_time: float, multistart_tolerance: float = 1e-4
+) -> tuple[dict[str, Any], dict[str, Array], dict[str, DesignCheck]]:
+    """Assemble result.json, trajectory.npz arrays and the fine-grid checks (keys initial/optimal/recheck_*)."""
+    main = results[0]
+    fine = fine_problem(problem)
+    recheck = fine_problem(problem, other_path(problem.id_path))
+    checks = {
+        "initial": design_summary(fine, main.z0),
+        "optimal": design_summary(fine, main.z),
+        "recheck_initial": design_summary(recheck, main.z0),
+        "recheck_optimal": design_summary(recheck, main.z),
+    }
+    colloc = {name: problem.evaluate(z) for name, z in (("initial", main.z0), ("optimal", main.z))}
+    out: dict[str, Any] = {
+        "crane": problem.study.crane_source,
+        "study": problem.study.path,
+        "name": problem.study.name,
+    }
+    for name in ("initial", "optimal"):
+        entry = dict(checks[name].summary)
+        entry["collocation_cost_W2s"] = colloc[name].cost
+        entry["collocation_max_violation"] = problem.max_violation(colloc[name].z)
+        out[name] = entry
+    e0 = checks["initial"].summary["net_electrical_energy_J"]
+    e1 = checks["optimal"].summary["net_electrical_energy_J"]
+    out["improvement"] = {
+        "cost_ratio": colloc["optimal"].cost / colloc["initial"].cost,
+        "net_energy_saved_J": e0 - e1,
+        "net_energy_saved_percent": 100.0 * (e0 - e1) / e0,
+    }
+    out["solver"] = {
+        "method": "SLSQP (scipy.optimize.minimize) with exact-structure gradients",
+        "id_path": problem.id_path,
+        "success": main.success,
+        "status": main.status,
+        "message": main.message,
+        "iterations": main.iterations,
+        "wall_time_s": main.wall_time,
+        "total_wall_time_s": wall_time,
+        "max_violation_scaled": problem.max_violation(main.z),
+        "function_evaluations": main.n_evaluations,
+        "gradient_evaluations": main.n_gradients,
+    }
+    rc = checks["recheck_optimal"].summary
+    out["recheck"] = {
+        "id_path": recheck.id_path,
+        "grid_points": len(recheck.times),
+        "note": "optimal design re-evaluated on the 10x finer grid with the other ID path and nominal bands",
+        "max_violation_scaled": rc["max_violation"],
+        "worst_constraint": rc["worst_constraint"],
+        "tracking_error": rc["tracking_error"],
+        "net_electrical_energy_J": rc["net_electrical_energy_J"],
+        "initial_max_violation_scaled": checks["recheck_initial"].summary["max_violation"],
+        "force_difference_between_paths_N": float(
+            np.max(np.abs(checks["optimal"].evaluation.actuators.force - checks["recheck_optimal"].evaluation.actuators.force))
+        ),
+    }
+    out["multistart"] = multistart_summary(problem, results, multistart_tolerance)
+    out["settings"] = {
+        "spline_control_points": problem.basis.n,
+        "spline_degree": problem.basis.k,
+        "collocation_points": len(problem.times),
+        "collocation_step_s": problem.dt,
+        "fine_grid_points": len(fine.times),
+        "redundancy": "xt2 prescribed by the study (third reference coordinate)",
+        "tracking_bands": {
+            "position_m": problem.study.tracking.position,
+            "velocity_m_per_s": problem.study.tracking.velocity,
+            "acceleration_m_per_s2": problem.study.tracking.acceleration,
+            "collocation_fraction": problem.study.tracking.collocation_fraction,
+        },
+        "xi_low": list(problem.study.bounds.xi_low),
+        "xi_up": list(problem.study.bounds.xi_up),
+        "envelope_margin": problem.study.bounds.envelope_margin,
+        "payload_kg": problem.study.payload,
+    }
+    out["history"] = [vars(h) for h in main.history]
+    arrays: dict[str, Array] = {"time": fine.times, "reference_tcp": fine.reference.tcp()}
+    for name in ("initial", "optimal"):
+        ev = checks[name].evaluation
+        arrays[f"{name}_position"] = ev.joints.position
+        arrays[f"{name}_velocity"] = ev.joints.velocity
+        arrays[f"{name}_acceleration"] = ev.joints.acceleration
+        arrays[f"{name}_tcp"] = fine.kin.position(ev.joints.position)
+        arrays[f"{name}_actuator_force"] = ev.actuators.force
+        arrays[f"{name}_actuator_velocity"] = ev.actuators.velocity
+        arrays[f"{name}_actuator_stroke"] = ev.actuators.stroke
+        arrays[f"{name}_electrical_power"] = ev.power
+    return out, arrays, checks
+
+
+def multistart_summary(problem: LinkLengthProblem, results: list[SolveResult], tolerance: float) -> dict[str, Any]:
+    """Whether every start reached the same Xi within ``tolerance`` [m]; else the distinct optima."""
+    rows = []
+    for r in results:
+        ev = problem.evaluate(r.z)
+        rows.append(
+            {
+                "start": r.start,
+                "initial_lengths": xi_table(r.initial_lengths),
+                "optimal_lengths": xi_table(ev.lengths),
+                "cost_W2s": ev.cost,
+                "success": r.success,
+                "message": r.message,
+                "iterations": r.iterations,
+            }
+        )
+    distinct: list[dict[str, Any]] = []
+    for r, row in zip(results, rows, strict=True):
+        xi = problem.unpack(r.z)[0].as_array()
+        for d in distinct:
+            if np.max(np.abs(np.asarray(d["xi"]) - xi)) <= tolerance:
+                d["starts"].append(r.start)
+                break
+        else:
+            distinct.append({"xi": xi.tolist(), "cost_W2s": row["cost_W2s"], "starts": [r.start]})
+    if len(results) > 1:
+        fine = fine_problem(problem)
+        for d in distinct:
+            z = results[d["starts"][0]].z
+            d["net_electrical_energy_J"] = design_summary(fine, z).summary["net_electrical_energy_J"]
+    return {
+        "starts": rows,
+        "tolerance_m": tolerance,
+        "same_optimum": len(distinct) == 1,
+        "distinct_optima": distinct,
+    }
+
+
+def write_results(out: Path, result: dict[str, Any], arrays: dict[str, Array]) -> None:
+    """Write ``result.json`` and ``trajectory.npz`` atomically."""
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, **arrays)  # type: ignore[arg-type]
+    write_atomic(out / "trajectory.npz", buffer.getvalue())
+    write_atomic(out / "result.json", json.dumps(result, indent=2) + "\n")

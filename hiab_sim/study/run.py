@@ -1,0 +1,80 @@
+"""One optimisation run end to end: study -> starts -> SQP -> result folder (JSON, NPZ, figures)."""
+
+from __future__ import annotations
+
+import shutil
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, TextIO
+
+from hiab_sim.config import CRANE_PRESETS
+from hiab_sim.errors import SolverError
+from hiab_sim.study.config import Study, load_study
+from hiab_sim.study.problem import LinkLengthProblem
+from hiab_sim.study.report import build_result, write_results
+from hiab_sim.study.solve import SolveResult, check_start, solve, start_points
+
+
+@dataclass(frozen=True)
+class RunOutput:
+    """What a run wrote: the folder, the result dictionary and the figure paths."""
+
+    folder: Path
+    result: dict[str, Any]
+    figures: list[Path]
+
+
+def run_study(
+    study: Study | str | Path | None,
+    out: str | Path,
+    starts: int = 1,
+    resume: bool = False,
+    id_path: str | None = None,
+    progress: TextIO | None = sys.stderr,
+    figures: bool = True,
+) -> RunOutput:
+    """Optimise a study and write its result folder.
+
+    Bad input (study, unreachable reference, infeasible start) raises before anything is
+    written. A failure of SLSQP on the study's own start raises :class:`SolverError` after
+    its checkpoint (the partial history) is on disk; failures of extra starts are reported.
+    """
+    t0 = time.perf_counter()
+    if not isinstance(study, Study):
+        study = load_study(study)
+    problem = LinkLengthProblem(study, id_path=id_path)
+    check_start(problem, problem.initial_point(study.initial_lengths))
+    initials = start_points(problem, starts)
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    results: list[SolveResult] = []
+    for k, initial in enumerate(initials):
+        try:
+            results.append(solve(problem, initial, start=k, out=folder, resume=resume, progress=progress))
+        except SolverError as error:
+            if k == 0:
+                raise
+            if progress is not None:
+                progress.write(f"[start {k}] {error}\n")
+            failed = SolveResult(start=k, initial_lengths=initial, z0=problem.initial_point(initial), z=problem.initial_point(initial))
+            failed.message = str(error)
+            results.append(failed)
+    result, arrays, checks = build_result(problem, results, time.perf_counter() - t0)
+    if study.crane_source not in CRANE_PRESETS:
+        shutil.copyfile(study.crane_source if Path(study.crane_source).is_file() else _crane_path(study), folder / "crane.yaml")
+        result["crane_source"] = study.crane_source
+        result["crane"] = "crane.yaml"
+    write_results(folder, result, arrays)
+    paths: list[Path] = []
+    if figures:
+        from hiab_sim.study.figures import write_figures
+
+        paths = write_figures(folder, problem.study.crane, problem.emlas, result, arrays, checks)
+    return RunOutput(folder, result, paths)
+
+
+def _crane_path(study: Study) -> Path:
+    candidate = Path(study.path).parent / study.crane_source
+    return candidate.resolve()
