@@ -15,7 +15,7 @@ from pathlib import Path
 from hiab_sim.errors import BackendUnavailableError, InvalidInputError
 
 
-def add_parser(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register the subcommand."""
     parser = subparsers.add_parser(
         "optimize",
@@ -26,12 +26,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[
             "tracking of a spiral, the EMLA envelope, stroke, triangle and joint limits (SLSQP)."
         ),
     )
-    parser.add_argument("study", nargs="?", metavar="STUDY.yaml", help="study file (default: optimize/xs031_spiral.yaml)")
+    parser.add_argument(
+        "study", nargs="?", metavar="STUDY.yaml", help="study file (default: optimize/xs031_spiral.yaml)"
+    )
     parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<study name>)")
     parser.add_argument("--resume", action="store_true", help="continue from the output folder's last checkpoint")
     parser.add_argument("--starts", type=int, default=1, metavar="K", help="number of feasible starts (default: 1)")
     parser.add_argument("--id", choices=("mujoco", "analytic"), help="inverse-dynamics path (default: the study's)")
     parser.add_argument("--no-video", action="store_true", help="do not render the playback video")
+    parser.add_argument("--no-figures", action="store_true", help="do not draw the figures (quick runs)")
     parser.add_argument("--quiet", action="store_true", help="no per-iteration progress lines")
     parser.set_defaults(run=run)
 
@@ -46,7 +49,13 @@ def run(args: argparse.Namespace) -> int:
     study = load_study(args.study or DEFAULT_STUDY)
     out = Path(args.out) if args.out else Path("runs") / study.name
     output = run_study(
-        study, out, starts=args.starts, resume=args.resume, id_path=args.id, progress=None if args.quiet else sys.stderr
+        study,
+        out,
+        starts=args.starts,
+        resume=args.resume,
+        id_path=args.id,
+        progress=None if args.quiet else sys.stderr,
+        figures=not args.no_figures,
     )
     r = output.result
     ini, opt, sol, rc = r["initial"], r["optimal"], r["solver"], r["recheck"]

@@ -40,7 +40,9 @@ def _save(fig: Figure, path: Path) -> None:
     write_atomic(path, buffer.getvalue())
 
 
-def draw_crane(ax: Axes, crane: Crane, lengths: LinkLengths, joints: np.ndarray, colour: str, alpha: float = 1.0) -> None:
+def draw_crane(
+    ax: Axes, crane: Crane, lengths: LinkLengths, joints: np.ndarray, colour: str, alpha: float = 1.0
+) -> None:
     """Draw the crane's links in the plane of {W} at one joint pose (theta1, theta2, xt2)."""
     f = forward_kinematics(crane, lengths, joints[0:1], joints[1:2], joints[2:3])
 
@@ -111,7 +113,9 @@ def structure_figure(crane: Crane, designs: dict[str, LinkLengths], pose: np.nda
     _save(fig, path)
 
 
-def spiral_figure(crane: Crane, lengths: LinkLengths, joints: np.ndarray, ref: np.ndarray, tcp: np.ndarray, path: Path) -> None:
+def spiral_figure(
+    crane: Crane, lengths: LinkLengths, joints: np.ndarray, ref: np.ndarray, tcp: np.ndarray, path: Path
+) -> None:
     """The crane at a few poses along the motion, with the reference spiral (seed Fig. hiab)."""
     fig = _figure((7.0, 5.0))
     ax = fig.add_subplot()

@@ -187,7 +187,14 @@ class LinkLengthProblem:
         self.n_gradients = 0
         self.cost_scale = 1.0
         if cost_scale is None:
-            cost_scale = self.evaluate(self.initial_point(study.initial_lengths)).cost
+            try:
+                cost_scale = self.evaluate(self.initial_point(study.initial_lengths)).cost
+            except InvalidInputError as error:
+                raise InvalidInputError(
+                    f"initial_lengths ({error.field})",
+                    error.value,
+                    f"the start is not an admissible crane: {error.allowed}",
+                ) from None
         self.cost_scale = max(float(cost_scale), 1e-300)
 
     # -- variables ---------------------------------------------------------------------------
@@ -361,11 +368,11 @@ class LinkLengthProblem:
         return self._gradients(z)[0]
 
     def constraints_jacobian(self, z: Array) -> Array:
-        """d g / dz, shape (m, n)."""
+        """D g / dz, shape (m, n)."""
         return self._gradients(z)[1]
 
     def equalities_jacobian(self, z: Array) -> Array:
-        """d e / dz (constant), shape (12, n)."""
+        """D e / dz (constant), shape (12, n)."""
         R = self._rest_matrix()  # (4, N)
         jac = np.zeros((12, self.n))
         for j in range(3):
@@ -472,9 +479,8 @@ class LinkLengthProblem:
         sizes = [6, 6, 6, 9, 6, 6, 6]
         starts = np.cumsum([0, *sizes])
         jac_blocks = [per_sample[:, starts[b] : starts[b + 1], :].reshape(-1, self.n) for b in range(len(sizes))]
-        wq, wxi = self._working_partials(lengths)
+        wxi = self._working_partials(lengths)
         jac_blocks.append(np.concatenate([wxi, np.zeros((wxi.shape[0], self.n_c))], axis=1))
-        assert not np.any(wq)
         jac = np.concatenate(jac_blocks, axis=0)
         # cost gradient
         dcost_q = np.einsum("ky,kyq->kq", dcost_dY, dY)
@@ -507,10 +513,10 @@ class LinkLengthProblem:
             dxi[:, r + 2, cols] = -dx_dxi
         return dq / STROKE_SCALE, dxi * XI_SCALE / STROKE_SCALE
 
-    def _working_partials(self, lengths: LinkLengths) -> tuple[Array, Array]:
+    def _working_partials(self, lengths: LinkLengths) -> Array:
+        """Partials of the working-range rows w.r.t. scaled Xi, (12, 6); they do not depend on c."""
         theta = np.array([[w[0] for w in self.working] + [0.0], [w[1] for w in self.working] + [0.0]])
-        dq, dxi = self._stroke_partials(lengths, theta)
-        return np.zeros(1), dxi.reshape(-1, 6)
+        return self._stroke_partials(lengths, theta)[1].reshape(-1, 6)
 
 
 def _centre_guess(study: Study) -> tuple[float, float]:

@@ -171,7 +171,11 @@ def build_result(
         "net_electrical_energy_J": rc["net_electrical_energy_J"],
         "initial_max_violation_scaled": checks["recheck_initial"].summary["max_violation"],
         "force_difference_between_paths_N": float(
-            np.max(np.abs(checks["optimal"].evaluation.actuators.force - checks["recheck_optimal"].evaluation.actuators.force))
+            np.max(
+                np.abs(
+                    checks["optimal"].evaluation.actuators.force - checks["recheck_optimal"].evaluation.actuators.force
+                )
+            )
         ),
     }
     out["multistart"] = multistart_summary(problem, results, multistart_tolerance)

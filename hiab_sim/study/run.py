@@ -58,12 +58,16 @@ def run_study(
                 raise
             if progress is not None:
                 progress.write(f"[start {k}] {error}\n")
-            failed = SolveResult(start=k, initial_lengths=initial, z0=problem.initial_point(initial), z=problem.initial_point(initial))
+            failed = SolveResult(
+                start=k, initial_lengths=initial, z0=problem.initial_point(initial), z=problem.initial_point(initial)
+            )
             failed.message = str(error)
             results.append(failed)
     result, arrays, checks = build_result(problem, results, time.perf_counter() - t0)
     if study.crane_source not in CRANE_PRESETS:
-        shutil.copyfile(study.crane_source if Path(study.crane_source).is_file() else _crane_path(study), folder / "crane.yaml")
+        shutil.copyfile(
+            study.crane_source if Path(study.crane_source).is_file() else _crane_path(study), folder / "crane.yaml"
+        )
         result["crane_source"] = study.crane_source
         result["crane"] = "crane.yaml"
     write_results(folder, result, arrays)

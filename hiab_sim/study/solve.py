@@ -77,7 +77,12 @@ def write_atomic(path: Path, text: str | bytes) -> None:
 
 def check_start(problem: LinkLengthProblem, z: Array, label: str = "initial_lengths") -> None:
     """Raise :class:`InvalidInputError` naming the worst violated constraint at a start point."""
-    ev = problem.evaluate(z)
+    try:
+        ev = problem.evaluate(z)
+    except InvalidInputError as error:
+        raise InvalidInputError(
+            f"{label} ({error.field})", error.value, f"the start is not an admissible crane: {error.allowed}"
+        ) from None
     worst = int(np.argmin(ev.constraints))
     if ev.constraints[worst] < -START_TOLERANCE:
         raise InvalidInputError(
@@ -272,7 +277,7 @@ def solve(
         record(result.z)
         result.iterations = len(result.history) - 1
     if out is not None:
-        _save_checkpoint(out, result, result.z, done=True)
+        _save_checkpoint(out, result, result.z, done=result.success)
     if not result.success:
         raise SolverError(
             f"start {start}: SLSQP status {result.status}: {result.message} after {result.iterations} iterations "

@@ -308,9 +308,10 @@ def inverse_kinematics(
     zero = np.zeros((n, 3))
     s0 = kin.samples(theta, zero, zero)
     jac = s0.d_velocity[:, :, 3:6]
-    dtheta = np.linalg.solve(jac, reference.velocity[..., None])[..., 0]
+    dtheta = np.asarray(np.linalg.solve(jac, reference.velocity[..., None])[..., 0], dtype=float)
     s1 = kin.samples(theta, dtheta, zero)
-    ddtheta = np.linalg.solve(jac, (reference.acceleration - s1.acceleration)[..., None])[..., 0]
+    rhs = (reference.acceleration - s1.acceleration)[..., None]
+    ddtheta = np.asarray(np.linalg.solve(jac, rhs)[..., 0], dtype=float)
     return JointTrajectory(reference.time, theta, dtheta, ddtheta)
 
 

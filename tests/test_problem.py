@@ -1,0 +1,98 @@
+"""The NLP of eq. costf2: gradients vs finite differences, the cost formula, constraint rows, bad starts."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_study_small import small_study
+
+from hiab_sim.config import ChainLengths, LinkLengths
+from hiab_sim.emla import electrical_power
+from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.study.config import study_from_dict
+from hiab_sim.study.problem import LinkLengthProblem
+from hiab_sim.study.solve import check_start, start_points
+
+STUDY = study_from_dict(small_study(), "small.yaml")
+
+
+@pytest.fixture(scope="module", params=["analytic", "mujoco"])
+def problem(request: pytest.FixtureRequest) -> LinkLengthProblem:
+    """The small study's NLP on either inverse-dynamics path."""
+    return LinkLengthProblem(STUDY, id_path=request.param)
+
+
+def _point(problem: LinkLengthProblem) -> np.ndarray:
+    rng = np.random.default_rng(3)
+    z = problem.initial_point(start_points(problem, 2)[1])
+    return z + np.concatenate([np.zeros(6), rng.normal(0.0, 0.02, problem.n_c)])
+
+
+def _central(fun, z: np.ndarray, i: int, h: float) -> np.ndarray:  # type: ignore[no-untyped-def]
+    zp, zm = z.copy(), z.copy()
+    zp[i] += h
+    zm[i] -= h
+    return (np.asarray(fun(zp)) - np.asarray(fun(zm))) / (2.0 * h)
+
+
+def test_cost_gradient_matches_finite_differences(problem: LinkLengthProblem) -> None:
+    """D f / dz (ID partials batched, chained through the B-spline matrices) equals central differences."""
+    z = _point(problem)
+    grad = problem.cost_gradient(z)
+    fd = np.array([_central(problem.cost, z, i, 1e-5 if i < 6 else 1e-4) for i in range(problem.n)])
+    np.testing.assert_allclose(grad, fd, atol=1e-5 * np.max(np.abs(grad)), rtol=1e-4)
+
+
+def test_constraint_jacobian_matches_finite_differences(problem: LinkLengthProblem) -> None:
+    """D g / dz for every constraint row, Xi and spline-coefficient columns alike."""
+    z = _point(problem)
+    jac = problem.constraints_jacobian(z)
+    cols = [*range(6), *range(6, problem.n, 5)]
+    for i in cols:
+        fd = _central(problem.constraints, z, i, 1e-5 if i < 6 else 1e-4)
+        np.testing.assert_allclose(jac[:, i], fd, atol=2e-5 * np.max(np.abs(jac[:, i])) + 1e-7, err_msg=f"column {i}")
+
+
+def test_equality_jacobian_is_exact(problem: LinkLengthProblem) -> None:
+    """The rest-to-rest equalities are linear in c; their jacobian reproduces them."""
+    z = _point(problem)
+    jac = problem.equalities_jacobian(z)
+    z0 = problem.initial_point(STUDY.initial_lengths)
+    np.testing.assert_allclose(problem.equalities(z) - problem.equalities(z0), jac @ (z - z0), atol=1e-9)
+
+
+def test_cost_is_the_seed_squared_power_sum_of_electrical_power() -> None:
+    """F = 1/2 Dt sum_k (sum_i P_i(t_k))^2 with the EMLA model's electrical power (never f v / eta)."""
+    problem = LinkLengthProblem(STUDY, id_path="analytic")
+    ev = problem.evaluate(_point(problem))
+    act = ev.actuators
+    power = sum(
+        electrical_power(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
+        for i, p in enumerate(problem.emlas)
+    )
+    assert ev.cost == pytest.approx(0.5 * problem.dt * np.sum(power**2), rel=1e-12)
+    assert len(ev.constraints) == len(problem.constraint_names)
+
+
+def test_start_violating_a_constraint_names_it() -> None:
+    """A start whose stroke leaves [0, stroke] is rejected with the constraint's name."""
+    problem = LinkLengthProblem(STUDY, id_path="analytic")
+    bad = LinkLengths(ChainLengths(1.0071227324212, 0.2, 0.745), STUDY.initial_lengths.tilt)
+    with pytest.raises(InvalidInputError, match=r"initial_lengths .*lift"):
+        check_start(problem, problem.initial_point(bad))
+
+
+@pytest.mark.parametrize(
+    ("change", "error", "field"),
+    [
+        ({"spline": {"control_points": 16, "degree": 2}}, InvalidInputError, "spline.degree"),
+        ({"grid": {"duration": -1.0}}, InvalidInputError, "grid.duration"),
+        ({"solver": {"id_path": "magic"}}, InvalidInputError, "solver.id_path"),
+        ({"typo": 1}, ConfigError, "typo"),
+        ({"reference": {"start_radius": 0.1}}, ConfigError, "missing"),
+    ],
+)
+def test_malformed_study_names_the_field(change: dict, error: type, field: str) -> None:
+    """Unknown keys, missing keys and out-of-range values name the field."""
+    with pytest.raises(error, match=field):
+        study_from_dict(small_study(**change), "bad.yaml")
