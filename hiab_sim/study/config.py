@@ -176,7 +176,6 @@ class Study:
     bounds: Bounds
     solver: SolverSettings
     payload: float = 0.0  # kg hanging at the TCP
-    crane_scale: float = 1.0
 
     @property
     def tcp_force(self) -> np.ndarray | None:
@@ -198,7 +197,6 @@ _TOP = {
     "bounds",
     "solver",
     "payload",
-    "crane_scale",
 }
 _REQUIRED_TOP = {"crane", "reference", "bounds"}
 
@@ -228,13 +226,8 @@ def study_from_dict(data: Any, file: str | Path = "<study>") -> Study:
     file = Path(file)
     top = _mapping(data, "study", _TOP, _REQUIRED_TOP)
     crane_source = str(top["crane"])
-    scale = _positive(top.get("crane_scale", 1.0), "crane_scale")
     crane_path = crane_source if crane_source in CRANE_PRESETS else str(_resolve(crane_source, file))
     crane = load_crane(crane_path)
-    if scale != 1.0:
-        from hiab_sim.study.scaling import scale_crane
-
-        crane = scale_crane(crane, scale)
     emla = top.get("emla")
     emla_source = None if emla in (None, "default") else str(_resolve(str(emla), file))
     if emla_source is not None and not Path(emla_source).is_file():
@@ -301,7 +294,6 @@ def study_from_dict(data: Any, file: str | Path = "<study>") -> Study:
         bounds=bounds,
         solver=solver,
         payload=payload,
-        crane_scale=scale,
     )
 
 
