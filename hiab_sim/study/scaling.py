@@ -85,7 +85,7 @@ def scale_emla_document(doc: dict[str, Any], s: float) -> dict[str, Any]:
 
 
 def seed_scale() -> float:
-    """s = 1.75 m / L of the XS 031 lift chain."""
+    """S = 1.75 m / L of the XS 031 lift chain."""
     doc = yaml.safe_load(CRANE_PRESETS["xs031"].read_text())
     return 1.75 / float(doc["chains"]["lift"]["L"])
 
@@ -104,7 +104,7 @@ def write_seed_scale_files(folder: Path = STUDY_DIR) -> tuple[Path, Path]:
         probe = ClosedChain(
             name=name,
             parent=chain["parent"],
-            cylinder_base_pivot=tuple(chain["cylinder_base_pivot"]),  # type: ignore[arg-type]
+            cylinder_base_pivot=tuple(chain["cylinder_base_pivot"]),
             base_axis_angle=chain["base_axis_angle"],
             joint_offset=chain["joint_offset"],
             L1=chain["L1"],
