@@ -46,9 +46,7 @@ def test_margins_have_one_row_per_named_limit_and_are_order_one_inside() -> None
 def test_margins_vanish_exactly_on_each_physical_limit(params) -> None:  # type: ignore[no-untyped-def]
     """Torque margin is 0 at |tau_m| = tau_peak, speed margin at top speed, voltage margin at V_LL = V_max."""
     k = params.transmission_ratio
-    g = envelope_margins(
-        params, np.array([k * params.motor.peak_torque, -k * params.motor.peak_torque]), 0.0, 0.0
-    )
+    g = envelope_margins(params, np.array([k * params.motor.peak_torque, -k * params.motor.peak_torque]), 0.0, 0.0)
     np.testing.assert_allclose(g[0], 0.0, atol=1e-12)
     g = envelope_margins(params, 0.0, np.array([top_speed(params), -top_speed(params)]), 0.0)
     np.testing.assert_allclose(g[1], 0.0, atol=1e-12)

@@ -60,9 +60,7 @@ def test_csv_and_npz_hold_the_same_numbers_as_the_model(tmp_path: Path) -> None:
         assert list(data["margin_names"]) == ["peak_torque", "rated_speed", "voltage"]
 
 
-def test_emla_map_command_writes_figure_csv_and_npz(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
+def test_emla_map_command_writes_figure_csv_and_npz(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """``hiab-sim emla-map --actuator telescope -o .. --csv .. --npz ..`` exits 0 and writes all three."""
     out = tmp_path / "t.png"
     status = main(
@@ -74,9 +72,7 @@ def test_emla_map_command_writes_figure_csv_and_npz(
     assert "peak force 52.5 kN (hydraulic 37.3 kN)" in capsys.readouterr().out
 
 
-def test_emla_map_command_rejects_a_missing_output_folder(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
+def test_emla_map_command_rejects_a_missing_output_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """An output path in a folder that does not exist exits 2 with a message, not a traceback."""
     status = main(["emla-map", "-o", str(tmp_path / "nowhere" / "x.png"), "--resolution", "11"])
     assert status == 2

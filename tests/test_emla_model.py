@@ -97,9 +97,7 @@ def test_dq_power_splits_into_copper_loss_and_air_gap_power_for_any_d_current(
     motor = params.motor
     v_d, v_q = dq_voltages(motor, i_d, i_q, omega)
     p_elec = 1.5 * (v_d * i_d + v_q * i_q)
-    expected = 1.5 * motor.stator_resistance * (i_d**2 + i_q**2) + omega * electromagnetic_torque(
-        motor, i_d, i_q
-    )
+    expected = 1.5 * motor.stator_resistance * (i_d**2 + i_q**2) + omega * electromagnetic_torque(motor, i_d, i_q)
     assert p_elec == pytest.approx(expected, rel=1e-12, abs=1e-9)
 
 
@@ -185,9 +183,7 @@ def test_electrical_power_matches_seed_form_f_v_over_eta_where_eta_is_defined() 
 
 @settings(max_examples=60, deadline=None)
 @given(data=st.data(), params=emla_params())
-def test_electrical_power_partials_match_central_finite_differences(
-    data: st.DataObject, params: EmlaParams
-) -> None:
+def test_electrical_power_partials_match_central_finite_differences(data: st.DataObject, params: EmlaParams) -> None:
     """Analytic dP/df, dP/dv, dP/da agree with central differences to 1e-6 relative (+ FD roundoff)."""
     f, v, a = samples(data.draw, params)
     analytic = electrical_power_partials(params, f, v, a)

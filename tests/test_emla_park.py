@@ -27,9 +27,7 @@ def test_abc_to_dq0_to_abc_round_trip_is_identity(x: np.ndarray, theta: np.ndarr
     i=arrays(float, (3, 4), elements=finite),
     theta=arrays(float, (4,), elements=angles),
 )
-def test_three_phase_power_equals_three_halves_dq_power(
-    v: np.ndarray, i: np.ndarray, theta: np.ndarray
-) -> None:
+def test_three_phase_power_equals_three_halves_dq_power(v: np.ndarray, i: np.ndarray, theta: np.ndarray) -> None:
     """sum_k v_k i_k = 3/2 (v_d i_d + v_q i_q) + 3 v_0 i_0 for the amplitude-invariant transform."""
     p_abc = np.sum(v * i, axis=0)
     p_dq = dq0_power(abc_to_dq0(v, theta), abc_to_dq0(i, theta))

@@ -12,9 +12,7 @@ from hiab_sim.emla import EmlaParams, abc_to_dq0, dq0_to_abc, electrical_power, 
 from hiab_sim.emla.pmsm import current_derivatives, electromagnetic_torque
 
 EMLAS = load_emla_set()
-SALIENT_LIFT = dataclasses.replace(
-    EMLAS.lift, motor=dataclasses.replace(EMLAS.lift.motor, Ld=1.6e-3, Lq=2.8e-3)
-)
+SALIENT_LIFT = dataclasses.replace(EMLAS.lift, motor=dataclasses.replace(EMLAS.lift.motor, Ld=1.6e-3, Lq=2.8e-3))
 
 
 @pytest.mark.parametrize(
@@ -84,9 +82,7 @@ def test_phase_frame_machine_fed_the_model_voltages_draws_the_model_power() -> N
 
     period = 2 * np.pi / omega_e
     t_end = 40 * period  # about 38 stator time constants L/R
-    sol = solve_ivp(
-        rhs, (0.0, t_end), np.zeros(3), method="DOP853", rtol=1e-12, atol=1e-12, dense_output=True
-    )
+    sol = solve_ivp(rhs, (0.0, t_end), np.zeros(3), method="DOP853", rtol=1e-12, atol=1e-12, dense_output=True)
     assert sol.success
     t = np.linspace(t_end - period, t_end, 64)
     i_abc = sol.sol(t)

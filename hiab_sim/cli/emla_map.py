@@ -21,9 +21,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--actuator", choices=ACTUATOR_NAMES, default="lift", help="actuator (default: lift)")
     parser.add_argument("--config", metavar="EMLA.yaml", help="EMLA parameter file (default: XS 031 preset)")
-    parser.add_argument(
-        "-o", "--output", metavar="FILE.png", help="figure path (default: emla_map_ACTUATOR.png)"
-    )
+    parser.add_argument("-o", "--output", metavar="FILE.png", help="figure path (default: emla_map_ACTUATOR.png)")
     parser.add_argument("--csv", metavar="FILE.csv", help="also write the grid as CSV")
     parser.add_argument("--npz", metavar="FILE.npz", help="also write the grid as NPZ")
     parser.add_argument("--resolution", type=int, default=161, help="grid points per axis (default: 161)")

@@ -215,9 +215,7 @@ def emla_set_from_mapping(document: object, where: str = "<mapping>") -> EmlaSet
     for name in ACTUATOR_NAMES:
         section = f"actuators.{name}"
         node = _mapping(actuators[name], where, section)
-        _check_keys(
-            node, required=_ACTUATOR_REQUIRED, optional=_ACTUATOR_OPTIONAL, where=where, section=section
-        )
+        _check_keys(node, required=_ACTUATOR_REQUIRED, optional=_ACTUATOR_OPTIONAL, where=where, section=section)
         override = _mapping(node.get("pmsm", {}), where, f"{section}.pmsm")
         _check_keys(override, required=(), optional=_PMSM_KEYS, where=where, section=f"{section}.pmsm")
         provenance: list[tuple[str, str]] = []

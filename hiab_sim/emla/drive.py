@@ -65,9 +65,7 @@ class DriveState:
     d_v_q: Partials
 
 
-def broadcast_inputs(
-    force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
-) -> tuple[Array, Array, Array]:
+def broadcast_inputs(force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike) -> tuple[Array, Array, Array]:
     """Return force [N], velocity [m/s] and acceleration [m/s^2] as float arrays of one shape."""
     f, v, a = np.broadcast_arrays(
         np.asarray(force, dtype=float),
@@ -77,9 +75,7 @@ def broadcast_inputs(
     return f, v, a
 
 
-def drive_state(
-    params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
-) -> DriveState:
+def drive_state(params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike) -> DriveState:
     """Map load-side force [N], velocity [m/s] and acceleration [m/s^2] to the motor and its dq quantities.
 
     Args:
@@ -107,8 +103,7 @@ def drive_state(
     d_omega: Partials = (zeros, k * ones, zeros)
     d_tau: Partials = (
         ones / k,
-        params.viscous_friction / k
-        + motor.rotor_coulomb_friction * sech2 * k / motor.friction_smoothing_speed,
+        params.viscous_friction / k + motor.rotor_coulomb_friction * sech2 * k / motor.friction_smoothing_speed,
         (params.screw_moving_mass / k + motor.rotor_inertia * k) * ones,
     )
 

@@ -59,9 +59,7 @@ class EfficiencyMap:
     hydraulic_pull_force: float | None
 
 
-def efficiency_map(
-    params: EmlaParams, n_force: int = 161, n_velocity: int = 161, span: float = 1.15
-) -> EfficiencyMap:
+def efficiency_map(params: EmlaParams, n_force: int = 161, n_velocity: int = 161, span: float = 1.15) -> EfficiencyMap:
     """Evaluate the EMLA on a symmetric grid covering ``span`` times its peak force and top speed.
 
     Args:
@@ -133,9 +131,7 @@ def plot_efficiency_map(
     ax.clabel(lines, fmt="%.2f", fontsize=7)
     drawing = emap.within_envelope & (emap.mechanical_power < 0) & (emap.efficiency < 0)
     if np.any(drawing):
-        ax.contourf(
-            v, f_kn, drawing.astype(float), levels=[0.5, 1.5], colors="0.6", hatches=["///"], alpha=0.9
-        )
+        ax.contourf(v, f_kn, drawing.astype(float), levels=[0.5, 1.5], colors="0.6", hatches=["///"], alpha=0.9)
     ax.contour(v, f_kn, emap.margins.min(axis=0), levels=[0.0], colors="black", linewidths=2.0)
     ax.plot([], [], color="black", linewidth=2.0, label="envelope (" + ", ".join(ENVELOPE_LIMIT_NAMES) + ")")
     if np.any(drawing):
@@ -165,13 +161,9 @@ def plot_efficiency_map(
         )  # fmt: skip
     ax.set_xlabel("rod velocity $v_x$ [m/s]")
     ax.set_ylabel("load force $f_x$ [kN]")
-    ax.set_title(
-        f"EMLA efficiency, {emap.actuator}: peak {emap.peak_force / 1e3:.1f} kN, top {emap.top_speed:.3f} m/s"
-    )
+    ax.set_title(f"EMLA efficiency, {emap.actuator}: peak {emap.peak_force / 1e3:.1f} kN, top {emap.top_speed:.3f} m/s")
     ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.07), ncol=2, fontsize=7, frameon=False)
-    fig.colorbar(
-        filled, ax=ax, label="efficiency: $f_x v_x / P_{elec}$ motoring, $P_{elec} / f_x v_x$ generating"
-    )
+    fig.colorbar(filled, ax=ax, label="efficiency: $f_x v_x / P_{elec}$ motoring, $P_{elec} / f_x v_x$ generating")
     return fig
 
 

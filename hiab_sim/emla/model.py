@@ -94,18 +94,14 @@ def operating_point(
         copper_loss=1.5 * motor.stator_resistance * (s.i_d**2 + s.i_q**2),
         rotor_friction_loss=s.friction_torque * s.motor_speed,
         screw_viscous_loss=params.viscous_friction * v * v,
-        inertial_power=(params.screw_moving_mass + motor.rotor_inertia * params.transmission_ratio**2)
-        * a
-        * v,
+        inertial_power=(params.screw_moving_mass + motor.rotor_inertia * params.transmission_ratio**2) * a * v,
         efficiency=efficiency(p_mech, p_elec),
         margins=margins,
         within_envelope=np.all(margins >= 0.0, axis=0),
     )
 
 
-def electrical_power(
-    params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
-) -> Array:
+def electrical_power(params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike) -> Array:
     """Return P_elec = 3/2 (V_d i_d + V_q i_q) [W] at load force [N], velocity [m/s], acceleration [m/s^2].
 
     This replaces f_x v_x / eta_EMLA in the seed's cost (eq. ``costf2``): equal where eta is
@@ -145,9 +141,7 @@ def efficiency(mechanical_power: ArrayLike, electrical_power: ArrayLike) -> Arra
         electrical_power: P_elec [W].
 
     """
-    pm, pe = np.broadcast_arrays(
-        np.asarray(mechanical_power, dtype=float), np.asarray(electrical_power, dtype=float)
-    )
+    pm, pe = np.broadcast_arrays(np.asarray(mechanical_power, dtype=float), np.asarray(electrical_power, dtype=float))
     eta = np.full(pm.shape, np.nan)
     motoring = (pm > 0) & (pe > 0)
     generating = pm < 0
@@ -179,9 +173,7 @@ def energy_summary(time: ArrayLike, electrical_power: ArrayLike) -> tuple[Array,
     if not np.all(np.diff(t) > 0):
         raise InvalidInputError("time", "not increasing", "must be strictly increasing")
     if p.shape[-1:] != t.shape:
-        raise InvalidInputError(
-            "electrical_power", f"shape {p.shape}", f"last axis must match time's {t.size} samples"
-        )
+        raise InvalidInputError("electrical_power", f"shape {p.shape}", f"last axis must match time's {t.size} samples")
     return _trapezoid(p, t), _trapezoid(np.maximum(p, 0.0), t)
 
 

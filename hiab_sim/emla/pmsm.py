@@ -63,7 +63,5 @@ def current_derivatives(
     omega_e = motor.pole_pairs * np.asarray(motor_speed, dtype=float)
     r = motor.stator_resistance
     di_d = (np.asarray(v_d, dtype=float) - r * i_d + omega_e * motor.Lq * i_q) / motor.Ld
-    di_q = (
-        np.asarray(v_q, dtype=float) - r * i_q - omega_e * (motor.Ld * i_d + motor.flux_linkage)
-    ) / motor.Lq
+    di_q = (np.asarray(v_q, dtype=float) - r * i_q - omega_e * (motor.Ld * i_d + motor.flux_linkage)) / motor.Lq
     return di_d, di_q
