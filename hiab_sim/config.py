@@ -20,15 +20,15 @@ Links (moving rigid bodies) and their frames, shared by both inverse-dynamics pa
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.yaml_fields import mapping, number, positive, read_yaml
 
 Vector3 = tuple[float, float, float]
 Matrix3 = tuple[Vector3, Vector3, Vector3]
@@ -314,22 +314,18 @@ def load_crane(source: str | Path = "xs031") -> Crane:
     path = CRANE_PRESETS.get(str(source), Path(source))
     if not path.is_file():
         raise ConfigError(f"crane '{source}' is neither a preset ({', '.join(CRANE_PRESETS)}) nor a readable YAML file")
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as error:
-        raise ConfigError(f"{path}: not valid YAML: {error}") from None
-    return crane_from_dict(data, origin=str(path))
+    return crane_from_dict(read_yaml(path, "crane"), origin=str(path))
 
 
 def crane_from_dict(data: Any, origin: str = "crane") -> Crane:
     """Build and validate a :class:`Crane` from a parsed YAML mapping."""
-    top = _mapping(data, origin, _TOP_KEYS)
-    gravity = _positive(top["gravity"], "gravity", "m/s^2")
-    chains_data = _mapping(top["chains"], "chains", set(CHAIN_NAMES))
+    top = mapping(data, origin, _TOP_KEYS)
+    gravity = positive(top["gravity"], "gravity", "m/s^2")
+    chains_data = mapping(top["chains"], "chains", set(CHAIN_NAMES))
     chains = {name: _chain(name, chains_data[name]) for name in CHAIN_NAMES}
     telescope = _telescope(top["telescope"])
     tcp = _pose(top["tcp"], "tcp")
-    bodies_data = _mapping(top["bodies"], "bodies", None)
+    bodies_data = mapping(top["bodies"], "bodies", None)
     placements = _source_frame_placements(chains["lift"], chains["tilt"], telescope)
     bodies = tuple(_body(name, bodies_data[name], placements) for name in bodies_data)
     crane = Crane(
@@ -346,38 +342,10 @@ def crane_from_dict(data: Any, origin: str = "crane") -> Crane:
     return crane
 
 
-def _mapping(data: Any, where: str, keys: set[str] | None) -> Mapping[str, Any]:
-    if not isinstance(data, Mapping):
-        raise ConfigError(f"{where}: expected a mapping, got {type(data).__name__}")
-    if keys is not None:
-        unknown = sorted(set(data) - keys)
-        missing = sorted(keys - set(data))
-        if unknown:
-            raise ConfigError(f"{where}: unknown key(s) {unknown}; allowed: {sorted(keys)}")
-        if missing:
-            raise ConfigError(f"{where}: missing key(s) {missing}")
-    return data
-
-
-def _number(value: Any, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ConfigError(f"{where}: expected a number, got {value!r}")
-    if not math.isfinite(value):
-        raise InvalidInputError(where, float(value), "must be finite")
-    return float(value)
-
-
-def _positive(value: Any, where: str, unit: str) -> float:
-    number = _number(value, where)
-    if number <= 0.0:
-        raise InvalidInputError(where, number, "must be > 0", unit)
-    return number
-
-
 def _vector(value: Any, where: str) -> Vector3:
     if not isinstance(value, list | tuple) or len(value) != 3:
         raise ConfigError(f"{where}: expected a list of 3 numbers, got {value!r}")
-    return _vec([_number(v, f"{where}[{i}]") for i, v in enumerate(value)])
+    return _vec([number(v, f"{where}[{i}]") for i, v in enumerate(value)])
 
 
 def _matrix(value: Any, where: str) -> Matrix3:
@@ -393,14 +361,14 @@ def _matrix(value: Any, where: str) -> Matrix3:
 def _range(value: Any, where: str, unit: str) -> tuple[float, float]:
     if not isinstance(value, list | tuple) or len(value) != 2:
         raise ConfigError(f"{where}: expected [min, max], got {value!r}")
-    low, high = _number(value[0], f"{where}[0]"), _number(value[1], f"{where}[1]")
+    low, high = number(value[0], f"{where}[0]"), number(value[1], f"{where}[1]")
     if not low < high:
         raise InvalidInputError(where, f"[{low:.6g}, {high:.6g}]", "must satisfy min < max", unit)
     return (low, high)
 
 
 def _pose(data: Any, where: str) -> Pose:
-    pose = _mapping(data, where, _POSE_KEYS)
+    pose = mapping(data, where, _POSE_KEYS)
     rotation = _matrix(pose["R"], f"{where}.R")
     matrix = np.asarray(rotation)
     error = float(np.max(np.abs(matrix @ matrix.T - np.eye(3))))
@@ -410,23 +378,23 @@ def _pose(data: Any, where: str) -> Pose:
 
 
 def _chain(name: str, data: Any) -> ClosedChain:
-    chain = _mapping(data, f"chains.{name}", _CHAIN_KEYS)
+    chain = mapping(data, f"chains.{name}", _CHAIN_KEYS)
     where = f"{name}"
     parent = str(chain["parent"])
     if parent not in LINK_NAMES:
         raise InvalidInputError(f"{where}.parent", parent, f"must be one of {list(LINK_NAMES)}")
-    stroke = _positive(chain["stroke"], f"{where}.stroke", "m")
+    stroke = positive(chain["stroke"], f"{where}.stroke", "m")
     return ClosedChain(
         name=name,
         parent=parent,
         cylinder_base_pivot=_vector(chain["cylinder_base_pivot"], f"{where}.cylinder_base_pivot"),
-        base_axis_angle=_number(chain["base_axis_angle"], f"{where}.base_axis_angle"),
-        joint_offset=_number(chain["joint_offset"], f"{where}.joint_offset"),
-        L1=_positive(chain["L1"], f"{where}.L1", "m"),
+        base_axis_angle=number(chain["base_axis_angle"], f"{where}.base_axis_angle"),
+        joint_offset=number(chain["joint_offset"], f"{where}.joint_offset"),
+        L1=positive(chain["L1"], f"{where}.L1", "m"),
         default_lengths=ChainLengths(
-            L=_positive(chain["L"], f"{where}.L", "m"),
-            Lc0=_positive(chain["Lc0"], f"{where}.Lc0", "m"),
-            Lc=_positive(chain["Lc"], f"{where}.Lc", "m"),
+            L=positive(chain["L"], f"{where}.L", "m"),
+            Lc0=positive(chain["Lc0"], f"{where}.Lc0", "m"),
+            Lc=positive(chain["Lc"], f"{where}.Lc", "m"),
         ),
         stroke=stroke,
         joint_range=_range(chain["joint_range"], f"{where}.joint_range", "rad"),
@@ -434,8 +402,8 @@ def _chain(name: str, data: Any) -> ClosedChain:
 
 
 def _telescope(data: Any) -> Telescope:
-    tele = _mapping(data, "telescope", _TELESCOPE_KEYS)
-    stroke = _positive(tele["stroke"], "telescope.stroke", "m")
+    tele = mapping(data, "telescope", _TELESCOPE_KEYS)
+    stroke = positive(tele["stroke"], "telescope.stroke", "m")
     joint_range = _range(tele["joint_range"], "telescope.joint_range", "m")
     if joint_range[0] < 0.0 or joint_range[1] > stroke:
         raise InvalidInputError(
@@ -447,8 +415,8 @@ def _telescope(data: Any) -> Telescope:
     return Telescope(
         parent=str(tele["parent"]),
         cylinder_frame=_pose(tele["cylinder_frame"], "telescope.cylinder_frame"),
-        rod_offset=_number(tele["rod_offset"], "telescope.rod_offset"),
-        rod_length=_positive(tele["rod_length"], "telescope.rod_length", "m"),
+        rod_offset=number(tele["rod_offset"], "telescope.rod_offset"),
+        rod_length=positive(tele["rod_length"], "telescope.rod_length", "m"),
         stroke=stroke,
         joint_range=joint_range,
     )
@@ -467,11 +435,11 @@ def _source_frame_placements(lift: ClosedChain, tilt: ClosedChain, telescope: Te
 
 def _body(name: str, data: Any, placements: dict[str, np.ndarray]) -> RigidBody:
     where = f"bodies.{name}"
-    body = _mapping(data, where, _BODY_KEYS)
+    body = mapping(data, where, _BODY_KEYS)
     frame = str(body["frame"])
     if frame not in _FRAME_LINKS:
         raise InvalidInputError(f"{where}.frame", frame, f"must be one of {sorted(_FRAME_LINKS)}")
-    mass = _positive(body["mass"], f"{where}.mass", "kg")
+    mass = positive(body["mass"], f"{where}.mass", "kg")
     inertia = np.asarray(_matrix(body["inertia"], f"{where}.inertia"))
     if np.max(np.abs(inertia - inertia.T)) > 1e-9 or np.min(np.linalg.eigvalsh(inertia)) <= 0.0:
         raise InvalidInputError(f"{where}.inertia", "not symmetric positive definite", "must be SPD", "kg m^2")

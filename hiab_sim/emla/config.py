@@ -8,9 +8,8 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.yaml_fields import read_yaml
 
 #: The default EMLA set for the HIAB XS 031 (lift, tilt, telescope).
 DEFAULT_EMLA_PRESET = Path(__file__).resolve().parent.parent / "presets" / "emla_xs031.yaml"
@@ -191,15 +190,7 @@ def load_emla_set(path: str | Path | None = None) -> EmlaSet:
 
     """
     file = DEFAULT_EMLA_PRESET if path is None else Path(path)
-    try:
-        text = file.read_text(encoding="utf-8")
-    except OSError as error:
-        raise ConfigError(f"cannot read EMLA config {file}: {error.strerror or error}") from error
-    try:
-        document = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        raise ConfigError(f"{file}: not valid YAML: {error}") from error
-    return emla_set_from_mapping(document, where=str(file))
+    return emla_set_from_mapping(read_yaml(file, "EMLA config"), where=str(file))
 
 
 def emla_set_from_mapping(document: object, where: str = "<mapping>") -> EmlaSet:

@@ -9,16 +9,15 @@ paths in a study (crane, EMLA) are resolved against the study file's folder.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from hiab_sim.config import CHAIN_NAMES, CRANE_PRESETS, ChainLengths, Crane, LinkLengths, load_crane
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.yaml_fields import mapping, number, positive, read_yaml
 
 #: Folder of the shipped studies (``optimize/`` at the repository root).
 STUDY_DIR = Path(__file__).resolve().parents[2] / "optimize"
@@ -210,21 +209,13 @@ def load_study(path: str | Path | None = None) -> Study:
 
     """
     file = DEFAULT_STUDY if path is None else Path(path)
-    try:
-        text = file.read_text(encoding="utf-8")
-    except OSError as error:
-        raise ConfigError(f"cannot read study {file}: {error.strerror or error}") from None
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        raise ConfigError(f"{file}: not valid YAML: {error}") from None
-    return study_from_dict(data, file)
+    return study_from_dict(read_yaml(file, "study"), file)
 
 
 def study_from_dict(data: Any, file: str | Path = "<study>") -> Study:
     """Build a :class:`Study` from a parsed YAML mapping (relative paths resolve next to ``file``)."""
     file = Path(file)
-    top = _mapping(data, "study", _TOP, _REQUIRED_TOP)
+    top = mapping(data, "study", _TOP, _REQUIRED_TOP)
     crane_source = str(top["crane"])
     crane_path = crane_source if crane_source in CRANE_PRESETS else str(_resolve(crane_source, file))
     crane = load_crane(crane_path)
@@ -233,7 +224,7 @@ def study_from_dict(data: Any, file: str | Path = "<study>") -> Study:
     if emla_source is not None and not Path(emla_source).is_file():
         raise ConfigError(f"emla: no such EMLA file {emla_source}")
     initial = _lengths(top.get("initial_lengths"), crane)
-    spline_d = _mapping(top.get("spline", {}), "spline", {"control_points", "degree"}, set())
+    spline_d = mapping(top.get("spline", {}), "spline", {"control_points", "degree"}, set())
     spline = SplineSettings(
         control_points=_integer(spline_d.get("control_points", 22), "spline.control_points", 6),
         degree=_integer(spline_d.get("degree", 5), "spline.degree", 3),
@@ -244,26 +235,26 @@ def study_from_dict(data: Any, file: str | Path = "<study>") -> Study:
         raise InvalidInputError(
             "spline.control_points", spline.control_points, f"must be >= degree + 2 = {spline.degree + 2}"
         )
-    grid_d = _mapping(top.get("grid", {}), "grid", {"duration", "intervals", "fine_factor"}, set())
+    grid_d = mapping(top.get("grid", {}), "grid", {"duration", "intervals", "fine_factor"}, set())
     grid = GridSettings(
-        duration=_positive(grid_d.get("duration", 6.25), "grid.duration", "s"),
+        duration=positive(grid_d.get("duration", 6.25), "grid.duration", "s"),
         intervals=_integer(grid_d.get("intervals", 25), "grid.intervals", 2),
         fine_factor=_integer(grid_d.get("fine_factor", 10), "grid.fine_factor", 1),
     )
     reference = _reference(top["reference"])
     track_keys = {"position", "velocity", "acceleration", "collocation_fraction"}
-    track_d = _mapping(top.get("tracking", {}), "tracking", track_keys, set())
+    track_d = mapping(top.get("tracking", {}), "tracking", track_keys, set())
     tracking = Tracking(
-        position=_positive(track_d.get("position", 1e-3), "tracking.position", "m"),
-        velocity=_positive(track_d.get("velocity", 5e-3), "tracking.velocity", "m/s"),
-        acceleration=_positive(track_d.get("acceleration", 5e-2), "tracking.acceleration", "m/s^2"),
-        collocation_fraction=_positive(track_d.get("collocation_fraction", 0.5), "tracking.collocation_fraction"),
+        position=positive(track_d.get("position", 1e-3), "tracking.position", "m"),
+        velocity=positive(track_d.get("velocity", 5e-3), "tracking.velocity", "m/s"),
+        acceleration=positive(track_d.get("acceleration", 5e-2), "tracking.acceleration", "m/s^2"),
+        collocation_fraction=positive(track_d.get("collocation_fraction", 0.5), "tracking.collocation_fraction"),
     )
     if tracking.collocation_fraction > 1.0:
         raise InvalidInputError("tracking.collocation_fraction", tracking.collocation_fraction, "must lie in (0, 1]")
     bounds = _bounds(top["bounds"], initial)
     solver_keys = {"maxiter", "ftol", "id_path", "fd_step", "xi_derivatives"}
-    solver_d = _mapping(top.get("solver", {}), "solver", solver_keys, set())
+    solver_d = mapping(top.get("solver", {}), "solver", solver_keys, set())
     xi_derivatives = str(solver_d.get("xi_derivatives", "analytic"))
     if xi_derivatives not in ("analytic", "rebuild"):
         raise InvalidInputError("solver.xi_derivatives", xi_derivatives, "must be 'analytic' or 'rebuild'")
@@ -272,12 +263,12 @@ def study_from_dict(data: Any, file: str | Path = "<study>") -> Study:
         raise InvalidInputError("solver.id_path", id_path, f"must be one of {', '.join(ID_PATHS)}")
     solver = SolverSettings(
         maxiter=_integer(solver_d.get("maxiter", 100), "solver.maxiter", 1),
-        ftol=_positive(solver_d.get("ftol", 1e-9), "solver.ftol"),
+        ftol=positive(solver_d.get("ftol", 1e-9), "solver.ftol"),
         id_path=id_path,
-        fd_step=_positive(solver_d.get("fd_step", 1e-6), "solver.fd_step"),
+        fd_step=positive(solver_d.get("fd_step", 1e-6), "solver.fd_step"),
         xi_derivatives=xi_derivatives,
     )
-    payload = _number(top.get("payload", 0.0), "payload")
+    payload = number(top.get("payload", 0.0), "payload")
     if payload < 0.0:
         raise InvalidInputError("payload", payload, "must be >= 0", "kg")
     return Study(
@@ -307,11 +298,11 @@ def _resolve(source: str, file: Path) -> Path:
 def _lengths(data: Any, crane: Crane) -> LinkLengths:
     if data is None:
         return crane.default_lengths
-    top = _mapping(data, "initial_lengths", set(CHAIN_NAMES), set(CHAIN_NAMES))
+    top = mapping(data, "initial_lengths", set(CHAIN_NAMES), set(CHAIN_NAMES))
     chains = []
     for name in CHAIN_NAMES:
-        d = _mapping(top[name], f"initial_lengths.{name}", {"L", "Lc0", "Lc"}, {"L", "Lc0", "Lc"})
-        values = [_positive(d[k], f"initial_lengths.{name}.{k}", "m") for k in ("L", "Lc0", "Lc")]
+        d = mapping(top[name], f"initial_lengths.{name}", {"L", "Lc0", "Lc"}, {"L", "Lc0", "Lc"})
+        values = [positive(d[k], f"initial_lengths.{name}.{k}", "m") for k in ("L", "Lc0", "Lc")]
         chains.append(ChainLengths(*values))
     return LinkLengths(chains[0], chains[1])
 
@@ -328,28 +319,28 @@ def _reference(data: Any) -> SpiralReference:
         "telescope_amplitude",
     }
     required = keys - {"centre_joints", "centre_tcp", "start_angle", "telescope_amplitude"}
-    d = _mapping(data, "reference", keys, required)
+    d = mapping(data, "reference", keys, required)
     if ("centre_joints" in d) == ("centre_tcp" in d):
         raise ConfigError("reference: give exactly one of centre_joints [theta1, theta2] or centre_tcp [x, y]")
     centre_key = "centre_joints" if "centre_joints" in d else "centre_tcp"
     centre = _pair(d[centre_key], f"reference.{centre_key}")
-    r0 = _number(d["start_radius"], "reference.start_radius")
-    r1 = _positive(d["end_radius"], "reference.end_radius", "m")
+    r0 = number(d["start_radius"], "reference.start_radius")
+    r1 = positive(d["end_radius"], "reference.end_radius", "m")
     if r0 < 0.0:
         raise InvalidInputError("reference.start_radius", r0, "must be >= 0", "m")
-    turns = _number(d["turns"], "reference.turns")
+    turns = number(d["turns"], "reference.turns")
     if turns == 0.0 or abs(turns) > 10.0:
         raise InvalidInputError("reference.turns", turns, "must be nonzero with |turns| <= 10")
-    tele = _number(d["telescope_start"], "reference.telescope_start")
+    tele = number(d["telescope_start"], "reference.telescope_start")
     if tele < 0.0:
         raise InvalidInputError("reference.telescope_start", tele, "must be >= 0", "m")
     return SpiralReference(
         start_radius=r0,
         end_radius=r1,
         turns=turns,
-        start_angle=_number(d.get("start_angle", 0.0), "reference.start_angle"),
+        start_angle=number(d.get("start_angle", 0.0), "reference.start_angle"),
         telescope_start=tele,
-        telescope_amplitude=_number(d.get("telescope_amplitude", 0.0), "reference.telescope_amplitude"),
+        telescope_amplitude=number(d.get("telescope_amplitude", 0.0), "reference.telescope_amplitude"),
         centre_joints=centre if centre_key == "centre_joints" else None,
         centre_tcp=centre if centre_key == "centre_tcp" else None,
     )
@@ -365,11 +356,11 @@ def _bounds(data: Any, initial: LinkLengths) -> Bounds:
         "working_margin_deg",
         "envelope_margin",
     }
-    d = _mapping(data, "bounds", keys, {"lift", "tilt"})
+    d = mapping(data, "bounds", keys, {"lift", "tilt"})
     low: list[float] = []
     up: list[float] = []
     for name in CHAIN_NAMES:
-        chain = _mapping(d[name], f"bounds.{name}", {"low", "up"}, {"low", "up"})
+        chain = mapping(d[name], f"bounds.{name}", {"low", "up"}, {"low", "up"})
         lo = _triple(chain["low"], f"bounds.{name}.low")
         hi = _triple(chain["up"], f"bounds.{name}.up")
         for i, key in enumerate(("L", "Lc0", "Lc")):
@@ -387,16 +378,16 @@ def _bounds(data: Any, initial: LinkLengths) -> Bounds:
     velocity = _triple(d.get("joint_velocity", [0.6, 0.6, 0.5]), "bounds.joint_velocity")
     if min(velocity) <= 0.0:
         raise InvalidInputError("bounds.joint_velocity", min(velocity), "every limit must be > 0")
-    margin = _number(d.get("triangle_margin_deg", 10.0), "bounds.triangle_margin_deg")
+    margin = number(d.get("triangle_margin_deg", 10.0), "bounds.triangle_margin_deg")
     if not 0.0 <= margin < 60.0:
         raise InvalidInputError("bounds.triangle_margin_deg", margin, "must lie in [0, 60)", "deg")
-    working = _number(d.get("working_margin_deg", 3.0), "bounds.working_margin_deg")
+    working = number(d.get("working_margin_deg", 3.0), "bounds.working_margin_deg")
     if not 0.0 <= working <= 30.0:
         raise InvalidInputError("bounds.working_margin_deg", working, "must lie in [0, 30]", "deg")
     working_range = str(d.get("working_range", "crane"))
     if working_range not in ("crane", "reference"):
         raise InvalidInputError("bounds.working_range", working_range, "must be 'crane' or 'reference'")
-    envelope = _number(d.get("envelope_margin", 0.02), "bounds.envelope_margin")
+    envelope = number(d.get("envelope_margin", 0.02), "bounds.envelope_margin")
     if not 0.0 <= envelope < 0.5:
         raise InvalidInputError("bounds.envelope_margin", envelope, "must lie in [0, 0.5)")
     return Bounds(
@@ -410,33 +401,6 @@ def _bounds(data: Any, initial: LinkLengths) -> Bounds:
     )
 
 
-def _mapping(data: Any, where: str, keys: set[str], required: set[str]) -> Mapping[str, Any]:
-    if not isinstance(data, Mapping):
-        raise ConfigError(f"{where}: expected a mapping, got {type(data).__name__}")
-    unknown = sorted(set(map(str, data)) - keys)
-    if unknown:
-        raise ConfigError(f"{where}: unknown key(s) {unknown}; allowed: {sorted(keys)}")
-    missing = sorted(required - set(data))
-    if missing:
-        raise ConfigError(f"{where}: missing key(s) {missing}")
-    return data
-
-
-def _number(value: Any, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ConfigError(f"{where}: expected a number, got {value!r}")
-    if not math.isfinite(value):
-        raise InvalidInputError(where, float(value), "must be finite")
-    return float(value)
-
-
-def _positive(value: Any, where: str, unit: str = "") -> float:
-    number = _number(value, where)
-    if number <= 0.0:
-        raise InvalidInputError(where, number, "must be > 0", unit)
-    return number
-
-
 def _integer(value: Any, where: str, minimum: int) -> int:
     if isinstance(value, bool) or not isinstance(value, int):
         raise ConfigError(f"{where}: expected an integer, got {value!r}")
@@ -448,10 +412,10 @@ def _integer(value: Any, where: str, minimum: int) -> int:
 def _pair(value: Any, where: str) -> tuple[float, float]:
     if not isinstance(value, list | tuple) or len(value) != 2:
         raise ConfigError(f"{where}: expected a list of 2 numbers, got {value!r}")
-    return (_number(value[0], f"{where}[0]"), _number(value[1], f"{where}[1]"))
+    return (number(value[0], f"{where}[0]"), number(value[1], f"{where}[1]"))
 
 
 def _triple(value: Any, where: str) -> list[float]:
     if not isinstance(value, list | tuple) or len(value) != 3:
         raise ConfigError(f"{where}: expected a list of 3 numbers, got {value!r}")
-    return [_number(v, f"{where}[{i}]") for i, v in enumerate(value)]
+    return [number(v, f"{where}[{i}]") for i, v in enumerate(value)]
