@@ -4,4 +4,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 .venv/bin/hiab-sim crane
-.venv/bin/hiab-sim optimize "$@"
+.venv/bin/hiab-sim optimize --starts 3 "$@"
