@@ -3,7 +3,10 @@
 ``--lengths`` takes six numbers in metres, comma-separated, lift chain first:
 ``L,Lc0,Lc,L,Lc0,Lc`` (seed eq. Xi). The file is written atomically (a temporary file in the
 target folder, then ``os.replace``), loads with ``mujoco.MjModel.from_xml_path`` and opens in
-``python -m mujoco.viewer --mjcf=FILE``.
+``python -m mujoco.viewer --mjcf=FILE``. The file carries a keyframe ``home``: the crane at the
+middle of its working ranges, loop-consistent, with the motors' ``ctrl`` set to the static
+actuator forces that hold it against gravity (load it in the viewer's "Key" panel; the open-loop
+crane drifts away from it slowly, as any unstabilised crane would).
 """
 
 from __future__ import annotations
@@ -14,7 +17,9 @@ import os
 import tempfile
 from pathlib import Path
 
-from hiab_sim.config import LinkLengths, load_crane
+import numpy as np
+
+from hiab_sim.config import Crane, LinkLengths, load_crane
 from hiab_sim.errors import InvalidInputError
 
 
@@ -67,6 +72,18 @@ def write_atomic(path: Path, text: str) -> None:
         raise
 
 
+def home_keyframe(crane: Crane, lengths: LinkLengths) -> tuple[np.ndarray, np.ndarray]:
+    """Loop-consistent qpos at the middle of the working ranges and the forces that hold it [N]."""
+    from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
+    from hiab_sim.dynamics.samples import JointSamples
+
+    ranges = [*(chain.joint_range for chain in crane.chains), crane.telescope.joint_range]
+    rest = JointSamples.at_rest([[0.5 * (low + high) for low, high in ranges]])
+    dynamics = MujocoInverseDynamics(crane, lengths)
+    qpos, _, _ = dynamics.state(rest)
+    return qpos[0], dynamics(rest).force[0]
+
+
 def run(args: argparse.Namespace) -> int:
     """Build the model, write it and print a one-line summary."""
     import mujoco
@@ -75,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
 
     crane = load_crane(args.crane)
     lengths = parse_lengths(args.lengths) if args.lengths else crane.default_lengths
-    text = to_xml(crane, lengths)
+    text = to_xml(crane, lengths, keyframes={"home": home_keyframe(crane, lengths)})
     model = mujoco.MjModel.from_xml_string(text)  # what the file will load as
     output = Path(args.output)
     write_atomic(output, text)

@@ -245,17 +245,33 @@ def build_model(crane: Crane, lengths: LinkLengths | None = None) -> mujoco.MjMo
     return build_spec(crane, lengths).compile()
 
 
-def to_xml(crane: Crane, lengths: LinkLengths | None = None) -> str:
+def to_xml(
+    crane: Crane,
+    lengths: LinkLengths | None = None,
+    keyframes: dict[str, tuple[np.ndarray, np.ndarray]] | None = None,
+) -> str:
     """MJCF text of the crane for link lengths Xi; loads with ``mujoco.MjModel.from_xml_string``.
 
     MuJoCo's XML writer keeps 6 significant digits, which would open the closed loops by ~1e-6 m
     and round masses; every body, inertial, geom and site placement is therefore rewritten
     from the compiled model at full double precision (``repr``), so the file reloads to the
     same model to round-off.
+
+    Args:
+        crane: The crane.
+        lengths: Link lengths Xi (default: the crane's own).
+        keyframes: Optional named keyframes, name -> (qpos (nq,), ctrl (nu,)), written at full
+            precision (e.g. a loop-consistent ``home`` pose with its gravity-holding forces).
+
     """
     spec = build_spec(crane, lengths)
     model = spec.compile()
     root = ElementTree.fromstring(spec.to_xml())
+    if keyframes:
+        frames = ElementTree.SubElement(root, "keyframe")
+        for name, (qpos, ctrl) in keyframes.items():
+            key = ElementTree.SubElement(frames, "key", name=name)
+            _set(key, qpos=np.asarray(qpos).reshape(model.nq), ctrl=np.asarray(ctrl).reshape(model.nu))
     world = root.find("worldbody")
     if world is None:
         raise AssertionError("MuJoCo wrote no worldbody")
