@@ -170,15 +170,67 @@ def test_rotor_friction_opposes_motion_and_is_smooth_through_zero_speed() -> Non
     assert np.all(op.rotor_friction_loss >= 0)
 
 
-def test_electrical_power_matches_seed_form_f_v_over_eta_where_eta_is_defined() -> None:
-    """electrical_power() = operating_point().electrical_power = f v / eta in the motoring quadrants."""
+def test_lift_operating_point_matches_a_hand_computed_one() -> None:
+    """One motoring point (f, v, a) = (50 kN, 0.1 m/s, 0.2 m/s^2) on the lift EMLA, by hand from README "EMLA model".
+
+    The preset's parameters are written out here (and checked against the preset), so the
+    expected values do not come from the code under test.
+    """
+    G, lead, m_sm, b_f = 4.0, 0.010, 0.0, 3000.0  # gear ratio, screw lead [m], screw mass [kg], N s/m
+    p, phi, r_s, l_q = 4, 0.12258, 0.268, 2.2e-3  # pole pairs, flux [Wb], ohm, H
+    j_m, tau_f, omega_eps = 4.8e-3, 0.2, 1.0  # kg m^2, N m, rad/s
+    params = EMLAS.lift
+    motor = params.motor
+    assert (params.gear_ratio, params.screw_lead, params.screw_moving_mass, params.viscous_friction) == (
+        G,
+        lead,
+        m_sm,
+        b_f,
+    )
+    assert (motor.pole_pairs, motor.flux_linkage, motor.stator_resistance, motor.Lq) == (p, phi, r_s, l_q)
+    assert (motor.rotor_inertia, motor.rotor_coulomb_friction, motor.friction_smoothing_speed) == (
+        j_m,
+        tau_f,
+        omega_eps,
+    )
+    f, v, a = 50e3, 0.1, 0.2
+    omega = 2 * np.pi * G * v / lead  # 80 pi rad/s
+    tau_m = (
+        lead * (f + m_sm * a + b_f * v) / (2 * np.pi * G)
+        + j_m * (2 * np.pi * G * a / lead)
+        + tau_f * np.tanh(omega / omega_eps)
+    )
+    i_q = tau_m / (1.5 * p * phi)
+    v_d = -p * omega * l_q * i_q
+    v_q = r_s * i_q + p * omega * phi
+    p_elec = 1.5 * v_q * i_q  # i_d = 0
+    # the same numbers, worked out once by hand: omega = 251.327 rad/s, tau_m = 22.6265 N m,
+    # i_q = 30.7642 A, V_q = 131.476 V, P = 6067.12 W = 5000 (f v) + 380.47 (copper) + 50.27
+    # (friction) + 30 (viscous) + 606.39 (inertial) W
+    assert omega == pytest.approx(251.32741, rel=1e-7)
+    assert tau_m == pytest.approx(22.626477, rel=1e-7)
+    assert p_elec == pytest.approx(6067.1220, rel=1e-7)
+    op = operating_point(params, f, v, a)
+    assert op.motor_speed == pytest.approx(omega, rel=1e-13)
+    assert op.motor_torque == pytest.approx(tau_m, rel=1e-13)
+    assert op.i_q == pytest.approx(i_q, rel=1e-13)
+    assert op.v_d == pytest.approx(v_d, rel=1e-13)
+    assert op.v_q == pytest.approx(v_q, rel=1e-13)
+    assert op.electrical_power == pytest.approx(p_elec, rel=1e-13)
+    assert op.copper_loss == pytest.approx(1.5 * r_s * i_q**2, rel=1e-13)
+    assert op.line_voltage_rms == pytest.approx(np.sqrt(1.5 * (v_d**2 + v_q**2)), rel=1e-13)
+    assert op.efficiency == pytest.approx(5000.0 / 6067.1220, rel=1e-7)
+    assert electrical_power(params, f, v, a) == pytest.approx(p_elec, rel=1e-13)
+
+
+def test_electrical_power_equals_the_operating_point_power_elementwise() -> None:
+    """electrical_power() (the optimiser's fast path) = operating_point().electrical_power, any shape."""
     f = np.array([[50e3, -30e3], [10e3, -90e3]])
     v = np.array([[0.1, -0.05], [0.18, -0.01]])
     op = operating_point(EMLAS.tilt, f, v, 0.0)
     p = electrical_power(EMLAS.tilt, f, v, 0.0)
     assert p.shape == (2, 2)
     np.testing.assert_array_equal(p, op.electrical_power)
-    np.testing.assert_allclose(f * v / op.efficiency, p, rtol=1e-13)
 
 
 @settings(max_examples=60, deadline=None)

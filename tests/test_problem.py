@@ -9,9 +9,10 @@ from test_study_small import small_study
 from hiab_sim.config import ChainLengths, LinkLengths
 from hiab_sim.emla import electrical_power
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study.config import study_from_dict
+from hiab_sim.study import problem as problem_module
+from hiab_sim.study.config import load_study, study_from_dict
 from hiab_sim.study.problem import LinkLengthProblem
-from hiab_sim.study.solve import check_start, start_points
+from hiab_sim.study.solve import START_TOLERANCE, check_start, start_points
 
 STUDY = study_from_dict(small_study(), "small.yaml")
 
@@ -70,8 +71,53 @@ def test_cost_is_the_seed_squared_power_sum_of_electrical_power() -> None:
         electrical_power(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
         for i, p in enumerate(problem.emlas)
     )
+    assert problem.dt == 6.25 / 12  # the small study: 12 intervals over 6.25 s
     assert ev.cost == pytest.approx(0.5 * problem.dt * np.sum(power**2), rel=1e-12)
     assert len(ev.constraints) == len(problem.constraint_names)
+
+
+def test_default_collocation_grid_has_26_points_a_quarter_second_apart() -> None:
+    """T = {0, 0.25, ..., 6.25} s (M = 25): 26 points, Dt = 0.25 s, on the default study's problem."""
+    study = load_study()
+    times = study.grid.times()
+    assert len(times) == 26 and times[0] == 0.0 and times[-1] == 6.25
+    problem = LinkLengthProblem(study, id_path="analytic", cost_scale=1.0)
+    assert problem.dt == 0.25
+    np.testing.assert_allclose(np.diff(problem.times), 0.25, rtol=0, atol=1e-15)
+
+
+def test_cost_of_known_powers_matches_a_hand_computation(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The cost of known powers on 26 points 0.25 s apart equals its hand value, 690.625 W^2 s.
+
+    With P_lift(t_k) = k W, P_tilt = 100 W, P_telescope = -100 W: sum_i P_i = k and
+    f = 1/2 * 0.25 s * sum_{k=0}^{25} k^2 W^2 = 0.125 * 5525 = 690.625 W^2 s, a rectangle sum over all
+    26 points (the seed's form), not a trapezoid (which gives 651.5625 W^2 s).
+    """
+    powers = iter(())
+
+    def fake_power(params, force, velocity, acceleration):  # type: ignore[no-untyped-def]
+        return next(powers)
+
+    monkeypatch.setattr(problem_module, "electrical_power", fake_power)
+    problem = LinkLengthProblem(STUDY, id_path="analytic", times=np.linspace(0.0, 6.25, 26), cost_scale=1.0)
+    powers = iter([np.arange(26.0), np.full(26, 100.0), np.full(26, -100.0)])
+    ev = problem.evaluate(problem.initial_point(STUDY.initial_lengths))
+    assert ev.cost == 690.625
+    np.testing.assert_array_equal(ev.power.sum(axis=1), np.arange(26.0))
+    assert problem.cost(ev.z) == 690.625  # cost_scale = 1
+
+
+def test_built_crane_is_a_start_with_no_violation() -> None:
+    """The built XS 031 (strokes exactly 0 at the low end of the working range) starts with violation ~0.
+
+    The optimiser's working-range clearance is not a constraint of the start.
+    """
+    problem = LinkLengthProblem(STUDY, id_path="analytic")
+    z0 = problem.initial_point(STUDY.initial_lengths)
+    assert problem.max_violation(z0) <= 1e-9
+    assert problem.margins(z0).min() >= -1e-12
+    check_start(problem, z0)
+    assert START_TOLERANCE <= 1e-9
 
 
 def test_start_violating_a_constraint_names_it() -> None:
@@ -80,6 +126,18 @@ def test_start_violating_a_constraint_names_it() -> None:
     bad = LinkLengths(ChainLengths(1.0071227324212, 0.2, 0.745), STUDY.initial_lengths.tilt)
     with pytest.raises(InvalidInputError, match=r"initial_lengths .*lift"):
         check_start(problem, problem.initial_point(bad))
+
+
+def test_start_violating_a_constraint_by_a_small_real_amount_is_rejected() -> None:
+    """Lc0 + 10 um makes the lift stroke -1e-5 m at the low end of the working range: -1e-4 scaled, rejected."""
+    problem = LinkLengthProblem(STUDY, id_path="analytic")
+    built = STUDY.initial_lengths.lift
+    bad = LinkLengths(ChainLengths(built.L, built.Lc0 + 1e-5, built.Lc), STUDY.initial_lengths.tilt)
+    z = problem.initial_point(bad)
+    assert problem.max_violation(z) == pytest.approx(1e-4, rel=1e-6)
+    with pytest.raises(InvalidInputError, match=r"working_range\.lift\.x >= 0 at the low end") as info:
+        check_start(problem, z)
+    assert info.value.value == pytest.approx(-1e-4, rel=1e-6)
 
 
 @pytest.mark.parametrize(

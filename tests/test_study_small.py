@@ -49,4 +49,4 @@ def test_small_study_loads_with_a_feasible_start() -> None:
 
     study = study_from_dict(small_study(), "small.yaml")
     problem = LinkLengthProblem(study)
-    assert problem.max_violation(problem.initial_point(study.initial_lengths)) <= 1e-5
+    assert problem.max_violation(problem.initial_point(study.initial_lengths)) <= 1e-9

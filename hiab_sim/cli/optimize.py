@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 from hiab_sim.errors import BackendUnavailableError, InvalidInputError
 
@@ -37,6 +38,26 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--no-figures", action="store_true", help="do not draw the figures (quick runs)")
     parser.add_argument("--quiet", action="store_true", help="no per-iteration progress lines")
     parser.set_defaults(run=run)
+
+
+def decomposition_line(d: dict[str, Any]) -> str:
+    """One line: the net-energy saving from the lengths alone and from the trajectory alone."""
+    designs = d["designs"]
+
+    def part(saved: float | None, percent: float | None, key: str) -> str:
+        design = designs[key]
+        if saved is None or percent is None or not design["evaluable"]:
+            return "not evaluable"
+        return f"{saved:.1f} J ({percent:.2f} %, max violation {design['max_violation']:.1e})"
+
+    interaction = d["interaction_J"]
+    return (
+        "net energy saved from the lengths alone (initial trajectory): "
+        f"{part(d['from_lengths_J'], d['from_lengths_percent'], 'optimal_lengths_initial_trajectory')}, "
+        "from the trajectory (initial lengths): "
+        f"{part(d['from_trajectory_J'], d['from_trajectory_percent'], 'initial_lengths_optimal_trajectory')}, "
+        f"interaction {'n/a' if interaction is None else f'{interaction:.1f} J'}"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -72,19 +93,26 @@ def run(args: argparse.Namespace) -> int:
         f"max violation {sol['max_violation_scaled']:.1e}); cost ratio {r['improvement']['cost_ratio']:.4f}, "
         f"net energy -{r['improvement']['net_energy_saved_percent']:.2f} %"
     )
+    print(decomposition_line(r["improvement"]["decomposition"]))
     print(
         f"re-check ({rc['id_path']}, {rc['grid_points']} points): max violation {rc['max_violation_scaled']:.1e}, "
         f"TCP tracking error {rc['tracking_error']['position_m'] * 1e3:.3f} mm"
     )
     ms = r["multistart"]
     if len(ms["starts"]) > 1:
-        if ms["same_optimum"]:
-            print(f"multi-start: all {len(ms['starts'])} starts reach the same optimum within {ms['tolerance_m']} m")
+        converged = ms["converged_starts"]
+        if ms["same_optimum"] and not ms["failed_starts"]:
+            print(f"multi-start: all {converged} starts reach the same optimum within {ms['tolerance_m']} m")
+        elif ms["same_optimum"]:
+            print(f"multi-start: all {converged} converged starts reach the same optimum within {ms['tolerance_m']} m")
         else:
-            print(f"multi-start: {len(ms['distinct_optima'])} distinct local optima:")
+            count = len(ms["distinct_optima"])
+            print(f"multi-start: {count} distinct local optima among {converged} converged starts:")
             for d in ms["distinct_optima"]:
                 xi = " ".join(f"{v:.4f}" for v in d["xi"])
                 print(f"  Xi [{xi}] m  net energy {d['net_electrical_energy_J'] / 1e3:.3f} kJ  starts {d['starts']}")
+        for f in ms["failed_starts"]:
+            print(f"  start {f['start']} failed (not an optimum): {f['message']}")
     print(f"wrote {output.folder}/result.json, trajectory.npz and {len(output.figures)} figures")
     if not args.no_video:
         try:

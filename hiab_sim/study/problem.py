@@ -63,7 +63,11 @@ STROKE_SCALE = 0.1
 ACTUATORS = ("lift", "tilt", "telescope")
 #: The ID's input check uses the working range shrunk by this much at both ends [rad].
 ID_SLACK = 0.02
-#: const_j at the ends of the working range holds with this clearance [m] (exact, not round-off).
+#: The optimiser (``tightened``) holds const_j at the ends of the working range with this clearance
+#: [m], so that its optimum passes the crane's exact stroke check despite SLSQP's round-off-level
+#: violations. It is part of the solver's rows only: start checks and reported violations
+#: (:meth:`LinkLengthProblem.margins`) use the nominal const_j, so the built crane, whose strokes reach
+#: exactly 0 and the full stroke at the ends of its joint range, is a start with violation ~0.
 WORKING_CLEARANCE = 1e-6
 
 
@@ -132,6 +136,7 @@ class LinkLengthProblem:
         self.study = study
         self.band_fraction = study.tracking.collocation_fraction if tightened else 1.0
         self.envelope_margin = study.bounds.envelope_margin if tightened else 0.0
+        self.working_clearance = WORKING_CLEARANCE / STROKE_SCALE if tightened else 0.0
         self.emlas = emlas or load_emla_set(study.emla_source)
         self.id_path = id_path or study.solver.id_path
         self.times = study.grid.times() if times is None else np.asarray(times, dtype=float)
@@ -185,6 +190,10 @@ class LinkLengthProblem:
         self._eval_cache: dict[bytes, Evaluation] = {}
         self._grad_cache: dict[bytes, tuple[Array, Array]] = {}
         self.constraint_names = self._names()
+        #: added to the solver's rows gives the nominal scaled margins (the clearance rows are last)
+        self.clearance = np.zeros(len(self.constraint_names))
+        assert all(name.startswith("working_range.") for name in self.constraint_names[-12:])
+        self.clearance[-12:] = self.working_clearance
         self.n_evaluations = 0
         self.n_gradients = 0
         self.cost_scale = 1.0
@@ -267,10 +276,18 @@ class LinkLengthProblem:
         """Rest-to-rest equalities (linear in c)."""
         return self.evaluate(z).equalities
 
+    def margins(self, z: Array) -> Array:
+        """Nominal scaled inequality margins (feasible where >= 0): the solver's rows without the clearance.
+
+        The tracking bands and envelope margins stay as this problem holds them (``tightened``);
+        only the working-range clearance, a safety the optimiser adds for its own optimum, is removed.
+        """
+        return self.evaluate(z).constraints + self.clearance
+
     def max_violation(self, z: Array) -> float:
-        """Largest violation of any constraint or bound, in scaled units."""
+        """Largest violation of any nominal constraint (:meth:`margins`) or bound, in scaled units."""
         ev = self.evaluate(z)
-        v = max(0.0, float(-ev.constraints.min()), float(np.abs(ev.equalities).max()))
+        v = max(0.0, float(-self.margins(z).min()), float(np.abs(ev.equalities).max()))
         zx = np.asarray(z)[: self.n_xi]
         return max(v, float(np.max(self.lower[: self.n_xi] - zx)), float(np.max(zx - self.upper[: self.n_xi])))
 
@@ -310,7 +327,7 @@ class LinkLengthProblem:
         dth = joints.velocity / vmax
         blocks.append((np.concatenate([1.0 - dth, 1.0 + dth], axis=1).ravel(), "joint_velocity"))
         xw = self._strokes(lengths, np.array([[w[0] for w in self.working], [w[1] for w in self.working]]))
-        blocks.append((self._stroke_rows(lengths, xw).ravel() - WORKING_CLEARANCE / STROKE_SCALE, "working_range"))
+        blocks.append((self._stroke_rows(lengths, xw).ravel() - self.working_clearance, "working_range"))
         return blocks
 
     def _strokes(self, lengths: LinkLengths, theta: Array) -> Array:

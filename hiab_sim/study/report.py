@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.emla import energy_summary, operating_point
+from hiab_sim.errors import HiabSimError
 from hiab_sim.study.problem import ACTUATORS, Evaluation, LinkLengthProblem
 from hiab_sim.study.solve import SolveResult, write_atomic, xi_table
 
@@ -80,7 +81,8 @@ def design_summary(problem: LinkLengthProblem, z: Array) -> DesignCheck:
         "acceleration_m_per_s2": float(np.max(np.abs(ev.tcp.acceleration[:, :2] - ref.acceleration[:, :2]))),
         "telescope_m": float(np.max(np.abs(ev.tcp.position[:, 2] - ref.position[:, 2]))),
     }
-    worst = int(np.argmin(ev.constraints))
+    margins = problem.margins(z)
+    worst = int(np.argmin(margins))
     summary = {
         "lengths": xi_table(ev.lengths),
         "id_path": problem.id_path,
@@ -93,7 +95,7 @@ def design_summary(problem: LinkLengthProblem, z: Array) -> DesignCheck:
         "energy_breakdown_J": breakdown,
         "actuators": per_actuator,
         "max_violation": problem.max_violation(z),
-        "worst_constraint": {"name": problem.constraint_names[worst], "scaled_margin": float(ev.constraints[worst])},
+        "worst_constraint": {"name": problem.constraint_names[worst], "scaled_margin": float(margins[worst])},
         "tracking_error": err,
     }
     return DesignCheck(ev, summary)
@@ -146,6 +148,7 @@ def build_result(
         "cost_ratio": colloc["optimal"].cost / colloc["initial"].cost,
         "net_energy_saved_J": e0 - e1,
         "net_energy_saved_percent": 100.0 * (e0 - e1) / e0,
+        "decomposition": energy_decomposition(problem, fine, main.z0, main.z),
     }
     out["solver"] = {
         "method": "SLSQP (scipy.optimize.minimize) with exact-structure gradients",
@@ -212,24 +215,105 @@ def build_result(
     return out, arrays, checks
 
 
+#: The four designs of :func:`energy_decomposition`: (key, lengths from, trajectory from).
+DECOMPOSITION_DESIGNS = (
+    ("initial_lengths_initial_trajectory", "initial", "initial"),
+    ("optimal_lengths_initial_trajectory", "optimal", "initial"),
+    ("initial_lengths_optimal_trajectory", "initial", "optimal"),
+    ("optimal_lengths_optimal_trajectory", "optimal", "optimal"),
+)
+
+
+def energy_decomposition(
+    problem: LinkLengthProblem, fine: LinkLengthProblem, z_initial: Array, z_optimal: Array
+) -> dict[str, Any]:
+    """Split the saving into what the lengths and what the re-shaped trajectory contribute.
+
+    The spline coefficients are decision variables free within the tracking bands, so the
+    optimum changes the trajectory as well as the mounting. Each of the four combinations of
+    {initial, optimal} lengths with the {initial, optimal} coefficients is evaluated on the fine
+    grid (nominal bands): net energy, cost (fine and collocation grid) and max violation (a
+    mixed design need not be feasible). ``from_lengths`` is the saving of the optimal lengths
+    with the initial trajectory, ``from_trajectory`` that of the optimal trajectory with the
+    initial lengths (both relative to the initial design), ``interaction`` the rest of the total.
+    """
+    n = problem.n_xi
+    source = {"initial": np.asarray(z_initial, dtype=float), "optimal": np.asarray(z_optimal, dtype=float)}
+    designs: dict[str, Any] = {}
+    energy: dict[str, float] = {}
+    for key, xi_from, c_from in DECOMPOSITION_DESIGNS:
+        z = np.concatenate([source[xi_from][:n], source[c_from][n:]])
+        entry: dict[str, Any] = {"lengths": xi_from, "trajectory": c_from}
+        try:
+            summary = design_summary(fine, z).summary
+            collocation_cost = problem.evaluate(z).cost
+        except HiabSimError as error:  # a mixed design may leave the model's domain
+            entry.update(evaluable=False, error=str(error))
+            energy[key] = float("nan")
+        else:
+            energy[key] = summary["net_electrical_energy_J"]
+            entry.update(
+                evaluable=True,
+                net_electrical_energy_J=summary["net_electrical_energy_J"],
+                drawn_energy_without_regeneration_J=summary["drawn_energy_without_regeneration_J"],
+                cost_W2s=summary["cost_W2s"],
+                collocation_cost_W2s=collocation_cost,
+                max_violation=summary["max_violation"],
+                worst_constraint=summary["worst_constraint"],
+            )
+        designs[key] = entry
+    e00 = energy["initial_lengths_initial_trajectory"]
+    lengths = e00 - energy["optimal_lengths_initial_trajectory"]
+    trajectory = e00 - energy["initial_lengths_optimal_trajectory"]
+    total = e00 - energy["optimal_lengths_optimal_trajectory"]
+
+    def finite(x: float) -> float | None:
+        return float(x) if np.isfinite(x) else None
+
+    return {
+        "note": (
+            "net electrical energy on the fine grid of the four combinations of initial/optimal lengths and "
+            "initial/optimal spline coefficients; savings relative to the initial design"
+        ),
+        "designs": designs,
+        "from_lengths_J": finite(lengths),
+        "from_lengths_percent": finite(100.0 * lengths / e00),
+        "from_trajectory_J": finite(trajectory),
+        "from_trajectory_percent": finite(100.0 * trajectory / e00),
+        "interaction_J": finite(total - lengths - trajectory),
+        "total_J": finite(total),
+    }
+
+
 def multistart_summary(problem: LinkLengthProblem, results: list[SolveResult], tolerance: float) -> dict[str, Any]:
-    """Whether every start reached the same Xi within ``tolerance`` [m]; else the distinct optima."""
+    """Whether every converged start reached the same Xi within ``tolerance`` [m]; else the distinct optima.
+
+    A start whose solver failed is no optimum: it is left out of ``distinct_optima`` and listed
+    under ``failed_starts`` with its message (its row has no optimal lengths or cost).
+    """
     rows = []
+    failed = []
     for r in results:
-        ev = problem.evaluate(r.z)
-        rows.append(
-            {
-                "start": r.start,
-                "initial_lengths": xi_table(r.initial_lengths),
-                "optimal_lengths": xi_table(ev.lengths),
-                "cost_W2s": ev.cost,
-                "success": r.success,
-                "message": r.message,
-                "iterations": r.iterations,
-            }
-        )
+        row: dict[str, Any] = {
+            "start": r.start,
+            "initial_lengths": xi_table(r.initial_lengths),
+            "optimal_lengths": None,
+            "cost_W2s": None,
+            "success": r.success,
+            "message": r.message,
+            "iterations": r.iterations,
+        }
+        if r.success:
+            ev = problem.evaluate(r.z)
+            row["optimal_lengths"] = xi_table(ev.lengths)
+            row["cost_W2s"] = ev.cost
+        else:
+            failed.append({"start": r.start, "initial_xi": r.initial_lengths.as_array().tolist(), "message": r.message})
+        rows.append(row)
     distinct: list[dict[str, Any]] = []
     for r, row in zip(results, rows, strict=True):
+        if not r.success:
+            continue
         xi = problem.unpack(r.z)[0].as_array()
         for d in distinct:
             if np.max(np.abs(np.asarray(d["xi"]) - xi)) <= tolerance:
@@ -239,14 +323,17 @@ def multistart_summary(problem: LinkLengthProblem, results: list[SolveResult], t
             distinct.append({"xi": xi.tolist(), "cost_W2s": row["cost_W2s"], "starts": [r.start]})
     if len(results) > 1:
         fine = fine_problem(problem)
+        by_start = {r.start: r for r in results}
         for d in distinct:
-            z = results[d["starts"][0]].z
+            z = by_start[d["starts"][0]].z
             d["net_electrical_energy_J"] = design_summary(fine, z).summary["net_electrical_energy_J"]
     return {
         "starts": rows,
         "tolerance_m": tolerance,
+        "converged_starts": len(results) - len(failed),
         "same_optimum": len(distinct) == 1,
         "distinct_optima": distinct,
+        "failed_starts": failed,
     }
 
 

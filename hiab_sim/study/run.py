@@ -14,7 +14,14 @@ from hiab_sim.errors import SolverError
 from hiab_sim.study.config import Study, load_study
 from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.report import build_result, write_results
-from hiab_sim.study.solve import SolveResult, check_start, solve, start_points
+from hiab_sim.study.solve import (
+    SolveResult,
+    check_checkpoint,
+    check_start,
+    remove_checkpoints,
+    solve,
+    start_points,
+)
 
 
 @dataclass(frozen=True)
@@ -37,9 +44,11 @@ def run_study(
 ) -> RunOutput:
     """Optimise a study and write its result folder.
 
-    Bad input (study, unreachable reference, infeasible start) raises before anything is
-    written. A failure of SLSQP on the study's own start raises :class:`SolverError` after
-    its checkpoint (the partial history) is on disk; failures of extra starts are reported.
+    Bad input (study, unreachable reference, infeasible start, with ``resume`` a checkpoint of
+    another study, ID path or start) raises before anything is written. A fresh run (no
+    ``resume``) deletes the folder's checkpoints of earlier runs. A failure of SLSQP on the
+    study's own start raises :class:`SolverError` after its checkpoint (the partial history) is
+    on disk; failures of extra starts are reported (``multistart.failed_starts``).
     """
     t0 = time.perf_counter()
     if not isinstance(study, Study):
@@ -48,6 +57,13 @@ def run_study(
     check_start(problem, problem.initial_point(study.initial_lengths))
     initials = start_points(problem, starts)
     folder = Path(out)
+    if resume:
+        for k, initial in enumerate(initials):
+            check_checkpoint(problem, initial, folder, k)
+    else:
+        removed = remove_checkpoints(folder)
+        if removed and progress is not None:
+            progress.write(f"removed {len(removed)} checkpoint(s) of an earlier run in {folder}\n")
     folder.mkdir(parents=True, exist_ok=True)
     results: list[SolveResult] = []
     for k, initial in enumerate(initials):
@@ -61,6 +77,7 @@ def run_study(
             failed = SolveResult(
                 start=k, initial_lengths=initial, z0=problem.initial_point(initial), z=problem.initial_point(initial)
             )
+            failed.success = False
             failed.message = str(error)
             results.append(failed)
     result, arrays, checks = build_result(problem, results, time.perf_counter() - t0)

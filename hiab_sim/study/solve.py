@@ -3,18 +3,22 @@
 Every SQP iteration appends (cost, scaled cost, max constraint violation, Xi) to the history and
 rewrites ``checkpoint_<k>.json`` in the output folder atomically (temp file + ``os.replace``),
 so a killed run continues from its last iterate with ``resume=True`` (the quasi-Newton Hessian
-restarts from the identity there).
+restarts from the identity there). Each checkpoint records what it belongs to (:func:`checkpoint_identity`:
+the study's path and content hash, the ID path and the start's Xi); resuming from a checkpoint of
+another run is refused with the differing field named, and a fresh run deletes the folder's old
+checkpoints first (:func:`remove_checkpoints`).
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import sys
 import tempfile
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -27,9 +31,9 @@ from hiab_sim.errors import HiabSimError, InvalidInputError, SolverError
 from hiab_sim.study.problem import LinkLengthProblem
 
 Array = NDArray[np.float64]
-#: Largest violation [scaled units] a start may have: the working-range clearance, so that the built
-#: crane, whose strokes reach exactly 0 at the ends of its joint range, is a valid start.
-START_TOLERANCE = 1.01e-5
+#: Largest violation [scaled units] of a nominal constraint (:meth:`LinkLengthProblem.margins`) a start
+#: may have: round-off only (the built crane's strokes reach exactly 0 at the ends of its joint range).
+START_TOLERANCE = 1e-9
 
 
 @dataclass
@@ -83,11 +87,12 @@ def check_start(problem: LinkLengthProblem, z: Array, label: str = "initial_leng
         raise InvalidInputError(
             f"{label} ({error.field})", error.value, f"the start is not an admissible crane: {error.allowed}"
         ) from None
-    worst = int(np.argmin(ev.constraints))
-    if ev.constraints[worst] < -START_TOLERANCE:
+    margins = ev.constraints + problem.clearance
+    worst = int(np.argmin(margins))
+    if margins[worst] < -START_TOLERANCE:
         raise InvalidInputError(
             f"{label} (constraint {problem.constraint_names[worst]})",
-            float(ev.constraints[worst]),
+            float(margins[worst]),
             "the start must satisfy every constraint (scaled margin >= 0)",
         )
 
@@ -124,7 +129,7 @@ def start_points(problem: LinkLengthProblem, count: int, seed: int = 6) -> list[
             continue
         lengths = LinkLengths.from_array(xi)
         try:
-            if problem.evaluate(problem.initial_point(lengths)).constraints.min() >= 0.0:
+            if problem.margins(problem.initial_point(lengths)).min() >= 0.0:
                 starts.append(lengths)
         except HiabSimError:
             continue
@@ -137,8 +142,64 @@ def _checkpoint_path(out: Path, start: int) -> Path:
     return out / f"checkpoint_{start}.json"
 
 
-def _save_checkpoint(out: Path, result: SolveResult, z: Array, done: bool) -> None:
+def study_digest(problem: LinkLengthProblem) -> str:
+    """SHA-256 of the study's content: every setting, the crane and the EMLA set.
+
+    The file path is recorded separately, and ``solver.maxiter`` is left out: it is the run's
+    iteration budget, not part of the problem, and resuming a run that hit it with a larger one is
+    what ``--resume`` is for.
+    """
+    study = problem.study
+    content = replace(study, path="", solver=replace(study.solver, maxiter=0))
+    text = "\n".join((repr(content), repr(study.crane), repr(problem.emlas)))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def checkpoint_identity(problem: LinkLengthProblem, initial: LinkLengths) -> dict[str, Any]:
+    """What a checkpoint belongs to: study path and content hash, ID path, start Xi [m]."""
+    return {
+        "study": str(Path(problem.study.path).resolve()),
+        "study_sha256": study_digest(problem),
+        "id_path": problem.id_path,
+        "initial_xi": initial.as_array().tolist(),
+    }
+
+
+def check_checkpoint(problem: LinkLengthProblem, initial: LinkLengths, out: Path, start: int) -> dict[str, Any] | None:
+    """The checkpoint of a start if it belongs to this run, None if there is none.
+
+    Raises:
+        InvalidInputError: The checkpoint was written for another study, ID path or start,
+            named by the first field that differs (``--resume (checkpoint_<k>.json <field>)``).
+
+    """
+    data = load_checkpoint(out, start)
+    if data is None:
+        return None
+    name = _checkpoint_path(out, start).name
+    for key, expected in checkpoint_identity(problem, initial).items():
+        found = data.get(key)
+        if found != expected:
+            raise InvalidInputError(
+                f"--resume ({name} {key})",
+                "missing" if found is None else found,
+                f"the checkpoint belongs to another run; this run has {key} = {expected} "
+                "(run without --resume to start afresh)",
+            )
+    return data
+
+
+def remove_checkpoints(out: Path) -> list[Path]:
+    """Delete the ``checkpoint_*.json`` files of earlier runs in ``out``; return them."""
+    removed = sorted(out.glob("checkpoint_*.json")) if out.is_dir() else []
+    for path in removed:
+        path.unlink(missing_ok=True)
+    return removed
+
+
+def _save_checkpoint(out: Path, result: SolveResult, z: Array, done: bool, identity: dict[str, Any]) -> None:
     data = {
+        **identity,
         "start": result.start,
         "initial_xi": result.initial_lengths.as_array().tolist(),
         "z0": result.z0.tolist(),
@@ -183,24 +244,27 @@ def solve(
         initial: Start link lengths (coefficients from inverse kinematics).
         start: Index of this start (names its checkpoint).
         out: Output folder for checkpoints, or None.
-        resume: Continue from ``out``'s checkpoint of this start if there is one.
+        resume: Continue from ``out``'s checkpoint of this start if there is one (it must belong
+            to this study, ID path and start: :func:`check_checkpoint`).
         progress: Stream for one line per iteration, or None (quiet).
         maxiter: Iteration limit (default: the study's).
         use_gradients: False uses scipy's finite-difference jacobians (the benchmark's baseline).
         on_iterate: Called with each new history row.
 
     Raises:
-        InvalidInputError: The start violates a constraint (named).
+        InvalidInputError: The start violates a constraint (named), or the checkpoint to resume
+            from belongs to another run.
         SolverError: SLSQP did not report success; the checkpoint keeps the partial history.
 
     """
     z0 = problem.initial_point(initial)
     check_start(problem, z0)
     result = SolveResult(start=start, initial_lengths=initial, z0=z0, z=z0.copy())
+    identity = checkpoint_identity(problem, initial)
     z_begin = z0
     previous_wall = 0.0
     if resume and out is not None:
-        data = load_checkpoint(out, start)
+        data = check_checkpoint(problem, initial, out, start)
         if data is not None:
             result.history = [Iterate(**h) for h in data["history"]]
             z_begin = np.asarray(data["z"], dtype=float)
@@ -229,7 +293,7 @@ def solve(
         result.z = np.array(z, dtype=float)
         result.wall_time = row.wall_time
         if out is not None:
-            _save_checkpoint(out, result, z, done=False)
+            _save_checkpoint(out, result, z, done=False, identity=identity)
         if progress is not None:
             xi = " ".join(f"{v:.4f}" for v in row.xi)
             progress.write(
@@ -263,7 +327,7 @@ def solve(
     except HiabSimError as error:
         result.message = f"a trial point left the model's domain: {error}"
         if out is not None:
-            _save_checkpoint(out, result, result.z, done=False)
+            _save_checkpoint(out, result, result.z, done=False, identity=identity)
         raise SolverError(f"start {start}: {result.message} (partial history kept)") from error
     result.z = np.asarray(res.x, dtype=float)
     result.success = bool(res.success)
@@ -277,7 +341,7 @@ def solve(
         record(result.z)
         result.iterations = len(result.history) - 1
     if out is not None:
-        _save_checkpoint(out, result, result.z, done=result.success)
+        _save_checkpoint(out, result, result.z, done=result.success, identity=identity)
     if not result.success:
         raise SolverError(
             f"start {start}: SLSQP status {result.status}: {result.message} after {result.iterations} iterations "
