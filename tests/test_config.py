@@ -179,3 +179,17 @@ def test_cli_help_lists_subcommands_and_version() -> None:
         [sys.executable, "-m", "hiab_sim", "--version"], capture_output=True, text=True, check=True
     )
     assert version.stdout.startswith("hiab-sim ")
+
+
+def test_cli_reports_missing_osmesa_in_one_line(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """MUJOCO_GL=osmesa without libOSMesa: MuJoCo subcommands exit 2 with the install hint."""
+    from hiab_sim import _gl
+    from hiab_sim.cli import main
+
+    monkeypatch.setenv("MUJOCO_GL", "osmesa")
+    monkeypatch.setattr(_gl.ctypes.util, "find_library", lambda name: None)
+    assert main(["mjcf", "-o", "unused.xml"]) == 2
+    err = capsys.readouterr().err
+    assert "apt-get install libosmesa6" in err and err.count("\n") == 1

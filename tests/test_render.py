@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from hiab_sim import _gl
 from hiab_sim.cli import main
 from hiab_sim.config import Crane, LinkLengths, check_lengths
 from hiab_sim.crane.kinematics import tcp_position
@@ -258,7 +259,7 @@ def test_missing_osmesa_is_one_line(
 ) -> None:
     """MUJOCO_GL=osmesa without libOSMesa says to apt-get install libosmesa6."""
     monkeypatch.setenv("MUJOCO_GL", "osmesa")
-    monkeypatch.setattr(render_backend.ctypes.util, "find_library", lambda name: None)
+    monkeypatch.setattr(_gl.ctypes.util, "find_library", lambda name: None)
     err = _cli_error(capsys, [str(result_dir), "-o", str(tmp_path / "v.mp4")])
     assert "apt-get install libosmesa6" in err
     assert list(tmp_path.iterdir()) == []

@@ -13,7 +13,11 @@ import sys
 from collections.abc import Sequence
 
 from hiab_sim import __version__
+from hiab_sim._gl import check_gl_backend
 from hiab_sim.errors import HiabSimError, SolverError
+
+#: Subcommands that import MuJoCo: its OpenGL backend is checked before they run.
+USES_MUJOCO = {"mjcf", "validate", "optimize", "render"}
 
 #: Subcommand name -> module under ``hiab_sim.cli`` that implements it.
 SUBCOMMANDS: dict[str, str] = {
@@ -48,6 +52,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return 0
     try:
+        if args.command in USES_MUJOCO:
+            check_gl_backend()
         return int(args.run(args))
     except SolverError as error:
         print(f"hiab-sim {args.command}: solver failed: {error}", file=sys.stderr)

@@ -16,7 +16,6 @@ Videos and images are written to a temporary name in the target folder and moved
 from __future__ import annotations
 
 import contextlib
-import ctypes.util
 import os
 import shutil
 import tempfile
@@ -28,12 +27,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim._gl import INSTALL_OSMESA, check_gl_backend
 from hiab_sim.errors import BackendUnavailableError, HiabSimError, InvalidInputError
 
 if TYPE_CHECKING:
     import mujoco
 
-INSTALL_OSMESA = "apt-get install libosmesa6"
 INSTALL_FFMPEG = "apt-get install ffmpeg (or pip install imageio-ffmpeg)"
 
 #: Video containers written by :func:`video_sink`: suffix -> mediapy codec.
@@ -56,14 +55,6 @@ def import_mujoco() -> Any:
             f"for CPU rendering: {INSTALL_OSMESA} and MUJOCO_GL=osmesa"
         ) from None
     return mujoco
-
-
-def check_gl_backend() -> str:
-    """Return the OpenGL backend in force; raise if it is OSMesa and libOSMesa is missing."""
-    backend = os.environ.get("MUJOCO_GL", "").strip().lower()
-    if backend == "osmesa" and not ctypes.util.find_library("OSMesa"):
-        raise BackendUnavailableError(f"MUJOCO_GL=osmesa but libOSMesa is not installed: {INSTALL_OSMESA}")
-    return backend or "default"
 
 
 def open_renderer(model: mujoco.MjModel, width: int, height: int, max_geom: int) -> mujoco.Renderer:
