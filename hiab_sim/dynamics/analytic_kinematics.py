@@ -31,22 +31,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.config import ClosedChain, Crane, LinkLengths
+from hiab_sim.config import LINK_NAMES, ClosedChain, Crane, LinkLengths
 from hiab_sim.crane import mechanism
 from hiab_sim.dynamics.spatial import ad, rotate, twist_to_child
 
 Array = NDArray[np.float64]
 
 #: Moving links in base-to-tip order (each link's parent comes before it).
-MOVING_LINKS = (
-    "lift_boom",
-    "lift_cylinder",
-    "lift_rod",
-    "tilt_boom",
-    "tilt_cylinder",
-    "tilt_rod",
-    "telescope_rod",
-)
+MOVING_LINKS = LINK_NAMES[1:]  # every link but the fixed base, parents first
 _REVOLUTE_Z = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
 _PRISMATIC_X = np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0])
 
