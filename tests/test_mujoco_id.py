@@ -174,9 +174,11 @@ def test_infeasible_lengths_name_the_field(crane: Crane) -> None:
 
 
 def test_qfrc_inverse_at_a_cylinder_slide_is_not_the_cylinder_force(crane: Crane) -> None:
-    """The trap the projection avoids: with the soft loops on, mj_inverse on a loop-consistent state
-    puts almost no force in the connect constraints, so qfrc_inverse at x1/x2 is a small fraction of
-    the cylinder force, and it breaks the power balance that the projected forces satisfy."""
+    """qfrc_inverse at a cylinder slide is not the cylinder force (the trap the projection avoids).
+
+    With the soft loops on, mj_inverse on a loop-consistent state puts almost no force in the
+    connect constraints, so qfrc_inverse at x1/x2 is a small fraction of the cylinder force.
+    """
     from hiab_sim.model.mjcf import build_model
 
     t = np.linspace(0.0, 4.0, 9)
