@@ -8,6 +8,7 @@ if [ "$(id -u)" != "0" ]; then SUDO="sudo"; fi
 need=""
 dpkg -s libosmesa6 >/dev/null 2>&1 || need="$need libosmesa6"
 command -v ffmpeg >/dev/null 2>&1 || need="$need ffmpeg"
+python3 -c "import ensurepip, venv" >/dev/null 2>&1 || need="$need python3-venv"   # Debian splits venv out
 if [ -n "$need" ]; then
   echo "[setup] apt-get install$need"
   $SUDO apt-get update -qq
