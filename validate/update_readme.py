@@ -9,10 +9,10 @@ when the README is out of date.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-import tempfile
 from pathlib import Path
+
+from hiab_sim.atomic_io import write_atomic
 
 START = "<!-- validation-table:start -->"
 END = "<!-- validation-table:end -->"
@@ -41,10 +41,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     if args.check:
         return 0 if new == old else 1
-    handle, temp = tempfile.mkstemp(dir=args.readme.parent, prefix=".README.", suffix=".md")
-    with os.fdopen(handle, "w") as stream:
-        stream.write(new)
-    os.replace(temp, args.readme)
+    write_atomic(args.readme, new)
     print(f"updated {args.readme} from {args.table}")
     return 0
 

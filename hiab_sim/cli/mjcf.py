@@ -13,12 +13,11 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from hiab_sim.atomic_io import write_atomic
 from hiab_sim.config import Crane, LinkLengths, load_crane
 from hiab_sim.errors import InvalidInputError
 
@@ -57,21 +56,6 @@ def parse_lengths(text: str) -> LinkLengths:
     return LinkLengths.from_array(values)
 
 
-def write_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file in the same folder and ``os.replace``."""
-    if not path.parent.is_dir():
-        raise InvalidInputError("--output", str(path), "its folder must exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as handle:
-            handle.write(text)
-        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a model file is meant to be shared
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def home_keyframe(crane: Crane, lengths: LinkLengths) -> tuple[np.ndarray, np.ndarray]:
     """Loop-consistent qpos at the middle of the working ranges and the forces that hold it [N]."""
     from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
@@ -95,6 +79,8 @@ def run(args: argparse.Namespace) -> int:
     text = to_xml(crane, lengths, keyframes={"home": home_keyframe(crane, lengths)})
     model = mujoco.MjModel.from_xml_string(text)  # what the file will load as
     output = Path(args.output)
+    if not output.parent.is_dir():
+        raise InvalidInputError("--output", str(output), "its folder must exist")
     write_atomic(output, text)
     xi = ", ".join(f"{v:.4g}" for v in lengths.as_array())
     print(f"wrote {output}: {crane.name}, Xi = [{xi}] m, {model.nbody - 1} bodies, {model.nv} dofs")

@@ -18,7 +18,6 @@ from __future__ import annotations
 import contextlib
 import os
 import shutil
-import tempfile
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
@@ -28,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim._gl import INSTALL_OSMESA, check_gl_backend
+from hiab_sim.atomic_io import atomic_path
 from hiab_sim.errors import BackendUnavailableError, HiabSimError, InvalidInputError
 
 if TYPE_CHECKING:
@@ -118,20 +118,6 @@ def check_output_path(path: Path, suffixes: tuple[str, ...], what: str) -> Path:
     return path
 
 
-@contextlib.contextmanager
-def _atomic_target(path: Path) -> Iterator[Path]:
-    """Yield a temporary path next to ``path`` (same suffix); move it onto ``path`` on success."""
-    handle, name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}", dir=path.parent)
-    os.close(handle)
-    temporary = Path(name)
-    try:
-        yield temporary
-        os.chmod(temporary, 0o644)
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
-
-
 class VideoSink:
     """An open video file: :meth:`add` frames one by one; the file appears when the sink closes."""
 
@@ -156,7 +142,7 @@ def video_sink(path: Path, size: tuple[int, int], fps: float) -> Iterator[VideoS
     path = check_output_path(path, tuple(VIDEO_CODECS), "video")
     ffmpeg_path()
     width, height = size
-    with _atomic_target(path) as temporary:
+    with atomic_path(path) as temporary:
         writer = mediapy.VideoWriter(temporary, (height, width), codec=VIDEO_CODECS[path.suffix.lower()], fps=fps)
         try:
             with writer:
@@ -173,6 +159,6 @@ def write_image(path: Path, image: NDArray[np.uint8]) -> Path:
     import mediapy
 
     path = check_output_path(path, (".png",), "image")
-    with _atomic_target(path) as temporary:
+    with atomic_path(path) as temporary:
         mediapy.write_image(temporary, image)
     return path

@@ -23,10 +23,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.atomic_io import write_atomic
 from hiab_sim.emla import energy_summary, operating_point
 from hiab_sim.errors import HiabSimError
 from hiab_sim.study.problem import ACTUATORS, Evaluation, LinkLengthProblem
-from hiab_sim.study.solve import SolveResult, write_atomic, xi_table
+from hiab_sim.study.solve import SolveResult, xi_table
 
 Array = NDArray[np.float64]
 

@@ -13,9 +13,7 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 import sys
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -26,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import minimize
 
+from hiab_sim.atomic_io import write_atomic
 from hiab_sim.config import CHAIN_NAMES, LinkLengths
 from hiab_sim.errors import HiabSimError, InvalidInputError, SolverError
 from hiab_sim.study.problem import LinkLengthProblem
@@ -64,19 +63,6 @@ class SolveResult:
     wall_time: float = 0.0
     n_evaluations: int = 0
     n_gradients: int = 0
-
-
-def write_atomic(path: Path, text: str | bytes) -> None:
-    """Write a file atomically: a temp file in the same folder, then ``os.replace``."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(text.encode() if isinstance(text, str) else text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def check_start(problem: LinkLengthProblem, z: Array, label: str = "initial_lengths") -> None:
