@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from lengths_helper import feasible_lengths
 
-from hiab_sim.config import ChainLengths, Crane, LinkLengths, check_lengths, load_crane
+from hiab_sim.config import ChainLengths, Crane, LinkLengths, load_crane
 from hiab_sim.crane import mechanism
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics, mechanical_energy
 from hiab_sim.dynamics.samples import JointSamples
@@ -17,22 +18,6 @@ from hiab_sim.errors import InvalidInputError
 CRANE = load_crane("xs031")
 LOW = np.array([CRANE.lift.joint_range[0], CRANE.tilt.joint_range[0], CRANE.telescope.joint_range[0]])
 HIGH = np.array([CRANE.lift.joint_range[1], CRANE.tilt.joint_range[1], CRANE.telescope.joint_range[1]])
-
-
-def feasible_lengths(u: np.ndarray) -> LinkLengths:
-    """Map u in [0, 1]^6 to a link-length set serving both working joint ranges (as in test_mjcf)."""
-    chains = []
-    for chain, (a, b, c), low in zip(CRANE.chains, np.reshape(u, (2, 3)), (0.9, 1.02), strict=True):
-        L = chain.default_lengths.L * (low + (1.3 - low) * a)
-        angles = mechanism.hinge_angle(chain, np.array(chain.joint_range))
-        s = mechanism.stroke_from_hinge_angle(angles, L, chain.L1, 0.0)
-        lowest = max(s[1] - chain.stroke, chain.stroke + 0.04)
-        x0 = lowest + (s[0] - lowest) * (0.02 + 0.96 * b)
-        Lc = chain.stroke + (x0 - 0.02 - chain.stroke) * c
-        chains.append(ChainLengths(L, x0 - Lc, Lc))
-    lengths = LinkLengths(*chains)
-    check_lengths(CRANE, lengths)
-    return lengths
 
 
 def sweep(t: np.ndarray, duration: float = 4.0) -> JointSamples:
