@@ -14,6 +14,12 @@ if [ -n "$need" ]; then
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $need >/dev/null
 fi
+# An existing .venv with another MuJoCo line (e.g. 4.x, whose split packages mujoco-core and
+# mujoco-studio break `import mujoco` when pip downgrades them in place) is rebuilt from scratch.
+if [ -x .venv/bin/python ] && ! .venv/bin/python -c "import mujoco, sys; sys.exit(not mujoco.__version__.startswith('3.17.'))" >/dev/null 2>&1; then
+  echo "[setup] .venv has no working MuJoCo 3.17: recreating it"
+  rm -rf .venv
+fi
 if [ ! -x .venv/bin/python ]; then
   python3 -m venv .venv
 fi

@@ -105,10 +105,12 @@ def drop_coincident(scene: mujoco.MjvScene, start: int, tolerance: float = 1e-4)
 _GEOM_FIELDS = ("type", "dataid", "objtype", "objid", "category", "matid", "texcoord", "segid", "transparent",
                 "size", "pos", "mat", "rgba", "emission", "specular", "shininess", "reflectance", "camdist",
                 "modelrbound", "castshadow", "label", "texid", "texrepeat", "texuniform")  # fmt: skip
+#: The fields this MuJoCo build has (``castshadow`` is new in MuJoCo 4.0; the pinned 3.17 lacks it).
+_PRESENT_FIELDS = tuple(name for name in _GEOM_FIELDS if hasattr(mujoco.MjvGeom(), name))
 
 
 def _copy_geom(target: mujoco.MjvGeom, source: mujoco.MjvGeom) -> None:
-    for name in _GEOM_FIELDS:
+    for name in _PRESENT_FIELDS:
         value = getattr(source, name)
         if isinstance(value, np.ndarray):
             getattr(target, name)[...] = value
