@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from hiab_sim.config import load_crane
+from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics, spatial_inverse_dynamics
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.validation import random_states

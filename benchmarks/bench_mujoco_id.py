@@ -13,7 +13,7 @@ import time
 import mujoco
 import numpy as np
 
-from hiab_sim.config import load_crane
+from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.model import build_model

@@ -17,8 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from hiab_sim.config import LinkLengths, load_crane
+from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.kinematics import tcp_position
+from hiab_sim.crane.loader import load_crane
 from hiab_sim.render import load_playback, playback_renderer
 from hiab_sim.render.frames import LAYOUTS, Layout
 

@@ -23,11 +23,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 from numpy.typing import NDArray
 
-from hiab_sim.config import ChainLengths, Crane, LinkLengths, check_lengths
 from hiab_sim.crane import kinematics, mechanism
+from hiab_sim.crane.description import ChainLengths, Crane, LinkLengths
+from hiab_sim.crane.mechanism import check_lengths
 from hiab_sim.dynamics.analytic_id import (
     analytic_inverse_dynamics,
     energy_rate,
@@ -37,12 +37,12 @@ from hiab_sim.dynamics.analytic_id import (
 )
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.resources import DEFAULT_CASES, Source, locate
+from hiab_sim.yaml_fields import check_choice, check_range, mapping, read_yaml, section, text, vector
 
 Array = NDArray[np.float64]
 IdFunction = Callable[[LinkLengths, JointSamples, Array], ActuatorSamples]
 
-#: The case file shipped with the repository.
-DEFAULT_CASES = Path(__file__).resolve().parents[1] / "validate" / "cases.yaml"
 CASE_KINDS = ("random_states", "trajectory", "random_lengths", "static")
 
 
@@ -53,6 +53,11 @@ class Tolerances:
     force_relative: float = 1e-6
     velocity_absolute: float = 1e-9
     balance_relative: float = 1e-6
+
+    def __post_init__(self) -> None:
+        check_range("tolerances.force_relative", self.force_relative, 0.0, low_open=True)
+        check_range("tolerances.velocity_absolute", self.velocity_absolute, 0.0, unit="m/s", low_open=True)
+        check_range("tolerances.balance_relative", self.balance_relative, 0.0, low_open=True)
 
 
 @dataclass(frozen=True)
@@ -66,6 +71,13 @@ class CaseSpec:
     payload: tuple[float, float, float] | None = None  # TCP force in {W} [N]
     length_sets: int = 1
     description: str = ""
+
+    def __post_init__(self) -> None:
+        where = f"cases.{self.name}"
+        check_choice(f"{where}.kind", self.kind, CASE_KINDS)
+        check_range(f"{where}.samples", self.samples, 1, integral=True)
+        check_range(f"{where}.seed", self.seed, 0, integral=True)
+        check_range(f"{where}.length_sets", self.length_sets, 1, integral=True)
 
 
 @dataclass(frozen=True)
@@ -102,7 +114,7 @@ def lengths_from_fractions(crane: Crane, fractions: Array, spread: float = 0.2) 
     [s_high - stroke, s_low] that keeps the stroke inside [0, stroke] over the joint range
     (s: the triangle side {Bc}-{Tc} at the range ends), at fraction u1; Lc in
     [max(stroke, s_high - x0), x0) at fraction u2 (const_j), Lc0 = x0 - Lc. Returns None when the
-    window is empty for this L. The result passes :func:`hiab_sim.config.check_lengths`.
+    window is empty for this L. The result passes :func:`hiab_sim.crane.mechanism.check_lengths`.
     """
     chains = []
     for chain, u in zip(crane.chains, np.asarray(fractions, dtype=float).reshape(2, 3), strict=True):
@@ -311,36 +323,33 @@ def mujoco_path(crane: Crane) -> IdFunction:
 # Case file
 # ---------------------------------------------------------------------------------------------
 
-_CASE_KEYS = {"name", "kind", "samples", "seed", "payload", "length_sets", "description"}
 
+def load_cases(path: str | Path | Source = DEFAULT_CASES) -> tuple[Tolerances, list[CaseSpec]]:
+    """Read the tolerances and cases (a shipped name or a path); ``payload: both`` makes two cases.
 
-def load_cases(path: str | Path = DEFAULT_CASES) -> tuple[Tolerances, list[CaseSpec]]:
-    """Read the tolerances and cases; each case with ``payload: both`` becomes two cases."""
-    path = Path(path)
-    if not path.is_file():
-        raise ConfigError(f"case file {path} not found (pass --cases FILE)")
-    data = yaml.safe_load(path.read_text())
-    if not isinstance(data, dict) or not isinstance(data.get("cases"), list):
-        raise ConfigError(f"{path}: expected a mapping with a 'cases' list")
-    tolerances = Tolerances(**data.get("tolerances", {}))
-    payload = tuple(float(v) for v in data.get("payload_force", (0.0, -2452.0, 0.0)))
+    Raises:
+        ConfigError: Missing file, malformed YAML, unknown or missing keys, wrong types.
+        InvalidInputError: A value out of range, named by its field.
+
+    """
+    found = path if isinstance(path, Source) else locate(path, "cases")
+    top = mapping(read_yaml(found), found.label, {"tolerances", "payload_force", "cases"}, {"cases"})
+    tolerances = Tolerances(**section(Tolerances, top.get("tolerances"), "tolerances"))
+    payload = vector(top.get("payload_force", [0.0, -2452.0, 0.0]), "payload_force", 3)
+    if not isinstance(top["cases"], list):
+        raise ConfigError(f"{found.label}: cases: expected a list of cases, got {type(top['cases']).__name__}")
+    choices: dict[str, list[tuple[float, ...] | None]] = {"none": [None], "payload": [payload], "both": [None, payload]}
     specs = []
-    for entry in data["cases"]:
-        unknown = set(entry) - _CASE_KEYS
-        if unknown:
-            raise ConfigError(f"{path}: case {entry.get('name')}: unknown key(s) {sorted(unknown)}")
-        choices: dict[str, list[tuple[float, ...] | None]] = {
-            "none": [None],
-            "payload": [payload],
-            "both": [None, payload],
-        }
-        variants = choices.get(str(entry.get("payload", "both")))
-        if variants is None:
-            raise ConfigError(f"{path}: case {entry.get('name')}: payload must be none, payload or both")
-        for force in variants:
-            spec = {k: v for k, v in entry.items() if k != "payload"}
-            spec["name"] = f"{entry['name']}{'' if force is None else '+payload'}"
-            specs.append(CaseSpec(**spec, payload=force))  # type: ignore[arg-type]
+    for k, entry in enumerate(top["cases"]):
+        node = mapping(entry, f"cases[{k}]", None)
+        where = f"cases.{node.get('name', k)}"
+        values = section(CaseSpec, {key: v for key, v in node.items() if key != "payload"}, where, skip=("payload",))
+        mode = text(node.get("payload", "both"), f"{where}.payload")
+        if mode not in choices:
+            raise InvalidInputError(f"{where}.payload", mode, "must be one of none, payload, both")
+        for force in choices[mode]:
+            suffix = "" if force is None else "+payload"
+            specs.append(CaseSpec(**{**values, "name": f"{values['name']}{suffix}"}, payload=force))  # type: ignore[arg-type]
     return tolerances, specs
 
 

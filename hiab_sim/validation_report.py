@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from hiab_sim.atomic_io import atomic_path, write_atomic
-from hiab_sim.config import Crane
+from hiab_sim.crane.description import Crane
 from hiab_sim.dynamics.samples import ACTUATOR_NAMES
 from hiab_sim.validation import CaseResult, Tolerances
 

@@ -1,27 +1,33 @@
-"""Reading YAML files and checking their fields, with errors that name the field (shared by all loaders)."""
+"""The one field reader: YAML text -> checked Python values, with errors that name the field.
+
+Every configuration file (crane, EMLA set, study, validation cases) is read here: the structure
+and the types (unknown or missing keys, a word where a number belongs) raise
+:class:`~hiab_sim.errors.ConfigError`; the ranges are checked once, by the frozen dataclass the
+values build (its ``__post_init__``, with :func:`check_range`), and raise
+:class:`~hiab_sim.errors.InvalidInputError` naming field, value, allowed range and unit.
+Defaults are the dataclasses' own: :func:`section` passes only the keys a file gives.
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from collections.abc import Mapping
-from pathlib import Path
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import yaml
 
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.resources import Source
 
 
-def read_yaml(path: Path, what: str) -> Any:
+def read_yaml(source: Source) -> Any:
     """Parse a YAML file; a missing file or malformed YAML raises :class:`ConfigError`."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise ConfigError(f"cannot read {what} {path}: {error.strerror or error}") from None
+    text = source.read_text()
     try:
         return yaml.safe_load(text)
     except yaml.YAMLError as error:
-        raise ConfigError(f"{path}: not valid YAML: {error}") from None
+        raise ConfigError(f"{source.label}: not valid YAML: {error}") from None
 
 
 def mapping(data: Any, where: str, allowed: set[str] | None, required: set[str] | None = None) -> Mapping[str, Any]:
@@ -49,7 +55,8 @@ def mapping(data: Any, where: str, allowed: set[str] | None, required: set[str] 
 def number(value: Any, where: str) -> float:
     """A finite number (bools and strings are rejected)."""
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ConfigError(f"{where}: expected a number, got {value!r}")
+        hint = " (YAML reads 1e3 as text: write 1.0e+3 or 1000.0)" if isinstance(value, str) else ""
+        raise ConfigError(f"{where}: expected a number, got {value!r}{hint}")
     if not math.isfinite(value):
         raise InvalidInputError(where, float(value), "must be finite")
     return float(value)
@@ -61,3 +68,112 @@ def positive(value: Any, where: str, unit: str = "") -> float:
     if result <= 0.0:
         raise InvalidInputError(where, result, "must be > 0", unit)
     return result
+
+
+def integer(value: Any, where: str) -> int:
+    """An integer (a float with an integral value is accepted; bools and strings are not)."""
+    if isinstance(value, float) and value.is_integer():
+        return int(value)
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ConfigError(f"{where}: expected an integer, got {value!r}")
+    return int(value)
+
+
+def text(value: Any, where: str) -> str:
+    """A string (numbers are written as text, as YAML users expect for names)."""
+    if isinstance(value, Mapping | list):
+        raise ConfigError(f"{where}: expected a string, got {type(value).__name__}")
+    return str(value)
+
+
+def vector(value: Any, where: str, size: int) -> tuple[float, ...]:
+    """A list of ``size`` finite numbers."""
+    if not isinstance(value, list | tuple) or len(value) != size:
+        raise ConfigError(f"{where}: expected a list of {size} numbers, got {value!r}")
+    return tuple(number(v, f"{where}[{i}]") for i, v in enumerate(value))
+
+
+def sourced_number(node: Any, where: str, kinds: tuple[str, ...]) -> tuple[float, str]:
+    """(number, provenance) from a bare number or a ``{value, source}`` mapping.
+
+    ``source`` must be a string whose first word (before ``:``) is one of ``kinds``; a bare
+    number's provenance is ``"unspecified"``.
+    """
+    source = "unspecified"
+    if isinstance(node, Mapping):
+        mapping(node, where, {"value", "source"}, {"value"})
+        if "source" in node:
+            source = node["source"]
+            if not isinstance(source, str) or source.split(":", 1)[0].strip() not in kinds:
+                raise ConfigError(
+                    f"{where}.source must be a string starting with one of {', '.join(kinds)}, got {source!r}"
+                )
+        node = node["value"]
+    return number(node, where), source
+
+
+_READERS: dict[str, Callable[[Any, str], Any]] = {
+    "float": number,
+    "int": integer,
+    "str": text,
+    "tuple[float, float]": lambda v, w: vector(v, w, 2),
+    "tuple[float, float, float]": lambda v, w: vector(v, w, 3),
+}
+
+
+def section(cls: type, data: Any, where: str, skip: tuple[str, ...] = ()) -> dict[str, Any]:
+    """Read a YAML mapping as the keyword arguments of dataclass ``cls``.
+
+    The keys are ``cls``'s fields (less ``skip``); fields without a default are required, and
+    keys a file omits are left out, so the dataclass's own default applies. Each value is read
+    by its annotated type (``float``, ``int``, ``str``, 2- and 3-tuples of floats, ``| None``).
+    """
+    fields = [f for f in dataclasses.fields(cls) if f.name not in skip and f.init]
+    required = {f.name for f in fields if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING}
+    node = mapping({} if data is None else data, where, {f.name for f in fields}, required)
+    values: dict[str, Any] = {}
+    for f in fields:
+        if f.name in node:
+            kind = str(f.type).replace(" | None", "")
+            values[f.name] = _READERS[kind](node[f.name], f"{where}.{f.name}")
+    return values
+
+
+def check_range(
+    where: str,
+    value: Any,
+    low: float | None = None,
+    high: float | None = None,
+    unit: str = "",
+    *,
+    low_open: bool = False,
+    high_open: bool = False,
+    integral: bool = False,
+) -> None:
+    """Raise :class:`InvalidInputError` unless ``value`` is a finite number in the interval.
+
+    ``low``/``high`` None: unbounded on that side; ``*_open``: the bound itself is excluded;
+    ``integral``: the value must be an ``int``. Used by the dataclasses' ``__post_init__``.
+    """
+    kind = "an integer" if integral else "a finite number"
+    ok = not isinstance(value, bool) and isinstance(value, int if integral else int | float)
+    ok = ok and math.isfinite(value)
+    ok = ok and (low is None or (value > low if low_open else value >= low))
+    ok = ok and (high is None or (value < high if high_open else value <= high))
+    if ok:
+        return
+    if low is not None and high is not None:
+        allowed = f"must lie in {'(' if low_open else '['}{low:.6g}, {high:.6g}{')' if high_open else ']'}"
+    elif low is not None:
+        allowed = f"must be {'>' if low_open else '>='} {low:.6g}"
+    elif high is not None:
+        allowed = f"must be {'<' if high_open else '<='} {high:.6g}"
+    else:
+        allowed = f"must be {kind}"
+    raise InvalidInputError(where, value, allowed, unit)
+
+
+def check_choice(where: str, value: Any, choices: tuple[str, ...]) -> None:
+    """Raise :class:`InvalidInputError` unless ``value`` is one of ``choices``."""
+    if value not in choices:
+        raise InvalidInputError(where, value, f"must be one of {', '.join(choices)}")

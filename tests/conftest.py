@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from hiab_sim.config import Crane, load_crane
+from hiab_sim.crane.description import Crane
+from hiab_sim.crane.loader import load_crane
 
 
 @pytest.fixture(scope="session")

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from hiab_sim.config import ChainLengths, LinkLengths, check_lengths, load_crane
 from hiab_sim.crane import mechanism
+from hiab_sim.crane.description import ChainLengths, LinkLengths
+from hiab_sim.crane.loader import load_crane
+from hiab_sim.crane.mechanism import check_lengths
 
 CRANE = load_crane("xs031")
 

@@ -7,8 +7,9 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from hiab_sim.config import ChainLengths, Crane, LinkLengths, load_crane
 from hiab_sim.crane import kinematics, mechanism
+from hiab_sim.crane.description import ChainLengths, Crane, LinkLengths
+from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.analytic_id import (
     analytic_inverse_dynamics,
     link_wrenches,

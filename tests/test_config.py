@@ -12,19 +12,14 @@ import numpy as np
 import pytest
 import yaml
 
-from hiab_sim.config import (
-    CRANE_PRESETS,
-    ChainLengths,
-    Crane,
-    LinkLengths,
-    check_lengths,
-    crane_from_dict,
-    load_crane,
-)
 from hiab_sim.crane import mechanism
+from hiab_sim.crane.description import ChainLengths, Crane, LinkLengths
+from hiab_sim.crane.loader import crane_from_dict, load_crane
+from hiab_sim.crane.mechanism import check_lengths
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.resources import shipped
 
-RAW = yaml.safe_load(CRANE_PRESETS["xs031"].read_text())
+RAW = yaml.safe_load(shipped("crane", "xs031").read_text())
 
 
 def test_preset_keeps_every_source_mass(crane: Crane) -> None:

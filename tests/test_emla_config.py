@@ -15,7 +15,6 @@ import yaml
 from hiab_sim.cli import main
 from hiab_sim.emla import (
     ACTUATOR_NAMES,
-    DEFAULT_EMLA_PRESET,
     EmlaParams,
     emla_set_from_mapping,
     envelope_margins,
@@ -25,6 +24,7 @@ from hiab_sim.emla import (
 )
 from hiab_sim.emla.config import PROVENANCE_KINDS
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.resources import shipped
 
 # Hydraulic cylinders of the XS 031 (shared/reference/hiab-xs031.yaml, hydraulic_cylinders):
 # bore, rod [m] and the 19.0 MPa supply pressure.
@@ -33,7 +33,7 @@ SUPPLY_PRESSURE = 19.0e6
 
 
 def _preset_document() -> dict[str, Any]:
-    return yaml.safe_load(DEFAULT_EMLA_PRESET.read_text(encoding="utf-8"))
+    return yaml.safe_load(shipped("emla", "default").read_text())
 
 
 def test_preset_iterates_lift_tilt_telescope_in_order() -> None:
@@ -133,7 +133,7 @@ def test_dataclass_rejects_bad_values_when_built() -> None:
         (lambda d: d["pmsm"].update(bogus=1.0), "unknown key.*bogus"),
         (lambda d: d["actuators"]["lift"].pop("screw_lead"), "missing key.*screw_lead"),
         (lambda d: d["actuators"].pop("telescope"), "missing key.*telescope"),
-        (lambda d: d["pmsm"].update(Ld="2.2e-3"), "must be a number.*1.0e\\+3"),
+        (lambda d: d["pmsm"].update(Ld="2.2e-3"), "expected a number.*1.0e\\+3"),
         (lambda d: d["pmsm"].update(Ld={"value": 2e-3, "source": "guess"}), "source must be"),
         (lambda d: d.update(extra={}), "unknown key.*extra"),
     ],

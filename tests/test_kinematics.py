@@ -6,8 +6,9 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hiab_sim.config import ChainLengths, Crane, LinkLengths, load_crane
 from hiab_sim.crane import kinematics
+from hiab_sim.crane.description import ChainLengths, Crane, LinkLengths
+from hiab_sim.crane.loader import load_crane
 
 CRANE = load_crane("xs031")
 

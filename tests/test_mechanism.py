@@ -7,8 +7,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hiab_sim.config import ChainLengths, load_crane
 from hiab_sim.crane import mechanism
+from hiab_sim.crane.description import ChainLengths
+from hiab_sim.crane.loader import load_crane
 
 CRANE = load_crane("xs031")
 CHAINS = {chain.name: chain for chain in CRANE.chains}

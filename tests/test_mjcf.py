@@ -12,8 +12,9 @@ from hypothesis import strategies as st
 from lengths_helper import feasible_lengths
 
 from hiab_sim.cli import main
-from hiab_sim.config import ChainLengths, Crane, LinkLengths, load_crane
 from hiab_sim.crane import kinematics
+from hiab_sim.crane.description import ChainLengths, Crane, LinkLengths
+from hiab_sim.crane.loader import load_crane
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.model import build_model, to_xml
 from hiab_sim.model.mjcf import SOURCE_TO_WORLD, source_to_world

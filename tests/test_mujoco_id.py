@@ -9,8 +9,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from lengths_helper import feasible_lengths
 
-from hiab_sim.config import ChainLengths, Crane, LinkLengths, load_crane
 from hiab_sim.crane import mechanism
+from hiab_sim.crane.description import ChainLengths, Crane, LinkLengths
+from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics, mechanical_energy
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import InvalidInputError

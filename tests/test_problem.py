@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from test_study_small import small_study
 
-from hiab_sim.config import ChainLengths, LinkLengths
+from hiab_sim.crane.description import ChainLengths, LinkLengths
 from hiab_sim.emla import electrical_power
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study import problem as problem_module

@@ -18,8 +18,9 @@ import pytest
 
 from hiab_sim import _gl
 from hiab_sim.cli import main
-from hiab_sim.config import Crane, LinkLengths, check_lengths
+from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.kinematics import tcp_position
+from hiab_sim.crane.mechanism import check_lengths
 from hiab_sim.model.mjcf import source_to_world
 from hiab_sim.render import backend as render_backend
 from hiab_sim.render import (

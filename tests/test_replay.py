@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hiab_sim.config import Crane
+from hiab_sim.crane.description import Crane
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.replay import replay
 from hiab_sim.dynamics.samples import JointSamples

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hiab_sim.config import Crane
 from hiab_sim.crane import kinematics
+from hiab_sim.crane.description import Crane
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study import trajectory as tr
 from hiab_sim.study.config import SpiralReference, load_study
@@ -105,7 +105,15 @@ def test_fitted_spline_is_at_rest_and_tracks_within_a_millimetre() -> None:
 def test_unreachable_reference_is_rejected() -> None:
     """A spiral beyond the crane's reach raises the named-field error."""
     kin = tr.TcpKinematics(STUDY.crane)
-    spec = SpiralReference(0.05, 6.0, 1.0, 0.0, 0.4, 0.0, centre_joints=(0.6, -1.3))
+    spec = SpiralReference(
+        start_radius=0.05,
+        end_radius=6.0,
+        turns=1.0,
+        telescope_start=0.4,
+        start_angle=0.0,
+        telescope_amplitude=0.0,
+        centre_joints=(0.6, -1.3),
+    )
     ref = tr.spiral_reference(kin, spec, 6.25, np.linspace(0.0, 6.25, 60))
     with pytest.raises(InvalidInputError, match="reference"):
         tr.inverse_kinematics(kin, ref, (0.6, -1.3))

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from hiab_sim.cli import main
-from hiab_sim.config import Crane, check_lengths
+from hiab_sim.crane.description import Crane
+from hiab_sim.crane.mechanism import check_lengths
 from hiab_sim.validation import (
     DEFAULT_CASES,
     load_cases,
@@ -21,6 +22,7 @@ from hiab_sim.validation import (
 )
 
 TOLERANCES, SPECS = load_cases(DEFAULT_CASES)
+UPDATE_README = Path(__file__).resolve().parents[1] / "validate" / "update_readme.py"
 
 
 def test_case_file_covers_every_required_case() -> None:
@@ -94,7 +96,9 @@ def test_validate_rejects_a_non_positive_sample_count() -> None:
 
 def test_update_readme_replaces_only_the_marked_block(tmp_path: Path) -> None:
     """validate/update_readme.py swaps the table between the markers and leaves the rest alone."""
-    spec = importlib.util.spec_from_file_location("update_readme", DEFAULT_CASES.parent / "update_readme.py")
+    spec = importlib.util.spec_from_file_location(
+        "update_readme", Path(__file__).resolve().parents[1] / "validate" / "update_readme.py"
+    )
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)

@@ -6,8 +6,8 @@ import argparse
 
 import numpy as np
 
-from hiab_sim.config import load_crane
 from hiab_sim.crane import mechanism
+from hiab_sim.crane.loader import load_crane
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:

@@ -18,7 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.config import Crane, LinkLengths, load_crane
+from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.crane.loader import load_crane
 from hiab_sim.errors import InvalidInputError
 
 

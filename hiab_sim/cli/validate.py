@@ -61,7 +61,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run every case, write the report files and return 0 (all within tolerance) or 1."""
-    from hiab_sim.config import load_crane
+    from hiab_sim.crane.loader import load_crane
     from hiab_sim.validation import DEFAULT_CASES, load_cases, mujoco_path, run_case, with_samples
     from hiab_sim.validation_report import write_report
 

@@ -1,7 +1,7 @@
 """Forward kinematics of the crane's links in the source world frame {W} (y up), numpy only.
 
 Given samples of the independent joints (theta1, theta2, xt2) and a link-length set, returns the
-pose of every link frame (see :mod:`hiab_sim.config`) and of the TCP {D22}, vectorised over
+pose of every link frame (see :mod:`hiab_sim.crane.description`) and of the TCP {D22}, vectorised over
 samples. The closed chains are solved with the trigonometry of :mod:`hiab_sim.crane.mechanism`.
 """
 
@@ -12,8 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hiab_sim.config import ClosedChain, Crane, LinkLengths, Pose
 from hiab_sim.crane import mechanism
+from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths, Pose
 
 Array = NDArray[np.float64]
 

@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hiab_sim.config import ChainLengths, ClosedChain
+from hiab_sim.crane.description import ChainLengths, ClosedChain, Crane, LinkLengths, check_positive_lengths
 from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
@@ -202,3 +202,20 @@ def check_joint_samples(chain: ClosedChain, lengths: ChainLengths, theta: ArrayL
         except InvalidInputError:
             allowed = "no stroke is usable for these lengths"
         raise InvalidInputError(name, worst, allowed, "rad")
+
+
+def check_lengths(crane: Crane, lengths: LinkLengths) -> None:
+    """Raise :class:`InvalidInputError` unless every chain can serve its working joint range.
+
+    Checks, per chain: finite, positive L, Lc0, Lc (const_g); the stroke inside [0, Lc]
+    (const_j); and over the working range of theta the stroke x inside [0, stroke] and the
+    triangle strict, |L - L1| < Lc0 + x + Lc < L + L1 (const_k), so that sin q != 0 and the
+    velocity ratios k1..k3 (eq. k1_3) are defined.
+    """
+    check_positive_lengths(lengths)
+    for chain, xi in zip(crane.chains, lengths, strict=True):
+        if chain.stroke > xi.Lc:
+            raise InvalidInputError(
+                f"{chain.name}.stroke", chain.stroke, f"must lie in [0, Lc] = [0, {xi.Lc:.6g}] m", "m"
+            )
+        check_joint_samples(chain, xi, np.asarray(chain.joint_range), field=f"{chain.name}.joint_range")

@@ -10,7 +10,7 @@ dynamics) after Petrovic & Mattila (2022), independently of MuJoCo:
        F_i = G_i (dV_i - [0; R_i^T g]) - ad_{V_i}^T G_i V_i,
 
    with ``G_i`` the 6x6 spatial inertia of the link (the sum of its rigid bodies, scaled with
-   the link lengths by :meth:`hiab_sim.config.Crane.bodies_for`) and ``g = (0, -g, 0)`` in {W}:
+   the link lengths by :meth:`hiab_sim.crane.description.Crane.bodies_for`) and ``g = (0, -g, 0)`` in {W}:
    the wrench the rest of the world must apply to link i. Wrenches are then expressed in {W}
    about its origin, where wrenches of different links add.
 3. The actuator forces, tip to base. All joint axes are z of {W} and all slides lie in the
@@ -37,8 +37,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hiab_sim.config import ClosedChain, Crane, LinkLengths, check_lengths
 from hiab_sim.crane import mechanism
+from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths
+from hiab_sim.crane.mechanism import check_lengths
 from hiab_sim.dynamics.analytic_kinematics import MOVING_LINKS, CraneMotion, crane_motion
 from hiab_sim.dynamics.analytic_planar import planar_inverse_dynamics, planar_model
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
@@ -98,7 +99,7 @@ def analytic_inverse_dynamics(
 
     Args:
         crane: the crane description.
-        lengths: the link-length set Xi (checked with :func:`hiab_sim.config.check_lengths`).
+        lengths: the link-length set Xi (checked with :func:`hiab_sim.crane.mechanism.check_lengths`).
         joints: (theta1 [rad], theta2 [rad], xt2 [m]) samples and their time derivatives.
         tcp_force: force the environment applies at the TCP, in {W} [N], (3,) or (T, 3);
             default zero.
@@ -263,7 +264,7 @@ def tcp_velocity(crane: Crane, lengths: LinkLengths, joints: JointSamples) -> Ar
 def check_analytic_inputs(crane: Crane, lengths: LinkLengths, joints: JointSamples) -> None:
     """Raise :class:`InvalidInputError` for unusable lengths or joint samples (named field).
 
-    Lengths: :func:`hiab_sim.config.check_lengths` (const_g, const_j, const_k); theta1 and
+    Lengths: :func:`hiab_sim.crane.mechanism.check_lengths` (const_g, const_j, const_k); theta1 and
     theta2: :func:`hiab_sim.crane.mechanism.check_joint_samples` (fields ``theta1``,
     ``theta2``); xt2: the telescope's joint range (field ``xt2``).
     """

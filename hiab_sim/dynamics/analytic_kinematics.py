@@ -21,7 +21,7 @@ frames) into two serial chains off the parent link:
   (x, dx, ddx) follow from (theta, dtheta, ddtheta) through eqs. qus_a, k1_3 and 04.
 
 The telescope rod slides by rod_offset + xt2 along x of {P22}, fixed on the tilt boom. Frames
-and links are those of :mod:`hiab_sim.config`; {W} has y up.
+and links are those of :mod:`hiab_sim.crane.description`; {W} has y up.
 """
 
 from __future__ import annotations
@@ -31,8 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.config import LINK_NAMES, ClosedChain, Crane, LinkLengths
 from hiab_sim.crane import mechanism
+from hiab_sim.crane.description import LINK_NAMES, ClosedChain, Crane, LinkLengths
 from hiab_sim.dynamics.spatial import ad, rotate, twist_to_child
 
 Array = NDArray[np.float64]

@@ -28,7 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.config import ClosedChain, Crane, LinkLengths, check_lengths
+from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths
+from hiab_sim.crane.mechanism import check_lengths
 
 Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]

@@ -64,8 +64,8 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hiab_sim.config import Crane, LinkLengths, check_lengths
-from hiab_sim.crane.mechanism import check_joint_samples
+from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.crane.mechanism import check_joint_samples, check_lengths
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.model.mjcf import SLIDES, build_spec, source_to_world

@@ -20,7 +20,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hiab_sim.config import Crane, LinkLengths
+from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 from hiab_sim.emla.config import (
     ACTUATOR_NAMES,
-    DEFAULT_EMLA_PRESET,
     EmlaParams,
     EmlaSet,
     PmsmParams,
@@ -42,7 +41,6 @@ from hiab_sim.emla.park import abc_to_dq0, dq0_power, dq0_to_abc, line_voltage_r
 
 __all__ = [
     "ACTUATOR_NAMES",
-    "DEFAULT_EMLA_PRESET",
     "ENVELOPE_LIMIT_NAMES",
     "DriveState",
     "EmlaParams",

@@ -3,16 +3,14 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
-from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.yaml_fields import read_yaml
-
-#: The default EMLA set for the HIAB XS 031 (lift, tilt, telescope).
-DEFAULT_EMLA_PRESET = Path(__file__).resolve().parent.parent / "presets" / "emla_xs031.yaml"
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.resources import Source, locate
+from hiab_sim.yaml_fields import mapping, read_yaml, sourced_number
 
 #: Actuator names, in the order the crane and the optimiser use them.
 ACTUATOR_NAMES: tuple[str, ...] = ("lift", "tilt", "telescope")
@@ -177,96 +175,55 @@ _ACTUATOR_REQUIRED: tuple[str, ...] = ("gear_ratio", "screw_lead", "screw_moving
 _ACTUATOR_OPTIONAL: tuple[str, ...] = ("hydraulic_push_force", "hydraulic_pull_force", "pmsm")
 
 
-def load_emla_set(path: str | Path | None = None) -> EmlaSet:
-    """Load an EMLA set from YAML; ``None`` loads the XS 031 default preset.
+def load_emla_set(path: str | Path | Source | None = None, relative_to: Source | None = None) -> EmlaSet:
+    """Load an EMLA set from YAML: a preset name (``default``, ``xs031``), a path or a :class:`Source`.
 
-    The file has a shared ``pmsm`` section and an ``actuators`` section with ``lift``, ``tilt``
-    and ``telescope``; an actuator may override motor parameters in its own ``pmsm`` mapping.
-    Every value is a bare number or ``{value: ..., source: "read|estimate|derived|model: ..."}``.
+    ``None`` loads the XS 031 default preset; a relative path resolves next to ``relative_to``
+    when given (see :func:`hiab_sim.resources.locate`). The file has a shared ``pmsm`` section
+    and an ``actuators`` section with ``lift``, ``tilt`` and ``telescope``; an actuator may
+    override motor parameters in its own ``pmsm`` mapping. Every value is a bare number or
+    ``{value: ..., source: "read|estimate|derived|model: ..."}``.
 
     Raises:
         ConfigError: The file is missing, is not YAML, or has unknown, missing or non-numeric keys.
         InvalidInputError: A value is out of range (the message names field, value and range).
 
     """
-    file = DEFAULT_EMLA_PRESET if path is None else Path(path)
-    return emla_set_from_mapping(read_yaml(file, "EMLA config"), where=str(file))
+    if isinstance(path, Source):
+        found = path
+    else:
+        found = locate("default" if path is None else path, "emla", relative_to)
+    return emla_set_from_mapping(read_yaml(found), where=found.label)
 
 
 def emla_set_from_mapping(document: object, where: str = "<mapping>") -> EmlaSet:
     """Build an :class:`EmlaSet` from an already parsed YAML document (see :func:`load_emla_set`)."""
-    root = _mapping(document, where, "top level")
-    _check_keys(root, required=("pmsm", "actuators"), optional=(), where=where, section="top level")
-    shared_pmsm = _mapping(root["pmsm"], where, "pmsm")
-    _check_keys(shared_pmsm, required=_PMSM_KEYS, optional=(), where=where, section="pmsm")
-    actuators = _mapping(root["actuators"], where, "actuators")
-    _check_keys(actuators, required=ACTUATOR_NAMES, optional=(), where=where, section="actuators")
+    root = mapping(document, f"{where}: top level", {"pmsm", "actuators"})
+    shared_pmsm = mapping(root["pmsm"], f"{where}: pmsm", set(_PMSM_KEYS))
+    actuators = mapping(root["actuators"], f"{where}: actuators", set(ACTUATOR_NAMES))
 
     built: dict[str, EmlaParams] = {}
     for name in ACTUATOR_NAMES:
         section = f"actuators.{name}"
-        node = _mapping(actuators[name], where, section)
-        _check_keys(node, required=_ACTUATOR_REQUIRED, optional=_ACTUATOR_OPTIONAL, where=where, section=section)
-        override = _mapping(node.get("pmsm", {}), where, f"{section}.pmsm")
-        _check_keys(override, required=(), optional=_PMSM_KEYS, where=where, section=f"{section}.pmsm")
+        node = mapping(
+            actuators[name], f"{where}: {section}", {*_ACTUATOR_REQUIRED, *_ACTUATOR_OPTIONAL}, set(_ACTUATOR_REQUIRED)
+        )
+        override = mapping(node.get("pmsm", {}), f"{where}: {section}.pmsm", set(_PMSM_KEYS), set())
         provenance: list[tuple[str, str]] = []
         motor_values: dict[str, Any] = {}
         for key in _PMSM_KEYS:
             src_node = override[key] if key in override else shared_pmsm[key]
             src_section = f"{section}.pmsm" if key in override else "pmsm"
-            value, source = _value(src_node, where, f"{src_section}.{key}")
+            value, source = sourced_number(src_node, f"{where}: {src_section}.{key}", PROVENANCE_KINDS)
             motor_values[key] = value
             provenance.append((f"pmsm.{key}", source))
-        motor_values["pole_pairs"] = _as_int(motor_values["pole_pairs"], where, "pmsm.pole_pairs")
+        pole_pairs = motor_values["pole_pairs"]  # a count: PmsmParams rejects a non-integral value
+        motor_values["pole_pairs"] = int(pole_pairs) if pole_pairs.is_integer() else pole_pairs
         motor = PmsmParams(**motor_values, label=f"{name}.pmsm" if override else "pmsm")
         values: dict[str, Any] = {}
         for key in (*_ACTUATOR_REQUIRED, "hydraulic_push_force", "hydraulic_pull_force"):
             if key in node:
-                values[key], source = _value(node[key], where, f"{section}.{key}")
+                values[key], source = sourced_number(node[key], f"{where}: {section}.{key}", PROVENANCE_KINDS)
                 provenance.append((key, source))
         built[name] = EmlaParams(name=name, motor=motor, provenance=tuple(provenance), **values)
     return EmlaSet(**built)
-
-
-def _mapping(node: object, where: str, section: str) -> Mapping[str, Any]:
-    if not isinstance(node, Mapping):
-        raise ConfigError(f"{where}: {section} must be a mapping, got {type(node).__name__}")
-    return node
-
-
-def _check_keys(
-    node: Mapping[str, Any], required: tuple[str, ...], optional: tuple[str, ...], where: str, section: str
-) -> None:
-    unknown = sorted(str(k) for k in node if k not in required and k not in optional)
-    if unknown:
-        allowed = ", ".join((*required, *optional))
-        raise ConfigError(f"{where}: unknown key(s) in {section}: {', '.join(unknown)} (allowed: {allowed})")
-    missing = [k for k in required if k not in node]
-    if missing:
-        raise ConfigError(f"{where}: missing key(s) in {section}: {', '.join(missing)}")
-
-
-def _value(node: object, where: str, key: str) -> tuple[float, str]:
-    """Return (number, provenance) from a bare number or a ``{value, source}`` mapping."""
-    source = "unspecified"
-    if isinstance(node, Mapping):
-        _check_keys(node, required=("value",), optional=("source",), where=where, section=key)
-        if "source" in node:
-            source = node["source"]
-            kind = str(source).split(":", 1)[0].strip()
-            if not isinstance(source, str) or kind not in PROVENANCE_KINDS:
-                raise ConfigError(
-                    f"{where}: {key}.source must be a string starting with one of "
-                    f"{', '.join(PROVENANCE_KINDS)}, got {source!r}"
-                )
-        node = node["value"]
-    if isinstance(node, bool) or not isinstance(node, int | float):
-        hint = " (YAML reads 1e3 as text: write 1.0e+3 or 1000.0)" if isinstance(node, str) else ""
-        raise ConfigError(f"{where}: {key} must be a number, got {node!r}{hint}")
-    return float(node), source
-
-
-def _as_int(value: float, where: str, key: str) -> int:
-    if not value.is_integer():
-        raise InvalidInputError(key, value, "must be a positive integer")
-    return int(value)

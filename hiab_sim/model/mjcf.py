@@ -1,7 +1,8 @@
 """MJCF model of the crane for one link-length set Xi, built with :class:`mujoco.MjSpec` (issue 3).
 
 The shared pieces (materials, visual defaults, lights, cameras, floor, options) are the template
-``assets/mjcf/crane_template.xml``; :func:`build_spec` loads it and adds the crane.
+``assets/mjcf/crane_template.xml`` (read through :func:`hiab_sim.resources.mjcf_template`);
+:func:`build_spec` loads it and adds the crane.
 
 Frames. hiab-sim keeps the crane in the source frames (world {W} with y up, every revolute
 axis along z). The root body ``base`` sits at the world origin with ``quat = Rx(+90 deg)``,
@@ -9,7 +10,7 @@ so a source point (x, y, z) lies at MuJoCo world (x, -z, y): z is up and the cra
 the world x-z plane. Below ``base`` every position is a source coordinate and every hinge
 axis is local z, so the model reads like the data sheet.
 
-Bodies (one per link of :mod:`hiab_sim.config`) and joints:
+Bodies (one per link of :mod:`hiab_sim.crane.description`) and joints:
 
 ================  ==================================================  ==========================
 body              placement in its parent                             joint (qpos)
@@ -38,7 +39,7 @@ is the TCP frame {D22} on the telescope rod; site ``telescope_cylinder`` is {P22
 Motors ``lift``, ``tilt``, ``telescope`` (gear 1, no control limits) act on ``x1``, ``x2``,
 ``xt2`` for forward replay; ctrl is the actuator force f_x [N], positive extending.
 
-Inertia. Every :class:`~hiab_sim.config.RigidBody` of ``crane.bodies_for(lengths)`` is merged
+Inertia. Every :class:`~hiab_sim.crane.description.RigidBody` of ``crane.bodies_for(lengths)`` is merged
 into the body of its link (several bodies on one link: ``lift_boom_a`` + ``lift_boom_b``,
 ``tilt_boom`` + ``telescope_cylinder``, ``telescope_rod`` + ``end_mass``): total mass, common
 centre of mass, and inertia about it by the parallel-axis theorem. This is exact for rigidly
@@ -48,7 +49,7 @@ Link lengths. Xi changes nothing but the closed chains' cylinder base pivots and
 cylinder and rod bodies: the pivot moves along its fixed direction from the boom hinge
 (``ClosedChain.base_pivot``), the rod-end site moves to (Lc, 0, 0), the rod body to
 (Lc0, 0, 0), and masses and inertias of cylinder and rod scale by the slender-body rule of
-:meth:`hiab_sim.config.Crane.bodies_for` (mass and com with length, axial inertia with l,
+:meth:`hiab_sim.crane.description.Crane.bodies_for` (mass and com with length, axial inertia with l,
 transverse with l^3; the cylinder's length is x0, the rod's Lc). Hinges, booms and TCP stay.
 
 Contacts are disabled (the loop bodies overlap by design); geoms are visual only.
@@ -57,18 +58,15 @@ Contacts are disabled (the loop bodies overlap by design); geoms are visual only
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from xml.etree import ElementTree
 
 import mujoco
 import numpy as np
 
-import hiab_sim
-from hiab_sim.config import ClosedChain, Crane, LinkLengths, RigidBody, check_lengths
-
-#: Folder of the shared MJCF pieces.
-ASSET_DIR = Path(hiab_sim.__file__).resolve().parents[1] / "assets" / "mjcf"
-TEMPLATE = ASSET_DIR / "crane_template.xml"
+from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths, RigidBody
+from hiab_sim.crane.mechanism import check_lengths
+from hiab_sim.errors import ConfigError
+from hiab_sim.resources import mjcf_template
 
 #: Independent joints (qpos equals the source's Θ1, Θ2, xt2) and the actuated slides, in order.
 JOINTS = ("theta1", "theta2", "xt2")
@@ -176,7 +174,7 @@ def build_spec(crane: Crane, lengths: LinkLengths | None = None) -> mujoco.MjSpe
 
     Raises:
         InvalidInputError: the lengths are infeasible for the crane's working joint ranges
-            (:func:`hiab_sim.config.check_lengths`, const_g .. const_k); the field is named.
+            (:func:`hiab_sim.crane.mechanism.check_lengths`, const_g .. const_k); the field is named.
 
     """
     lengths = crane.default_lengths if lengths is None else lengths
@@ -185,7 +183,7 @@ def build_spec(crane: Crane, lengths: LinkLengths | None = None) -> mujoco.MjSpe
     for body in crane.bodies_for(lengths):
         links.setdefault(body.link, []).append(body)
 
-    spec = mujoco.MjSpec.from_file(str(TEMPLATE))
+    spec = mujoco.MjSpec.from_string(mjcf_template())
     spec.modelname = crane.name
     spec.option.gravity = [0.0, 0.0, -crane.gravity]
     base = spec.worldbody.add_body(name="base", quat=list(SOURCE_TO_WORLD_QUAT))
@@ -203,7 +201,7 @@ def build_spec(crane: Crane, lengths: LinkLengths | None = None) -> mujoco.MjSpe
     while pending:  # parents first: a chain may sit on another chain's boom
         chain = next((c for c in pending if c.parent in bodies), None)
         if chain is None:
-            raise hiab_sim.ConfigError(f"chain parent(s) {[c.parent for c in pending]} are not links of the crane")
+            raise ConfigError(f"chain parent(s) {[c.parent for c in pending]} are not links of the crane")
         pending.remove(chain)
         bodies[f"{chain.name}_boom"] = _add_chain(spec, bodies[chain.parent], chain, lengths, links)
         parent = bodies[chain.parent]
@@ -215,7 +213,7 @@ def build_spec(crane: Crane, lengths: LinkLengths | None = None) -> mujoco.MjSpe
 
     tele = crane.telescope
     if tele.parent not in bodies:
-        raise hiab_sim.ConfigError(f"telescope.parent '{tele.parent}' is not a boom of the crane")
+        raise ConfigError(f"telescope.parent '{tele.parent}' is not a boom of the crane")
     carrier = bodies[tele.parent]
     frame = tele.cylinder_frame
     rotation = np.asarray(frame.rotation)

@@ -28,9 +28,11 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.config import ChainLengths, Crane, LinkLengths, load_crane
+from hiab_sim.crane.description import ChainLengths, Crane, LinkLengths
+from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.resources import Source
 
 Array = NDArray[np.float64]
 Mode = Literal["kinematic", "simulate"]
@@ -82,12 +84,8 @@ def load_playback(result_dir: str | Path) -> PlaybackData:
         raise ConfigError(f"{folder / RESULT_FILE}: not valid JSON: {error}") from None
     if not isinstance(result, dict) or "crane" not in result:
         raise ConfigError(f"{folder / RESULT_FILE}: missing key 'crane'")
-    crane_source = str(result["crane"])
-    if not crane_source.endswith((".yaml", ".yml")) or Path(crane_source).is_absolute():
-        crane = load_crane(crane_source)
-    else:  # a relative YAML path: relative to the result folder if it is there
-        local = folder / crane_source
-        crane = load_crane(local if local.is_file() else crane_source)
+    # a preset name, or a crane file relative to the result folder (hiab_sim.resources.locate)
+    crane = load_crane(str(result["crane"]), relative_to=Source(str(folder / RESULT_FILE), folder / RESULT_FILE, False))
     arrays = _read_npz(folder / TRAJECTORY_FILE)
     time = _array(arrays, "time", 1, folder)
     if len(time) < 2 or not np.all(np.diff(time) > 0):

@@ -15,13 +15,13 @@ from typing import Any
 
 import numpy as np
 
-from hiab_sim.config import CHAIN_NAMES, CRANE_PRESETS, ChainLengths, Crane, LinkLengths, load_crane
+from hiab_sim.crane.description import CHAIN_NAMES, ChainLengths, Crane, LinkLengths
+from hiab_sim.crane.loader import load_crane
+from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.yaml_fields import mapping, number, positive, read_yaml
+from hiab_sim.resources import DEFAULT_STUDY, Source, locate
+from hiab_sim.yaml_fields import check_choice, check_range, mapping, number, positive, read_yaml, section, vector
 
-#: Folder of the shipped studies (``optimize/`` at the repository root).
-STUDY_DIR = Path(__file__).resolve().parents[2] / "optimize"
-DEFAULT_STUDY = STUDY_DIR / "xs031_spiral.yaml"
 ID_PATHS = ("mujoco", "analytic")
 
 
@@ -38,6 +38,10 @@ class SplineSettings:
     control_points: int = 22
     degree: int = 5
 
+    def __post_init__(self) -> None:
+        check_range("spline.degree", self.degree, 3, 7, integral=True)
+        check_range("spline.control_points", self.control_points, max(6, self.degree + 2), integral=True)
+
 
 @dataclass(frozen=True)
 class GridSettings:
@@ -53,6 +57,11 @@ class GridSettings:
     duration: float = 6.25
     intervals: int = 25
     fine_factor: int = 10
+
+    def __post_init__(self) -> None:
+        check_range("grid.duration", self.duration, 0.0, unit="s", low_open=True)
+        check_range("grid.intervals", self.intervals, 2, integral=True)
+        check_range("grid.fine_factor", self.fine_factor, 1, integral=True)
 
     @property
     def dt(self) -> float:
@@ -83,11 +92,23 @@ class SpiralReference:
     start_radius: float
     end_radius: float
     turns: float
-    start_angle: float
     telescope_start: float
-    telescope_amplitude: float
+    start_angle: float = 0.0
+    telescope_amplitude: float = 0.0
     centre_joints: tuple[float, float] | None = None
     centre_tcp: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        if (self.centre_joints is None) == (self.centre_tcp is None):
+            raise ConfigError("reference: give exactly one of centre_joints [theta1, theta2] or centre_tcp [x, y]")
+        check_range("reference.start_radius", self.start_radius, 0.0, unit="m")
+        check_range("reference.end_radius", self.end_radius, 0.0, unit="m", low_open=True)
+        check_range("reference.turns", self.turns, -10.0, 10.0)
+        if self.turns == 0.0:
+            raise InvalidInputError("reference.turns", self.turns, "must be nonzero with |turns| <= 10")
+        check_range("reference.telescope_start", self.telescope_start, 0.0, unit="m")
+        check_range("reference.start_angle", self.start_angle, unit="rad")
+        check_range("reference.telescope_amplitude", self.telescope_amplitude, unit="m")
 
 
 @dataclass(frozen=True)
@@ -107,6 +128,12 @@ class Tracking:
     velocity: float = 5e-3
     acceleration: float = 5e-2
     collocation_fraction: float = 0.5
+
+    def __post_init__(self) -> None:
+        check_range("tracking.position", self.position, 0.0, unit="m", low_open=True)
+        check_range("tracking.velocity", self.velocity, 0.0, unit="m/s", low_open=True)
+        check_range("tracking.acceleration", self.acceleration, 0.0, unit="m/s^2", low_open=True)
+        check_range("tracking.collocation_fraction", self.collocation_fraction, 0.0, 1.0, low_open=True)
 
 
 @dataclass(frozen=True)
@@ -135,6 +162,21 @@ class Bounds:
     envelope_margin: float = 0.02
     working_range: str = "crane"
 
+    def __post_init__(self) -> None:
+        for i, (low, up) in enumerate(zip(self.xi_low, self.xi_up, strict=True)):
+            name, key = CHAIN_NAMES[i // 3], ("L", "Lc0", "Lc")[i % 3]
+            if not 0.0 < low < up:
+                raise InvalidInputError(
+                    f"bounds.{name}.low[{i % 3}] ({key})", low, f"must satisfy 0 < low < up = {up:.6g}", "m"
+                )
+        if min(self.joint_velocity) <= 0.0:
+            raise InvalidInputError("bounds.joint_velocity", min(self.joint_velocity), "every limit must be > 0")
+        margin = math.degrees(self.triangle_margin)
+        check_range("bounds.triangle_margin_deg", margin, 0.0, 60.0, "deg", high_open=True)
+        check_range("bounds.working_margin_deg", math.degrees(self.working_margin), 0.0, 30.0, "deg")
+        check_range("bounds.envelope_margin", self.envelope_margin, 0.0, 0.5, high_open=True)
+        check_choice("bounds.working_range", self.working_range, ("crane", "reference"))
+
 
 @dataclass(frozen=True)
 class SolverSettings:
@@ -157,16 +199,28 @@ class SolverSettings:
     fd_step: float = 1e-6
     xi_derivatives: str = "analytic"
 
+    def __post_init__(self) -> None:
+        check_range("solver.maxiter", self.maxiter, 1, integral=True)
+        check_range("solver.ftol", self.ftol, 0.0, low_open=True)
+        check_choice("solver.id_path", self.id_path, ID_PATHS)
+        check_range("solver.fd_step", self.fd_step, 0.0, low_open=True)
+        check_choice("solver.xi_derivatives", self.xi_derivatives, ("analytic", "rebuild"))
+
 
 @dataclass(frozen=True)
 class Study:
-    """Everything one optimisation needs (see module docstring)."""
+    """Everything one optimisation needs (see module docstring).
+
+    ``crane_source`` and ``emla_source`` are what the study file wrote (a preset name or a path
+    relative to it), kept for reports and for copying the crane file next to a result.
+    """
 
     name: str
     path: str
     crane_source: str
     crane: Crane = field(repr=False)
-    emla_source: str | None
+    emla_source: str
+    emlas: EmlaSet = field(repr=False)
     initial_lengths: LinkLengths
     spline: SplineSettings
     grid: GridSettings
@@ -175,6 +229,19 @@ class Study:
     bounds: Bounds
     solver: SolverSettings
     payload: float = 0.0  # kg hanging at the TCP
+    crane_file: Source | None = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        check_range("payload", self.payload, 0.0, unit="kg")
+        for name in CHAIN_NAMES:
+            for i, key in enumerate(("L", "Lc0", "Lc")):
+                k = 3 * CHAIN_NAMES.index(name) + i
+                low, up = self.bounds.xi_low[k], self.bounds.xi_up[k]
+                start = getattr(getattr(self.initial_lengths, name), key)
+                if not low <= start <= up:
+                    raise InvalidInputError(
+                        f"initial_lengths.{name}.{key}", start, f"must lie in the bounds [{low:.6g}, {up:.6g}]", "m"
+                    )
 
     @property
     def tcp_force(self) -> np.ndarray | None:
@@ -200,99 +267,50 @@ _TOP = {
 _REQUIRED_TOP = {"crane", "reference", "bounds"}
 
 
-def load_study(path: str | Path | None = None) -> Study:
-    """Load and validate a study YAML file (default: ``optimize/xs031_spiral.yaml``).
+def load_study(path: str | Path | Source | None = None) -> Study:
+    """Load and validate a study: a shipped name (``xs031_spiral``, the default) or a YAML path.
 
     Raises:
         ConfigError: Missing file, malformed YAML, unknown or missing keys, wrong types.
         InvalidInputError: A value out of range, named by its field.
 
     """
-    file = DEFAULT_STUDY if path is None else Path(path)
-    return study_from_dict(read_yaml(file, "study"), file)
+    if isinstance(path, Source):
+        found = path
+    else:
+        found = locate(DEFAULT_STUDY if path is None else path, "study")
+    return study_from_dict(read_yaml(found), found)
 
 
-def study_from_dict(data: Any, file: str | Path = "<study>") -> Study:
+def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
     """Build a :class:`Study` from a parsed YAML mapping (relative paths resolve next to ``file``)."""
-    file = Path(file)
+    if not isinstance(file, Source):
+        file = Source(str(file), Path(file), shipped=False)
     top = mapping(data, "study", _TOP, _REQUIRED_TOP)
     crane_source = str(top["crane"])
-    crane_path = crane_source if crane_source in CRANE_PRESETS else str(_resolve(crane_source, file))
-    crane = load_crane(crane_path)
-    emla = top.get("emla")
-    emla_source = None if emla in (None, "default") else str(_resolve(str(emla), file))
-    if emla_source is not None and not Path(emla_source).is_file():
-        raise ConfigError(f"emla: no such EMLA file {emla_source}")
+    crane_file = locate(crane_source, "crane", relative_to=file)
+    crane = load_crane(crane_file)
+    emla_source = "default" if top.get("emla") is None else str(top["emla"])
+    emlas = load_emla_set(locate(emla_source, "emla", relative_to=file))
     initial = _lengths(top.get("initial_lengths"), crane)
-    spline_d = mapping(top.get("spline", {}), "spline", {"control_points", "degree"}, set())
-    spline = SplineSettings(
-        control_points=_integer(spline_d.get("control_points", 22), "spline.control_points", 6),
-        degree=_integer(spline_d.get("degree", 5), "spline.degree", 3),
-    )
-    if spline.degree > 7:
-        raise InvalidInputError("spline.degree", spline.degree, "must lie in [3, 7]")
-    if spline.control_points < spline.degree + 2:
-        raise InvalidInputError(
-            "spline.control_points", spline.control_points, f"must be >= degree + 2 = {spline.degree + 2}"
-        )
-    grid_d = mapping(top.get("grid", {}), "grid", {"duration", "intervals", "fine_factor"}, set())
-    grid = GridSettings(
-        duration=positive(grid_d.get("duration", 6.25), "grid.duration", "s"),
-        intervals=_integer(grid_d.get("intervals", 25), "grid.intervals", 2),
-        fine_factor=_integer(grid_d.get("fine_factor", 10), "grid.fine_factor", 1),
-    )
-    reference = _reference(top["reference"])
-    track_keys = {"position", "velocity", "acceleration", "collocation_fraction"}
-    track_d = mapping(top.get("tracking", {}), "tracking", track_keys, set())
-    tracking = Tracking(
-        position=positive(track_d.get("position", 1e-3), "tracking.position", "m"),
-        velocity=positive(track_d.get("velocity", 5e-3), "tracking.velocity", "m/s"),
-        acceleration=positive(track_d.get("acceleration", 5e-2), "tracking.acceleration", "m/s^2"),
-        collocation_fraction=positive(track_d.get("collocation_fraction", 0.5), "tracking.collocation_fraction"),
-    )
-    if tracking.collocation_fraction > 1.0:
-        raise InvalidInputError("tracking.collocation_fraction", tracking.collocation_fraction, "must lie in (0, 1]")
-    bounds = _bounds(top["bounds"], initial)
-    solver_keys = {"maxiter", "ftol", "id_path", "fd_step", "xi_derivatives"}
-    solver_d = mapping(top.get("solver", {}), "solver", solver_keys, set())
-    xi_derivatives = str(solver_d.get("xi_derivatives", "analytic"))
-    if xi_derivatives not in ("analytic", "rebuild"):
-        raise InvalidInputError("solver.xi_derivatives", xi_derivatives, "must be 'analytic' or 'rebuild'")
-    id_path = str(solver_d.get("id_path", "mujoco"))
-    if id_path not in ID_PATHS:
-        raise InvalidInputError("solver.id_path", id_path, f"must be one of {', '.join(ID_PATHS)}")
-    solver = SolverSettings(
-        maxiter=_integer(solver_d.get("maxiter", 100), "solver.maxiter", 1),
-        ftol=positive(solver_d.get("ftol", 1e-9), "solver.ftol"),
-        id_path=id_path,
-        fd_step=positive(solver_d.get("fd_step", 1e-6), "solver.fd_step"),
-        xi_derivatives=xi_derivatives,
-    )
-    payload = number(top.get("payload", 0.0), "payload")
-    if payload < 0.0:
-        raise InvalidInputError("payload", payload, "must be >= 0", "kg")
+    bounds = _bounds(top["bounds"])
     return Study(
-        name=str(top.get("name", file.stem)),
-        path=str(file),
+        name=str(top.get("name", Path(str(file.file)).stem)),
+        path=str(file.file),
         crane_source=crane_source,
         crane=crane,
         emla_source=emla_source,
+        emlas=emlas,
         initial_lengths=initial,
-        spline=spline,
-        grid=grid,
-        reference=reference,
-        tracking=tracking,
+        spline=SplineSettings(**section(SplineSettings, top.get("spline"), "spline")),
+        grid=GridSettings(**section(GridSettings, top.get("grid"), "grid")),
+        reference=_reference(top["reference"]),
+        tracking=Tracking(**section(Tracking, top.get("tracking"), "tracking")),
         bounds=bounds,
-        solver=solver,
-        payload=payload,
+        solver=SolverSettings(**section(SolverSettings, top.get("solver"), "solver")),
+        payload=number(top.get("payload", 0.0), "payload"),
+        crane_file=crane_file,
     )
-
-
-def _resolve(source: str, file: Path) -> Path:
-    candidate = Path(source)
-    if candidate.is_absolute() or candidate.exists():
-        return candidate
-    return (file.parent / candidate).resolve()
 
 
 def _lengths(data: Any, crane: Crane) -> LinkLengths:
@@ -308,45 +326,11 @@ def _lengths(data: Any, crane: Crane) -> LinkLengths:
 
 
 def _reference(data: Any) -> SpiralReference:
-    keys = {
-        "centre_joints",
-        "centre_tcp",
-        "start_radius",
-        "end_radius",
-        "turns",
-        "start_angle",
-        "telescope_start",
-        "telescope_amplitude",
-    }
-    required = keys - {"centre_joints", "centre_tcp", "start_angle", "telescope_amplitude"}
-    d = mapping(data, "reference", keys, required)
-    if ("centre_joints" in d) == ("centre_tcp" in d):
-        raise ConfigError("reference: give exactly one of centre_joints [theta1, theta2] or centre_tcp [x, y]")
-    centre_key = "centre_joints" if "centre_joints" in d else "centre_tcp"
-    centre = _pair(d[centre_key], f"reference.{centre_key}")
-    r0 = number(d["start_radius"], "reference.start_radius")
-    r1 = positive(d["end_radius"], "reference.end_radius", "m")
-    if r0 < 0.0:
-        raise InvalidInputError("reference.start_radius", r0, "must be >= 0", "m")
-    turns = number(d["turns"], "reference.turns")
-    if turns == 0.0 or abs(turns) > 10.0:
-        raise InvalidInputError("reference.turns", turns, "must be nonzero with |turns| <= 10")
-    tele = number(d["telescope_start"], "reference.telescope_start")
-    if tele < 0.0:
-        raise InvalidInputError("reference.telescope_start", tele, "must be >= 0", "m")
-    return SpiralReference(
-        start_radius=r0,
-        end_radius=r1,
-        turns=turns,
-        start_angle=number(d.get("start_angle", 0.0), "reference.start_angle"),
-        telescope_start=tele,
-        telescope_amplitude=number(d.get("telescope_amplitude", 0.0), "reference.telescope_amplitude"),
-        centre_joints=centre if centre_key == "centre_joints" else None,
-        centre_tcp=centre if centre_key == "centre_tcp" else None,
-    )
+    return SpiralReference(**section(SpiralReference, data, "reference"))
 
 
-def _bounds(data: Any, initial: LinkLengths) -> Bounds:
+def _bounds(data: Any) -> Bounds:
+    """Bounds from YAML: per chain ``low``/``up`` triples; angles in degrees (``*_deg``)."""
     keys = {
         "lift",
         "tilt",
@@ -361,61 +345,16 @@ def _bounds(data: Any, initial: LinkLengths) -> Bounds:
     up: list[float] = []
     for name in CHAIN_NAMES:
         chain = mapping(d[name], f"bounds.{name}", {"low", "up"}, {"low", "up"})
-        lo = _triple(chain["low"], f"bounds.{name}.low")
-        hi = _triple(chain["up"], f"bounds.{name}.up")
-        for i, key in enumerate(("L", "Lc0", "Lc")):
-            if not 0.0 < lo[i] < hi[i]:
-                raise InvalidInputError(
-                    f"bounds.{name}.low[{i}] ({key})", lo[i], f"must satisfy 0 < low < up = {hi[i]:.6g}", "m"
-                )
-            start = getattr(getattr(initial, name), key)
-            if not lo[i] <= start <= hi[i]:
-                raise InvalidInputError(
-                    f"initial_lengths.{name}.{key}", start, f"must lie in the bounds [{lo[i]:.6g}, {hi[i]:.6g}]", "m"
-                )
-        low += lo
-        up += hi
-    velocity = _triple(d.get("joint_velocity", [0.6, 0.6, 0.5]), "bounds.joint_velocity")
-    if min(velocity) <= 0.0:
-        raise InvalidInputError("bounds.joint_velocity", min(velocity), "every limit must be > 0")
-    margin = number(d.get("triangle_margin_deg", 10.0), "bounds.triangle_margin_deg")
-    if not 0.0 <= margin < 60.0:
-        raise InvalidInputError("bounds.triangle_margin_deg", margin, "must lie in [0, 60)", "deg")
-    working = number(d.get("working_margin_deg", 3.0), "bounds.working_margin_deg")
-    if not 0.0 <= working <= 30.0:
-        raise InvalidInputError("bounds.working_margin_deg", working, "must lie in [0, 30]", "deg")
-    working_range = str(d.get("working_range", "crane"))
-    if working_range not in ("crane", "reference"):
-        raise InvalidInputError("bounds.working_range", working_range, "must be 'crane' or 'reference'")
-    envelope = number(d.get("envelope_margin", 0.02), "bounds.envelope_margin")
-    if not 0.0 <= envelope < 0.5:
-        raise InvalidInputError("bounds.envelope_margin", envelope, "must lie in [0, 0.5)")
-    return Bounds(
-        tuple(low),
-        tuple(up),
-        (velocity[0], velocity[1], velocity[2]),
-        math.radians(margin),
-        math.radians(working),
-        envelope,
-        working_range,
-    )
-
-
-def _integer(value: Any, where: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ConfigError(f"{where}: expected an integer, got {value!r}")
-    if value < minimum:
-        raise InvalidInputError(where, value, f"must be >= {minimum}")
-    return int(value)
-
-
-def _pair(value: Any, where: str) -> tuple[float, float]:
-    if not isinstance(value, list | tuple) or len(value) != 2:
-        raise ConfigError(f"{where}: expected a list of 2 numbers, got {value!r}")
-    return (number(value[0], f"{where}[0]"), number(value[1], f"{where}[1]"))
-
-
-def _triple(value: Any, where: str) -> list[float]:
-    if not isinstance(value, list | tuple) or len(value) != 3:
-        raise ConfigError(f"{where}: expected a list of 3 numbers, got {value!r}")
-    return [number(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        low += vector(chain["low"], f"bounds.{name}.low", 3)
+        up += vector(chain["up"], f"bounds.{name}.up", 3)
+    values: dict[str, Any] = {"xi_low": tuple(low), "xi_up": tuple(up)}
+    if "joint_velocity" in d:
+        values["joint_velocity"] = vector(d["joint_velocity"], "bounds.joint_velocity", 3)
+    for key in ("triangle_margin", "working_margin"):
+        if f"{key}_deg" in d:
+            values[key] = math.radians(number(d[f"{key}_deg"], f"bounds.{key}_deg"))
+    if "envelope_margin" in d:
+        values["envelope_margin"] = number(d["envelope_margin"], "bounds.envelope_margin")
+    if "working_range" in d:
+        values["working_range"] = str(d["working_range"])
+    return Bounds(**values)

@@ -19,7 +19,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.config import Crane, LinkLengths
+from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.kinematics import forward_kinematics
 from hiab_sim.emla import EmlaSet
 from hiab_sim.study.problem import ACTUATORS

@@ -36,7 +36,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.config import CHAIN_NAMES, Crane, LinkLengths
+from hiab_sim.crane.description import CHAIN_NAMES, Crane, LinkLengths
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.emla import (
     ENVELOPE_LIMIT_NAMES,
@@ -45,7 +45,6 @@ from hiab_sim.emla import (
     electrical_power_partials,
     envelope_margin_partials,
     envelope_margins,
-    load_emla_set,
 )
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study import trajectory as tr
@@ -137,7 +136,7 @@ class LinkLengthProblem:
         self.band_fraction = study.tracking.collocation_fraction if tightened else 1.0
         self.envelope_margin = study.bounds.envelope_margin if tightened else 0.0
         self.working_clearance = WORKING_CLEARANCE / STROKE_SCALE if tightened else 0.0
-        self.emlas = emlas or load_emla_set(study.emla_source)
+        self.emlas = emlas or study.emlas
         self.id_path = id_path or study.solver.id_path
         self.times = study.grid.times() if times is None else np.asarray(times, dtype=float)
         self.dt = float(self.times[1] - self.times[0])

@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import shutil
 import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TextIO
 
-from hiab_sim.config import CRANE_PRESETS
+from hiab_sim.atomic_io import write_atomic
 from hiab_sim.errors import SolverError
 from hiab_sim.study.config import Study, load_study
 from hiab_sim.study.problem import LinkLengthProblem
@@ -81,10 +80,9 @@ def run_study(
             failed.message = str(error)
             results.append(failed)
     result, arrays, checks = build_result(problem, results, time.perf_counter() - t0)
-    if study.crane_source not in CRANE_PRESETS:
-        shutil.copyfile(
-            study.crane_source if Path(study.crane_source).is_file() else _crane_path(study), folder / "crane.yaml"
-        )
+    crane_file = study.crane_file
+    if crane_file is not None and not (crane_file.shipped and crane_file.label == study.crane_source):
+        write_atomic(folder / "crane.yaml", crane_file.read_bytes())  # a crane file, not a preset name
         result["crane_source"] = study.crane_source
         result["crane"] = "crane.yaml"
     write_results(folder, result, arrays)
@@ -94,8 +92,3 @@ def run_study(
 
         paths = write_figures(folder, problem.study.crane, problem.emlas, result, arrays, checks)
     return RunOutput(folder, result, paths)
-
-
-def _crane_path(study: Study) -> Path:
-    candidate = Path(study.path).parent / study.crane_source
-    return candidate.resolve()

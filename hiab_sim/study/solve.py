@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from scipy.optimize import minimize
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.config import CHAIN_NAMES, LinkLengths
+from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
 from hiab_sim.errors import HiabSimError, InvalidInputError, SolverError
 from hiab_sim.study.problem import LinkLengthProblem
 

@@ -21,8 +21,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import BSpline
 
-from hiab_sim.config import Crane
 from hiab_sim.crane import mechanism
+from hiab_sim.crane.description import Crane
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.config import SpiralReference
 
@@ -337,7 +337,7 @@ def fit_coefficients(basis: SplineBasis, joints: JointTrajectory, rate_weight: f
 
 def check_reachable(crane: Crane, lengths_chain: object, joints: JointTrajectory) -> None:
     """Raise :class:`InvalidInputError` if the joint samples leave a chain's usable stroke."""
-    from hiab_sim.config import LinkLengths
+    from hiab_sim.crane.description import LinkLengths
 
     assert isinstance(lengths_chain, LinkLengths)
     for j, chain in enumerate(crane.chains):

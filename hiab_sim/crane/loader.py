@@ -1,0 +1,213 @@
+"""Crane YAML -> validated :class:`~hiab_sim.crane.description.Crane` (presets or files, via hiab_sim.resources)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hiab_sim.crane.description import (
+    CHAIN_NAMES,
+    LINK_NAMES,
+    ChainLengths,
+    ClosedChain,
+    Crane,
+    Matrix3,
+    Pose,
+    RigidBody,
+    Telescope,
+    Vector3,
+    mat3,
+    rot_z,
+    vec3,
+)
+from hiab_sim.crane.mechanism import check_lengths
+from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.resources import Source, locate
+from hiab_sim.yaml_fields import mapping, number, positive, read_yaml
+
+_CHAIN_KEYS = {
+    "parent",
+    "cylinder_base_pivot",
+    "base_axis_angle",
+    "joint_offset",
+    "L",
+    "L1",
+    "Lc",
+    "Lc0",
+    "stroke",
+    "joint_range",
+}
+_TELESCOPE_KEYS = {"parent", "cylinder_frame", "rod_offset", "rod_length", "stroke", "joint_range"}
+_TOP_KEYS = {"name", "source", "gravity", "chains", "telescope", "tcp", "bodies"}
+_BODY_KEYS = {"frame", "mass", "com", "inertia"}
+_POSE_KEYS = {"r", "R"}
+
+#: Source frame -> (link it is rigidly attached to). Frames not listed coincide with a link.
+_FRAME_LINKS = {
+    "Bc1": "base",
+    "B11": "lift_boom",
+    "Bc2": "lift_boom",
+    "B31": "lift_cylinder",
+    "B41": "lift_rod",
+    "B12": "tilt_boom",
+    "B32": "tilt_cylinder",
+    "B42": "tilt_rod",
+    "P22": "tilt_boom",
+    "B52": "telescope_rod",
+    "P32": "telescope_rod",
+}
+
+
+def load_crane(source: str | Path | Source = "xs031", relative_to: Source | None = None) -> Crane:
+    """Load a crane from a preset name (``xs031``), a YAML file path or a located :class:`Source`.
+
+    A relative path resolves next to ``relative_to`` (the file that names it) when given
+    (see :func:`hiab_sim.resources.locate`).
+
+    Raises:
+        ConfigError: unknown preset or file, malformed YAML, unknown or missing keys.
+        InvalidInputError: a value out of its allowed range (the field is named).
+
+    """
+    found = source if isinstance(source, Source) else locate(source, "crane", relative_to)
+    return crane_from_dict(read_yaml(found), origin=found.label)
+
+
+def crane_from_dict(data: Any, origin: str = "crane") -> Crane:
+    """Build and validate a :class:`Crane` from a parsed YAML mapping."""
+    top = mapping(data, origin, _TOP_KEYS)
+    gravity = positive(top["gravity"], "gravity", "m/s^2")
+    chains_data = mapping(top["chains"], "chains", set(CHAIN_NAMES))
+    chains = {name: _chain(name, chains_data[name]) for name in CHAIN_NAMES}
+    telescope = _telescope(top["telescope"])
+    tcp = _pose(top["tcp"], "tcp")
+    bodies_data = mapping(top["bodies"], "bodies", None)
+    placements = _source_frame_placements(chains["lift"], chains["tilt"], telescope)
+    bodies = tuple(_body(name, bodies_data[name], placements) for name in bodies_data)
+    crane = Crane(
+        name=str(top["name"]),
+        source=str(top["source"]),
+        gravity=gravity,
+        lift=chains["lift"],
+        tilt=chains["tilt"],
+        telescope=telescope,
+        tcp=tcp,
+        bodies=bodies,
+    )
+    check_lengths(crane, crane.default_lengths)
+    return crane
+
+
+def _vector(value: Any, where: str) -> Vector3:
+    if not isinstance(value, list | tuple) or len(value) != 3:
+        raise ConfigError(f"{where}: expected a list of 3 numbers, got {value!r}")
+    return vec3([number(v, f"{where}[{i}]") for i, v in enumerate(value)])
+
+
+def _matrix(value: Any, where: str) -> Matrix3:
+    if not isinstance(value, list | tuple) or len(value) != 3:
+        raise ConfigError(f"{where}: expected a 3x3 nested list, got {value!r}")
+    return (
+        _vector(value[0], f"{where}[0]"),
+        _vector(value[1], f"{where}[1]"),
+        _vector(value[2], f"{where}[2]"),
+    )
+
+
+def _range(value: Any, where: str, unit: str) -> tuple[float, float]:
+    if not isinstance(value, list | tuple) or len(value) != 2:
+        raise ConfigError(f"{where}: expected [min, max], got {value!r}")
+    low, high = number(value[0], f"{where}[0]"), number(value[1], f"{where}[1]")
+    if not low < high:
+        raise InvalidInputError(where, f"[{low:.6g}, {high:.6g}]", "must satisfy min < max", unit)
+    return (low, high)
+
+
+def _pose(data: Any, where: str) -> Pose:
+    pose = mapping(data, where, _POSE_KEYS)
+    rotation = _matrix(pose["R"], f"{where}.R")
+    matrix = np.asarray(rotation)
+    error = float(np.max(np.abs(matrix @ matrix.T - np.eye(3))))
+    if error > 1e-6 or np.linalg.det(matrix) < 0.0:
+        raise InvalidInputError(f"{where}.R", f"|R R^T - I| = {error:.3g}", "must be a rotation matrix")
+    return Pose(_vector(pose["r"], f"{where}.r"), rotation)
+
+
+def _chain(name: str, data: Any) -> ClosedChain:
+    chain = mapping(data, f"chains.{name}", _CHAIN_KEYS)
+    where = f"{name}"
+    parent = str(chain["parent"])
+    if parent not in LINK_NAMES:
+        raise InvalidInputError(f"{where}.parent", parent, f"must be one of {list(LINK_NAMES)}")
+    stroke = positive(chain["stroke"], f"{where}.stroke", "m")
+    return ClosedChain(
+        name=name,
+        parent=parent,
+        cylinder_base_pivot=_vector(chain["cylinder_base_pivot"], f"{where}.cylinder_base_pivot"),
+        base_axis_angle=number(chain["base_axis_angle"], f"{where}.base_axis_angle"),
+        joint_offset=number(chain["joint_offset"], f"{where}.joint_offset"),
+        L1=positive(chain["L1"], f"{where}.L1", "m"),
+        default_lengths=ChainLengths(
+            L=positive(chain["L"], f"{where}.L", "m"),
+            Lc0=positive(chain["Lc0"], f"{where}.Lc0", "m"),
+            Lc=positive(chain["Lc"], f"{where}.Lc", "m"),
+        ),
+        stroke=stroke,
+        joint_range=_range(chain["joint_range"], f"{where}.joint_range", "rad"),
+    )
+
+
+def _telescope(data: Any) -> Telescope:
+    tele = mapping(data, "telescope", _TELESCOPE_KEYS)
+    stroke = positive(tele["stroke"], "telescope.stroke", "m")
+    joint_range = _range(tele["joint_range"], "telescope.joint_range", "m")
+    if joint_range[0] < 0.0 or joint_range[1] > stroke:
+        raise InvalidInputError(
+            "telescope.joint_range",
+            f"{list(joint_range)}",
+            f"must lie in [0, stroke] = [0, {stroke:.6g}]",
+            "m",
+        )
+    return Telescope(
+        parent=str(tele["parent"]),
+        cylinder_frame=_pose(tele["cylinder_frame"], "telescope.cylinder_frame"),
+        rod_offset=number(tele["rod_offset"], "telescope.rod_offset"),
+        rod_length=positive(tele["rod_length"], "telescope.rod_length", "m"),
+        stroke=stroke,
+        joint_range=joint_range,
+    )
+
+
+def _source_frame_placements(lift: ClosedChain, tilt: ClosedChain, telescope: Telescope) -> dict[str, np.ndarray]:
+    """4x4 pose of each source frame in the link it belongs to (default lengths)."""
+    placements = {name: np.eye(4) for name in _FRAME_LINKS}
+    for frame, chain in (("Bc1", lift), ("Bc2", tilt)):
+        placements[frame][:3, :3] = rot_z(chain.base_axis_angle)
+        placements[frame][:3, 3] = chain.cylinder_base_pivot
+    placements["P22"] = telescope.cylinder_frame.matrix
+    placements["P32"][0, 3] = telescope.rod_length
+    return placements
+
+
+def _body(name: str, data: Any, placements: dict[str, np.ndarray]) -> RigidBody:
+    where = f"bodies.{name}"
+    body = mapping(data, where, _BODY_KEYS)
+    frame = str(body["frame"])
+    if frame not in _FRAME_LINKS:
+        raise InvalidInputError(f"{where}.frame", frame, f"must be one of {sorted(_FRAME_LINKS)}")
+    mass = positive(body["mass"], f"{where}.mass", "kg")
+    inertia = np.asarray(_matrix(body["inertia"], f"{where}.inertia"))
+    if np.max(np.abs(inertia - inertia.T)) > 1e-9 or np.min(np.linalg.eigvalsh(inertia)) <= 0.0:
+        raise InvalidInputError(f"{where}.inertia", "not symmetric positive definite", "must be SPD", "kg m^2")
+    placement = placements[frame]
+    rotation = placement[:3, :3]
+    com = placement[:3, :3] @ np.asarray(_vector(body["com"], f"{where}.com")) + placement[:3, 3]
+    return RigidBody(
+        name=name,
+        link=_FRAME_LINKS[frame],
+        mass=mass,
+        com=vec3(com),
+        inertia=mat3(rotation @ inertia @ rotation.T),
+    )
