@@ -156,9 +156,11 @@ def locate(source: str | Path, kind: Kind, relative_to: Source | None = None) ->
     else:
         candidate = relative_to.sibling(str(path))
     if not candidate.file.is_file():
-        names = ", ".join(shipped_names(kind))
+        known = ", ".join(shipped_names(kind))
         where = f" (looked for {candidate.label})" if str(candidate.label) != str(source) else ""
-        raise ConfigError(f"{_WHAT[kind]} '{source}' is neither a shipped name ({names}) nor a readable file{where}")
+        raise ConfigError(
+            f"cannot read {_WHAT[kind]} '{source}': neither a shipped name ({known}) nor a readable file{where}"
+        )
     return candidate
 
 

@@ -136,7 +136,7 @@ def study_digest(problem: LinkLengthProblem) -> str:
     what ``--resume`` is for.
     """
     study = problem.study
-    content = replace(study, path="", solver=replace(study.solver, maxiter=0))
+    content = replace(study, path="", solver=replace(study.solver, maxiter=1))  # any fixed value
     text = "\n".join((repr(content), repr(study.crane), repr(problem.emlas)))
     return hashlib.sha256(text.encode()).hexdigest()
 
