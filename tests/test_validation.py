@@ -5,13 +5,16 @@ from __future__ import annotations
 import importlib.util
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
+import yaml
 
 from hiab_sim.cli import main
 from hiab_sim.crane.description import Crane
 from hiab_sim.crane.mechanism import check_lengths
+from hiab_sim.resources import shipped
 from hiab_sim.validation import (
     DEFAULT_CASES,
     load_cases,
@@ -110,3 +113,28 @@ def test_update_readme_replaces_only_the_marked_block(tmp_path: Path) -> None:
     assert module.main(["--table", str(table), "--readme", str(readme)]) == 0
     assert readme.read_text() == f"intro\n{module.START}\n| new | table |\n{module.END}\noutro\n"
     assert module.main(["--table", str(table), "--readme", str(readme), "--check"]) == 0
+
+
+@pytest.mark.parametrize(
+    ("edit", "field"),
+    [
+        (lambda d: d["tolerances"].update(force_relativ=1e-6), "force_relativ"),
+        (lambda d: d["cases"][0].update(samples="many"), "cases.random_states.samples"),
+        (lambda d: d["cases"][1].pop("kind"), "cases.trajectory: missing key(s) ['kind']"),
+        (lambda d: d["cases"][2].pop("name"), "cases.2: missing key(s) ['name']"),
+        (lambda d: d["cases"][3].update(kind="wobble"), "cases.static.kind"),
+        (lambda d: d["tolerances"].update(balance_relative=-1.0), "tolerances.balance_relative"),
+    ],
+)
+def test_bad_case_file_exits_2_with_one_line_naming_the_field(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], edit: Any, field: str
+) -> None:
+    """Unknown tolerance key, non-numeric samples, missing case fields: exit 2, one line naming the field."""
+    document = yaml.safe_load(shipped("cases", "cases").read_text())
+    edit(document)
+    bad = tmp_path / "cases.yaml"
+    bad.write_text(yaml.safe_dump(document))
+    assert main(["validate", "--cases", str(bad), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert field in err and "Traceback" not in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "out").exists()
