@@ -99,9 +99,7 @@ def test_validate_rejects_a_non_positive_sample_count() -> None:
 
 def test_update_readme_replaces_only_the_marked_block(tmp_path: Path) -> None:
     """validate/update_readme.py swaps the table between the markers and leaves the rest alone."""
-    spec = importlib.util.spec_from_file_location(
-        "update_readme", Path(__file__).resolve().parents[1] / "validate" / "update_readme.py"
-    )
+    spec = importlib.util.spec_from_file_location("update_readme", UPDATE_README)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)

@@ -1,6 +1,7 @@
 """Replace the validation table in README.md with the one ``hiab-sim validate`` wrote.
 
-Usage: ``python validate/update_readme.py [--table runs/validate/table.md] [--readme README.md] [--check]``.
+Usage: ``python validate/update_readme.py [--table runs/validate/table.md] [--readme README.md] [--check]``,
+from the repository root (the defaults are relative to the working folder, like ``hiab-sim validate --out``).
 The table goes between the markers ``<!-- validation-table:start -->`` and
 ``<!-- validation-table:end -->``; with ``--check`` nothing is written and the exit status is 1
 when the README is out of date.
@@ -16,7 +17,6 @@ from hiab_sim.atomic_io import write_atomic
 
 START = "<!-- validation-table:start -->"
 END = "<!-- validation-table:end -->"
-ROOT = Path(__file__).resolve().parents[1]
 
 
 def replace_block(readme: str, table: str) -> str:
@@ -29,8 +29,8 @@ def replace_block(readme: str, table: str) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--table", type=Path, default=ROOT / "runs" / "validate" / "table.md")
-    parser.add_argument("--readme", type=Path, default=ROOT / "README.md")
+    parser.add_argument("--table", type=Path, default=Path("runs/validate/table.md"))
+    parser.add_argument("--readme", type=Path, default=Path("README.md"))
     parser.add_argument("--check", action="store_true", help="only check that the README is up to date")
     args = parser.parse_args(argv)
     try:

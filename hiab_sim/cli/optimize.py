@@ -28,7 +28,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         ),
     )
     parser.add_argument(
-        "study", nargs="?", metavar="STUDY.yaml", help="study file (default: optimize/xs031_spiral.yaml)"
+        "study", nargs="?", metavar="STUDY.yaml", help="study file or shipped study name (default: xs031_spiral)"
     )
     parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<study name>)")
     parser.add_argument("--resume", action="store_true", help="continue from the output folder's last checkpoint")

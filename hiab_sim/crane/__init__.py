@@ -1,1 +1,1 @@
-"""The crane: closed-chain mechanism math and forward kinematics (numpy only)."""
+"""The crane: its description (dataclasses), YAML loader, closed-chain mechanism math and forward kinematics."""
