@@ -73,6 +73,20 @@ def test_wheel_installed_in_a_fresh_environment_optimizes_and_writes_mjcf(tmp_pa
         text=True,
     ).stdout
     assert where.startswith(str(env_dir)), where
+    # A shipped study whose crane and EMLA files sit next to it resolves them inside the installed package.
+    seed = subprocess.run(
+        [
+            str(python),
+            "-c",
+            "from hiab_sim.study.config import load_study; print(load_study('seed_scale_spiral').path)",
+        ],
+        cwd=work,
+        env=environment,
+        check=False,
+        capture_output=True,
+        text=True,
+    )
+    assert seed.returncode == 0 and seed.stdout.startswith(str(env_dir)), seed.stderr
     cli = str(env_dir / "bin" / "hiab-sim")
     optimized = subprocess.run(
         [cli, "optimize", "--no-video", "--no-figures", "--quiet", "--out", "out"],
