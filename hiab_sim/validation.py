@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.checks import check_choice, check_range
 from hiab_sim.crane import kinematics, mechanism
 from hiab_sim.crane.description import ChainLengths, Crane, LinkLengths
 from hiab_sim.crane.mechanism import check_lengths
@@ -38,7 +39,7 @@ from hiab_sim.dynamics.analytic_id import (
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import DEFAULT_CASES, Source, locate
-from hiab_sim.yaml_fields import check_choice, check_range, mapping, read_yaml, section, text, vector
+from hiab_sim.yaml_fields import mapping, read_yaml, section, text, vector
 
 Array = NDArray[np.float64]
 IdFunction = Callable[[LinkLengths, JointSamples, Array], ActuatorSamples]

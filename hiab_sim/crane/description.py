@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from hiab_sim.checks import check_range
 from hiab_sim.errors import InvalidInputError
 
 Vector3 = tuple[float, float, float]
@@ -56,6 +57,12 @@ class Pose:
 
     position: Vector3
     rotation: Matrix3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+    def __post_init__(self) -> None:
+        matrix = np.asarray(self.rotation, dtype=float)
+        error = float(np.max(np.abs(matrix @ matrix.T - np.eye(3))))
+        if not error <= 1e-6 or np.linalg.det(matrix) < 0.0:
+            raise InvalidInputError("R", f"|R R^T - I| = {error:.3g}", "must be a rotation matrix")
 
     @property
     def matrix(self) -> np.ndarray:
@@ -129,6 +136,18 @@ class ClosedChain:
     stroke: float  # actuator stroke [m]
     joint_range: tuple[float, float]  # working range of theta [rad]
 
+    def __post_init__(self) -> None:
+        name = self.name
+        if self.parent not in LINK_NAMES:
+            raise InvalidInputError(f"{name}.parent", self.parent, f"must be one of {list(LINK_NAMES)}")
+        check_range(f"{name}.base_axis_angle", self.base_axis_angle, unit="rad")
+        check_range(f"{name}.joint_offset", self.joint_offset, unit="rad")
+        for key in ("L1", "stroke"):
+            check_range(f"{name}.{key}", getattr(self, key), 0.0, unit="m", low_open=True)
+        for key in ("L", "Lc0", "Lc"):
+            check_range(f"{name}.{key}", getattr(self.default_lengths, key), 0.0, unit="m", low_open=True)
+        _check_interval(f"{name}.joint_range", self.joint_range, "rad")
+
     @property
     def base_axis(self) -> np.ndarray:
         """Unit vector from the cylinder base pivot to the boom hinge, in the parent frame."""
@@ -155,6 +174,16 @@ class Telescope:
     stroke: float  # [m]
     joint_range: tuple[float, float]  # [m]
 
+    def __post_init__(self) -> None:
+        check_range("telescope.rod_offset", self.rod_offset, unit="m")
+        check_range("telescope.rod_length", self.rod_length, 0.0, unit="m", low_open=True)
+        check_range("telescope.stroke", self.stroke, 0.0, unit="m", low_open=True)
+        low, high = _check_interval("telescope.joint_range", self.joint_range, "m")
+        if low < 0.0 or high > self.stroke:
+            raise InvalidInputError(
+                "telescope.joint_range", f"{[low, high]}", f"must lie in [0, stroke] = [0, {self.stroke:.6g}]", "m"
+            )
+
 
 @dataclass(frozen=True)
 class RigidBody:
@@ -169,6 +198,13 @@ class RigidBody:
     com: Vector3
     inertia: Matrix3
 
+    def __post_init__(self) -> None:
+        where = f"bodies.{self.name}"
+        check_range(f"{where}.mass", self.mass, 0.0, unit="kg", low_open=True)
+        inertia = np.asarray(self.inertia, dtype=float)
+        if not (np.max(np.abs(inertia - inertia.T)) <= 1e-9 and np.min(np.linalg.eigvalsh(inertia)) > 0.0):
+            raise InvalidInputError(f"{where}.inertia", "not symmetric positive definite", "must be SPD", "kg m^2")
+
 
 @dataclass(frozen=True)
 class Crane:
@@ -182,6 +218,9 @@ class Crane:
     telescope: Telescope
     tcp: Pose  # TCP frame {D22} in the end-mass frame {P32}
     bodies: tuple[RigidBody, ...] = field(repr=False)
+
+    def __post_init__(self) -> None:
+        check_range("gravity", self.gravity, 0.0, unit="m/s^2", low_open=True)
 
     @property
     def chains(self) -> tuple[ClosedChain, ClosedChain]:
@@ -230,6 +269,16 @@ def scale_slender_body(body: RigidBody, factor: float) -> RigidBody:
         com=vec3(np.asarray(body.com) * factor),
         inertia=mat3(inertia),
     )
+
+
+def _check_interval(where: str, interval: tuple[float, float], unit: str) -> tuple[float, float]:
+    """A finite [min, max] with min < max."""
+    low, high = interval
+    check_range(f"{where}[0]", low, unit=unit)
+    check_range(f"{where}[1]", high, unit=unit)
+    if not low < high:
+        raise InvalidInputError(where, f"[{low:.6g}, {high:.6g}]", "must satisfy min < max", unit)
+    return (low, high)
 
 
 def check_positive_lengths(lengths: LinkLengths) -> None:

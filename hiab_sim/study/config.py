@@ -15,12 +15,13 @@ from typing import Any
 
 import numpy as np
 
+from hiab_sim.checks import check_choice, check_range
 from hiab_sim.crane.description import CHAIN_NAMES, ChainLengths, Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import DEFAULT_STUDY, Source, locate
-from hiab_sim.yaml_fields import check_choice, check_range, mapping, number, positive, read_yaml, section, vector
+from hiab_sim.yaml_fields import mapping, number, positive, read_yaml, section, vector
 
 ID_PATHS = ("mujoco", "analytic")
 

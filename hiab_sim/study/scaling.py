@@ -111,7 +111,7 @@ def write_seed_scale_files(folder: Path | None = None) -> tuple[Path, Path]:
             L1=chain["L1"],
             default_lengths=xi,
             stroke=chain["stroke"],
-            joint_range=(0.0, 0.0),
+            joint_range=(-np.pi, np.pi),  # not used by reachable_joint_range
         )
         reach = mechanism.reachable_joint_range(probe, xi)
         margin = np.radians(2.0)

@@ -1,0 +1,48 @@
+"""Range checks for the dataclasses' ``__post_init__``: one-line errors naming field, value, allowed range and unit."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from hiab_sim.errors import InvalidInputError
+
+
+def check_range(
+    where: str,
+    value: Any,
+    low: float | None = None,
+    high: float | None = None,
+    unit: str = "",
+    *,
+    low_open: bool = False,
+    high_open: bool = False,
+    integral: bool = False,
+) -> None:
+    """Raise :class:`InvalidInputError` unless ``value`` is a finite number in the interval.
+
+    ``low``/``high`` None: unbounded on that side; ``*_open``: the bound itself is excluded;
+    ``integral``: the value must be an ``int``. Used by the dataclasses' ``__post_init__``.
+    """
+    kind = "an integer" if integral else "a finite number"
+    ok = not isinstance(value, bool) and isinstance(value, int if integral else int | float)
+    ok = ok and math.isfinite(value)
+    ok = ok and (low is None or (value > low if low_open else value >= low))
+    ok = ok and (high is None or (value < high if high_open else value <= high))
+    if ok:
+        return
+    if low is not None and high is not None:
+        allowed = f"must lie in {'(' if low_open else '['}{low:.6g}, {high:.6g}{')' if high_open else ']'}"
+    elif low is not None:
+        allowed = f"must be {'>' if low_open else '>='} {low:.6g}"
+    elif high is not None:
+        allowed = f"must be {'<' if high_open else '<='} {high:.6g}"
+    else:
+        allowed = f"must be {kind}"
+    raise InvalidInputError(where, value, allowed, unit)
+
+
+def check_choice(where: str, value: Any, choices: tuple[str, ...]) -> None:
+    """Raise :class:`InvalidInputError` unless ``value`` is one of ``choices``."""
+    if value not in choices:
+        raise InvalidInputError(where, value, f"must be one of {', '.join(choices)}")
