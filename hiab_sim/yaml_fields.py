@@ -134,6 +134,10 @@ def section(cls: type, data: Any, where: str, skip: tuple[str, ...] = ()) -> dic
     values: dict[str, Any] = {}
     for f in fields:
         if f.name in node:
-            kind = str(f.type).replace(" | None", "")
+            kind = (f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type))).replace(
+                " | None", ""
+            )
+            if kind not in _READERS:
+                raise TypeError(f"{cls.__name__}.{f.name}: no YAML reader for type {kind!r}")
             values[f.name] = _READERS[kind](node[f.name], f"{where}.{f.name}")
     return values

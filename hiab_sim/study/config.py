@@ -2,8 +2,11 @@
 
 A study file names everything the optimiser of seed eqs. ``costf2`` / ``const_a``..``const_m``
 needs; every unknown or missing key raises :class:`~hiab_sim.errors.ConfigError` and every
-out-of-range value :class:`~hiab_sim.errors.InvalidInputError` naming the field. Relative file
-paths in a study (crane, EMLA) are resolved against the study file's folder.
+out-of-range value :class:`~hiab_sim.errors.InvalidInputError` naming the field. Values are read
+by :mod:`hiab_sim.yaml_fields`; each dataclass checks its own ranges in ``__post_init__`` and
+holds the only copy of its defaults (a key a file omits takes the dataclass default). The crane
+and the EMLA set are a preset name or a path, resolved by :func:`hiab_sim.resources.locate`:
+relative paths next to the study file (inside the installed package for a shipped study).
 """
 
 from __future__ import annotations
@@ -213,7 +216,8 @@ class Study:
     """Everything one optimisation needs (see module docstring).
 
     ``crane_source`` and ``emla_source`` are what the study file wrote (a preset name or a path
-    relative to it), kept for reports and for copying the crane file next to a result.
+    relative to it), kept for reports; ``crane_file`` is where the crane was read from, for
+    copying a crane file next to a result.
     """
 
     name: str
