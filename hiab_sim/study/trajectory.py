@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from scipy.interpolate import BSpline
 
 from hiab_sim.crane import mechanism
-from hiab_sim.crane.description import Crane
+from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.config import SpiralReference
 
@@ -335,11 +335,8 @@ def fit_coefficients(basis: SplineBasis, joints: JointTrajectory, rate_weight: f
     return out
 
 
-def check_reachable(crane: Crane, lengths_chain: object, joints: JointTrajectory) -> None:
+def check_reachable(crane: Crane, lengths_chain: LinkLengths, joints: JointTrajectory) -> None:
     """Raise :class:`InvalidInputError` if the joint samples leave a chain's usable stroke."""
-    from hiab_sim.crane.description import LinkLengths
-
-    assert isinstance(lengths_chain, LinkLengths)
     for j, chain in enumerate(crane.chains):
         mechanism.check_joint_samples(
             chain, getattr(lengths_chain, chain.name), joints.position[:, j], field=f"reference ({chain.name} joint)"
