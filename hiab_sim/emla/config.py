@@ -8,14 +8,13 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
+from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.yaml_fields import read_yaml
 
 #: The default EMLA set for the HIAB XS 031 (lift, tilt, telescope).
 DEFAULT_EMLA_PRESET = Path(__file__).resolve().parent.parent / "presets" / "emla_xs031.yaml"
 
-#: Actuator names, in the order the crane and the optimiser use them.
-ACTUATOR_NAMES: tuple[str, ...] = ("lift", "tilt", "telescope")
 
 #: First words allowed in a ``source`` provenance label.
 PROVENANCE_KINDS: tuple[str, ...] = ("read", "estimate", "derived", "model")

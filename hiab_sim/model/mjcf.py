@@ -65,15 +65,16 @@ import numpy as np
 
 import hiab_sim
 from hiab_sim.config import ClosedChain, Crane, LinkLengths, RigidBody, check_lengths
+from hiab_sim.crane.names import ACTUATOR_NAMES, JOINT_NAMES
 
 #: Folder of the shared MJCF pieces.
 ASSET_DIR = Path(hiab_sim.__file__).resolve().parents[1] / "assets" / "mjcf"
 TEMPLATE = ASSET_DIR / "crane_template.xml"
 
 #: Independent joints (qpos equals the source's Θ1, Θ2, xt2) and the actuated slides, in order.
-JOINTS = ("theta1", "theta2", "xt2")
+JOINTS = JOINT_NAMES
 SLIDES = ("x1", "x2", "xt2")
-ACTUATORS = ("lift", "tilt", "telescope")
+ACTUATORS = ACTUATOR_NAMES
 #: Passive joints of the closed chains: cylinder hinge (seed's q1) and stroke, per chain.
 PASSIVE = ("lift_q1", "x1", "tilt_q1", "x2")
 _CHAIN_JOINT = {"lift": ("theta1", "x1"), "tilt": ("theta2", "x2")}
