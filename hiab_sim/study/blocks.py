@@ -112,9 +112,7 @@ class EnvelopeMargins(PerSampleBlock):
             gf, gv, ga = envelope_margin_partials(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
             dG[:, i, :, i], dG[:, i, :, 3 + i], dG[:, i, :, 6 + i] = gf.T, gv.T, ga.T
         dGY = dG.reshape(K, 9, 9) / (1.0 - self.margin)
-        return SampleRows(
-            np.einsum("kmy,kyq->kmq", dGY, partials.id_q), np.einsum("kmy,kyx->kmx", dGY, partials.id_xi)
-        )
+        return SampleRows(np.einsum("kmy,kyq->kmq", dGY, partials.id_q), np.einsum("kmy,kyx->kmx", dGY, partials.id_xi))
 
 
 def stroke_margins(chains: Sequence[ClosedChain], lengths: LinkLengths, theta: Array) -> Array:
@@ -218,9 +216,7 @@ class WorkingRange(ConstraintBlock):
 
     """
 
-    def __init__(
-        self, chains: Sequence[ClosedChain], working: Sequence[tuple[float, float]], clearance: float
-    ) -> None:
+    def __init__(self, chains: Sequence[ClosedChain], working: Sequence[tuple[float, float]], clearance: float) -> None:
         self.name = "working_range"
         self.chains = tuple(chains)
         self.working = tuple(working)

@@ -188,8 +188,10 @@ class BlockLayout:
     ) -> Array:
         """Jacobian (m, n): each block's partials mapped to z by ``to_z(jacobian, rows)``."""
         return np.concatenate(
-            [to_z(block.jacobian(state, partials), self.slices[block.name].stop - self.slices[block.name].start)
-             for block in self.blocks],
+            [
+                to_z(block.jacobian(state, partials), self.slices[block.name].stop - self.slices[block.name].start)
+                for block in self.blocks
+            ],
             axis=0,
         )
 
@@ -201,6 +203,4 @@ class BlockLayout:
     def named(self, rows: Array) -> dict[str, dict[str, float]]:
         """A row vector as {block name: {row name: value}} (e.g. multipliers for a sensitivity report)."""
         rows = np.asarray(rows, dtype=float)
-        return {
-            name: dict(zip(self.names[s], map(float, rows[s]), strict=True)) for name, s in self.slices.items()
-        }
+        return {name: dict(zip(self.names[s], map(float, rows[s]), strict=True)) for name, s in self.slices.items()}

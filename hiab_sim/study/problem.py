@@ -47,6 +47,7 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.study import blocks as bl
 from hiab_sim.study import trajectory as tr
 from hiab_sim.study.config import Study
+from hiab_sim.study.id_partials import id_joint_partials, id_length_partials
 from hiab_sim.study.nlp import (
     N_XI,
     Array,
@@ -337,46 +338,6 @@ class LinkLengthProblem:
         out[order] = jac
         return out
 
-    def _sample_partials(self, lengths: LinkLengths, joints: tr.JointTrajectory) -> Array:
-        """d(f, v, a)/d(theta, dtheta, ddtheta) per sample by central differences, (K, 9, 9).
-
-        All K samples and all 9 perturbations go into one ID call of 18 K samples: samples are
-        independent, so perturbing them together is exact bookkeeping, not an approximation.
-        """
-        K = len(self.times)
-        base = np.concatenate([joints.position, joints.velocity, joints.acceleration], axis=1)  # (K, 9)
-        h = self.fd_step * np.maximum(1.0, np.abs(base))  # (K, 9)
-        batch = np.repeat(base[None], 18, axis=0)  # (18, K, 9)
-        for j in range(9):
-            batch[2 * j, :, j] += h[:, j]
-            batch[2 * j + 1, :, j] -= h[:, j]
-        flat = batch.reshape(18 * K, 9)
-        act = self._id(lengths)(JointSamples(flat[:, 0:3], flat[:, 3:6], flat[:, 6:9]), tcp_force=self.tcp_force)
-        out = np.concatenate([act.force, act.velocity, act.acceleration], axis=1).reshape(18, K, 9)
-        d = (out[0::2] - out[1::2]) / (2.0 * h.T[:, :, None])  # (9 inputs, K, 9 outputs)
-        return np.transpose(d, (1, 2, 0))
-
-    def _xi_partials(self, lengths: LinkLengths, joints: tr.JointTrajectory) -> Array:
-        """d(f, v, a)/dXi per sample by central differences, (K, 9, 6) [per m].
-
-        On the analytic path (no model to rebuild) or, with ``xi_derivatives: rebuild``, on the
-        optimisation's own path with one model build per perturbed Xi.
-        """
-        xi = lengths.as_array()
-        js = JointSamples(joints.position, joints.velocity, joints.acceleration)
-        out = np.zeros((len(self.times), 9, 6))
-        for i in range(6):
-            h = self.fd_step * max(1.0, abs(xi[i]))
-            values = []
-            for sign in (1.0, -1.0):
-                x = xi.copy()
-                x[i] += sign * h
-                model = make_inverse_dynamics(self.crane, LinkLengths.from_array(x), self.xi_path)
-                a = model(js, tcp_force=self.tcp_force)
-                values.append(np.concatenate([a.force, a.velocity, a.acceleration], axis=1))
-            out[:, :, i] = (values[0] - values[1]) / (2.0 * h)
-        return out
-
     def _to_z(self, jac: BlockJacobian, rows: int) -> Array:
         """A block's partials w.r.t. q9 and Xi [per m] as rows of D g / dz (m, n), through the spline matrices."""
         K = len(self.times)
@@ -403,8 +364,10 @@ class LinkLengthProblem:
             return self._grad_cache[key]
         self.n_gradients += 1
         ev = self.evaluate(z)
+        samples = JointSamples(ev.joints.position, ev.joints.velocity, ev.joints.acceleration)
         partials = SamplePartials(
-            lambda: self._sample_partials(ev.lengths, ev.joints), lambda: self._xi_partials(ev.lengths, ev.joints)
+            lambda: id_joint_partials(self._id(ev.lengths), samples, self.fd_step, self.tcp_force),
+            lambda: id_length_partials(self.crane, ev.lengths, samples, self.xi_path, self.fd_step, self.tcp_force),
         )
         jac = self.blocks.jacobian(ev, partials, self._to_z)
         dcost_q, dcost_xi = self.objective.gradient(ev, partials)

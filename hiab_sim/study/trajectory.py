@@ -22,7 +22,6 @@ from numpy.typing import NDArray
 from scipy.interpolate import BSpline
 
 from hiab_sim.config import Crane
-from hiab_sim.crane import mechanism
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.config import SpiralReference
 
