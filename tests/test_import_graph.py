@@ -121,7 +121,7 @@ def _mutually_reachable(graph: dict[str, set[str]]) -> set[frozenset[str]]:
 
 
 def test_finder_sees_a_circle_hidden_inside_a_function(tmp_path: Path) -> None:
-    """A circle whose second edge is an import inside a function is found; a module that only imports it is not in it."""
+    """A circle closed by an import inside a function is found; a module that only imports it is not in it."""
     package = tmp_path / "pkg"
     package.mkdir()
     (package / "__init__.py").write_text("")

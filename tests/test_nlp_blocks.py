@@ -84,7 +84,7 @@ def test_clearance_belongs_to_the_working_range_block_only() -> None:
 
 
 def test_an_added_integral_block_gets_an_exact_jacobian() -> None:
-    """A block whose row depends on every sample (RMS force) is assembled into D g / dz; it matches central differences."""
+    """A row that depends on every sample (RMS force) is assembled into D g / dz and matches central differences."""
     problem = WithRmsBlock(STUDY, id_path="analytic")
     assert problem.constraint_names[-1] == "rms_force.lift <= limit"
     z = _point(problem)
