@@ -7,9 +7,10 @@ import pytest
 from test_study_small import small_study
 
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.study.blocks import ObjectiveBound
 from hiab_sim.study.config import study_from_dict
 from hiab_sim.study.nlp import ConstraintBlock, DenseRows, SamplePartials, SampleState
-from hiab_sim.study.objectives import make_objective
+from hiab_sim.study.objectives import SquaredPowerCost, make_objective
 from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.solve import start_points
 
@@ -49,9 +50,18 @@ class WithRmsBlock(LinkLengthProblem):
         return [*super()._build_blocks(), RmsForceLimit(limit=60e3)]
 
 
+class WithCostBound(LinkLengthProblem):
+    """The small study's NLP with its own cost held below a bound (an epsilon constraint)."""
+
+    def _build_blocks(self) -> list[ConstraintBlock]:
+        cost = SquaredPowerCost(self.emlas, self.dt)
+        return [*super()._build_blocks(), ObjectiveBound(cost, bound=5e5, scale=1e5)]
+
+
 def _point(problem: LinkLengthProblem) -> np.ndarray:
+    """A feasible start other than the built crane's (drawn on the plain NLP), with perturbed coefficients."""
     rng = np.random.default_rng(5)
-    z = problem.initial_point(start_points(problem, 2)[1])
+    z = problem.initial_point(start_points(LinkLengthProblem(STUDY, id_path="analytic"), 2)[1])
     return z + np.concatenate([np.zeros(6), rng.normal(0.0, 0.02, problem.n_c)])
 
 
@@ -83,10 +93,15 @@ def test_clearance_belongs_to_the_working_range_block_only() -> None:
     np.testing.assert_allclose(tight.margins(z)[rows], loose.constraints(z)[rows], rtol=0, atol=1e-15)
 
 
-def test_an_added_integral_block_gets_an_exact_jacobian() -> None:
-    """A row that depends on every sample (RMS force) is assembled into D g / dz and matches central differences."""
-    problem = WithRmsBlock(STUDY, id_path="analytic")
-    assert problem.constraint_names[-1] == "rms_force.lift <= limit"
+@pytest.mark.parametrize(
+    ("kind", "last_row"),
+    [(WithRmsBlock, "rms_force.lift <= limit"), (WithCostBound, "bound.costf2 <= 500000 W^2 s")],
+    ids=["rms_force", "cost_bound"],
+)
+def test_an_added_integral_block_gets_an_exact_jacobian(kind: type[LinkLengthProblem], last_row: str) -> None:
+    """A row that depends on every sample (RMS force, a cost bound) enters D g / dz and matches central differences."""
+    problem = kind(STUDY, id_path="analytic")
+    assert problem.constraint_names[-1] == last_row
     z = _point(problem)
     row = problem.constraints_jacobian(z)[-1]
     fd = np.zeros(problem.n)
@@ -100,6 +115,13 @@ def test_an_added_integral_block_gets_an_exact_jacobian() -> None:
     # the other rows are those of the plain problem
     plain = LinkLengthProblem(STUDY, id_path="analytic")
     np.testing.assert_array_equal(problem.constraints(z)[:-1], plain.constraints(z))
+
+
+def test_cost_bound_row_is_the_bound_less_the_problem_cost() -> None:
+    """The epsilon row equals (bound - f) / scale with f the problem's own (unscaled) cost at the same point."""
+    problem = WithCostBound(STUDY, id_path="analytic")
+    z = _point(problem)
+    assert problem.constraints(z)[-1] == pytest.approx((5e5 - problem.evaluate(z).cost) / 1e5, rel=1e-14)
 
 
 def test_unknown_objective_names_the_field() -> None:

@@ -11,7 +11,9 @@ All rows are scaled to O(1) and written g >= 0 (see :mod:`hiab_sim.study.nlp` fo
   the hinge-angle margin (linear in the joint samples);
 * :class:`JointVelocityLimits` (``const_i``): |dtheta| <= the joint velocity limit;
 * :class:`WorkingRange` (``const_j`` at the ends of the working range, Xi only), with the
-  optimiser's clearance.
+  optimiser's clearance;
+* :class:`ObjectiveBound`: any objective held below a bound, (bound - f) / scale >= 0 (the
+  epsilon constraint of a Pareto front).
 
 The stroke trigonometry is :func:`hiab_sim.crane.mechanism.joint_to_stroke` and its partials
 :func:`hiab_sim.crane.mechanism.joint_to_stroke_partials`.
@@ -27,12 +29,14 @@ from hiab_sim.config import ClosedChain, LinkLengths
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.names import ACTUATOR_NAMES, JOINT_NAMES
 from hiab_sim.emla import ENVELOPE_LIMIT_NAMES, EmlaSet, envelope_margin_partials, envelope_margins
+from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.nlp import (
     N_Q,
     N_XI,
     Array,
     ConstraintBlock,
     DenseRows,
+    Objective,
     PerSampleBlock,
     SamplePartials,
     SampleRows,
@@ -240,3 +244,35 @@ class WorkingRange(ConstraintBlock):
     def clearance(self) -> float:
         """The optimiser's clearance (scaled)."""
         return self._clearance
+
+
+class ObjectiveBound(ConstraintBlock):
+    """(bound - f(state)) / scale >= 0 for an objective f: an epsilon constraint (one row, all samples).
+
+    Args:
+        objective: the criterion f (:class:`hiab_sim.study.nlp.Objective`).
+        bound: epsilon [f's unit].
+        scale: divisor that makes the row O(1) [f's unit], > 0.
+
+    """
+
+    def __init__(self, objective: Objective, bound: float, scale: float) -> None:
+        if not scale > 0.0:
+            raise InvalidInputError(f"bound.{objective.name}.scale", scale, "must be > 0", objective.unit)
+        self.name = f"bound.{objective.name}"
+        self.objective = objective
+        self.bound = bound
+        self.scale = scale
+
+    def row_names(self) -> list[str]:
+        """``bound.<objective> <= <bound> <unit>``."""
+        return [f"{self.name} <= {self.bound:.6g} {self.objective.unit}"]
+
+    def values(self, state: SampleState) -> Array:
+        """(bound - f) / scale, (1,)."""
+        return np.array([(self.bound - self.objective.value(state)) / self.scale])
+
+    def jacobian(self, state: SampleState, partials: SamplePartials) -> DenseRows:
+        """-(df/dq9, df/dXi) / scale."""
+        dq, dxi = self.objective.gradient(state, partials)
+        return DenseRows(dq=-dq[None] / self.scale, dxi=-dxi[None] / self.scale)

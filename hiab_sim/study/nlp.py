@@ -184,16 +184,21 @@ class BlockLayout:
         return out
 
     def jacobian(
-        self, state: SampleState, partials: SamplePartials, to_z: Callable[[BlockJacobian, int], Array]
+        self,
+        state: SampleState,
+        partials: SamplePartials,
+        to_z: Callable[[ConstraintBlock, BlockJacobian, int], Array],
     ) -> Array:
-        """Jacobian (m, n): each block's partials mapped to z by ``to_z(jacobian, rows)``."""
-        return np.concatenate(
-            [
-                to_z(block.jacobian(state, partials), self.slices[block.name].stop - self.slices[block.name].start)
-                for block in self.blocks
-            ],
-            axis=0,
-        )
+        """Jacobian (m, n): each block's partials mapped to z by ``to_z(block, jacobian, rows)``.
+
+        ``to_z`` belongs to the problem, which alone knows the layout of z (for several tasks it
+        picks the block's task's spline matrices and columns).
+        """
+        parts = []
+        for block in self.blocks:
+            rows = self.slices[block.name]
+            parts.append(to_z(block, block.jacobian(state, partials), rows.stop - rows.start))
+        return np.concatenate(parts, axis=0)
 
     def split(self, rows: Array) -> dict[str, Array]:
         """A row vector (margins, multipliers) cut into blocks by name."""

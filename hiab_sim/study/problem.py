@@ -338,7 +338,7 @@ class LinkLengthProblem:
         out[order] = jac
         return out
 
-    def _to_z(self, jac: BlockJacobian, rows: int) -> Array:
+    def _to_z(self, block: ConstraintBlock, jac: BlockJacobian, rows: int) -> Array:
         """A block's partials w.r.t. q9 and Xi [per m] as rows of D g / dz (m, n), through the spline matrices."""
         K = len(self.times)
         out = np.zeros((rows, self.n))
