@@ -69,7 +69,7 @@ def test_every_row_belongs_to_one_named_block() -> None:
     """Block slices tile the rows in order, each row is named after its block, and values match names."""
     problem = LinkLengthProblem(STUDY, id_path="analytic")
     ev = problem.evaluate(problem.initial_point(STUDY.initial_lengths))
-    layout = problem.blocks
+    layout = problem.layout
     stop = 0
     for block in layout.blocks:
         rows = layout.slices[block.name]
@@ -85,11 +85,11 @@ def test_every_row_belongs_to_one_named_block() -> None:
 def test_clearance_belongs_to_the_working_range_block_only() -> None:
     """The solver's rows plus the clearance are the nominal rows; only working_range rows carry it."""
     tight = LinkLengthProblem(STUDY, id_path="analytic")
-    nominal = {name: values for name, values in tight.blocks.split(tight.clearance).items() if np.any(values)}
+    nominal = {name: values for name, values in tight.layout.split(tight.clearance).items() if np.any(values)}
     assert list(nominal) == ["working_range"]
     z = tight.initial_point(STUDY.initial_lengths)
     loose = LinkLengthProblem(STUDY, id_path="analytic", tightened=False)
-    rows = tight.blocks.slices["working_range"]
+    rows = tight.layout.slices["working_range"]
     np.testing.assert_allclose(tight.margins(z)[rows], loose.constraints(z)[rows], rtol=0, atol=1e-15)
 
 

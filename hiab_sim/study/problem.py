@@ -182,10 +182,10 @@ class LinkLengthProblem:
         self.lower = np.concatenate([np.asarray(study.bounds.xi_low) / XI_SCALE, np.full(self.n_c, -np.inf)])
         self.upper = np.concatenate([np.asarray(study.bounds.xi_up) / XI_SCALE, np.full(self.n_c, np.inf)])
         self.objective = make_objective(objective, self.emlas, self.dt)
-        self.blocks: BlockLayout = BlockLayout(self._build_blocks())
-        self.constraint_names = self.blocks.names
+        self.layout = BlockLayout(self._build_blocks())
+        self.constraint_names = self.layout.names
         #: added to the solver's rows gives the nominal scaled margins (each block owns its clearance)
-        self.clearance = self.blocks.clearance
+        self.clearance = self.layout.clearance
         self._id_cache: dict[bytes, InverseDynamics] = {}
         self._eval_cache: dict[bytes, Evaluation] = {}
         self._grad_cache: dict[bytes, tuple[Array, Array]] = {}
@@ -274,7 +274,7 @@ class LinkLengthProblem:
             z=z,
             coefficients=c,
             cost=self.objective.value(state),
-            constraints=self.blocks.values(state),
+            constraints=self.layout.values(state),
             equalities=self._equalities(c),
         )
         if len(self._eval_cache) > 8:
@@ -369,7 +369,7 @@ class LinkLengthProblem:
             lambda: id_joint_partials(self._id(ev.lengths), samples, self.fd_step, self.tcp_force),
             lambda: id_length_partials(self.crane, ev.lengths, samples, self.xi_path, self.fd_step, self.tcp_force),
         )
-        jac = self.blocks.jacobian(ev, partials, self._to_z)
+        jac = self.layout.jacobian(ev, partials, self._to_z)
         dcost_q, dcost_xi = self.objective.gradient(ev, partials)
         K = len(self.times)
         grad_c = np.einsum("koj,okn->jn", dcost_q.reshape(K, 3, 3), self.B).ravel() * C_SCALE
