@@ -18,6 +18,22 @@ the Jacobian of one list of blocks, and splits any row vector (margins, multipli
 
 An objective (:class:`Objective`) returns its value [its unit] and gradient w.r.t. q9 (K, 9)
 and Xi (6,); the problem divides both by its ``cost_scale``.
+
+Extending (one edit each):
+
+- a block: subclass :class:`PerSampleBlock` (same rows at every sample, return :class:`SampleRows`)
+  or :class:`ConstraintBlock` (return :class:`DenseRows`), and add an instance to
+  ``LinkLengthProblem._build_blocks``. An integral row (RMS torque over the duty, a thermal
+  steady state) returns ``DenseRows(dq=(m, K, 9), dxi=(m, 6))``; a row of Xi only (working
+  range, mounting-space polygons) ``DenseRows(dxi=...)``; an epsilon constraint on any objective
+  is :class:`hiab_sim.study.blocks.ObjectiveBound`.
+- an objective: a class with ``name``, ``unit``, ``value`` and ``gradient`` and one entry in
+  :data:`hiab_sim.study.objectives.OBJECTIVES`.
+- several tasks: each task's blocks read that task's state; the problem's ``to_z(block, jacobian,
+  rows)`` (passed to :meth:`BlockLayout.jacobian`) receives the block, so it can map q9 partials
+  to the block's task's spline matrices and coefficient columns.
+- multipliers or margins by name: :meth:`BlockLayout.split` and :meth:`BlockLayout.named` cut any
+  row vector into blocks and rows.
 """
 
 from __future__ import annotations
