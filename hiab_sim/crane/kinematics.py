@@ -31,7 +31,8 @@ class Frames:
         return self.position[link] + self.rotation[link] @ np.asarray(local, dtype=float)
 
 
-def _rz(angle: Array) -> Array:
+def rotation_z(angle: Array) -> Array:
+    """Rotation matrices about z by ``angle`` [rad], shape (*angle.shape, 3, 3)."""
     c, s = np.cos(angle), np.sin(angle)
     out = np.zeros((*np.shape(angle), 3, 3))
     out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1], out[..., 2, 2] = c, -s, s, c, 1.0
@@ -56,10 +57,10 @@ def _add_chain(frames: Frames, chain: ClosedChain, lengths: LinkLengths, theta: 
         frames,
         chain.parent,
         f"{chain.name}_boom",
-        _rz(chain.base_axis_angle + theta - chain.joint_offset),
+        rotation_z(chain.base_axis_angle + theta - chain.joint_offset),
         hinge,
     )
-    _compose(frames, chain.parent, f"{chain.name}_cylinder", _rz(chain.base_axis_angle + q1), pivot)
+    _compose(frames, chain.parent, f"{chain.name}_cylinder", rotation_z(chain.base_axis_angle + q1), pivot)
     rod_offset = np.zeros((*n, 3))
     rod_offset[..., 0] = xi.Lc0 + x
     _compose(

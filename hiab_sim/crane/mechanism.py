@@ -119,6 +119,21 @@ def joint_to_stroke(chain: ClosedChain, lengths: ChainLengths, theta: ArrayLike)
     return stroke_from_hinge_angle(hinge_angle(chain, theta), lengths.L, chain.L1, lengths.x0)
 
 
+def joint_to_stroke_partials(chain: ClosedChain, lengths: ChainLengths, theta: ArrayLike) -> tuple[Array, Array]:
+    """Partials of :func:`joint_to_stroke`: (dx/dtheta [m/rad], dx/d(L, Lc0, Lc) [-], shape (..., 3)).
+
+    With q = psi - theta and s = sqrt(L^2 + L1^2 - 2 L L1 cos q) (eq. qus_a), x = s - x0, so
+    dx/dtheta = -L L1 sin q / s (= -1 / k1 of eq. k1_3), dx/dL = (L - L1 cos q) / s and
+    dx/dLc0 = dx/dLc = -1 (x0 = Lc0 + Lc).
+    """
+    q = hinge_angle(chain, theta)
+    L, L1 = lengths.L, chain.L1
+    s = np.sqrt(L**2 + L1**2 - 2.0 * L * L1 * np.cos(q))
+    d_theta = -L * L1 * np.sin(q) / s
+    d_lengths = np.stack([(L - L1 * np.cos(q)) / s, -np.ones_like(q), -np.ones_like(q)], axis=-1)
+    return d_theta, d_lengths
+
+
 def stroke_to_joint(chain: ClosedChain, lengths: ChainLengths, x: ArrayLike) -> Array:
     """Joint angle theta for actuator stroke x (eqs. qus_a, thetas) [rad]."""
     q, _, _ = triangle_angles(x, lengths.L, chain.L1, lengths.x0)

@@ -37,14 +37,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths
 from hiab_sim.crane.mechanism import check_lengths
+from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.dynamics.analytic_kinematics import MOVING_LINKS, CraneMotion, crane_motion
 from hiab_sim.dynamics.analytic_planar import planar_inverse_dynamics, planar_model
+from hiab_sim.dynamics.checks import check_joints, tcp_force_samples
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.dynamics.spatial import newton_euler_wrench, rotate, spatial_inertia, wrench_to_parent
-from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
 
@@ -113,12 +113,28 @@ def analytic_inverse_dynamics(
 
     """
     planar_model(crane, lengths)  # checks the lengths once per (crane, lengths)
-    _check_joints(crane, lengths, joints)
-    external = _tcp_force(tcp_force, len(joints))
+    check_joints(crane, lengths, joints)
+    external = _external(tcp_force, len(joints))
     force, velocity, acceleration, stroke = planar_inverse_dynamics(
         crane, lengths, joints.position, joints.velocity, joints.acceleration, external
     )
     return ActuatorSamples(force=force, velocity=velocity, acceleration=acceleration, stroke=stroke)
+
+
+class AnalyticInverseDynamics:
+    """:func:`analytic_inverse_dynamics` for one link-length set, with the interface of the MuJoCo path.
+
+    Building it checks the lengths (once per set, :func:`planar_model`); a call evaluates eq. dynamics.
+    """
+
+    def __init__(self, crane: Crane, lengths: LinkLengths | None = None) -> None:
+        self.crane = crane
+        self.lengths = crane.default_lengths if lengths is None else lengths
+        planar_model(crane, self.lengths)
+
+    def __call__(self, joints: JointSamples, tcp_force: ArrayLike | None = None) -> ActuatorSamples:
+        """Actuator samples [f_x, v_x] = ID(theta, dtheta, ddtheta, robot(Xi)) (eq. dynamics)."""
+        return analytic_inverse_dynamics(self.crane, self.lengths, joints, tcp_force=tcp_force)
 
 
 def spatial_inverse_dynamics(
@@ -130,7 +146,7 @@ def spatial_inverse_dynamics(
     2022): steps 1-3 of the module docstring on every link's full 6D motion.
     """
     check_analytic_inputs(crane, lengths, joints)
-    external = _tcp_force(tcp_force, len(joints))
+    external = _external(tcp_force, len(joints))
     motion = crane_motion(crane, lengths, joints.position, joints.velocity, joints.acceleration)
     W = link_wrenches(crane, lengths, motion)
     tcp = crane.tcp_in_telescope_rod
@@ -144,13 +160,12 @@ def spatial_inverse_dynamics(
     lift_subtree = tilt_subtree + W["tilt_cylinder"] + W["tilt_rod"] + W["lift_boom"]
     f_lift = _chain_force(crane.lift, lengths, motion, W, lift_subtree)
 
-    names = ("lift", "tilt", "telescope")
     act = motion.actuators
     return ActuatorSamples(
         force=np.stack([f_lift, f_tilt, f_telescope], axis=1),
-        velocity=np.stack([act[n].velocity for n in names], axis=1),
-        acceleration=np.stack([act[n].acceleration for n in names], axis=1),
-        stroke=np.stack([act[n].stroke for n in names], axis=1),
+        velocity=np.stack([act[n].velocity for n in ACTUATOR_NAMES], axis=1),
+        acceleration=np.stack([act[n].acceleration for n in ACTUATOR_NAMES], axis=1),
+        stroke=np.stack([act[n].stroke for n in ACTUATOR_NAMES], axis=1),
     )
 
 
@@ -269,26 +284,10 @@ def check_analytic_inputs(crane: Crane, lengths: LinkLengths, joints: JointSampl
     ``theta2``); xt2: the telescope's joint range (field ``xt2``).
     """
     check_lengths(crane, lengths)
-    _check_joints(crane, lengths, joints)
+    check_joints(crane, lengths, joints)
 
 
-def _check_joints(crane: Crane, lengths: LinkLengths, joints: JointSamples) -> None:
-    for column, (chain, name) in enumerate(zip(crane.chains, ("theta1", "theta2"), strict=True)):
-        mechanism.check_joint_samples(chain, getattr(lengths, chain.name), joints.position[:, column], field=name)
-    low, high = crane.telescope.joint_range
-    xt2 = joints.position[:, 2]
-    bad = (xt2 < low) | (xt2 > high)
-    if np.any(bad):
-        raise InvalidInputError("xt2", float(xt2[np.argmax(bad)]), f"must lie in [{low:.6g}, {high:.6g}]", "m")
-
-
-def _tcp_force(tcp_force: ArrayLike | None, n: int) -> Array:
-    """TCP force broadcast to (T, 3) [N]; zero when None."""
-    if tcp_force is None:
-        return np.zeros((n, 3))
-    force = np.asarray(tcp_force, dtype=float)
-    if force.shape not in ((3,), (n, 3)):
-        raise InvalidInputError("tcp_force", f"shape {force.shape}", f"must have shape (3,) or ({n}, 3)", "N")
-    if not np.all(np.isfinite(force)):
-        raise InvalidInputError("tcp_force", "NaN or inf", "must be finite", "N")
-    return np.broadcast_to(force, (n, 3)).astype(float)
+def _external(tcp_force: ArrayLike | None, n: int) -> Array:
+    """TCP force broadcast to (T, 3) [N]; zero when None (checked by :func:`tcp_force_samples`)."""
+    force = tcp_force_samples(tcp_force, n)
+    return np.zeros((n, 3)) if force is None else force

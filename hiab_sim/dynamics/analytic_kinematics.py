@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import LINK_NAMES, ClosedChain, Crane, LinkLengths
+from hiab_sim.crane.kinematics import rotation_z
 from hiab_sim.dynamics.spatial import ad, rotate, twist_to_child
 
 Array = NDArray[np.float64]
@@ -75,13 +76,6 @@ class CraneMotion:
     actuators: dict[str, ActuatorState]  # "lift", "tilt", "telescope"
 
 
-def _rz(angle: Array) -> Array:
-    c, s = np.cos(angle), np.sin(angle)
-    out = np.zeros((*np.shape(angle), 3, 3))
-    out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1], out[..., 2, 2] = c, -s, s, c, 1.0
-    return out
-
-
 def _child(parent: LinkMotion, R: Array, p: Array, axis: Array, rate: Array, acc: Array) -> LinkMotion:
     """Propagate a link's motion to a child at pose (R, p) in it, moving along screw ``axis``."""
     joint_twist = axis * rate[:, None]
@@ -112,7 +106,7 @@ def _add_chain(
     parent = links[chain.parent]
     links[f"{chain.name}_boom"] = _child(
         parent,
-        _rz(chain.base_axis_angle + mechanism.boom_rotation(chain, theta)),
+        rotation_z(chain.base_axis_angle + mechanism.boom_rotation(chain, theta)),
         chain.boom_hinge,
         _REVOLUTE_Z,
         dtheta,
@@ -120,7 +114,7 @@ def _add_chain(
     )
     cylinder = _child(
         parent,
-        _rz(chain.base_axis_angle + q1),
+        rotation_z(chain.base_axis_angle + q1),
         chain.base_pivot(xi),
         _REVOLUTE_Z,
         k2 * dx,

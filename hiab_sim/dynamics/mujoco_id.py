@@ -51,9 +51,9 @@ vectorised over samples:
    tau_ext = J_tcp^T F (``mj_jacSite`` on site ``tcp``; mj_inverse does not subtract applied
    forces itself).
 
-Joint samples are validated before MuJoCo sees them: Θ1, Θ2 with
-:func:`hiab_sim.crane.mechanism.check_joint_samples` (fields ``theta1``, ``theta2``), xt2
-against the telescope's ``joint_range`` (field ``xt2``); NaN and inf are rejected.
+Joint samples and the TCP force are validated before MuJoCo sees them, by the checks both paths
+share (:mod:`hiab_sim.dynamics.checks`); the lengths once, when :func:`hiab_sim.model.mjcf.build_spec`
+builds the model.
 """
 
 from __future__ import annotations
@@ -64,10 +64,10 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hiab_sim.crane.description import Crane, LinkLengths
-from hiab_sim.crane.mechanism import check_joint_samples, check_lengths
+from hiab_sim.crane.description import CHAIN_NAMES, Crane, LinkLengths
+from hiab_sim.crane.names import JOINT_NAMES
+from hiab_sim.dynamics.checks import check_joints, tcp_force_samples
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
-from hiab_sim.errors import InvalidInputError
 from hiab_sim.model.mjcf import SLIDES, build_spec, source_to_world
 
 Array = NDArray[np.float64]
@@ -84,9 +84,8 @@ _SENSORS = (
     ("base_pivot", mujoco.mjtSensor.mjSENS_FRAMEANGVEL),
     ("base_pivot", mujoco.mjtSensor.mjSENS_FRAMEANGACC),
 )
-_CHAINS = ("lift", "tilt")
-_DEPENDENT = ("theta1", "theta2", "lift_q1", "tilt_q1")
-_INDEPENDENT = ("theta1", "theta2", "xt2")
+_CHAINS = CHAIN_NAMES
+_DEPENDENT = (*JOINT_NAMES[:2], *(f"{c}_q1" for c in CHAIN_NAMES))
 
 
 def _dot(a: Array, b: Array) -> Array:
@@ -111,7 +110,6 @@ class MujocoInverseDynamics:
     def __init__(self, crane: Crane, lengths: LinkLengths | None = None) -> None:
         self.crane = crane
         self.lengths = crane.default_lengths if lengths is None else lengths
-        check_lengths(crane, self.lengths)
         spec = build_spec(crane, self.lengths)
         spec.option.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
         for chain in _CHAINS:
@@ -129,7 +127,7 @@ class MujocoInverseDynamics:
         adr = {m.joint(j).name: int(m.joint(j).dofadr[0]) for j in range(m.njnt)}
         if m.nq != m.nv:
             raise AssertionError("the crane model has only hinges and slides")
-        self._independent = np.array([adr[n] for n in _INDEPENDENT])
+        self._independent = np.array([adr[n] for n in JOINT_NAMES])
         self._slides = np.array([adr[n] for n in SLIDES])
         self._dependent = np.array([adr[n] for n in _DEPENDENT])
         self._cylinder = np.array([adr[f"{c}_q1"] for c in _CHAINS])
@@ -147,16 +145,6 @@ class MujocoInverseDynamics:
 
     # -----------------------------------------------------------------------------------------
 
-    def _check(self, joints: JointSamples) -> None:
-        position = joints.position
-        check_joint_samples(self.crane.lift, self.lengths.lift, position[:, 0], field="theta1")
-        check_joint_samples(self.crane.tilt, self.lengths.tilt, position[:, 1], field="theta2")
-        low, high = self.crane.telescope.joint_range
-        xt2 = position[:, 2]
-        outside = (xt2 < low) | (xt2 > high)
-        if np.any(outside):
-            raise InvalidInputError("xt2", float(xt2[np.argmax(outside)]), f"must lie in [{low:.6g}, {high:.6g}]", "m")
-
     def state(self, joints: JointSamples) -> tuple[Array, Array, Array]:
         """Loop-consistent full state (qpos, qvel, qacc), each (T, nv), from MuJoCo's kinematics (pass 1).
 
@@ -164,7 +152,7 @@ class MujocoInverseDynamics:
             InvalidInputError: a joint sample outside its range, or not finite.
 
         """
-        self._check(joints)
+        check_joints(self.crane, self.lengths, joints)
         m, d = self._kin_model, self._kin_data
         T = len(joints)
         qpos = np.zeros((T, m.nv))
@@ -220,7 +208,8 @@ class MujocoInverseDynamics:
 
         """
         T = len(joints)
-        external = self._tcp_force(tcp_force, T)
+        force_samples = tcp_force_samples(tcp_force, T)
+        external = None if force_samples is None else source_to_world(force_samples)
         qpos, qvel, qacc = self.state(joints)
         m, d = self.model, self.data
         nv = m.nv
@@ -251,16 +240,6 @@ class MujocoInverseDynamics:
             acceleration=qacc[:, self._slides],
             stroke=qpos[:, self._slides],
         )
-
-    def _tcp_force(self, tcp_force: ArrayLike | None, T: int) -> Array | None:
-        if tcp_force is None:
-            return None
-        force = np.asarray(tcp_force, dtype=float)
-        if force.shape not in ((3,), (T, 3)):
-            raise InvalidInputError("tcp_force", f"shape {force.shape}", f"must have shape (3,) or ({T}, 3)", "N")
-        if not np.all(np.isfinite(force)):
-            raise InvalidInputError("tcp_force", "NaN or inf", "must be finite", "N")
-        return np.broadcast_to(source_to_world(force), (T, 3))
 
     def energy(self, joints: JointSamples) -> tuple[Array, Array]:
         """Potential and kinetic energy [J] along the samples, (T,) each (``mj_energyPos``/``mj_energyVel``).

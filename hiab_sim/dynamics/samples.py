@@ -1,4 +1,4 @@
-"""Time samples exchanged by the inverse-dynamics paths, and the one entry point that picks a path.
+"""Time samples exchanged by the inverse-dynamics paths (their one data type, no path imported here).
 
 Conventions shared by both paths (issue 3, 4):
 - Independent joints, in this order: ``theta1`` [rad], ``theta2`` [rad], ``xt2`` [m] (the
@@ -20,12 +20,12 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.crane.names import ACTUATOR_NAMES, JOINT_NAMES
 from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
-JOINT_NAMES = ("theta1", "theta2", "xt2")
-ACTUATOR_NAMES = ("lift", "tilt", "telescope")
+__all__ = ["ACTUATOR_NAMES", "JOINT_NAMES", "ActuatorSamples", "IdPath", "JointSamples"]
+
 IdPath = Literal["mujoco", "analytic"]
 
 
@@ -75,22 +75,3 @@ class ActuatorSamples:
     def power(self) -> Array:
         """Mechanical power delivered by each actuator, f_x v_x [W], (T, 3)."""
         return self.force * self.velocity
-
-
-def inverse_dynamics(
-    crane: Crane,
-    lengths: LinkLengths,
-    joints: JointSamples,
-    path: IdPath = "mujoco",
-    tcp_force: ArrayLike | None = None,
-) -> ActuatorSamples:
-    """[f_x, v_x] = ID(theta, dtheta, ddtheta, robot(Xi)) (seed eq. dynamics) by the chosen path."""
-    if path == "mujoco":
-        from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
-
-        return MujocoInverseDynamics(crane, lengths)(joints, tcp_force=tcp_force)
-    if path == "analytic":
-        from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
-
-        return analytic_inverse_dynamics(crane, lengths, joints, tcp_force=tcp_force)
-    raise InvalidInputError("path", path, "must be 'mujoco' or 'analytic'")

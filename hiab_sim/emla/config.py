@@ -8,12 +8,10 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
+from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.resources import Source, locate
 from hiab_sim.yaml_fields import mapping, read_yaml, sourced_number
-
-#: Actuator names, in the order the crane and the optimiser use them.
-ACTUATOR_NAMES: tuple[str, ...] = ("lift", "tilt", "telescope")
 
 #: First words allowed in a ``source`` provenance label.
 PROVENANCE_KINDS: tuple[str, ...] = ("read", "estimate", "derived", "model")

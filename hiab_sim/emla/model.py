@@ -23,6 +23,7 @@ from hiab_sim.emla.config import EmlaParams
 from hiab_sim.emla.drive import Array, drive_state
 from hiab_sim.emla.envelope import margins_from_state
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.quadrature import trapezoid
 
 
 @dataclass(frozen=True)
@@ -174,12 +175,7 @@ def energy_summary(time: ArrayLike, electrical_power: ArrayLike) -> tuple[Array,
         raise InvalidInputError("time", "not increasing", "must be strictly increasing")
     if p.shape[-1:] != t.shape:
         raise InvalidInputError("electrical_power", f"shape {p.shape}", f"last axis must match time's {t.size} samples")
-    return _trapezoid(p, t), _trapezoid(np.maximum(p, 0.0), t)
-
-
-def _trapezoid(y: Array, t: Array) -> Array:
-    # Written out because np.trapz/np.trapezoid changed names between numpy 1.26 and 2.x.
-    return np.asarray(0.5 * np.sum((y[..., 1:] + y[..., :-1]) * np.diff(t), axis=-1))
+    return trapezoid(p, t), trapezoid(np.maximum(p, 0.0), t)
 
 
 def peak_force(params: EmlaParams) -> float:

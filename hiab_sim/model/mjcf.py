@@ -65,13 +65,14 @@ import numpy as np
 
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths, RigidBody
 from hiab_sim.crane.mechanism import check_lengths
+from hiab_sim.crane.names import ACTUATOR_NAMES, JOINT_NAMES
 from hiab_sim.errors import ConfigError
 from hiab_sim.resources import mjcf_template
 
 #: Independent joints (qpos equals the source's Θ1, Θ2, xt2) and the actuated slides, in order.
-JOINTS = ("theta1", "theta2", "xt2")
+JOINTS = JOINT_NAMES
 SLIDES = ("x1", "x2", "xt2")
-ACTUATORS = ("lift", "tilt", "telescope")
+ACTUATORS = ACTUATOR_NAMES
 #: Passive joints of the closed chains: cylinder hinge (seed's q1) and stroke, per chain.
 PASSIVE = ("lift_q1", "x1", "tilt_q1", "x2")
 _CHAIN_JOINT = {"lift": ("theta1", "x1"), "tilt": ("theta2", "x2")}

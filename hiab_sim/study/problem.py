@@ -21,6 +21,10 @@ Constraints, all scaled to O(1) and written g(z) >= 0 (rows named in :attr:`cons
   theta only, so it is part of ``const_h``), which keeps Lc0 + x + Lc < L + L1;
 * ``const_l``, ``const_m`` hold by construction: the chain is solved from its triangle.
 
+Each inequality group is a constraint block (:mod:`hiab_sim.study.blocks`) and the cost an objective
+(:mod:`hiab_sim.study.objectives`); :meth:`LinkLengthProblem._build_blocks` lists the blocks once, and
+row names, row layout, clearances and the Jacobian follow from that list (:class:`~.nlp.BlockLayout`).
+
 Gradients: per-sample ID partials by batched central differences (all samples and all 9
 perturbations in one ID call), chained through the B-spline matrices (exact); Xi partials by
 central differences (on the analytic path, which agrees with the MuJoCo path to ~1e-14 relative, or
@@ -30,36 +34,41 @@ with MuJoCo model rebuilds); EMLA and kinematic partials analytic.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
-from numpy.typing import NDArray
 
-from hiab_sim.crane.description import CHAIN_NAMES, Crane, LinkLengths
-from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
+from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.crane.names import ACTUATOR_NAMES
+from hiab_sim.dynamics.interface import InverseDynamics, make_inverse_dynamics
+from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla import (
-    ENVELOPE_LIMIT_NAMES,
     EmlaSet,
     electrical_power,
-    electrical_power_partials,
-    envelope_margin_partials,
-    envelope_margins,
 )
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.study import blocks as bl
 from hiab_sim.study import trajectory as tr
 from hiab_sim.study.config import Study
-
-Array = NDArray[np.float64]
-IdFunction = Callable[[JointSamples], ActuatorSamples]
+from hiab_sim.study.id_partials import id_joint_partials, id_length_partials
+from hiab_sim.study.nlp import (
+    N_XI,
+    Array,
+    BlockJacobian,
+    BlockLayout,
+    ConstraintBlock,
+    SamplePartials,
+    SampleRows,
+    SampleState,
+)
+from hiab_sim.study.objectives import make_objective
 
 #: Scale of the link-length variables [m per unit].
 XI_SCALE = 1.0
 #: Scale of the spline-coefficient variables [rad or m per unit] (chosen for fast SQP convergence).
 C_SCALE = 0.1
-#: Scale of the stroke constraints [m per unit].
-STROKE_SCALE = 0.1
-ACTUATORS = ("lift", "tilt", "telescope")
+STROKE_SCALE = bl.STROKE_SCALE
+ACTUATORS = ACTUATOR_NAMES
 #: The ID's input check uses the working range shrunk by this much at both ends [rad].
 ID_SLACK = 0.02
 #: The optimiser (``tightened``) holds const_j at the ends of the working range with this clearance
@@ -70,32 +79,13 @@ ID_SLACK = 0.02
 WORKING_CLEARANCE = 1e-6
 
 
-def make_id(crane: Crane, lengths: LinkLengths, path: str, tcp_force: Array | None) -> IdFunction:
-    """Inverse dynamics (seed eq. ``dynamics``) for one link-length set, by ``path``."""
-    if path == "mujoco":
-        from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
-
-        model = MujocoInverseDynamics(crane, lengths)
-        return lambda joints: model(joints, tcp_force=tcp_force)
-    if path == "analytic":
-        from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
-
-        return lambda joints: analytic_inverse_dynamics(crane, lengths, joints, tcp_force=tcp_force)
-    raise InvalidInputError("id_path", path, "must be 'mujoco' or 'analytic'")
-
-
 @dataclass(frozen=True)
-class Evaluation:
-    """Everything computed at one point z (unscaled quantities in SI units)."""
+class Evaluation(SampleState):
+    """Everything computed at one point z (unscaled quantities in SI units): the state and its rows."""
 
     z: Array
-    lengths: LinkLengths
     coefficients: Array  # (3, N)
-    joints: tr.JointTrajectory
-    tcp: tr.TcpSamples
-    actuators: ActuatorSamples
-    power: Array  # (K, 3) electrical power [W]
-    cost: float  # [W^2 s]
+    cost: float  # the objective's value [its unit; W^2 s for costf2]
     constraints: Array  # scaled, feasible where >= 0
     equalities: Array  # scaled, feasible where == 0
 
@@ -114,12 +104,13 @@ class LinkLengthProblem:
 
     Args:
         study: The study.
-        emlas: EMLA set (default: the study's).
+        emlas: EMLA set (default: the study's own).
         id_path: ``mujoco`` or ``analytic`` (default: the study's).
         times: Sample times [s] (default: the collocation grid); Dt of the cost is their step.
         cost_scale: Divisor of the cost [W^2 s] (default: its value at the study's start).
         tightened: Hold the tracking bands times ``collocation_fraction`` and the envelope margins
             >= ``envelope_margin`` (the optimiser's grid); False for the nominal re-check.
+        objective: Name of the objective (:data:`hiab_sim.study.objectives.OBJECTIVES`; default ``costf2``).
 
     """
 
@@ -131,12 +122,14 @@ class LinkLengthProblem:
         times: Array | None = None,
         cost_scale: float | None = None,
         tightened: bool = True,
+        objective: str = "costf2",
     ) -> None:
         self.study = study
+        self.tightened = tightened
         self.band_fraction = study.tracking.collocation_fraction if tightened else 1.0
         self.envelope_margin = study.bounds.envelope_margin if tightened else 0.0
         self.working_clearance = WORKING_CLEARANCE / STROKE_SCALE if tightened else 0.0
-        self.emlas = emlas or study.emlas
+        self.emlas = emlas if emlas is not None else study.emlas
         self.id_path = id_path or study.solver.id_path
         self.times = study.grid.times() if times is None else np.asarray(times, dtype=float)
         self.dt = float(self.times[1] - self.times[0])
@@ -180,19 +173,19 @@ class LinkLengthProblem:
             lift=replace(study.crane.lift, joint_range=inner[0]),
             tilt=replace(study.crane.tilt, joint_range=inner[1]),
         )
-        self.n_xi = 6
+        self.n_xi = N_XI
         self.n_c = 3 * self.basis.n
         self.n = self.n_xi + self.n_c
         self.lower = np.concatenate([np.asarray(study.bounds.xi_low) / XI_SCALE, np.full(self.n_c, -np.inf)])
         self.upper = np.concatenate([np.asarray(study.bounds.xi_up) / XI_SCALE, np.full(self.n_c, np.inf)])
-        self._id_cache: dict[bytes, IdFunction] = {}
+        self.objective = make_objective(objective, self.emlas, self.dt)
+        self.layout = BlockLayout(self._build_blocks())
+        self.constraint_names = self.layout.names
+        #: added to the solver's rows gives the nominal scaled margins (each block owns its clearance)
+        self.clearance = self.layout.clearance
+        self._id_cache: dict[bytes, InverseDynamics] = {}
         self._eval_cache: dict[bytes, Evaluation] = {}
         self._grad_cache: dict[bytes, tuple[Array, Array]] = {}
-        self.constraint_names = self._names()
-        #: added to the solver's rows gives the nominal scaled margins (the clearance rows are last)
-        self.clearance = np.zeros(len(self.constraint_names))
-        assert all(name.startswith("working_range.") for name in self.constraint_names[-12:])
-        self.clearance[-12:] = self.working_clearance
         self.n_evaluations = 0
         self.n_gradients = 0
         self.cost_scale = 1.0
@@ -206,6 +199,20 @@ class LinkLengthProblem:
                     f"the start is not an admissible crane: {error.allowed}",
                 ) from None
         self.cost_scale = max(float(cost_scale), 1e-300)
+
+    def _build_blocks(self) -> list[ConstraintBlock]:
+        """The inequality blocks in row order: the one list that defines the NLP's rows."""
+        tol, ref, t = self.study.tracking, self.reference, self.times
+        return [
+            bl.TrackingBand("position", t, ref.position, tol.position, self.band_fraction),
+            bl.TrackingBand("velocity", t, ref.velocity, tol.velocity, self.band_fraction),
+            bl.TrackingBand("acceleration", t, ref.acceleration, tol.acceleration, self.band_fraction),
+            bl.EnvelopeMargins(t, self.emlas, self.envelope_margin),
+            bl.StrokeLimits(t, self.crane.chains),
+            bl.JointLimits(t, self.theta_low, self.theta_up),
+            bl.JointVelocityLimits(t, np.asarray(self.study.bounds.joint_velocity)),
+            bl.WorkingRange(self.crane.chains, self.working, self.working_clearance),
+        ]
 
     # -- variables ---------------------------------------------------------------------------
 
@@ -223,12 +230,12 @@ class LinkLengthProblem:
 
     # -- evaluation --------------------------------------------------------------------------
 
-    def _id(self, lengths: LinkLengths) -> IdFunction:
+    def _id(self, lengths: LinkLengths) -> InverseDynamics:
         key = lengths.as_array().tobytes()
         if key not in self._id_cache:
             if len(self._id_cache) > 32:
                 self._id_cache.clear()
-            self._id_cache[key] = make_id(self.crane, lengths, self.id_path, self.tcp_force)
+            self._id_cache[key] = make_inverse_dynamics(self.crane, lengths, self.id_path)
         return self._id_cache[key]
 
     def joints(self, c: Array) -> tr.JointTrajectory:
@@ -245,7 +252,8 @@ class LinkLengthProblem:
         self.n_evaluations += 1
         lengths, c = self.unpack(z)
         joints = self.joints(c)
-        act = self._id(lengths)(JointSamples(joints.position, joints.velocity, joints.acceleration))
+        samples = JointSamples(joints.position, joints.velocity, joints.acceleration)
+        act = self._id(lengths)(samples, tcp_force=self.tcp_force)
         tcp = self.kin.samples(joints.position, joints.velocity, joints.acceleration)
         power = np.column_stack(
             [
@@ -253,11 +261,19 @@ class LinkLengthProblem:
                 for i, p in enumerate(self.emlas)
             ]
         )
-        total = power.sum(axis=1)
-        cost = 0.5 * self.dt * float(np.sum(total**2))
-        g = self._constraints(lengths, joints, tcp, act)
-        e = self._equalities(c)
-        ev = Evaluation(z, lengths, c, joints, tcp, act, power, cost, g, e)
+        state = SampleState(lengths, joints, tcp, act, power)
+        ev = Evaluation(
+            lengths,
+            joints,
+            tcp,
+            act,
+            power,
+            z=z,
+            coefficients=c,
+            cost=self.objective.value(state),
+            constraints=self.layout.values(state),
+            equalities=self._equalities(c),
+        )
         if len(self._eval_cache) > 8:
             self._eval_cache.clear()
         self._eval_cache[key] = ev
@@ -290,94 +306,12 @@ class LinkLengthProblem:
         zx = np.asarray(z)[: self.n_xi]
         return max(v, float(np.max(self.lower[: self.n_xi] - zx)), float(np.max(zx - self.upper[: self.n_xi])))
 
-    def _constraints(
-        self, lengths: LinkLengths, joints: tr.JointTrajectory, tcp: tr.TcpSamples, act: ActuatorSamples
-    ) -> Array:
-        return np.concatenate([block for block, _ in self._constraint_blocks(lengths, joints, tcp, act)])
-
-    def _constraint_blocks(
-        self, lengths: LinkLengths, joints: tr.JointTrajectory, tcp: tr.TcpSamples, act: ActuatorSamples
-    ) -> list[tuple[Array, str]]:
-        """Constraint values in row order, (K, m) blocks flattened per sample."""
-        tol = self.study.tracking
-        ref = self.reference
-        blocks: list[tuple[Array, str]] = []
-        for value, target, band, name in (
-            (tcp.position, ref.position, tol.position, "position"),
-            (tcp.velocity, ref.velocity, tol.velocity, "velocity"),
-            (tcp.acceleration, ref.acceleration, tol.acceleration, "acceleration"),
-        ):
-            err = (value - target) / (band * self.band_fraction)
-            blocks.append((np.concatenate([1.0 - err, 1.0 + err], axis=1).ravel(), name))
-        env = np.stack(
-            [
-                envelope_margins(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
-                for i, p in enumerate(self.emlas)
-            ],
-            axis=1,
-        )  # (3 limits, 3 actuators, K)
-        env = (env - self.envelope_margin) / (1.0 - self.envelope_margin)
-        blocks.append((np.transpose(env, (2, 1, 0)).reshape(len(self.times), 9).ravel(), "envelope"))
-        x = self._strokes(lengths, joints.position)  # (K, 2)
-        blocks.append((self._stroke_rows(lengths, x).ravel(), "stroke"))
-        th = joints.position
-        blocks.append((np.concatenate([th - self.theta_low, self.theta_up - th], axis=1).ravel(), "joint"))
-        vmax = np.asarray(self.study.bounds.joint_velocity)
-        dth = joints.velocity / vmax
-        blocks.append((np.concatenate([1.0 - dth, 1.0 + dth], axis=1).ravel(), "joint_velocity"))
-        xw = self._strokes(lengths, np.array([[w[0] for w in self.working], [w[1] for w in self.working]]))
-        blocks.append((self._stroke_rows(lengths, xw).ravel() - self.working_clearance, "working_range"))
-        return blocks
-
-    def _strokes(self, lengths: LinkLengths, theta: Array) -> Array:
-        """Strokes x (K, 2) of lift and tilt from joint angles (eqs. thetas, qus_a)."""
-        from hiab_sim.crane import mechanism
-
-        return np.column_stack(
-            [
-                mechanism.joint_to_stroke(ch, getattr(lengths, ch.name), theta[:, j])
-                for j, ch in enumerate(self.crane.chains)
-            ]
-        )
-
-    def _stroke_rows(self, lengths: LinkLengths, x: Array) -> Array:
-        """const_j per chain: x >= 0, Lc - x >= 0, stroke - x >= 0, as (K, 6) scaled."""
-        cols = []
-        for j, chain in enumerate(self.crane.chains):
-            xi = getattr(lengths, chain.name)
-            cols += [x[:, j], xi.Lc - x[:, j], chain.stroke - x[:, j]]
-        return np.column_stack(cols) / STROKE_SCALE
-
     def _equalities(self, c: Array) -> Array:
         return (self._rest_matrix() @ c.T).ravel() / C_SCALE
 
     def _rest_matrix(self) -> Array:
         ends = np.array([0.0, self.basis.duration])
         return np.vstack([self.basis.matrix(ends, 1), self.basis.matrix(ends, 2)])  # (4, N)
-
-    def _names(self) -> list[str]:
-        names: list[str] = []
-        k_times = self.times
-        coords = ("x_tcp", "y_tcp", "xt2")
-        for order in ("position", "velocity", "acceleration"):
-            for t in k_times:
-                names += [f"tracking.{order}.{c} <= band at t={t:.4g} s" for c in coords]
-                names += [f"tracking.{order}.{c} >= -band at t={t:.4g} s" for c in coords]
-        for t in k_times:
-            names += [f"envelope.{a}.{lim} at t={t:.4g} s" for a in ACTUATORS for lim in ENVELOPE_LIMIT_NAMES]
-        stroke_names = [f"{ch}.{w}" for ch in CHAIN_NAMES for w in ("x >= 0", "x <= Lc", "x <= stroke")]
-        for t in k_times:
-            names += [f"stroke.{s} at t={t:.4g} s" for s in stroke_names]
-        joint_names = ("theta1", "theta2", "xt2")
-        for t in k_times:
-            names += [f"joint.{j} >= low at t={t:.4g} s" for j in joint_names]
-            names += [f"joint.{j} <= up at t={t:.4g} s" for j in joint_names]
-        for t in k_times:
-            names += [f"joint_velocity.{j} <= limit at t={t:.4g} s" for j in joint_names]
-            names += [f"joint_velocity.{j} >= -limit at t={t:.4g} s" for j in joint_names]
-        for end in ("low", "up"):
-            names += [f"working_range.{s} at the {end} end" for s in stroke_names]
-        return names
 
     # -- gradients ---------------------------------------------------------------------------
 
@@ -401,44 +335,23 @@ class LinkLengthProblem:
         out[order] = jac
         return out
 
-    def _sample_partials(self, lengths: LinkLengths, joints: tr.JointTrajectory) -> Array:
-        """d(f, v, a)/d(theta, dtheta, ddtheta) per sample by central differences, (K, 9, 9).
-
-        All K samples and all 9 perturbations go into one ID call of 18 K samples: samples are
-        independent, so perturbing them together is exact bookkeeping, not an approximation.
-        """
+    def _to_z(self, block: ConstraintBlock, jac: BlockJacobian, rows: int) -> Array:
+        """A block's partials w.r.t. q9 and Xi [per m] as rows of D g / dz (m, n), through the spline matrices."""
         K = len(self.times)
-        base = np.concatenate([joints.position, joints.velocity, joints.acceleration], axis=1)  # (K, 9)
-        h = self.fd_step * np.maximum(1.0, np.abs(base))  # (K, 9)
-        batch = np.repeat(base[None], 18, axis=0)  # (18, K, 9)
-        for j in range(9):
-            batch[2 * j, :, j] += h[:, j]
-            batch[2 * j + 1, :, j] -= h[:, j]
-        flat = batch.reshape(18 * K, 9)
-        act = self._id(lengths)(JointSamples(flat[:, 0:3], flat[:, 3:6], flat[:, 6:9]))
-        out = np.concatenate([act.force, act.velocity, act.acceleration], axis=1).reshape(18, K, 9)
-        d = (out[0::2] - out[1::2]) / (2.0 * h.T[:, :, None])  # (9 inputs, K, 9 outputs)
-        return np.transpose(d, (1, 2, 0))
-
-    def _xi_partials(self, lengths: LinkLengths, joints: tr.JointTrajectory) -> Array:
-        """d(f, v, a)/dXi per sample by central differences, (K, 9, 6) [per m].
-
-        On the analytic path (no model to rebuild) or, with ``xi_derivatives: rebuild``, on the
-        optimisation's own path with one model build per perturbed Xi.
-        """
-        xi = lengths.as_array()
-        js = JointSamples(joints.position, joints.velocity, joints.acceleration)
-        out = np.zeros((len(self.times), 9, 6))
-        for i in range(6):
-            h = self.fd_step * max(1.0, abs(xi[i]))
-            values = []
-            for sign in (1.0, -1.0):
-                x = xi.copy()
-                x[i] += sign * h
-                model = make_id(self.crane, LinkLengths.from_array(x), self.xi_path, self.tcp_force)
-                a = model(js)
-                values.append(np.concatenate([a.force, a.velocity, a.acceleration], axis=1))
-            out[:, :, i] = (values[0] - values[1]) / (2.0 * h)
+        out = np.zeros((rows, self.n))
+        if isinstance(jac, SampleRows):
+            r = jac.dq.shape[1]
+            # q9 index = order * 3 + joint
+            dc = np.einsum("kmoj,okn->kmjn", jac.dq.reshape(K, r, 3, 3), self.B) * C_SCALE
+            out[:, self.n_xi :] = dc.reshape(rows, self.n_c)
+            if jac.dxi is not None:
+                out[:, : self.n_xi] = (jac.dxi * XI_SCALE).reshape(rows, self.n_xi)
+        else:
+            if jac.dq is not None:
+                dc = np.einsum("mkoj,okn->mjn", jac.dq.reshape(rows, K, 3, 3), self.B) * C_SCALE
+                out[:, self.n_xi :] = dc.reshape(rows, self.n_c)
+            if jac.dxi is not None:
+                out[:, : self.n_xi] = jac.dxi * XI_SCALE
         return out
 
     def _gradients(self, z: Array) -> tuple[Array, Array]:
@@ -448,97 +361,20 @@ class LinkLengthProblem:
             return self._grad_cache[key]
         self.n_gradients += 1
         ev = self.evaluate(z)
-        lengths, joints, act = ev.lengths, ev.joints, ev.actuators
+        samples = JointSamples(ev.joints.position, ev.joints.velocity, ev.joints.acceleration)
+        partials = SamplePartials(
+            lambda: id_joint_partials(self._id(ev.lengths), samples, self.fd_step, self.tcp_force),
+            lambda: id_length_partials(self.crane, ev.lengths, samples, self.xi_path, self.fd_step, self.tcp_force),
+        )
+        jac = self.layout.jacobian(ev, partials, self._to_z)
+        dcost_q, dcost_xi = self.objective.gradient(ev, partials)
         K = len(self.times)
-        dY = self._sample_partials(lengths, joints)  # (K, 9 out, 9 in)
-        dYxi = self._xi_partials(lengths, joints) * XI_SCALE  # (K, 9, 6) per scaled unit
-        # EMLA partials per actuator: dP/d(f, v, a) and dg/d(f, v, a)
-        dP = np.zeros((K, 3, 9))  # power of actuator i w.r.t. Y (f0 f1 f2 v0 v1 v2 a0 a1 a2)
-        dG = np.zeros((K, 3, 3, 9))  # margins (actuator, limit) w.r.t. Y
-        for i, p in enumerate(self.emlas):
-            f, v, a = act.force[:, i], act.velocity[:, i], act.acceleration[:, i]
-            pf, pv, pa = electrical_power_partials(p, f, v, a)
-            dP[:, i, i], dP[:, i, 3 + i], dP[:, i, 6 + i] = pf, pv, pa
-            gf, gv, ga = envelope_margin_partials(p, f, v, a)  # each (3 limits, K)
-            dG[:, i, :, i], dG[:, i, :, 3 + i], dG[:, i, :, 6 + i] = gf.T, gv.T, ga.T
-        total = ev.power.sum(axis=1)
-        dcost_dY = self.dt * total[:, None] * dP.sum(axis=1)  # (K, 9)
-        # per-sample derivative tensors w.r.t. q9 = (theta, dtheta, ddtheta) and scaled Xi
-        rows_q: list[Array] = []  # each (K, m, 9)
-        rows_xi: list[Array] = []  # each (K, m, 6)
-        tol = self.study.tracking
-        for d, band in (
-            (ev.tcp.d_position, tol.position),
-            (ev.tcp.d_velocity, tol.velocity),
-            (ev.tcp.d_acceleration, tol.acceleration),
-        ):
-            b = band * self.band_fraction
-            rows_q.append(np.concatenate([-d / b, d / b], axis=1))
-            rows_xi.append(np.zeros((K, 6, 6)))
-        dGY = dG.reshape(K, 9, 9) / (1.0 - self.envelope_margin)
-        rows_q.append(np.einsum("kmy,kyq->kmq", dGY, dY))
-        rows_xi.append(np.einsum("kmy,kyx->kmx", dGY, dYxi))
-        sq, sxi = self._stroke_partials(lengths, joints.position)
-        rows_q.append(sq)
-        rows_xi.append(sxi)
-        eye = np.eye(3)
-        jq = np.zeros((K, 6, 9))
-        jq[:, :3, :3], jq[:, 3:, :3] = eye, -eye
-        rows_q.append(jq)
-        rows_xi.append(np.zeros((K, 6, 6)))
-        vmax = np.asarray(self.study.bounds.joint_velocity)
-        vq = np.zeros((K, 6, 9))
-        vq[:, :3, 3:6], vq[:, 3:, 3:6] = -np.diag(1.0 / vmax), np.diag(1.0 / vmax)
-        rows_q.append(vq)
-        rows_xi.append(np.zeros((K, 6, 6)))
-        Dq = np.concatenate(rows_q, axis=1)  # (K, m_per_sample, 9)
-        Dxi = np.concatenate(rows_xi, axis=1)
-        m_s = Dq.shape[1]
-        # chain through the spline matrices: q9 index = order * 3 + joint
-        Dc = np.einsum("kmoj,okn->kmjn", Dq.reshape(K, m_s, 3, 3), self.B) * C_SCALE
-        per_sample = np.concatenate([Dxi, Dc.reshape(K, m_s, self.n_c)], axis=2)  # (K, m_s, n)
-        # reorder rows to the block order of _constraint_blocks: block-major, then sample-major
-        sizes = [6, 6, 6, 9, 6, 6, 6]
-        starts = np.cumsum([0, *sizes])
-        jac_blocks = [per_sample[:, starts[b] : starts[b + 1], :].reshape(-1, self.n) for b in range(len(sizes))]
-        wxi = self._working_partials(lengths)
-        jac_blocks.append(np.concatenate([wxi, np.zeros((wxi.shape[0], self.n_c))], axis=1))
-        jac = np.concatenate(jac_blocks, axis=0)
-        # cost gradient
-        dcost_q = np.einsum("ky,kyq->kq", dcost_dY, dY)
         grad_c = np.einsum("koj,okn->jn", dcost_q.reshape(K, 3, 3), self.B).ravel() * C_SCALE
-        grad_xi = np.einsum("ky,kyx->x", dcost_dY, dYxi)
-        grad = np.concatenate([grad_xi, grad_c]) / self.cost_scale
+        grad = np.concatenate([dcost_xi * XI_SCALE, grad_c]) / self.cost_scale
         if len(self._grad_cache) > 4:
             self._grad_cache.clear()
         self._grad_cache[key] = (grad, jac)
         return grad, jac
-
-    def _stroke_partials(self, lengths: LinkLengths, theta: Array) -> tuple[Array, Array]:
-        """Partials of the (K, 6) stroke rows w.r.t. q9 (K, 6, 9) and scaled Xi (K, 6, 6)."""
-        K = theta.shape[0]
-        dq = np.zeros((K, 6, 9))
-        dxi = np.zeros((K, 6, 6))
-        for j, chain in enumerate(self.crane.chains):
-            xi = getattr(lengths, chain.name)
-            q = chain.joint_offset - math.pi - theta[:, j]
-            s = np.sqrt(xi.L**2 + chain.L1**2 - 2.0 * xi.L * chain.L1 * np.cos(q))
-            dx_dtheta = -xi.L * chain.L1 * np.sin(q) / s
-            dx_dL = (xi.L - chain.L1 * np.cos(q)) / s
-            dx_dxi = np.column_stack([dx_dL, -np.ones(K), -np.ones(K)])  # (K, 3): L, Lc0, Lc
-            r = 3 * j
-            dq[:, r, j], dq[:, r + 1, j], dq[:, r + 2, j] = dx_dtheta, -dx_dtheta, -dx_dtheta
-            cols = slice(3 * j, 3 * j + 3)
-            dxi[:, r, cols] = dx_dxi
-            dxi[:, r + 1, cols] = -dx_dxi
-            dxi[:, r + 1, 3 * j + 2] += 1.0
-            dxi[:, r + 2, cols] = -dx_dxi
-        return dq / STROKE_SCALE, dxi * XI_SCALE / STROKE_SCALE
-
-    def _working_partials(self, lengths: LinkLengths) -> Array:
-        """Partials of the working-range rows w.r.t. scaled Xi, (12, 6); they do not depend on c."""
-        theta = np.array([[w[0] for w in self.working] + [0.0], [w[1] for w in self.working] + [0.0]])
-        return self._stroke_partials(lengths, theta)[1].reshape(-1, 6)
 
 
 def _centre_guess(study: Study) -> tuple[float, float]:

@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.emla import energy_summary, operating_point
 from hiab_sim.errors import HiabSimError
+from hiab_sim.quadrature import trapezoid
 from hiab_sim.study.problem import ACTUATORS, Evaluation, LinkLengthProblem
 from hiab_sim.study.solve import SolveResult, xi_table
 
@@ -40,10 +41,6 @@ class DesignCheck:
     summary: dict[str, Any]
 
 
-def _trapezoid(y: Array, t: Array) -> float:
-    return float(0.5 * np.sum((y[1:] + y[:-1]) * np.diff(t)))
-
-
 def design_summary(problem: LinkLengthProblem, z: Array) -> DesignCheck:
     """Evaluate z on ``problem``'s grid (the fine grid, nominal bands): energies, peaks, violations."""
     ev = problem.evaluate(z)
@@ -55,12 +52,12 @@ def design_summary(problem: LinkLengthProblem, z: Array) -> DesignCheck:
     for i, (name, params) in enumerate(zip(ACTUATORS, problem.emlas, strict=True)):
         op = operating_point(params, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
         parts = {
-            "mechanical": _trapezoid(op.mechanical_power, t),
-            "copper": _trapezoid(op.copper_loss, t),
-            "rotor_friction": _trapezoid(op.rotor_friction_loss, t),
-            "screw_viscous": _trapezoid(op.screw_viscous_loss, t),
-            "inertial": _trapezoid(op.inertial_power, t),
-            "electrical": _trapezoid(op.electrical_power, t),
+            "mechanical": float(trapezoid(op.mechanical_power, t)),
+            "copper": float(trapezoid(op.copper_loss, t)),
+            "rotor_friction": float(trapezoid(op.rotor_friction_loss, t)),
+            "screw_viscous": float(trapezoid(op.screw_viscous_loss, t)),
+            "inertial": float(trapezoid(op.inertial_power, t)),
+            "electrical": float(trapezoid(op.electrical_power, t)),
         }
         for k, v in parts.items():
             breakdown[k] += v

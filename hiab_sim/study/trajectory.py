@@ -21,8 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import BSpline
 
-from hiab_sim.crane import mechanism
-from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.crane.description import Crane
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.config import SpiralReference
 
@@ -333,16 +332,3 @@ def fit_coefficients(basis: SplineBasis, joints: JointTrajectory, rate_weight: f
         sol = np.linalg.solve(kkt, np.concatenate([lhs.T @ rhs, np.zeros(len(E))]))
         out[j] = sol[: basis.n]
     return out
-
-
-def check_reachable(crane: Crane, lengths_chain: LinkLengths, joints: JointTrajectory) -> None:
-    """Raise :class:`InvalidInputError` if the joint samples leave a chain's usable stroke."""
-    for j, chain in enumerate(crane.chains):
-        mechanism.check_joint_samples(
-            chain, getattr(lengths_chain, chain.name), joints.position[:, j], field=f"reference ({chain.name} joint)"
-        )
-    low, high = crane.telescope.joint_range
-    xt = joints.position[:, 2]
-    if xt.min() < low or xt.max() > high:
-        bad = float(xt.min() if xt.min() < low else xt.max())
-        raise InvalidInputError("reference.telescope", bad, f"must lie in [{low:.6g}, {high:.6g}]", "m")

@@ -1,0 +1,64 @@
+"""Partials of the inverse dynamics [f_x, v_x, a_x] = ID(theta, dtheta, ddtheta, robot(Xi)) by central differences.
+
+Outputs Y per sample are ordered (f_lift, f_tilt, f_tele, v_lift, v_tilt, v_tele, a_lift, a_tilt,
+a_tele); inputs q9 = (theta1, theta2, xt2, their rates, their accelerations) and Xi = (lift L, Lc0,
+Lc, tilt L, Lc0, Lc) [m]. Steps are relative: h = fd_step * max(1, |value|).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.dynamics.interface import InverseDynamics, make_inverse_dynamics
+from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
+
+Array = NDArray[np.float64]
+
+
+def _outputs(act: ActuatorSamples) -> Array:
+    return np.concatenate([act.force, act.velocity, act.acceleration], axis=1)
+
+
+def id_joint_partials(
+    model: InverseDynamics, joints: JointSamples, fd_step: float, tcp_force: ArrayLike | None
+) -> Array:
+    """dY/dq9 per sample by central differences, (K, 9 outputs, 9 inputs).
+
+    All K samples and all 9 perturbations go into one ID call of 18 K samples: samples are
+    independent, so perturbing them together is exact bookkeeping, not an approximation.
+    """
+    K = len(joints)
+    base = np.concatenate([joints.position, joints.velocity, joints.acceleration], axis=1)  # (K, 9)
+    h = fd_step * np.maximum(1.0, np.abs(base))  # (K, 9)
+    batch = np.repeat(base[None], 18, axis=0)  # (18, K, 9)
+    for j in range(9):
+        batch[2 * j, :, j] += h[:, j]
+        batch[2 * j + 1, :, j] -= h[:, j]
+    flat = batch.reshape(18 * K, 9)
+    # a constant force (3,) serves every sample; a force per sample (K, 3) is repeated for each perturbation
+    stacked = tcp_force
+    if tcp_force is not None and np.ndim(tcp_force) == 2:
+        stacked = np.tile(np.asarray(tcp_force, dtype=float), (18, 1))
+    out = _outputs(model(JointSamples(flat[:, 0:3], flat[:, 3:6], flat[:, 6:9]), tcp_force=stacked)).reshape(18, K, 9)
+    d = (out[0::2] - out[1::2]) / (2.0 * h.T[:, :, None])  # (9 inputs, K, 9 outputs)
+    return np.transpose(d, (1, 2, 0))
+
+
+def id_length_partials(
+    crane: Crane, lengths: LinkLengths, joints: JointSamples, path: str, fd_step: float, tcp_force: ArrayLike | None
+) -> Array:
+    """dY/dXi per sample by central differences, (K, 9, 6) [per m], one model per perturbed Xi on ``path``."""
+    xi = lengths.as_array()
+    out = np.zeros((len(joints), 9, 6))
+    for i in range(6):
+        h = fd_step * max(1.0, abs(xi[i]))
+        values = []
+        for sign in (1.0, -1.0):
+            x = xi.copy()
+            x[i] += sign * h
+            model = make_inverse_dynamics(crane, LinkLengths.from_array(x), path)
+            values.append(_outputs(model(joints, tcp_force=tcp_force)))
+        out[:, :, i] = (values[0] - values[1]) / (2.0 * h)
+    return out
