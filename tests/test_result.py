@@ -238,6 +238,7 @@ class _Section:
     """A section a later version adds."""
 
     value: float
+    matrix: tuple[tuple[float, ...], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -256,14 +257,17 @@ def test_an_optional_section_is_absent_until_set_and_older_files_still_load() ->
     old = to_json(_Old("a"))
     assert from_json(_New, old) == _New("a")
     assert to_json(_New("a")) == old == {"name": "a"}
-    assert to_json(_New("a", _Section(2))) == {"name": "a", "section": {"value": 2.0}}
+    assert to_json(_New("a", _Section(2))) == {"name": "a", "section": {"value": 2.0, "matrix": []}}
     assert from_json(_New, {"name": "a", "section": {"value": 2}}) == _New("a", _Section(2.0))
+    matrix = _New("a", _Section(1.0, ((1.0, 2.0), (3.0, 4.0))))  # e.g. a cross-evaluation of designs x tasks
+    assert from_json(_New, json.loads(json.dumps(to_json(matrix)))) == matrix
 
 
-def test_numpy_scalars_are_written_as_plain_numbers() -> None:
-    """np.float64 / np.int64 / np.bool_ values become JSON numbers and booleans."""
+def test_numpy_values_are_written_as_plain_numbers() -> None:
+    """np.float64 / np.int64 / np.bool_ values become JSON numbers and booleans, arrays nested lists."""
     out = to_json({"a": np.float64(1.5), "b": np.int64(3), "c": np.bool_(True), "d": (np.float32(0.5),)})
     assert json.dumps(out) == '{"a": 1.5, "b": 3, "c": true, "d": [0.5]}'
+    assert to_json(np.arange(4.0).reshape(2, 2)) == [[0.0, 1.0], [2.0, 3.0]]
 
 
 def test_replace_keeps_a_result_frozen_and_typed() -> None:

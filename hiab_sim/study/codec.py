@@ -57,8 +57,8 @@ def to_json(value: Any) -> Any:
         return int(value)
     if isinstance(value, float):
         return float(value)
-    if hasattr(value, "item"):  # a numpy scalar
-        return to_json(value.item())
+    if hasattr(value, "tolist"):  # a numpy scalar or array
+        return to_json(value.tolist())
     raise TypeError(f"cannot write {type(value).__name__} as JSON")
 
 
