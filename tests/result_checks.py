@@ -9,6 +9,7 @@ path called directly, the EMLA electrical power, and the quadratures written out
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -26,14 +27,16 @@ def other_path(path: str) -> str:
     return {"mujoco": "analytic", "analytic": "mujoco"}[path]
 
 
-def design_energy(crane, emlas: EmlaSet, lengths, time, joints: JointSamples, path: str, payload_kg: float):  # type: ignore[no-untyped-def]
+def design_energy(
+    crane: Any, emlas: EmlaSet, lengths: Any, time: np.ndarray, joints: JointSamples, path: str, payload_kg: float
+) -> tuple[float, float]:
     """(net electrical energy [J] by the trapezoid rule, eq. costf2 cost 1/2 Dt sum_k (sum_i P_i)^2 [W^2 s])."""
     tcp_force = None if payload_kg == 0.0 else np.array([0.0, -payload_kg * crane.gravity, 0.0])
     if path == "mujoco":
         act = MujocoInverseDynamics(crane, lengths)(joints, tcp_force=tcp_force)
     else:
         act = analytic_inverse_dynamics(crane, lengths, joints, tcp_force=tcp_force)
-    power = sum(
+    power: np.ndarray = sum(  # type: ignore[assignment]
         electrical_power(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i]) for i, p in enumerate(emlas)
     )
     step = np.diff(time)
@@ -43,7 +46,9 @@ def design_energy(crane, emlas: EmlaSet, lengths, time, joints: JointSamples, pa
     return net, cost
 
 
-def four_designs(folder: Path, result: Result, crane, emlas: EmlaSet) -> dict[tuple[str, str], tuple[float, float]]:  # type: ignore[no-untyped-def]
+def four_designs(
+    folder: Path, result: Result, crane: Any, emlas: EmlaSet
+) -> dict[tuple[str, str], tuple[float, float]]:
     """(net energy, cost) of {initial, optimal} lengths x {initial, optimal} joint trajectory, by the other path."""
     data = np.load(folder / "trajectory.npz")
     time = data["time"]
