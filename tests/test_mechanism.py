@@ -60,13 +60,42 @@ def _sample_strokes(chain_name: str) -> np.ndarray:
     return np.linspace(x_min + 0.02, x_max - 0.02, 41)
 
 
+def _constructed_angles(s: np.ndarray, L: float, L1: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(q, q1, q2) of the triangle built from its vertices, independent of the module's law-of-cosines form.
+
+    Boom hinge {B1} at the origin, cylinder base {Bc} at (L, 0), rod end {Tc} where the circles of
+    radius L1 about {B1} and s about {Bc} meet (upper half plane). Each internal angle is minus the
+    angle between the two edges at its vertex, measured with atan2(|cross|, dot).
+    """
+    tx = (L**2 + L1**2 - s**2) / (2.0 * L)
+    b1, bc = np.zeros((len(s), 2)), np.tile([L, 0.0], (len(s), 1))
+    tc = np.column_stack([tx, np.sqrt(L1**2 - tx**2)])
+
+    def angle(at: np.ndarray, p: np.ndarray, r: np.ndarray) -> np.ndarray:
+        u, v = p - at, r - at
+        return np.arctan2(np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]), np.sum(u * v, axis=1))
+
+    return -angle(b1, bc, tc), -angle(bc, b1, tc), -angle(tc, b1, bc)
+
+
+@pytest.mark.parametrize("name", sorted(CHAINS))
+def test_triangle_angles_match_the_constructed_triangle(name: str) -> None:
+    """Q, q1, q2 (eq. qus) equal the angles of the triangle drawn from its side lengths, to 1e-12 rad."""
+    chain, xi = CHAINS[name], CHAINS[name].default_lengths
+    x = _sample_strokes(name)
+    for ours, built in zip(
+        mechanism.triangle_angles(x, xi.L, chain.L1, xi.x0), _constructed_angles(x + xi.x0, xi.L, chain.L1), strict=True
+    ):
+        np.testing.assert_allclose(ours, built, rtol=0, atol=1e-12)
+
+
 @pytest.mark.parametrize("name", sorted(CHAINS))
 def test_velocity_ratios_match_central_differences(name: str) -> None:
-    """k1, k2, k3 (eq. k1_3) equal d(q, q1, q2)/dx by central differences."""
+    """k1, k2, k3 (eq. k1_3) equal d(q, q1, q2)/dx of the constructed triangle by central differences."""
     chain, xi = CHAINS[name], CHAINS[name].default_lengths
     x, h = _sample_strokes(name), 1e-6
-    plus = mechanism.triangle_angles(x + h, xi.L, chain.L1, xi.x0)
-    minus = mechanism.triangle_angles(x - h, xi.L, chain.L1, xi.x0)
+    plus = _constructed_angles(x + h + xi.x0, xi.L, chain.L1)
+    minus = _constructed_angles(x - h + xi.x0, xi.L, chain.L1)
     ratios = mechanism.velocity_ratios(x, xi.L, chain.L1, xi.x0)
     for k, a_plus, a_minus in zip(ratios, plus, minus, strict=True):
         np.testing.assert_allclose(k, (a_plus - a_minus) / (2 * h), rtol=1e-7, atol=1e-9)
@@ -74,14 +103,17 @@ def test_velocity_ratios_match_central_differences(name: str) -> None:
 
 
 @pytest.mark.parametrize("name", sorted(CHAINS))
-def test_seed_k1_expression_differs_by_sign(name: str) -> None:
-    """The seed prints k1 = -(x + x0) / (L L1 sin q); the true dq/dx is its negative."""
+def test_seed_k1_expression_has_the_wrong_sign(name: str) -> None:
+    """The seed prints k1 = -(x + x0) / (L L1 sin q); central differences of q(x) give its negative everywhere."""
     chain, xi = CHAINS[name], CHAINS[name].default_lengths
-    x = _sample_strokes(name)
-    q, _, _ = mechanism.triangle_angles(x, xi.L, chain.L1, xi.x0)
+    x, h = _sample_strokes(name), 1e-6
+    q = _constructed_angles(x + xi.x0, xi.L, chain.L1)[0]
     seed_k1 = -(x + xi.x0) / (xi.L * chain.L1 * np.sin(q))
-    k1, _, _ = mechanism.velocity_ratios(x, xi.L, chain.L1, xi.x0)
-    np.testing.assert_allclose(k1, -seed_k1, rtol=1e-14)
+    dq_dx = (
+        _constructed_angles(x + h + xi.x0, xi.L, chain.L1)[0] - _constructed_angles(x - h + xi.x0, xi.L, chain.L1)[0]
+    ) / (2 * h)
+    np.testing.assert_allclose(-seed_k1, dq_dx, rtol=1e-7)
+    assert np.all(np.sign(seed_k1) == -np.sign(dq_dx)) and np.all(np.abs(dq_dx) > 0.1)
 
 
 @pytest.mark.parametrize("name", sorted(CHAINS))

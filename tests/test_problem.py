@@ -1,4 +1,4 @@
-"""The NLP of eq. costf2: gradients vs finite differences, the cost formula, constraint rows, bad starts."""
+"""The NLP of eq. costf2: gradients vs finite differences, the cost vs an independent quadrature, bad starts."""
 
 from __future__ import annotations
 
@@ -7,7 +7,10 @@ import pytest
 from test_study_small import small_study
 
 from hiab_sim.crane.description import ChainLengths, LinkLengths
-from hiab_sim.emla import electrical_power
+from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
+from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
+from hiab_sim.dynamics.samples import JointSamples
+from hiab_sim.emla import electrical_power, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study import problem as problem_module
 from hiab_sim.study.config import load_study, study_from_dict
@@ -62,17 +65,27 @@ def test_equality_jacobian_is_exact(problem: LinkLengthProblem) -> None:
     np.testing.assert_allclose(problem.equalities(z) - problem.equalities(z0), jac @ (z - z0), atol=1e-9)
 
 
-def test_cost_is_the_seed_squared_power_sum_of_electrical_power() -> None:
-    """F = 1/2 Dt sum_k (sum_i P_i(t_k))^2 with the EMLA model's electrical power (never f v / eta)."""
-    problem = LinkLengthProblem(STUDY, id_path="analytic")
+@pytest.mark.parametrize("path", ["analytic", "mujoco"])
+def test_cost_equals_a_quadrature_of_power_from_the_other_id_path(path: str) -> None:
+    """F = 1/2 Dt sum_k (sum_i P_i(t_k))^2 with P from the EMLA model fed by the *other* ID path's forces.
+
+    The joint samples at z are taken from the problem; the forces are recomputed by calling the other
+    inverse-dynamics implementation directly, and Dt is the grid's spacing (6.25 s / 12 intervals).
+    """
+    problem = LinkLengthProblem(STUDY, id_path=path)
     ev = problem.evaluate(_point(problem))
-    act = ev.actuators
+    joints = JointSamples(ev.joints.position, ev.joints.velocity, ev.joints.acceleration)
+    if path == "analytic":
+        act = MujocoInverseDynamics(STUDY.crane, ev.lengths)(joints)
+    else:
+        act = analytic_inverse_dynamics(STUDY.crane, ev.lengths, joints)
     power = sum(
         electrical_power(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
-        for i, p in enumerate(problem.emlas)
+        for i, p in enumerate(load_emla_set())
     )
-    assert problem.dt == 6.25 / 12  # the small study: 12 intervals over 6.25 s
-    assert ev.cost == pytest.approx(0.5 * problem.dt * np.sum(power**2), rel=1e-12)
+    assert len(power) == 13 and np.ptp(power) > 1e3  # a real power history, not a constant
+    assert ev.cost == pytest.approx(0.5 * (6.25 / 12) * np.sum(power**2), rel=1e-10)
+    np.testing.assert_allclose(ev.power.sum(axis=1), power, rtol=1e-10, atol=1e-6)
     assert len(ev.constraints) == len(problem.constraint_names)
 
 

@@ -11,9 +11,12 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from hiab_sim.errors import BackendUnavailableError, InvalidInputError
+
+if TYPE_CHECKING:
+    from hiab_sim.study.result import Decomposition, Result
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -40,24 +43,66 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(run=run)
 
 
-def decomposition_line(d: dict[str, Any]) -> str:
+def decomposition_line(d: Decomposition) -> str:
     """One line: the net-energy saving from the lengths alone and from the trajectory alone."""
-    designs = d["designs"]
 
     def part(saved: float | None, percent: float | None, key: str) -> str:
-        design = designs[key]
-        if saved is None or percent is None or not design["evaluable"]:
+        design = d.designs[key]
+        if saved is None or percent is None or not design.evaluable or design.max_violation is None:
             return "not evaluable"
-        return f"{saved:.1f} J ({percent:.2f} %, max violation {design['max_violation']:.1e})"
+        return f"{saved:.1f} J ({percent:.2f} %, max violation {design.max_violation:.1e})"
 
-    interaction = d["interaction_J"]
+    interaction = d.interaction_J
     return (
         "net energy saved from the lengths alone (initial trajectory): "
-        f"{part(d['from_lengths_J'], d['from_lengths_percent'], 'optimal_lengths_initial_trajectory')}, "
+        f"{part(d.from_lengths_J, d.from_lengths_percent, 'optimal_lengths_initial_trajectory')}, "
         "from the trajectory (initial lengths): "
-        f"{part(d['from_trajectory_J'], d['from_trajectory_percent'], 'initial_lengths_optimal_trajectory')}, "
+        f"{part(d.from_trajectory_J, d.from_trajectory_percent, 'initial_lengths_optimal_trajectory')}, "
         f"interaction {'n/a' if interaction is None else f'{interaction:.1f} J'}"
     )
+
+
+def summary_lines(r: Result) -> list[str]:
+    """The run's summary as printed to stdout: designs, solver, decomposition, re-check, multi-start."""
+    lines = []
+    for name, entry in (("initial", r.initial), ("optimal", r.optimal)):
+        lift, tilt = entry.lengths.lift, entry.lengths.tilt
+        lines.append(
+            f"{name:8s} lift L={lift.L:.4f} Lc0={lift.Lc0:.4f} Lc={lift.Lc:.4f}  "
+            f"tilt L={tilt.L:.4f} Lc0={tilt.Lc0:.4f} Lc={tilt.Lc:.4f} m  "
+            f"net energy {entry.net_electrical_energy_J / 1e3:.3f} kJ  "
+            f"drawn {entry.drawn_energy_without_regeneration_J / 1e3:.3f} kJ"
+        )
+    sol, rc = r.solver, r.recheck
+    lines.append(
+        f"SLSQP: {sol.message} ({sol.iterations} iterations, {sol.wall_time_s:.1f} s, "
+        f"max violation {sol.max_violation_scaled:.1e}); cost ratio {r.improvement.cost_ratio:.4f}, "
+        f"net energy -{r.improvement.net_energy_saved_percent:.2f} %"
+    )
+    lines.append(decomposition_line(r.improvement.decomposition))
+    lines.append(
+        f"re-check ({rc.id_path}, {rc.grid_points} points): max violation {rc.max_violation_scaled:.1e}, "
+        f"TCP tracking error {rc.tracking_error.position_m * 1e3:.3f} mm"
+    )
+    ms = r.multistart
+    if len(ms.starts) > 1:
+        converged = ms.converged_starts
+        if ms.same_optimum and not ms.failed_starts:
+            lines.append(f"multi-start: all {converged} starts reach the same optimum within {ms.tolerance_m} m")
+        elif ms.same_optimum:
+            lines.append(
+                f"multi-start: all {converged} converged starts reach the same optimum within {ms.tolerance_m} m"
+            )
+        else:
+            count = len(ms.distinct_optima)
+            lines.append(f"multi-start: {count} distinct local optima among {converged} converged starts:")
+            for d in ms.distinct_optima:
+                xi = " ".join(f"{v:.4f}" for v in d.xi)
+                energy = "n/a" if d.net_electrical_energy_J is None else f"{d.net_electrical_energy_J / 1e3:.3f}"
+                lines.append(f"  Xi [{xi}] m  net energy {energy} kJ  starts {list(d.starts)}")
+        for f in ms.failed_starts:
+            lines.append(f"  start {f.start} failed (not an optimum): {f.message}")
+    return lines
 
 
 def run(args: argparse.Namespace) -> int:
@@ -78,41 +123,8 @@ def run(args: argparse.Namespace) -> int:
         progress=None if args.quiet else sys.stderr,
         figures=not args.no_figures,
     )
-    r = output.result
-    ini, opt, sol, rc = r["initial"], r["optimal"], r["solver"], r["recheck"]
-    for name, entry in (("initial", ini), ("optimal", opt)):
-        xi = entry["lengths"]
-        print(
-            f"{name:8s} lift L={xi['lift']['L']:.4f} Lc0={xi['lift']['Lc0']:.4f} Lc={xi['lift']['Lc']:.4f}  "
-            f"tilt L={xi['tilt']['L']:.4f} Lc0={xi['tilt']['Lc0']:.4f} Lc={xi['tilt']['Lc']:.4f} m  "
-            f"net energy {entry['net_electrical_energy_J'] / 1e3:.3f} kJ  "
-            f"drawn {entry['drawn_energy_without_regeneration_J'] / 1e3:.3f} kJ"
-        )
-    print(
-        f"SLSQP: {sol['message']} ({sol['iterations']} iterations, {sol['wall_time_s']:.1f} s, "
-        f"max violation {sol['max_violation_scaled']:.1e}); cost ratio {r['improvement']['cost_ratio']:.4f}, "
-        f"net energy -{r['improvement']['net_energy_saved_percent']:.2f} %"
-    )
-    print(decomposition_line(r["improvement"]["decomposition"]))
-    print(
-        f"re-check ({rc['id_path']}, {rc['grid_points']} points): max violation {rc['max_violation_scaled']:.1e}, "
-        f"TCP tracking error {rc['tracking_error']['position_m'] * 1e3:.3f} mm"
-    )
-    ms = r["multistart"]
-    if len(ms["starts"]) > 1:
-        converged = ms["converged_starts"]
-        if ms["same_optimum"] and not ms["failed_starts"]:
-            print(f"multi-start: all {converged} starts reach the same optimum within {ms['tolerance_m']} m")
-        elif ms["same_optimum"]:
-            print(f"multi-start: all {converged} converged starts reach the same optimum within {ms['tolerance_m']} m")
-        else:
-            count = len(ms["distinct_optima"])
-            print(f"multi-start: {count} distinct local optima among {converged} converged starts:")
-            for d in ms["distinct_optima"]:
-                xi = " ".join(f"{v:.4f}" for v in d["xi"])
-                print(f"  Xi [{xi}] m  net energy {d['net_electrical_energy_J'] / 1e3:.3f} kJ  starts {d['starts']}")
-        for f in ms["failed_starts"]:
-            print(f"  start {f['start']} failed (not an optimum): {f['message']}")
+    for line in summary_lines(output.result):
+        print(line)
     print(f"wrote {output.folder}/result.json, trajectory.npz and {len(output.figures)} figures")
     if not args.no_video:
         try:

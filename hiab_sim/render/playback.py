@@ -19,26 +19,25 @@ Both are resampled to the video's frame rate, in real time.
 
 from __future__ import annotations
 
-import json
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.crane.description import ChainLengths, Crane, LinkLengths
+from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import Source
+from hiab_sim.study.result import RESULT_FILE, PlaybackView, read_json_as
 
 Array = NDArray[np.float64]
 Mode = Literal["kinematic", "simulate"]
 MODES: tuple[str, ...] = ("kinematic", "simulate")
 DESIGNS = ("initial", "optimal")
-RESULT_FILE = "result.json"
 TRAJECTORY_FILE = "trajectory.npz"
 _HINT = "write one with 'hiab-sim optimize'"
 #: Spacing of the force samples of a simulated playback [s]: the replay's integrator step.
@@ -78,14 +77,9 @@ def load_playback(result_dir: str | Path) -> PlaybackData:
     for name in (RESULT_FILE, TRAJECTORY_FILE):
         if not (folder / name).is_file():
             raise ConfigError(f"result folder {folder} has no {name} ({_HINT})")
-    try:
-        result = json.loads((folder / RESULT_FILE).read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise ConfigError(f"{folder / RESULT_FILE}: not valid JSON: {error}") from None
-    if not isinstance(result, dict) or "crane" not in result:
-        raise ConfigError(f"{folder / RESULT_FILE}: missing key 'crane'")
+    view = read_json_as(PlaybackView, folder / RESULT_FILE)
     # a preset name, or a crane file relative to the result folder (hiab_sim.resources.locate)
-    crane = load_crane(str(result["crane"]), relative_to=Source(str(folder / RESULT_FILE), folder / RESULT_FILE, False))
+    crane = load_crane(view.crane, relative_to=Source(str(folder / RESULT_FILE), folder / RESULT_FILE, False))
     arrays = _read_npz(folder / TRAJECTORY_FILE)
     time = _array(arrays, "time", 1, folder)
     if len(time) < 2 or not np.all(np.diff(time) > 0):
@@ -94,7 +88,7 @@ def load_playback(result_dir: str | Path) -> PlaybackData:
     designs = []
     for name in DESIGNS:
         joints = JointSamples(*(_array(arrays, f"{name}_{kind}", 2, folder, len(time)) for kind in _KINDS))
-        designs.append(DesignMotion(name, _lengths(result, name, folder / RESULT_FILE), joints))
+        designs.append(DesignMotion(name, getattr(view, name).lengths, joints))
     return PlaybackData(crane, time, reference, tuple(designs))
 
 
@@ -121,16 +115,6 @@ def _array(arrays: dict[str, Array], key: str, ndim: int, folder: Path, rows: in
     if not np.all(np.isfinite(value)):
         raise ConfigError(f"{where}: array '{key}' holds NaN or inf")
     return value.astype(float)
-
-
-def _lengths(result: dict[str, Any], design: str, where: Path) -> LinkLengths:
-    try:
-        chains = result[design]["lengths"]
-        return LinkLengths(
-            *(ChainLengths(*(float(chains[c][k]) for k in ("L", "Lc0", "Lc"))) for c in ("lift", "tilt"))
-        )
-    except (KeyError, TypeError, ValueError):
-        raise ConfigError(f"{where}: '{design}.lengths' must map lift and tilt to numbers L, Lc0, Lc [m]") from None
 
 
 def frame_times(time: Array, fps: float) -> Array:

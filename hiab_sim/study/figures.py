@@ -24,6 +24,7 @@ from hiab_sim.crane.kinematics import forward_kinematics
 from hiab_sim.emla import EmlaSet
 from hiab_sim.study.problem import ACTUATORS
 from hiab_sim.study.report import DesignCheck
+from hiab_sim.study.result import ENERGY_PARTS, HistoryRow, Result
 
 COLOURS = {"initial": "tab:blue", "optimal": "tab:red"}
 
@@ -65,28 +66,28 @@ def draw_crane(
     ax.plot(*f.position["tcp"][0, :2], "s", color=colour, alpha=alpha, markersize=5)
 
 
-def objective_figure(history: list[dict[str, Any]], path: Path) -> None:
+def objective_figure(history: tuple[HistoryRow, ...], path: Path) -> None:
     """Scaled cost and max violation per SQP iteration (seed Fig. Objective_function)."""
     fig = _figure((6.5, 4.0))
     ax = fig.add_subplot()
-    it = [h["iteration"] for h in history]
-    ax.plot(it, [h["scaled_cost"] for h in history], "o-", color="tab:blue", markersize=3)
+    it = [h.iteration for h in history]
+    ax.plot(it, [h.scaled_cost for h in history], "o-", color="tab:blue", markersize=3)
     ax.set_xlabel("SQP iteration")
     ax.set_ylabel("cost f / f(start)  (eq. costf2)")
     ax2 = ax.twinx()
-    ax2.semilogy(it, [max(h["max_violation"], 1e-16) for h in history], ".--", color="tab:gray", markersize=3)
+    ax2.semilogy(it, [max(h.max_violation, 1e-16) for h in history], ".--", color="tab:gray", markersize=3)
     ax2.set_ylabel("max constraint violation (scaled)")
     ax.set_title("Objective per iteration")
     _save(fig, path)
 
 
-def decision_figure(history: list[dict[str, Any]], chain: int, name: str, path: Path) -> None:
+def decision_figure(history: tuple[HistoryRow, ...], chain: int, name: str, path: Path) -> None:
     """L, Lc0, Lc of one chain per iteration (seed Figs. Decision_variables_1/2)."""
     fig = _figure((6.5, 4.0))
     ax = fig.add_subplot()
-    it = [h["iteration"] for h in history]
+    it = [h.iteration for h in history]
     for j, label in enumerate(("L", "Lc0", "Lc")):
-        ax.plot(it, [h["xi"][3 * chain + j] for h in history], "o-", markersize=3, label=label)
+        ax.plot(it, [h.xi[3 * chain + j] for h in history], "o-", markersize=3, label=label)
     ax.set_xlabel("SQP iteration")
     ax.set_ylabel("length [m]")
     ax.set_title(f"Decision variables of the {name} chain")
@@ -172,13 +173,12 @@ def efficiency_figure(emlas: EmlaSet, checks: dict[str, DesignCheck], path: Path
 
 def energy_figure(checks: dict[str, DesignCheck], path: Path) -> None:
     """Energy breakdown (mechanical, copper, friction, inertial) initial vs optimal [kJ]."""
-    keys = ("mechanical", "copper", "rotor_friction", "screw_viscous", "inertial", "electrical")
     fig = _figure((8.0, 4.2))
     ax = fig.add_subplot()
-    x = np.arange(len(keys))
+    x = np.arange(len(ENERGY_PARTS))
     for k, name in enumerate(("initial", "optimal")):
-        b = checks[name].summary["energy_breakdown_J"]
-        ax.bar(x + (k - 0.5) * 0.38, [b[key] / 1e3 for key in keys], 0.38, color=COLOURS[name], label=name)
+        b = checks[name].summary.energy_breakdown_J.as_tuple()
+        ax.bar(x + (k - 0.5) * 0.38, [v / 1e3 for v in b], 0.38, color=COLOURS[name], label=name)
     ax.set_xticks(x, ["mechanical\nf v", "copper", "rotor\nfriction", "screw\nviscous", "inertial", "net\nelectrical"])
     ax.set_ylabel("energy over the motion [kJ]")
     ax.axhline(0.0, color="0.3", linewidth=0.6)
@@ -191,13 +191,13 @@ def write_figures(
     out: Path,
     crane: Crane,
     emlas: EmlaSet,
-    result: dict[str, Any],
+    result: Result,
     arrays: dict[str, np.ndarray],
     checks: dict[str, DesignCheck],
 ) -> list[Path]:
     """Write every figure into ``out``; return their paths."""
-    designs = {name: checks[name].evaluation.lengths for name in ("initial", "optimal")}
-    history = result["history"]
+    designs = {"initial": result.initial.lengths, "optimal": result.optimal.lengths}
+    history = result.history
     paths = {
         "objective": out / "objective.png",
         "lift": out / "decision_variables_lift.png",

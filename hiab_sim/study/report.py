@@ -16,9 +16,8 @@ from __future__ import annotations
 
 import io
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,17 +27,39 @@ from hiab_sim.emla import energy_summary, operating_point
 from hiab_sim.errors import HiabSimError
 from hiab_sim.quadrature import trapezoid
 from hiab_sim.study.problem import ACTUATORS, Evaluation, LinkLengthProblem
-from hiab_sim.study.solve import SolveResult, xi_table
+from hiab_sim.study.result import (
+    ENERGY_PARTS,
+    RESULT_FILE,
+    ActuatorSummary,
+    Decomposition,
+    DecompositionDesign,
+    DesignSummary,
+    DistinctOptimum,
+    EnergyBreakdown,
+    FailedStart,
+    HistoryRow,
+    Improvement,
+    MultiStart,
+    Recheck,
+    Result,
+    Settings,
+    SolverSummary,
+    StartRow,
+    TrackingBands,
+    TrackingError,
+    WorstConstraint,
+)
+from hiab_sim.study.solve import SolveResult
 
 Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
 class DesignCheck:
-    """A design evaluated on the fine grid by one ID path, with its summary as JSON-ready dict."""
+    """A design evaluated on the fine grid by one ID path, with its summary."""
 
     evaluation: Evaluation
-    summary: dict[str, Any]
+    summary: DesignSummary
 
 
 def design_summary(problem: LinkLengthProblem, z: Array) -> DesignCheck:
@@ -47,56 +68,60 @@ def design_summary(problem: LinkLengthProblem, z: Array) -> DesignCheck:
     t = problem.times
     act = ev.actuators
     net, drawn = energy_summary(t, ev.power.T)
-    breakdown = {k: 0.0 for k in ("mechanical", "copper", "rotor_friction", "screw_viscous", "inertial", "electrical")}
-    per_actuator: dict[str, Any] = {}
+    breakdown = np.zeros(len(ENERGY_PARTS))
+    per_actuator: dict[str, ActuatorSummary] = {}
     for i, (name, params) in enumerate(zip(ACTUATORS, problem.emlas, strict=True)):
         op = operating_point(params, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
-        parts = {
-            "mechanical": float(trapezoid(op.mechanical_power, t)),
-            "copper": float(trapezoid(op.copper_loss, t)),
-            "rotor_friction": float(trapezoid(op.rotor_friction_loss, t)),
-            "screw_viscous": float(trapezoid(op.screw_viscous_loss, t)),
-            "inertial": float(trapezoid(op.inertial_power, t)),
-            "electrical": float(trapezoid(op.electrical_power, t)),
-        }
-        for k, v in parts.items():
-            breakdown[k] += v
-        per_actuator[name] = {
-            "peak_force_N": float(np.max(np.abs(act.force[:, i]))),
-            "peak_velocity_m_per_s": float(np.max(np.abs(act.velocity[:, i]))),
-            "peak_electrical_power_W": float(np.max(ev.power[:, i])),
-            "min_envelope_margin": float(op.margins.min()),
-            "net_energy_J": float(net[i]),
-            "drawn_energy_J": float(drawn[i]),
-            "energy_J": parts,
-        }
+        parts = EnergyBreakdown(
+            mechanical=float(trapezoid(op.mechanical_power, t)),
+            copper=float(trapezoid(op.copper_loss, t)),
+            rotor_friction=float(trapezoid(op.rotor_friction_loss, t)),
+            screw_viscous=float(trapezoid(op.screw_viscous_loss, t)),
+            inertial=float(trapezoid(op.inertial_power, t)),
+            electrical=float(trapezoid(op.electrical_power, t)),
+        )
+        breakdown += parts.as_tuple()
+        per_actuator[name] = ActuatorSummary(
+            peak_force_N=float(np.max(np.abs(act.force[:, i]))),
+            peak_velocity_m_per_s=float(np.max(np.abs(act.velocity[:, i]))),
+            peak_electrical_power_W=float(np.max(ev.power[:, i])),
+            min_envelope_margin=float(op.margins.min()),
+            net_energy_J=float(net[i]),
+            drawn_energy_J=float(drawn[i]),
+            energy_J=parts,
+        )
     total_power = ev.power.sum(axis=1)
     net_total, drawn_total = energy_summary(t, total_power)
     ref = problem.reference
-    err = {
-        "position_m": float(np.max(np.abs(ev.tcp.position[:, :2] - ref.position[:, :2]))),
-        "velocity_m_per_s": float(np.max(np.abs(ev.tcp.velocity[:, :2] - ref.velocity[:, :2]))),
-        "acceleration_m_per_s2": float(np.max(np.abs(ev.tcp.acceleration[:, :2] - ref.acceleration[:, :2]))),
-        "telescope_m": float(np.max(np.abs(ev.tcp.position[:, 2] - ref.position[:, 2]))),
-    }
+    err = TrackingError(
+        position_m=float(np.max(np.abs(ev.tcp.position[:, :2] - ref.position[:, :2]))),
+        velocity_m_per_s=float(np.max(np.abs(ev.tcp.velocity[:, :2] - ref.velocity[:, :2]))),
+        acceleration_m_per_s2=float(np.max(np.abs(ev.tcp.acceleration[:, :2] - ref.acceleration[:, :2]))),
+        telescope_m=float(np.max(np.abs(ev.tcp.position[:, 2] - ref.position[:, 2]))),
+    )
+    summary = DesignSummary(
+        lengths=ev.lengths,
+        id_path=problem.id_path,
+        grid_points=len(t),
+        cost_W2s=ev.cost,
+        cost_note="1/2 Dt sum_k (sum_i P_i(t_k))^2 on this grid: a squared-power integral, not an energy",
+        net_electrical_energy_J=float(net_total),
+        drawn_energy_without_regeneration_J=float(drawn_total),
+        drawn_energy_sum_of_actuators_J=float(np.sum(drawn)),
+        energy_breakdown_J=EnergyBreakdown(*(float(v) for v in breakdown)),
+        actuators=per_actuator,
+        max_violation=problem.max_violation(z),
+        worst_constraint=worst_constraint(problem, z),
+        tracking_error=err,
+    )
+    return DesignCheck(ev, summary)
+
+
+def worst_constraint(problem: LinkLengthProblem, z: Array) -> WorstConstraint:
+    """The constraint row of least scaled margin at z."""
     margins = problem.margins(z)
     worst = int(np.argmin(margins))
-    summary = {
-        "lengths": xi_table(ev.lengths),
-        "id_path": problem.id_path,
-        "grid_points": len(t),
-        "cost_W2s": ev.cost,
-        "cost_note": "1/2 Dt sum_k (sum_i P_i(t_k))^2 on this grid: a squared-power integral, not an energy",
-        "net_electrical_energy_J": float(net_total),
-        "drawn_energy_without_regeneration_J": float(drawn_total),
-        "drawn_energy_sum_of_actuators_J": float(np.sum(drawn)),
-        "energy_breakdown_J": breakdown,
-        "actuators": per_actuator,
-        "max_violation": problem.max_violation(z),
-        "worst_constraint": {"name": problem.constraint_names[worst], "scaled_margin": float(margins[worst])},
-        "tracking_error": err,
-    }
-    return DesignCheck(ev, summary)
+    return WorstConstraint(problem.constraint_names[worst], float(margins[worst]))
 
 
 def fine_problem(problem: LinkLengthProblem, id_path: str | None = None) -> LinkLengthProblem:
@@ -118,7 +143,7 @@ def other_path(path: str) -> str:
 
 def build_result(
     problem: LinkLengthProblem, results: list[SolveResult], wall_time: float, multistart_tolerance: float = 1e-4
-) -> tuple[dict[str, Any], dict[str, Array], dict[str, DesignCheck]]:
+) -> tuple[Result, dict[str, Array], dict[str, DesignCheck]]:
     """Assemble result.json, trajectory.npz arrays and the fine-grid checks (keys initial/optimal/recheck_*)."""
     main = results[0]
     fine = fine_problem(problem)
@@ -130,75 +155,85 @@ def build_result(
         "recheck_optimal": design_summary(recheck, main.z),
     }
     colloc = {name: problem.evaluate(z) for name, z in (("initial", main.z0), ("optimal", main.z))}
-    out: dict[str, Any] = {
-        "crane": problem.study.crane_source,
-        "study": problem.study.path,
-        "name": problem.study.name,
+    designs = {
+        name: replace(
+            checks[name].summary,
+            collocation_cost_W2s=colloc[name].cost,
+            collocation_max_violation=problem.max_violation(colloc[name].z),
+        )
+        for name in ("initial", "optimal")
     }
-    for name in ("initial", "optimal"):
-        entry = dict(checks[name].summary)
-        entry["collocation_cost_W2s"] = colloc[name].cost
-        entry["collocation_max_violation"] = problem.max_violation(colloc[name].z)
-        out[name] = entry
-    e0 = checks["initial"].summary["net_electrical_energy_J"]
-    e1 = checks["optimal"].summary["net_electrical_energy_J"]
-    out["improvement"] = {
-        "cost_ratio": colloc["optimal"].cost / colloc["initial"].cost,
-        "net_energy_saved_J": e0 - e1,
-        "net_energy_saved_percent": 100.0 * (e0 - e1) / e0,
-        "decomposition": energy_decomposition(problem, fine, main.z0, main.z),
-    }
-    out["solver"] = {
-        "method": "SLSQP (scipy.optimize.minimize) with exact-structure gradients",
-        "id_path": problem.id_path,
-        "success": main.success,
-        "status": main.status,
-        "message": main.message,
-        "iterations": main.iterations,
-        "wall_time_s": main.wall_time,
-        "total_wall_time_s": wall_time,
-        "max_violation_scaled": problem.max_violation(main.z),
-        "function_evaluations": main.n_evaluations,
-        "gradient_evaluations": main.n_gradients,
-    }
+    e0 = designs["initial"].net_electrical_energy_J
+    e1 = designs["optimal"].net_electrical_energy_J
+    improvement = Improvement(
+        cost_ratio=colloc["optimal"].cost / colloc["initial"].cost,
+        net_energy_saved_J=e0 - e1,
+        net_energy_saved_percent=100.0 * (e0 - e1) / e0,
+        decomposition=energy_decomposition(problem, fine, main.z0, main.z),
+    )
+    solver = SolverSummary(
+        method="SLSQP (scipy.optimize.minimize) with exact-structure gradients",
+        id_path=problem.id_path,
+        success=main.success,
+        status=main.status,
+        message=main.message,
+        iterations=main.iterations,
+        wall_time_s=main.wall_time,
+        total_wall_time_s=wall_time,
+        max_violation_scaled=problem.max_violation(main.z),
+        function_evaluations=main.n_evaluations,
+        gradient_evaluations=main.n_gradients,
+    )
     rc = checks["recheck_optimal"].summary
-    out["recheck"] = {
-        "id_path": recheck.id_path,
-        "grid_points": len(recheck.times),
-        "note": "optimal design re-evaluated on the 10x finer grid with the other ID path and nominal bands",
-        "max_violation_scaled": rc["max_violation"],
-        "worst_constraint": rc["worst_constraint"],
-        "tracking_error": rc["tracking_error"],
-        "net_electrical_energy_J": rc["net_electrical_energy_J"],
-        "initial_max_violation_scaled": checks["recheck_initial"].summary["max_violation"],
-        "force_difference_between_paths_N": float(
-            np.max(
-                np.abs(
-                    checks["optimal"].evaluation.actuators.force - checks["recheck_optimal"].evaluation.actuators.force
-                )
-            )
+    force_difference = np.abs(
+        checks["optimal"].evaluation.actuators.force - checks["recheck_optimal"].evaluation.actuators.force
+    )
+    recheck_summary = Recheck(
+        id_path=recheck.id_path,
+        grid_points=len(recheck.times),
+        note="optimal design re-evaluated on the 10x finer grid with the other ID path and nominal bands",
+        max_violation_scaled=rc.max_violation,
+        worst_constraint=rc.worst_constraint,
+        tracking_error=rc.tracking_error,
+        net_electrical_energy_J=rc.net_electrical_energy_J,
+        initial_max_violation_scaled=checks["recheck_initial"].summary.max_violation,
+        force_difference_between_paths_N=float(np.max(force_difference)),
+    )
+    study = problem.study
+    settings = Settings(
+        spline_control_points=problem.basis.n,
+        spline_degree=problem.basis.k,
+        collocation_points=len(problem.times),
+        collocation_step_s=problem.dt,
+        fine_grid_points=len(fine.times),
+        redundancy="xt2 prescribed by the study (third reference coordinate)",
+        tracking_bands=TrackingBands(
+            position_m=study.tracking.position,
+            velocity_m_per_s=study.tracking.velocity,
+            acceleration_m_per_s2=study.tracking.acceleration,
+            collocation_fraction=study.tracking.collocation_fraction,
         ),
-    }
-    out["multistart"] = multistart_summary(problem, results, multistart_tolerance)
-    out["settings"] = {
-        "spline_control_points": problem.basis.n,
-        "spline_degree": problem.basis.k,
-        "collocation_points": len(problem.times),
-        "collocation_step_s": problem.dt,
-        "fine_grid_points": len(fine.times),
-        "redundancy": "xt2 prescribed by the study (third reference coordinate)",
-        "tracking_bands": {
-            "position_m": problem.study.tracking.position,
-            "velocity_m_per_s": problem.study.tracking.velocity,
-            "acceleration_m_per_s2": problem.study.tracking.acceleration,
-            "collocation_fraction": problem.study.tracking.collocation_fraction,
-        },
-        "xi_low": list(problem.study.bounds.xi_low),
-        "xi_up": list(problem.study.bounds.xi_up),
-        "envelope_margin": problem.study.bounds.envelope_margin,
-        "payload_kg": problem.study.payload,
-    }
-    out["history"] = [vars(h) for h in main.history]
+        xi_low=tuple(study.bounds.xi_low),
+        xi_up=tuple(study.bounds.xi_up),
+        envelope_margin=study.bounds.envelope_margin,
+        payload_kg=study.payload,
+    )
+    result = Result(
+        crane=study.crane_source,
+        study=study.path,
+        name=study.name,
+        initial=designs["initial"],
+        optimal=designs["optimal"],
+        improvement=improvement,
+        solver=solver,
+        recheck=recheck_summary,
+        multistart=multistart_summary(problem, results, multistart_tolerance),
+        settings=settings,
+        history=tuple(
+            HistoryRow(h.iteration, h.cost, h.scaled_cost, h.max_violation, tuple(h.xi), h.wall_time)
+            for h in main.history
+        ),
+    )
     arrays: dict[str, Array] = {"time": fine.times, "reference_tcp": fine.reference.tcp()}
     for name in ("initial", "optimal"):
         ev = checks[name].evaluation
@@ -210,7 +245,7 @@ def build_result(
         arrays[f"{name}_actuator_velocity"] = ev.actuators.velocity
         arrays[f"{name}_actuator_stroke"] = ev.actuators.stroke
         arrays[f"{name}_electrical_power"] = ev.power
-    return out, arrays, checks
+    return result, arrays, checks
 
 
 #: The four designs of :func:`energy_decomposition`: (key, lengths from, trajectory from).
@@ -224,7 +259,7 @@ DECOMPOSITION_DESIGNS = (
 
 def energy_decomposition(
     problem: LinkLengthProblem, fine: LinkLengthProblem, z_initial: Array, z_optimal: Array
-) -> dict[str, Any]:
+) -> Decomposition:
     """Split the saving into what the lengths and what the re-shaped trajectory contribute.
 
     The spline coefficients are decision variables free within the tracking bands, so the
@@ -237,29 +272,29 @@ def energy_decomposition(
     """
     n = problem.n_xi
     source = {"initial": np.asarray(z_initial, dtype=float), "optimal": np.asarray(z_optimal, dtype=float)}
-    designs: dict[str, Any] = {}
+    designs: dict[str, DecompositionDesign] = {}
     energy: dict[str, float] = {}
     for key, xi_from, c_from in DECOMPOSITION_DESIGNS:
         z = np.concatenate([source[xi_from][:n], source[c_from][n:]])
-        entry: dict[str, Any] = {"lengths": xi_from, "trajectory": c_from}
         try:
             summary = design_summary(fine, z).summary
             collocation_cost = problem.evaluate(z).cost
         except HiabSimError as error:  # a mixed design may leave the model's domain
-            entry.update(evaluable=False, error=str(error))
+            designs[key] = DecompositionDesign(xi_from, c_from, evaluable=False, error=str(error))
             energy[key] = float("nan")
         else:
-            energy[key] = summary["net_electrical_energy_J"]
-            entry.update(
+            energy[key] = summary.net_electrical_energy_J
+            designs[key] = DecompositionDesign(
+                xi_from,
+                c_from,
                 evaluable=True,
-                net_electrical_energy_J=summary["net_electrical_energy_J"],
-                drawn_energy_without_regeneration_J=summary["drawn_energy_without_regeneration_J"],
-                cost_W2s=summary["cost_W2s"],
+                net_electrical_energy_J=summary.net_electrical_energy_J,
+                drawn_energy_without_regeneration_J=summary.drawn_energy_without_regeneration_J,
+                cost_W2s=summary.cost_W2s,
                 collocation_cost_W2s=collocation_cost,
-                max_violation=summary["max_violation"],
-                worst_constraint=summary["worst_constraint"],
+                max_violation=summary.max_violation,
+                worst_constraint=summary.worst_constraint,
             )
-        designs[key] = entry
     e00 = energy["initial_lengths_initial_trajectory"]
     lengths = e00 - energy["optimal_lengths_initial_trajectory"]
     trajectory = e00 - energy["initial_lengths_optimal_trajectory"]
@@ -268,76 +303,74 @@ def energy_decomposition(
     def finite(x: float) -> float | None:
         return float(x) if np.isfinite(x) else None
 
-    return {
-        "note": (
+    return Decomposition(
+        note=(
             "net electrical energy on the fine grid of the four combinations of initial/optimal lengths and "
             "initial/optimal spline coefficients; savings relative to the initial design"
         ),
-        "designs": designs,
-        "from_lengths_J": finite(lengths),
-        "from_lengths_percent": finite(100.0 * lengths / e00),
-        "from_trajectory_J": finite(trajectory),
-        "from_trajectory_percent": finite(100.0 * trajectory / e00),
-        "interaction_J": finite(total - lengths - trajectory),
-        "total_J": finite(total),
-    }
+        designs=designs,
+        from_lengths_J=finite(lengths),
+        from_lengths_percent=finite(100.0 * lengths / e00),
+        from_trajectory_J=finite(trajectory),
+        from_trajectory_percent=finite(100.0 * trajectory / e00),
+        interaction_J=finite(total - lengths - trajectory),
+        total_J=finite(total),
+    )
 
 
-def multistart_summary(problem: LinkLengthProblem, results: list[SolveResult], tolerance: float) -> dict[str, Any]:
+def multistart_summary(problem: LinkLengthProblem, results: list[SolveResult], tolerance: float) -> MultiStart:
     """Whether every converged start reached the same Xi within ``tolerance`` [m]; else the distinct optima.
 
     A start whose solver failed is no optimum: it is left out of ``distinct_optima`` and listed
     under ``failed_starts`` with its message (its row has no optimal lengths or cost).
     """
-    rows = []
-    failed = []
+    rows: list[StartRow] = []
+    failed: list[FailedStart] = []
     for r in results:
-        row: dict[str, Any] = {
-            "start": r.start,
-            "initial_lengths": xi_table(r.initial_lengths),
-            "optimal_lengths": None,
-            "cost_W2s": None,
-            "success": r.success,
-            "message": r.message,
-            "iterations": r.iterations,
-        }
+        optimal, cost = None, None
         if r.success:
             ev = problem.evaluate(r.z)
-            row["optimal_lengths"] = xi_table(ev.lengths)
-            row["cost_W2s"] = ev.cost
+            optimal, cost = ev.lengths, ev.cost
         else:
-            failed.append({"start": r.start, "initial_xi": r.initial_lengths.as_array().tolist(), "message": r.message})
-        rows.append(row)
-    distinct: list[dict[str, Any]] = []
+            failed.append(FailedStart(r.start, tuple(r.initial_lengths.as_array().tolist()), r.message))
+        rows.append(StartRow(r.start, r.initial_lengths, optimal, cost, r.success, r.message, r.iterations))
+    groups: list[tuple[Array, float | None, list[int]]] = []  # (Xi, cost of its first start, starts)
     for r, row in zip(results, rows, strict=True):
         if not r.success:
             continue
         xi = problem.unpack(r.z)[0].as_array()
-        for d in distinct:
-            if np.max(np.abs(np.asarray(d["xi"]) - xi)) <= tolerance:
-                d["starts"].append(r.start)
+        for group in groups:
+            if np.max(np.abs(group[0] - xi)) <= tolerance:
+                group[2].append(r.start)
                 break
         else:
-            distinct.append({"xi": xi.tolist(), "cost_W2s": row["cost_W2s"], "starts": [r.start]})
-    if len(results) > 1:
-        fine = fine_problem(problem)
-        by_start = {r.start: r for r in results}
-        for d in distinct:
-            z = by_start[d["starts"][0]].z
-            d["net_electrical_energy_J"] = design_summary(fine, z).summary["net_electrical_energy_J"]
-    return {
-        "starts": rows,
-        "tolerance_m": tolerance,
-        "converged_starts": len(results) - len(failed),
-        "same_optimum": len(distinct) == 1,
-        "distinct_optima": distinct,
-        "failed_starts": failed,
-    }
+            groups.append((xi, row.cost_W2s, [r.start]))
+    fine = fine_problem(problem) if len(results) > 1 else None
+    by_start = {r.start: r for r in results}
+    distinct = tuple(
+        DistinctOptimum(
+            xi=tuple(xi.tolist()),
+            cost_W2s=cost,
+            starts=tuple(starts),
+            net_electrical_energy_J=(
+                None if fine is None else design_summary(fine, by_start[starts[0]].z).summary.net_electrical_energy_J
+            ),
+        )
+        for xi, cost, starts in groups
+    )
+    return MultiStart(
+        starts=tuple(rows),
+        tolerance_m=tolerance,
+        converged_starts=len(results) - len(failed),
+        same_optimum=len(distinct) == 1,
+        distinct_optima=distinct,
+        failed_starts=tuple(failed),
+    )
 
 
-def write_results(out: Path, result: dict[str, Any], arrays: dict[str, Array]) -> None:
+def write_results(out: Path, result: Result, arrays: dict[str, Array]) -> None:
     """Write ``result.json`` and ``trajectory.npz`` atomically."""
     buffer = io.BytesIO()
     np.savez_compressed(buffer, **arrays)  # type: ignore[arg-type]
     write_atomic(out / "trajectory.npz", buffer.getvalue())
-    write_atomic(out / "result.json", json.dumps(result, indent=2) + "\n")
+    write_atomic(out / RESULT_FILE, json.dumps(result.to_json(), indent=2) + "\n")

@@ -4,15 +4,16 @@ from __future__ import annotations
 
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TextIO
 
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.errors import SolverError
 from hiab_sim.study.config import Study, load_study
 from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.report import build_result, write_results
+from hiab_sim.study.result import Result
 from hiab_sim.study.solve import (
     SolveResult,
     check_checkpoint,
@@ -25,10 +26,10 @@ from hiab_sim.study.solve import (
 
 @dataclass(frozen=True)
 class RunOutput:
-    """What a run wrote: the folder, the result dictionary and the figure paths."""
+    """What a run wrote: the folder, the result (as in its result.json) and the figure paths."""
 
     folder: Path
-    result: dict[str, Any]
+    result: Result
     figures: list[Path]
 
 
@@ -83,8 +84,7 @@ def run_study(
     crane_file = study.crane_file
     if crane_file is not None and not (crane_file.shipped and crane_file.label == study.crane_source):
         write_atomic(folder / "crane.yaml", crane_file.read_bytes())  # a crane file, not a preset name
-        result["crane_source"] = study.crane_source
-        result["crane"] = "crane.yaml"
+        result = replace(result, crane="crane.yaml", crane_source=study.crane_source)
     write_results(folder, result, arrays)
     paths: list[Path] = []
     if figures:
