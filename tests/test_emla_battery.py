@@ -97,12 +97,12 @@ def test_smooth_energy_gradient_matches_finite_differences(
         up, down = p.copy(), p.copy()
         up[k, i] += h
         down[k, i] -= h
-        fd = (battery_energy(t, up, params, smooth=True).energy - battery_energy(t, down, params, smooth=True).energy)
+        fd = battery_energy(t, up, params, smooth=True).energy - battery_energy(t, down, params, smooth=True).energy
         assert grad[k, i] == pytest.approx(fd / (2 * h), rel=1e-6, abs=1e-9)
 
 
-def test_trapezoid_weights_integrate_a_quadratic_on_an_uneven_grid() -> None:
-    """sum w_k y_k equals the piecewise-linear integral (exact for a linear function)."""
+def test_trapezoid_weights_integrate_a_linear_function_exactly_on_an_uneven_grid() -> None:
+    """The weights integrate a linear function exactly on an uneven grid."""
     t = np.array([0.0, 0.1, 0.5, 0.6, 2.0])
     assert trapezoid_weights(t) @ (3.0 * t + 1.0) == pytest.approx(1.5 * 4.0 + 2.0, rel=1e-14)
 
