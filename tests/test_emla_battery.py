@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -118,7 +120,7 @@ def test_trapezoid_weights_integrate_a_linear_function_exactly_on_an_uneven_grid
 )
 def test_out_of_range_battery_parameters_name_the_field(field: str, kwargs: dict[str, float]) -> None:
     """Efficiencies outside (0, 1] and a non-positive smoothing width are rejected by name."""
-    with pytest.raises(InvalidInputError, match=field):
+    with pytest.raises(InvalidInputError, match=re.escape(field)):
         BatteryParams(**kwargs)
 
 

@@ -71,7 +71,8 @@ class ThermalParams:
         _positive(f"{self.label}.time_constant", self.time_constant, "s")
         if not math.isfinite(self.ambient_temperature):
             raise InvalidInputError(f"{self.label}.ambient_temperature", self.ambient_temperature, "must be finite")
-        if not (math.isfinite(self.max_winding_temperature) and self.max_winding_temperature > self.ambient_temperature):
+        t_max = self.max_winding_temperature
+        if not (math.isfinite(t_max) and t_max > self.ambient_temperature):
             raise InvalidInputError(
                 f"{self.label}.max_winding_temperature",
                 self.max_winding_temperature,
