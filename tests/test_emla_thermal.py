@@ -107,7 +107,7 @@ def test_periodic_temperature_matches_an_ode_integration_over_repeated_cycles() 
 
 
 def test_temperature_gradients_match_finite_differences() -> None:
-    """The peak temperature gradient d peak / d P_k and the sensitivity of another sample agree with central differences."""
+    """Peak and per-sample temperature gradients agree with central differences."""
     t = np.linspace(0.0, 3.0, 16)
     loss = _loss(t)
     duty = Duty(3.0, 1.0)
