@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.hydraulics.cylinders import HydraulicCylinders, hydraulic_cylinders_from_mapping
 from hiab_sim.yaml_fields import mapping, number, positive, read_yaml
 
 Vector3 = tuple[float, float, float]
@@ -188,6 +189,7 @@ class Crane:
     telescope: Telescope
     tcp: Pose  # TCP frame {D22} in the end-mass frame {P32}
     bodies: tuple[RigidBody, ...] = field(repr=False)
+    hydraulic_cylinders: HydraulicCylinders | None = None  # the cylinders the EMLAs replace, if given
 
     @property
     def chains(self) -> tuple[ClosedChain, ClosedChain]:
@@ -319,7 +321,7 @@ def load_crane(source: str | Path = "xs031") -> Crane:
 
 def crane_from_dict(data: Any, origin: str = "crane") -> Crane:
     """Build and validate a :class:`Crane` from a parsed YAML mapping."""
-    top = mapping(data, origin, _TOP_KEYS)
+    top = mapping(data, origin, _TOP_KEYS | {"hydraulic_cylinders"}, _TOP_KEYS)
     gravity = positive(top["gravity"], "gravity", "m/s^2")
     chains_data = mapping(top["chains"], "chains", set(CHAIN_NAMES))
     chains = {name: _chain(name, chains_data[name]) for name in CHAIN_NAMES}
@@ -337,6 +339,9 @@ def crane_from_dict(data: Any, origin: str = "crane") -> Crane:
         telescope=telescope,
         tcp=tcp,
         bodies=bodies,
+        hydraulic_cylinders=(
+            hydraulic_cylinders_from_mapping(top["hydraulic_cylinders"]) if "hydraulic_cylinders" in top else None
+        ),
     )
     check_lengths(crane, crane.default_lengths)
     return crane
