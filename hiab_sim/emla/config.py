@@ -166,6 +166,14 @@ class EmlaSet:
     telescope: EmlaParams
     battery: BatteryParams = field(default_factory=BatteryParams)
 
+    def __post_init__(self) -> None:
+        if self.battery.inverter_efficiency < 1.0 and any(p.losses.inverter_on for p in self.as_tuple()):
+            raise InvalidInputError(
+                "battery.inverter_efficiency",
+                self.battery.inverter_efficiency,
+                "must be 1 when drive_losses models the inverter (it would be counted twice)",
+            )
+
     def __iter__(self) -> Iterator[EmlaParams]:
         return iter((self.lift, self.tilt, self.telescope))
 

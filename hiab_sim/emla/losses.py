@@ -22,7 +22,11 @@ Inverter loss (DC side minus motor terminals), with the phase current amplitude 
     P_inv = c0 + c1 I + c2 I^2
 
 c0 [W] standby (control, gate drives), c1 [W/A] switching and semiconductor threshold voltage,
-c2 [ohm] semiconductor on-resistance. Smooth form: I -> sqrt(i_q^2 + i_eps^2) - i_eps.
+c2 [ohm] semiconductor on-resistance. Smooth form: I -> sqrt(i_q^2 + i_eps^2) - i_eps, which is
+0 at zero current and within i_eps of |i_q| everywhere, so |P_inv,smooth - P_inv| <= c1 i_eps.
+Likewise the smooth |f_sm| is within f_eps of the exact one, so away from standstill
+(|omega_m| >> omega_eps, where tanh = sign to within 2 exp(-2 |omega_m| / omega_eps)) the smooth
+transmission loss torque is within a f_eps / k of the exact one.
 
 Holding brake (spring applied, released by its coil while moving). Exact: engaged where
 |v_x| < v_b; there the motor carries no current, the brake carries the load, and the drive draws
