@@ -150,3 +150,33 @@ def test_a_duty_with_no_time_is_rejected() -> None:
         Duty(5.0, -1.0)
     with pytest.raises(InvalidInputError, match=r"duty\.cycle_time"):
         rms_torque([0.0, 1.0], [1.0, 1.0], Duty(2.0))
+
+
+def test_preset_thermal_resistance_heats_the_winding_to_its_limit_at_continuous_torque() -> None:
+    """The derived R_th: copper loss at the continuous torque, held, brings the winding to T_max (1e-4)."""
+    from hiab_sim.emla import load_emla_set
+
+    for params in load_emla_set():
+        th = params.thermal
+        assert th is not None and th.label == f"{params.name}.thermal"
+        loss, _ = copper_loss(params.motor.stator_resistance, params.motor.torque_constant, th.continuous_torque)
+        rise = th.max_winding_temperature - th.ambient_temperature
+        assert float(loss) * th.thermal_resistance == pytest.approx(rise, rel=1e-4)
+        assert params.source_of("thermal.thermal_resistance").startswith("derived")
+
+
+def test_negative_thermal_resistance_in_the_emla_file_names_the_field() -> None:
+    """An override with R_th < 0 is rejected as tilt.thermal.thermal_resistance; a missing key is a ConfigError."""
+    import yaml
+
+    from hiab_sim.emla.config import DEFAULT_EMLA_PRESET, emla_set_from_mapping
+    from hiab_sim.errors import ConfigError
+
+    doc = yaml.safe_load(DEFAULT_EMLA_PRESET.read_text(encoding="utf-8"))
+    doc["actuators"]["tilt"]["thermal"] = {"thermal_resistance": -0.5}
+    with pytest.raises(InvalidInputError, match=re.escape("tilt.thermal.thermal_resistance")):
+        emla_set_from_mapping(doc)
+    doc = yaml.safe_load(DEFAULT_EMLA_PRESET.read_text(encoding="utf-8"))
+    del doc["thermal"]["time_constant"]
+    with pytest.raises(ConfigError, match="time_constant"):
+        emla_set_from_mapping(doc)

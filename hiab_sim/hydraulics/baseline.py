@@ -129,6 +129,7 @@ class SupplyResult:
         input_energy: int P_in dt [J], the baseline's energy.
         input_energy_per_actuator: int p_pump Q_i dt / (eta_pump eta_motor) [J], summing to input_energy.
         useful_work: int f_x v_x dt [J] per actuator (v_x = 0 below the standstill speed).
+        delivered_work: int max(f_x v_x, 0) dt [J] per actuator, the work done on the load.
         friction_loss: [J] per actuator.
         meter_in_loss: int (p_pump - p_L) Q dt [J] per actuator.
         meter_out_loss: [J] per actuator.
@@ -145,6 +146,7 @@ class SupplyResult:
     input_energy: float
     input_energy_per_actuator: Array
     useful_work: Array
+    delivered_work: Array
     friction_loss: Array
     meter_in_loss: Array
     meter_out_loss: Array
@@ -154,8 +156,12 @@ class SupplyResult:
 
     @property
     def system_efficiency(self) -> float:
-        """Useful work over input energy [-] (compare Liang et al. 1999: about 0.085 to 0.27)."""
-        return float(np.sum(self.useful_work) / self.input_energy)
+        """Work delivered to the loads over input energy [-] (Liang et al. 1999: about 0.085 to 0.27).
+
+        The delivered work (f_x v_x > 0 only) is used because a closed cycle's net work is about 0:
+        what the loads return while lowering is throttled, not recovered.
+        """
+        return float(np.sum(self.delivered_work) / self.input_energy) if self.input_energy > 0 else float("nan")
 
 
 def cylinder_flows(
@@ -250,6 +256,7 @@ def hydraulic_baseline(
                 input_energy=float(w @ p_in),
                 input_energy_per_actuator=w @ (p_pump[:, None] * flows.inlet_flow) / eta,
                 useful_work=useful,
+                delivered_work=w @ np.maximum(flows.useful_power, 0.0),
                 friction_loss=friction,
                 meter_in_loss=w @ ((p_pump[:, None] - flows.load_pressure) * flows.inlet_flow),
                 meter_out_loss=meter_out,
