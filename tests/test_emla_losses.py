@@ -11,7 +11,14 @@ import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hiab_sim.emla import EmlaParams, electrical_power, electrical_power_partials, load_emla_set, operating_point
+from hiab_sim.emla import (
+    EmlaParams,
+    electrical_power,
+    electrical_power_partials,
+    load_emla_set,
+    operating_point,
+    peak_force,
+)
 from hiab_sim.emla.config import DEFAULT_EMLA_PRESET, emla_set_from_mapping
 from hiab_sim.emla.losses import DriveLosses
 from hiab_sim.errors import ConfigError, InvalidInputError
@@ -210,9 +217,20 @@ def test_efficiency_map_names_the_losses_that_are_on_and_they_cap_its_efficiency
 
     params = dataclasses.replace(EMLAS.lift, losses=ON)
     emap = efficiency_map(params, n_force=41, n_velocity=41)
-    title = plot_efficiency_map(emap).axes[0].get_title()
+    title = plot_efficiency_map(emap).axes[0].get_title().replace("\n", " ")
     assert "transmission eta 0.87 fwd / 0.862 back" in title and "inverter" in title and "holding brake" in title
     motoring = emap.within_envelope & (emap.mechanical_power > 0)
     assert np.nanmax(emap.efficiency[motoring]) <= 0.87
     plain = plot_efficiency_map(efficiency_map(EMLAS.lift, n_force=21, n_velocity=21)).axes[0].get_title()
     assert "drive losses: off (paper model)" in plain
+
+
+def test_peak_push_force_pays_the_forward_transmission_efficiency() -> None:
+    """At the peak force, moving out at 10 mm/s, the exact motor torque is tau_peak + b v / (k eta_fwd)."""
+    params = dataclasses.replace(EMLAS.lift, losses=ON)
+    f = peak_force(params)
+    assert f == pytest.approx(0.87 * peak_force(EMLAS.lift), rel=1e-15)
+    op = operating_point(params, f, 0.01, 0.0, exact=True)
+    k = params.transmission_ratio
+    expected = params.motor.peak_torque + params.viscous_friction * 0.01 / (k * 0.87)
+    assert float(op.motor_torque) == pytest.approx(expected, rel=1e-6)

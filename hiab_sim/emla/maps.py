@@ -6,6 +6,7 @@ the Agg canvas (no pyplot, no display, no global backend switch); CSV/NPZ writer
 
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -165,12 +166,13 @@ def plot_efficiency_map(
         )  # fmt: skip
     ax.set_xlabel("rod velocity $v_x$ [m/s]")
     ax.set_ylabel("load force $f_x$ [kN]")
-    ax.set_title(
+    title = (
         f"EMLA efficiency, {emap.actuator}: peak {emap.peak_force / 1e3:.1f} kN, top {emap.top_speed:.3f} m/s\n"
-        f"{emap.loss_options}",
-        fontsize=9,
+        + "\n".join(textwrap.wrap(emap.loss_options, 95))
     )
-    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.07), ncol=2, fontsize=7, frameon=False)
+    ax.set_title(title, fontsize=9)
+    lines = title.count("\n") + 1
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.035 + 0.035 * lines), ncol=2, fontsize=7, frameon=False)
     fig.colorbar(filled, ax=ax, label="efficiency: $f_x v_x / P_{elec}$ motoring, $P_{elec} / f_x v_x$ generating")
     return fig
 

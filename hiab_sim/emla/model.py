@@ -237,13 +237,16 @@ def _trapezoid(y: Array, t: Array) -> Array:
 
 
 def peak_force(params: EmlaParams) -> float:
-    """Return the largest push force [N]: 2 pi G (tau_peak - tau_f) / rho.
+    """Return the largest push force [N]: 2 pi G eta_fwd (tau_peak - tau_f) / rho.
 
     The force at the peak motor torque while starting to move against the rotor's Coulomb friction
-    (at a_x = 0 and v_x -> 0, so the viscous term vanishes). The regularised friction is zero at
-    exactly v_x = 0, where the envelope admits 2 pi G tau_peak / rho; this value is the safe one.
+    (at a_x = 0 and v_x -> 0, so the viscous term vanishes), through the forward transmission
+    efficiency eta_fwd (1 unless the drive-loss option is on). The regularised friction and the
+    smooth transmission loss are zero at exactly v_x = 0, where the envelope admits
+    2 pi G tau_peak / rho; this value is the safe one.
     """
-    return params.transmission_ratio * (params.motor.peak_torque - params.motor.rotor_coulomb_friction)
+    eta = params.losses.transmission_efficiency_forward
+    return params.transmission_ratio * eta * (params.motor.peak_torque - params.motor.rotor_coulomb_friction)
 
 
 def top_speed(params: EmlaParams) -> float:
