@@ -171,8 +171,8 @@ def plot_efficiency_map(
         + "\n".join(textwrap.wrap(emap.loss_options, 95))
     )
     ax.set_title(title, fontsize=9)
-    lines = title.count("\n") + 1
-    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.035 + 0.035 * lines), ncol=2, fontsize=7, frameon=False)
+    title_lines = title.count("\n") + 1
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.035 + 0.035 * title_lines), ncol=2, fontsize=7, frameon=False)
     fig.colorbar(filled, ax=ax, label="efficiency: $f_x v_x / P_{elec}$ motoring, $P_{elec} / f_x v_x$ generating")
     return fig
 
