@@ -42,7 +42,7 @@ def emla_params(draw: st.DrawFn) -> EmlaParams:
     return dataclasses.replace(
         base,
         motor=motor,
-        gear_ratio=draw(st.floats(1.0, 10.0)),
+        gear_ratio=draw(st.floats(1.0, 10.0, exclude_min=True)),
         screw_lead=draw(st.floats(0.002, 0.025)),
         screw_moving_mass=draw(st.floats(0.0, 200.0)),
         viscous_friction=draw(st.floats(0.0, 1e4)),

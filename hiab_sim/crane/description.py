@@ -28,6 +28,7 @@ import numpy as np
 
 from hiab_sim.checks import check_range
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.hydraulics.cylinders import HydraulicCylinders
 
 Vector3 = tuple[float, float, float]
 Matrix3 = tuple[Vector3, Vector3, Vector3]
@@ -218,6 +219,7 @@ class Crane:
     telescope: Telescope
     tcp: Pose  # TCP frame {D22} in the end-mass frame {P32}
     bodies: tuple[RigidBody, ...] = field(repr=False)
+    hydraulic_cylinders: HydraulicCylinders | None = None  # the cylinders the EMLAs replace, if given
 
     def __post_init__(self) -> None:
         check_range("gravity", self.gravity, 0.0, unit="m/s^2", low_open=True)

@@ -28,6 +28,7 @@ from hiab_sim.crane.description import (
 )
 from hiab_sim.crane.mechanism import check_lengths
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.hydraulics.cylinders import hydraulic_cylinders_from_mapping
 from hiab_sim.resources import Source, locate
 from hiab_sim.yaml_fields import mapping, number, read_yaml
 
@@ -81,7 +82,7 @@ def load_crane(source: str | Path | Source = "xs031", relative_to: Source | None
 
 def crane_from_dict(data: Any, origin: str = "crane") -> Crane:
     """Build and validate a :class:`Crane` from a parsed YAML mapping."""
-    top = mapping(data, origin, _TOP_KEYS)
+    top = mapping(data, origin, _TOP_KEYS | {"hydraulic_cylinders"}, _TOP_KEYS)
     gravity = number(top["gravity"], "gravity")
     chains_data = mapping(top["chains"], "chains", set(CHAIN_NAMES))
     chains = {name: _chain(name, chains_data[name]) for name in CHAIN_NAMES}
@@ -99,6 +100,9 @@ def crane_from_dict(data: Any, origin: str = "crane") -> Crane:
         telescope=telescope,
         tcp=tcp,
         bodies=bodies,
+        hydraulic_cylinders=(
+            hydraulic_cylinders_from_mapping(top["hydraulic_cylinders"]) if "hydraulic_cylinders" in top else None
+        ),
     )
     check_lengths(crane, crane.default_lengths)
     return crane

@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
-from dataclasses import dataclass, fields
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
 from hiab_sim.crane.names import ACTUATOR_NAMES
-from hiab_sim.errors import InvalidInputError
+from hiab_sim.emla.battery import BatteryParams
+from hiab_sim.emla.losses import DriveLosses
+from hiab_sim.emla.thermal import ThermalParams
+from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import Source, locate
 from hiab_sim.yaml_fields import mapping, read_yaml, sourced_number
 
@@ -104,12 +107,14 @@ class EmlaParams:
     Attributes:
         name: Actuator name (``lift``, ``tilt`` or ``telescope`` for the XS 031), used in messages.
         motor: The PMSM.
-        gear_ratio: Gearbox ratio G [-] (motor turns per screw turn), > 0.
+        gear_ratio: Gearbox ratio G [-] (motor turns per screw turn), > 1 (a reduction).
         screw_lead: Screw lead rho [m per screw revolution], > 0.
         screw_moving_mass: Screw moving mass M_sm [kg], >= 0.
         viscous_friction: Screw viscous friction b_f [N s/m], >= 0.
         hydraulic_push_force: Push force of the hydraulic cylinder this EMLA replaces [N], or None.
         hydraulic_pull_force: Pull force of that cylinder [N], or None.
+        losses: Optional drive losses (:mod:`hiab_sim.emla.losses`); the default is all off.
+        thermal: Continuous torque and winding thermal model (:mod:`hiab_sim.emla.thermal`), or None.
         provenance: (parameter key, source label) pairs, e.g.
             ``("pmsm.peak_torque", "estimate: 3 x rated torque ...")``.
 
@@ -123,10 +128,13 @@ class EmlaParams:
     viscous_friction: float
     hydraulic_push_force: float | None = None
     hydraulic_pull_force: float | None = None
+    losses: DriveLosses = field(default_factory=DriveLosses)
+    thermal: ThermalParams | None = None
     provenance: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
-        _positive(f"{self.name}.gear_ratio", self.gear_ratio)
+        if not (math.isfinite(self.gear_ratio) and self.gear_ratio > 1.0):
+            raise InvalidInputError(f"{self.name}.gear_ratio", self.gear_ratio, "must be finite and > 1 (a reduction)")
         _positive(f"{self.name}.screw_lead", self.screw_lead, "m")
         _non_negative(f"{self.name}.screw_moving_mass", self.screw_moving_mass, "kg")
         _non_negative(f"{self.name}.viscous_friction", self.viscous_friction, "N s/m")
@@ -147,11 +155,20 @@ class EmlaParams:
 
 @dataclass(frozen=True)
 class EmlaSet:
-    """The three EMLAs of an XS 031 crane; iterate for ``lift``, ``tilt``, ``telescope`` in that order."""
+    """The three EMLAs of an XS 031 crane and their DC bus; iterate for ``lift``, ``tilt``, ``telescope``."""
 
     lift: EmlaParams
     tilt: EmlaParams
     telescope: EmlaParams
+    battery: BatteryParams = field(default_factory=BatteryParams)
+
+    def __post_init__(self) -> None:
+        if self.battery.inverter_efficiency < 1.0 and any(p.losses.inverter_on for p in self.as_tuple()):
+            raise InvalidInputError(
+                "battery.inverter_efficiency",
+                self.battery.inverter_efficiency,
+                "must be 1 when drive_losses models the inverter (it would be counted twice)",
+            )
 
     def __iter__(self) -> Iterator[EmlaParams]:
         return iter((self.lift, self.tilt, self.telescope))
@@ -170,7 +187,17 @@ class EmlaSet:
 
 _PMSM_KEYS: tuple[str, ...] = tuple(f.name for f in fields(PmsmParams) if f.name != "label")
 _ACTUATOR_REQUIRED: tuple[str, ...] = ("gear_ratio", "screw_lead", "screw_moving_mass", "viscous_friction")
-_ACTUATOR_OPTIONAL: tuple[str, ...] = ("hydraulic_push_force", "hydraulic_pull_force", "pmsm")
+_ACTUATOR_OPTIONAL: tuple[str, ...] = (
+    "hydraulic_push_force",
+    "hydraulic_pull_force",
+    "pmsm",
+    "thermal",
+    "drive_losses",
+)
+#: Optional sections (shared at the top level; ``thermal`` and ``drive_losses`` may be overridden per actuator).
+_THERMAL_KEYS: tuple[str, ...] = tuple(f.name for f in fields(ThermalParams) if f.name != "label")
+_LOSS_KEYS: tuple[str, ...] = tuple(f.name for f in fields(DriveLosses) if f.name != "label")
+_BATTERY_KEYS: tuple[str, ...] = tuple(f.name for f in fields(BatteryParams))
 
 
 def load_emla_set(path: str | Path | Source | None = None, relative_to: Source | None = None) -> EmlaSet:
@@ -196,7 +223,12 @@ def load_emla_set(path: str | Path | Source | None = None, relative_to: Source |
 
 def emla_set_from_mapping(document: object, where: str = "<mapping>") -> EmlaSet:
     """Build an :class:`EmlaSet` from an already parsed YAML document (see :func:`load_emla_set`)."""
-    root = mapping(document, f"{where}: top level", {"pmsm", "actuators"})
+    root = mapping(
+        document,
+        f"{where}: top level",
+        {"pmsm", "actuators", "thermal", "drive_losses", "battery"},
+        {"pmsm", "actuators"},
+    )
     shared_pmsm = mapping(root["pmsm"], f"{where}: pmsm", set(_PMSM_KEYS))
     actuators = mapping(root["actuators"], f"{where}: actuators", set(ACTUATOR_NAMES))
 
@@ -223,5 +255,53 @@ def emla_set_from_mapping(document: object, where: str = "<mapping>") -> EmlaSet
             if key in node:
                 values[key], source = sourced_number(node[key], f"{where}: {section}.{key}", PROVENANCE_KINDS)
                 provenance.append((key, source))
+        values["thermal"] = _optional_section(
+            ThermalParams, _THERMAL_KEYS, root, node, "thermal", where, name, provenance, required=True
+        )
+        losses = _optional_section(
+            DriveLosses, _LOSS_KEYS, root, node, "drive_losses", where, name, provenance, switchable=True
+        )
+        if losses is not None:
+            values["losses"] = losses
         built[name] = EmlaParams(name=name, motor=motor, provenance=tuple(provenance), **values)
-    return EmlaSet(**built)
+    battery: dict[str, Any] = {}
+    if "battery" in root:
+        node = mapping(root["battery"], f"{where}: battery", set(_BATTERY_KEYS), set())
+        battery = {key: sourced_number(node[key], f"{where}: battery.{key}", PROVENANCE_KINDS)[0] for key in node}
+    return EmlaSet(**built, battery=BatteryParams(**battery))
+
+
+def _optional_section(
+    cls: Any,
+    keys: tuple[str, ...],
+    root: Mapping[str, Any],
+    actuator: Mapping[str, Any],
+    section: str,
+    where: str,
+    name: str,
+    provenance: list[tuple[str, str]],
+    required: bool = False,
+    switchable: bool = False,
+) -> Any:
+    """Build ``cls`` from the shared ``section`` overlaid with the actuator's own, or None if neither exists.
+
+    With ``switchable``, ``enabled: false`` in the shared section keeps the dataclass defaults (all
+    off). With ``required``, every key must be given (shared or overridden).
+    """
+    if section not in root and section not in actuator:
+        return None
+    shared = dict(mapping(root.get(section, {}), f"{where}: {section}", None))
+    enabled = shared.pop("enabled", True) if switchable else True
+    if not isinstance(enabled, bool):
+        raise ConfigError(f"{where}: {section}.enabled must be true or false, got {enabled!r}")
+    override = mapping(actuator.get(section, {}), f"{where}: actuators.{name}.{section}", set(keys), set())
+    merged = {**shared, **override}
+    mapping(merged, f"{where}: {section}", set(keys), set(keys) if required else set())
+    if not enabled:
+        return cls(label=f"{name}.{section}")
+    values: dict[str, Any] = {}
+    for key in merged:
+        scope = f"actuators.{name}.{section}" if key in override else section
+        values[key], source = sourced_number(merged[key], f"{where}: {scope}.{key}", PROVENANCE_KINDS)
+        provenance.append((f"{section}.{key}", source))
+    return cls(**values, label=f"{name}.{section}")

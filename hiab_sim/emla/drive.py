@@ -9,6 +9,9 @@ its analytic partial derivatives with respect to load force f_x, velocity v_x an
 Rotor Coulomb friction opposes the motor speed and is regularised as
 tau_f tanh(omega_m / omega_eps) (omega_eps = ``friction_smoothing_speed``), so it is smooth and
 exactly zero at standstill; its power tau_f tanh(omega_m / omega_eps) omega_m is never negative.
+
+The optional direction-dependent transmission efficiency (:mod:`hiab_sim.emla.losses`, off by
+default, then exactly 0) adds its loss torque tau_tr to the motor torque.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.emla.config import EmlaParams
+from hiab_sim.emla.losses import transmission_loss_torque
 
 Array = NDArray[np.float64]
 #: Partial derivatives (d/d f_x, d/d v_x, d/d a_x) of one quantity.
@@ -35,7 +39,8 @@ class DriveState:
         screw_force: f_sm = f_x + M_sm a_x + b_f v_x [N] (eq. ``torque_force``).
         screw_torque: tau_sm = rho f_sm / (2 pi G) [N m] (eq. ``torque_force``).
         friction_torque: tau_f tanh(omega_m / omega_eps) [N m].
-        motor_torque: tau_m = tau_sm + J_m domega_m/dt + friction [N m] (eq. ``torque_torque``).
+        transmission_loss_torque: tau_tr [N m] of the optional transmission efficiency (0 when off).
+        motor_torque: tau_m = tau_sm + tau_tr + J_m domega_m/dt + friction [N m] (eq. ``torque_torque``).
         i_d: d-axis current [A] (0).
         i_q: q-axis current tau_m / (3/2 p Phi_PM) [A].
         v_d: d-axis voltage -p omega_m L_q i_q [V].
@@ -53,6 +58,7 @@ class DriveState:
     screw_force: Array
     screw_torque: Array
     friction_torque: Array
+    transmission_loss_torque: Array
     motor_torque: Array
     i_d: Array
     i_q: Array
@@ -75,7 +81,9 @@ def broadcast_inputs(force: ArrayLike, velocity: ArrayLike, acceleration: ArrayL
     return f, v, a
 
 
-def drive_state(params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike) -> DriveState:
+def drive_state(
+    params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike, exact: bool = False
+) -> DriveState:
     """Map load-side force [N], velocity [m/s] and acceleration [m/s^2] to the motor and its dq quantities.
 
     Args:
@@ -83,6 +91,7 @@ def drive_state(params: EmlaParams, force: ArrayLike, velocity: ArrayLike, accel
         force: Load force f_x [N], positive when the actuator pushes.
         velocity: Rod velocity v_x [m/s], positive when extending.
         acceleration: Rod acceleration dv_x/dt [m/s^2].
+        exact: Exact (kinked) transmission loss instead of its smooth form (no effect when it is off).
 
     """
     f, v, a = broadcast_inputs(force, velocity, acceleration)
@@ -97,14 +106,20 @@ def drive_state(params: EmlaParams, force: ArrayLike, velocity: ArrayLike, accel
     tau_sm = f_sm / k
     x = omega / motor.friction_smoothing_speed
     tau_fric = motor.rotor_coulomb_friction * np.tanh(x)
-    tau_m = tau_sm + motor.rotor_inertia * domega + tau_fric
+    tau_tr, dtr_df, dtr_dw = transmission_loss_torque(
+        params.losses, f_sm, omega, k, motor.friction_smoothing_speed, exact
+    )
+    tau_m = tau_sm + motor.rotor_inertia * domega + tau_fric + tau_tr
 
     sech2 = 1.0 / np.cosh(np.clip(x, -350.0, 350.0)) ** 2
     d_omega: Partials = (zeros, k * ones, zeros)
     d_tau: Partials = (
-        ones / k,
-        params.viscous_friction / k + motor.rotor_coulomb_friction * sech2 * k / motor.friction_smoothing_speed,
-        (params.screw_moving_mass / k + motor.rotor_inertia * k) * ones,
+        ones / k + dtr_df,
+        params.viscous_friction / k
+        + motor.rotor_coulomb_friction * sech2 * k / motor.friction_smoothing_speed
+        + dtr_df * params.viscous_friction
+        + dtr_dw * k,
+        (params.screw_moving_mass / k + motor.rotor_inertia * k) * ones + dtr_df * params.screw_moving_mass,
     )
 
     kt = motor.torque_constant
@@ -125,6 +140,7 @@ def drive_state(params: EmlaParams, force: ArrayLike, velocity: ArrayLike, accel
         screw_force=f_sm,
         screw_torque=tau_sm,
         friction_torque=tau_fric,
+        transmission_loss_torque=tau_tr,
         motor_torque=tau_m,
         i_d=i_d,
         i_q=i_q,

@@ -6,6 +6,7 @@ the Agg canvas (no pyplot, no display, no global backend switch); CSV/NPZ writer
 
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -42,6 +43,7 @@ class EfficiencyMap:
         top_speed: :func:`~hiab_sim.emla.model.top_speed` [m/s].
         hydraulic_push_force: Push force of the replaced hydraulic cylinder [N] or None.
         hydraulic_pull_force: Pull force of the replaced hydraulic cylinder [N] or None.
+        loss_options: Which optional drive losses are on (:meth:`~hiab_sim.emla.losses.DriveLosses.describe`).
 
     """
 
@@ -57,6 +59,7 @@ class EfficiencyMap:
     top_speed: float
     hydraulic_push_force: float | None
     hydraulic_pull_force: float | None
+    loss_options: str = "drive losses: off (paper model)"
 
 
 def efficiency_map(params: EmlaParams, n_force: int = 161, n_velocity: int = 161, span: float = 1.15) -> EfficiencyMap:
@@ -80,7 +83,7 @@ def efficiency_map(params: EmlaParams, n_force: int = 161, n_velocity: int = 161
     force = np.linspace(-f_max, f_max, n_force)
     velocity = np.linspace(-v_max, v_max, n_velocity)
     ff, vv = np.meshgrid(force, velocity, indexing="ij")
-    op = operating_point(params, ff, vv, 0.0)
+    op = operating_point(params, ff, vv, 0.0, exact=True)
     return EfficiencyMap(
         actuator=params.name,
         force=force,
@@ -94,6 +97,7 @@ def efficiency_map(params: EmlaParams, n_force: int = 161, n_velocity: int = 161
         top_speed=top_speed(params),
         hydraulic_push_force=params.hydraulic_push_force,
         hydraulic_pull_force=params.hydraulic_pull_force,
+        loss_options=params.losses.describe(),
     )
 
 
@@ -104,7 +108,8 @@ def plot_efficiency_map(
 ) -> Figure:
     """Draw the efficiency map: filled contours with labelled levels, the envelope and references.
 
-    Outside the envelope the map is blank. In the generating quadrants (f_x v_x < 0) the colour is
+    Outside the envelope the map is blank. The title names the optional drive losses that are on
+    (the map uses their exact forms). In the generating quadrants (f_x v_x < 0) the colour is
     the generating efficiency P_elec / (f_x v_x) = |P_elec| / |f_x v_x|; grey hatching marks where
     the drive still draws power there (losses exceed the returned power).
 
@@ -161,8 +166,13 @@ def plot_efficiency_map(
         )  # fmt: skip
     ax.set_xlabel("rod velocity $v_x$ [m/s]")
     ax.set_ylabel("load force $f_x$ [kN]")
-    ax.set_title(f"EMLA efficiency, {emap.actuator}: peak {emap.peak_force / 1e3:.1f} kN, top {emap.top_speed:.3f} m/s")
-    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.07), ncol=2, fontsize=7, frameon=False)
+    title = (
+        f"EMLA efficiency, {emap.actuator}: peak {emap.peak_force / 1e3:.1f} kN, top {emap.top_speed:.3f} m/s\n"
+        + "\n".join(textwrap.wrap(emap.loss_options, 95))
+    )
+    ax.set_title(title, fontsize=9)
+    title_lines = title.count("\n") + 1
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.035 + 0.035 * title_lines), ncol=2, fontsize=7, frameon=False)
     fig.colorbar(filled, ax=ax, label="efficiency: $f_x v_x / P_{elec}$ motoring, $P_{elec} / f_x v_x$ generating")
     return fig
 
@@ -192,4 +202,5 @@ def save_npz(emap: EfficiencyMap, path: str | Path) -> None:
         within_envelope=emap.within_envelope,
         peak_force=emap.peak_force,
         top_speed=emap.top_speed,
+        loss_options=np.array(emap.loss_options),
     )

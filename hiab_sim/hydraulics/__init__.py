@@ -1,0 +1,36 @@
+"""The hydraulic baseline the EMLAs replace: valve-controlled cylinders on a constant-pressure or load-sensing pump.
+
+Public API: :class:`Cylinder`, :class:`HydraulicCylinders`, :func:`hydraulic_cylinders_from_mapping`,
+:class:`HydraulicSupplyParams`, :func:`cylinder_flows`, :func:`hydraulic_baseline` (returns one
+:class:`SupplyResult` per variant in :data:`VARIANTS`).
+"""
+
+from __future__ import annotations
+
+from hiab_sim.hydraulics.baseline import (
+    VARIANTS,
+    CylinderFlows,
+    HydraulicSupplyParams,
+    SupplyResult,
+    cylinder_flows,
+    hydraulic_baseline,
+)
+from hiab_sim.hydraulics.cylinders import (
+    CYLINDER_NAMES,
+    Cylinder,
+    HydraulicCylinders,
+    hydraulic_cylinders_from_mapping,
+)
+
+__all__ = [
+    "CYLINDER_NAMES",
+    "VARIANTS",
+    "Cylinder",
+    "CylinderFlows",
+    "HydraulicCylinders",
+    "HydraulicSupplyParams",
+    "SupplyResult",
+    "cylinder_flows",
+    "hydraulic_baseline",
+    "hydraulic_cylinders_from_mapping",
+]

@@ -1,0 +1,113 @@
+"""The crane's original hydraulic cylinders: bore, rod, areas, supply pressure and friction (crane YAML)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.yaml_fields import mapping, number
+
+#: Cylinder names, in the order of the crane's actuators.
+CYLINDER_NAMES: tuple[str, ...] = ("lift", "tilt", "telescope")
+
+
+def _positive(field: str, value: float, unit: str) -> None:
+    if not (math.isfinite(value) and value > 0):
+        raise InvalidInputError(field, value, "must be finite and > 0", unit)
+
+
+def _non_negative(field: str, value: float, unit: str) -> None:
+    if not (math.isfinite(value) and value >= 0):
+        raise InvalidInputError(field, value, "must be finite and >= 0", unit)
+
+
+@dataclass(frozen=True)
+class Cylinder:
+    """A double-acting single-rod cylinder.
+
+    Attributes:
+        name: Actuator name.
+        bore: Piston diameter D [m] > 0.
+        rod: Rod diameter d [m], 0 < d < D.
+        stroke: Stroke [m] > 0 (reported, not a limit here).
+
+    """
+
+    name: str
+    bore: float
+    rod: float
+    stroke: float
+
+    def __post_init__(self) -> None:
+        _positive(f"hydraulic_cylinders.{self.name}.bore", self.bore, "m")
+        _positive(f"hydraulic_cylinders.{self.name}.rod", self.rod, "m")
+        if self.rod >= self.bore:
+            raise InvalidInputError(
+                f"hydraulic_cylinders.{self.name}.rod", self.rod, f"must be < bore = {self.bore:g} m", "m"
+            )
+        _positive(f"hydraulic_cylinders.{self.name}.stroke", self.stroke, "m")
+
+    @property
+    def piston_area(self) -> float:
+        """A_p = pi D^2 / 4 [m^2], the piston (cap) side: pushes while extending."""
+        return 0.25 * math.pi * self.bore**2
+
+    @property
+    def annulus_area(self) -> float:
+        """A_r = pi (D^2 - d^2) / 4 [m^2], the rod side: pulls while retracting."""
+        return 0.25 * math.pi * (self.bore**2 - self.rod**2)
+
+
+@dataclass(frozen=True)
+class HydraulicCylinders:
+    """The three cylinders, the supply pressure and the per-cylinder friction of the source simulation.
+
+    Attributes:
+        lift: Lift cylinder.
+        tilt: Tilt cylinder.
+        telescope: Telescope cylinder.
+        supply_pressure: p_s [Pa] > 0, the system (relief) pressure.
+        coulomb_friction: F_c [N] >= 0, seal friction opposing the rod velocity.
+        viscous_friction: b [N s/m] >= 0.
+
+    """
+
+    lift: Cylinder
+    tilt: Cylinder
+    telescope: Cylinder
+    supply_pressure: float
+    coulomb_friction: float = 0.0
+    viscous_friction: float = 0.0
+
+    def __post_init__(self) -> None:
+        _positive("hydraulic_cylinders.supply_pressure", self.supply_pressure, "Pa")
+        _non_negative("hydraulic_cylinders.friction.coulomb", self.coulomb_friction, "N")
+        _non_negative("hydraulic_cylinders.friction.viscous", self.viscous_friction, "N s/m")
+
+    def __iter__(self) -> Iterator[Cylinder]:
+        return iter((self.lift, self.tilt, self.telescope))
+
+
+def hydraulic_cylinders_from_mapping(data: Any, where: str = "hydraulic_cylinders") -> HydraulicCylinders:
+    """Build :class:`HydraulicCylinders` from the crane YAML's ``hydraulic_cylinders`` mapping.
+
+    Keys: ``lift``, ``tilt``, ``telescope`` (each ``bore``, ``rod``, ``stroke`` [m], optional
+    ``pin_to_pin_at_zero``), ``supply_pressure`` [Pa], optional ``friction: {coulomb, viscous}``.
+    """
+    required = {"lift", "tilt", "telescope", "supply_pressure"}
+    top = mapping(data, where, required | {"friction"}, required)
+    cylinders = {}
+    for name in CYLINDER_NAMES:
+        keys = {"bore", "rod", "stroke"}
+        node = mapping(top[name], f"{where}.{name}", keys | {"pin_to_pin_at_zero"}, keys)
+        cylinders[name] = Cylinder(name, *(number(node[k], f"{where}.{name}.{k}") for k in ("bore", "rod", "stroke")))
+    friction = mapping(top.get("friction", {}), f"{where}.friction", {"coulomb", "viscous"}, set())
+    return HydraulicCylinders(
+        **cylinders,
+        supply_pressure=number(top["supply_pressure"], f"{where}.supply_pressure"),
+        coulomb_friction=number(friction.get("coulomb", 0.0), f"{where}.friction.coulomb"),
+        viscous_friction=number(friction.get("viscous", 0.0), f"{where}.friction.viscous"),
+    )
