@@ -81,7 +81,7 @@ def test_actuator_forces_jump_by_the_payloads_weight_and_inertia(path: int, inst
 
 @pytest.mark.parametrize("path", [0, 1], ids=["mujoco", "analytic"])
 def test_power_balance_holds_with_a_payload_schedule(path: int) -> None:
-    """sum f v + F . v_tcp = dE/dt (energy rate from energies alone) before, during and after the payload."""
+    """Power balance sum f v + F . v_tcp = dE/dt (dE/dt from energies alone) before, with and after the load."""
     times = np.linspace(0.3, 6.0, 24)
     ref, joints = _spiral(times)
     force = PAYLOAD.tcp_force(times, ref.acceleration[:, :2], CRANE.gravity)
