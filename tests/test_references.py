@@ -60,7 +60,13 @@ def test_closed_form_ik_agrees_with_newton_ik_on_the_spiral() -> None:
 
 @pytest.mark.parametrize(
     ("xy", "xt2", "status"),
-    [((8.0, 0.0), 0.5, 1), ((0.0, 0.0), 0.5, 1), ((1.555, -1.811), 0.0, 2), ((-0.206, 0.239), 0.0, 3), ((3.0, 0.5), 1.5, 4)],
+    [
+        ((8.0, 0.0), 0.5, 1),
+        ((0.0, 0.0), 0.5, 1),
+        ((1.555, -1.811), 0.0, 2),
+        ((-0.206, 0.239), 0.0, 3),
+        ((3.0, 0.5), 1.5, 4),
+    ],
     ids=["too-far", "too-close", "theta1-range", "theta2-range", "telescope-range"],
 )
 def test_closed_form_ik_names_why_a_point_is_unreachable(xy: tuple[float, float], xt2: float, status: int) -> None:
