@@ -27,14 +27,16 @@ TASK = PickAndPlace(
 
 
 def test_spiral_from_the_default_study_block_is_the_loaders_spiral() -> None:
-    """The default study's reference block read as a ``spiral`` kind gives the loader's spiral and samples."""
+    """The default study's reference block read as a ``spiral`` kind has the loader's fields and today's samples."""
     block = yaml.safe_load(DEFAULT_STUDY.read_text())["reference"]
     spiral = reference_from_mapping(block, "reference", DEFAULT_STUDY.parent, STUDY.grid.duration)
-    assert isinstance(spiral, Spiral) and spiral.spec == STUDY.reference and spiral.duration == STUDY.grid.duration
+    assert isinstance(spiral, Spiral) and spiral.duration == STUDY.grid.duration
+    assert {f: getattr(spiral, f) for f in vars(STUDY.reference)} == vars(STUDY.reference)
     t = STUDY.grid.fine_times()
     ref, today = spiral.sample(KIN, t), tr.spiral_reference(KIN, STUDY.reference, STUDY.grid.duration, t)
     for name in ("position", "velocity", "acceleration"):
         np.testing.assert_array_equal(getattr(ref, name), getattr(today, name))
+    assert ref.centre == today.centre
 
 
 def test_closed_form_ik_puts_the_foundation_tcp_on_the_point() -> None:

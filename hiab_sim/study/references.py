@@ -6,8 +6,9 @@ Every kind is a frozen dataclass, validated when built, with a ``duration`` [s] 
 the tolerance bands (eqs. ``const_b``..``const_d``); its initial spline comes from inverse
 kinematics of r started at :func:`initial_joints`.
 
-* :class:`Spiral`: today's spiral (:func:`hiab_sim.study.trajectory.spiral_reference`, the same
-  numbers). Telescope: prescribed, out and back, xt2 = xt0 + a sin(pi s(t)).
+* :class:`Spiral`: today's spiral (the fields of ``study.config.SpiralReference`` and the numbers of
+  ``trajectory.spiral_reference``, moved here). Telescope: prescribed, out and back,
+  xt2 = xt0 + a sin(pi s(t)).
 * :class:`PickAndPlace`: rest to rest from a pick point to a place point over an obstacle.
   The path is the cubic Bezier curve with control points pick, (x_pick, h), (x_place, h), place:
   it leaves the pick point vertically, moves over, comes down vertically onto the place point,
@@ -42,9 +43,8 @@ from scipy.optimize import brentq
 
 from hiab_sim.config import Crane
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study.config import SpiralReference
 from hiab_sim.study.csv_reference import CsvReference
-from hiab_sim.study.trajectory import Reference, TcpKinematics, spiral_reference
+from hiab_sim.study.trajectory import Reference, TcpKinematics, timing_law
 from hiab_sim.study.workspace import check_workspace, dense_times, initial_joints
 from hiab_sim.yaml_fields import mapping, number, positive
 
@@ -88,25 +88,78 @@ def septic_law(times: Array, start: float, duration: float) -> tuple[Array, Arra
 
 @dataclass(frozen=True)
 class Spiral:
-    """Today's spiral (:class:`~hiab_sim.study.config.SpiralReference`) over ``duration`` [s]."""
+    """TCP spiral in the vertical plane of {W} with a prescribed telescope schedule, over ``duration`` [s].
 
-    spec: SpiralReference
+    The fields and numbers of today's ``SpiralReference`` / ``trajectory.spiral_reference`` (moved
+    here so that this module does not import the study loader). The TCP goes around ``centre``
+    with a radius growing linearly from ``start_radius`` to ``end_radius`` [m] over ``turns``
+    turns from ``start_angle`` [rad]; the path parameter follows the rest-to-rest quintic
+    s = 10 tau^3 - 15 tau^4 + 6 tau^5 (tau = t / duration). The telescope follows
+    xt2 = ``telescope_start`` + ``telescope_amplitude`` sin(pi s) [m]. Exactly one of
+    ``centre_joints`` (theta1, theta2) [rad] at xt2 = ``telescope_start``, or ``centre_tcp``
+    (x, y) [m] is given.
+    """
+
+    start_radius: float
+    end_radius: float
+    turns: float
+    telescope_start: float
     duration: float
+    start_angle: float = 0.0
+    telescope_amplitude: float = 0.0
+    centre_joints: tuple[float, float] | None = None
+    centre_tcp: tuple[float, float] | None = None
     kind: ClassVar[str] = "spiral"
 
     def __post_init__(self) -> None:
-        s = self.spec
         _check(self.duration > 0.0, "reference.duration", self.duration, "must be > 0", "s")
-        if (s.centre_joints is None) == (s.centre_tcp is None):
+        if (self.centre_joints is None) == (self.centre_tcp is None):
             raise ConfigError("reference: give exactly one of centre_joints [theta1, theta2] or centre_tcp [x, y]")
-        _check(s.start_radius >= 0.0, "reference.start_radius", s.start_radius, "must be >= 0", "m")
-        _check(s.end_radius > 0.0, "reference.end_radius", s.end_radius, "must be > 0", "m")
-        _check(s.turns != 0.0 and abs(s.turns) <= 10.0, "reference.turns", s.turns, "must be nonzero, |turns| <= 10")
-        _check(s.telescope_start >= 0.0, "reference.telescope_start", s.telescope_start, "must be >= 0", "m")
+        _check(self.start_radius >= 0.0, "reference.start_radius", self.start_radius, "must be >= 0", "m")
+        _check(self.end_radius > 0.0, "reference.end_radius", self.end_radius, "must be > 0", "m")
+        _check(
+            self.turns != 0.0 and abs(self.turns) <= 10.0,
+            "reference.turns",
+            self.turns,
+            "must be nonzero, |turns| <= 10",
+        )
+        _check(self.telescope_start >= 0.0, "reference.telescope_start", self.telescope_start, "must be >= 0", "m")
+
+    def centre(self, kin: TcpKinematics) -> tuple[float, float]:
+        """Spiral centre in {W} (x, y) [m]: given, or the TCP at the given centre joints."""
+        if self.centre_tcp is not None:
+            return self.centre_tcp
+        assert self.centre_joints is not None
+        p = kin.position(np.array([[*self.centre_joints, self.telescope_start]]))[0]
+        return float(p[0]), float(p[1])
 
     def sample(self, kin: TcpKinematics, times: Array) -> Reference:
-        """The spiral of :func:`~hiab_sim.study.trajectory.spiral_reference` at ``times``."""
-        return spiral_reference(kin, self.spec, self.duration, times)
+        """Reference r = (x, y, xt2) of the spiral and its rates at ``times`` [s]."""
+        s, ds, dds = timing_law(times, self.duration)
+        cx, cy = self.centre(kin)
+        omega = 2.0 * np.pi * self.turns
+        phi = self.start_angle + omega * s
+        dr = self.end_radius - self.start_radius
+        r = self.start_radius + dr * s
+        radial = np.column_stack([np.cos(phi), np.sin(phi)])
+        tangent = np.column_stack([-np.sin(phi), np.cos(phi)])
+        p_s = dr * radial + (r * omega)[:, None] * tangent
+        p_ss = 2.0 * dr * omega * tangent - (r * omega**2)[:, None] * radial
+        xy = np.array([cx, cy]) + r[:, None] * radial
+        v = p_s * ds[:, None]
+        a = p_ss * (ds**2)[:, None] + p_s * dds[:, None]
+        amp = self.telescope_amplitude
+        xt = self.telescope_start + amp * np.sin(np.pi * s)
+        dxt = amp * np.pi * np.cos(np.pi * s) * ds
+        ddxt = -amp * np.pi**2 * np.sin(np.pi * s) * ds**2 + amp * np.pi * np.cos(np.pi * s) * dds
+        return Reference(
+            time=np.asarray(times, dtype=float),
+            position=np.column_stack([xy, xt]),
+            velocity=np.column_stack([v, dxt]),
+            acceleration=np.column_stack([a, ddxt]),
+            z=kin.z,
+            centre=(cx, cy),
+        )
 
     def check_reach(self, kin: TcpKinematics, crane: Crane) -> None:
         """Closed-form IK of the reference every <= 10 ms; raises naming the first unreachable time."""
@@ -120,17 +173,17 @@ class Spiral:
         required = {"start_radius", "end_radius", "turns", "telescope_start"}
         d = mapping(data, where, keys, required)
         centre = {key: _pair(d[key], f"{where}.{key}") for key in ("centre_joints", "centre_tcp") if key in d}
-        spec = SpiralReference(
+        return cls(
             start_radius=number(d["start_radius"], f"{where}.start_radius"),
             end_radius=number(d["end_radius"], f"{where}.end_radius"),
             turns=number(d["turns"], f"{where}.turns"),
-            start_angle=number(d.get("start_angle", 0.0), f"{where}.start_angle"),
             telescope_start=number(d["telescope_start"], f"{where}.telescope_start"),
+            duration=positive(d.get("duration", default_duration), f"{where}.duration", "s"),
+            start_angle=number(d.get("start_angle", 0.0), f"{where}.start_angle"),
             telescope_amplitude=number(d.get("telescope_amplitude", 0.0), f"{where}.telescope_amplitude"),
             centre_joints=centre.get("centre_joints"),
             centre_tcp=centre.get("centre_tcp"),
         )
-        return cls(spec, positive(d.get("duration", default_duration), f"{where}.duration", "s"))
 
 
 # ---------------------------------------------------------------------------------------------
