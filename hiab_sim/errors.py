@@ -21,6 +21,7 @@ class InvalidInputError(HiabSimError, ValueError):
         self.field = field
         self.value = value
         self.allowed = allowed
+        self.unit = unit
         unit_part = f" {unit}" if unit else ""
         super().__init__(f"{field} = {_show(value)}{unit_part} is out of range: {allowed}")
 
