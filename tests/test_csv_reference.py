@@ -6,12 +6,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study import trajectory as tr
 from hiab_sim.study.config import load_study
 from hiab_sim.study.csv_reference import CsvReference, read_table
-from hiab_sim.study.references import reference_from_mapping
+from hiab_sim.study.references import PickAndPlace, reference_from_mapping
 
 STUDY = load_study()
 CRANE = STUDY.crane
@@ -150,3 +152,37 @@ def test_telescope_given_once(tmp_path: Path, header: str, telescope: float | No
     )
     with pytest.raises(ConfigError, match=match):
         CsvReference(read_table(path), telescope=telescope)
+
+
+@settings(max_examples=15, deadline=None)
+@given(
+    pick=st.tuples(st.floats(1.2, 2.2), st.floats(-1.6, -0.4)),
+    place=st.tuples(st.floats(2.6, 4.0), st.floats(-1.0, 1.0)),
+    rise=st.floats(0.05, 1.0),
+    telescope=st.tuples(st.floats(0.0, 1.1), st.floats(0.0, 1.1)),
+    move_time=st.floats(5.0, 16.0),
+    dwell=st.tuples(st.floats(0.0, 2.0), st.floats(0.0, 2.0)),
+)
+def test_csv_of_any_pick_and_place_reproduces_it_within_the_collocation_bands(
+    tmp_path_factory: pytest.TempPathFactory,
+    pick: tuple[float, float],
+    place: tuple[float, float],
+    rise: float,
+    telescope: tuple[float, float],
+    move_time: float,
+    dwell: tuple[float, float],
+) -> None:
+    """A 40 Hz file (1 um resolution) of a pick-and-place, fitted, gives its r, dr, ddr within half the bands."""
+    task = PickAndPlace(pick, place, max(pick[1], place[1]) + rise, telescope, move_time, dwell)
+    rows = np.linspace(0.0, task.duration, int(np.ceil(task.duration * 40.0)) + 1)
+    path = tmp_path_factory.mktemp("pp") / "pp.csv"
+    body = "\n".join(
+        f"{t:.6f},{x:.6f},{y:.6f},{xt:.6f}" for t, (x, y, xt) in zip(rows, task.sample(KIN, rows).position, strict=True)
+    )
+    path.write_text("t,x,y,xt2\n" + body + "\n")
+    fitted = CsvReference(read_table(path))
+    grid = np.linspace(0.0, task.duration, 401)
+    a, b = fitted.sample(KIN, grid), task.sample(KIN, grid)
+    band = STUDY.tracking
+    for name, tol in (("position", band.position), ("velocity", band.velocity), ("acceleration", band.acceleration)):
+        assert np.abs(getattr(a, name) - getattr(b, name)).max() <= band.collocation_fraction * tol, name
