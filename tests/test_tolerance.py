@@ -30,7 +30,7 @@ lengths_strategy = st.tuples(
 @settings(max_examples=100, deadline=None)
 @given(st.lists(st.floats(0.01, 2.0), min_size=6, max_size=6), st.sampled_from([1e-3, 5e-4, 1e-2]))
 def test_rounding_lands_on_the_tolerance_grid_within_half_a_step(values: list[float], tolerance: float) -> None:
-    """Each rounded length is a multiple of the tolerance, within tolerance/2 of the input, and rounding is idempotent."""
+    """A rounded length is a multiple of the tolerance, within tolerance/2 of the input; rounding is idempotent."""
     lengths = LinkLengths.from_array(values)
     rounded = round_lengths(lengths, tolerance).as_array()
     steps = rounded / tolerance
