@@ -132,3 +132,16 @@ def test_bad_tolerance_is_rejected_with_the_field() -> None:
     """A tolerance that is not a positive finite length is a one-line error naming the field."""
     with pytest.raises(InvalidInputError, match="tolerance"):
         round_lengths(CRANE.default_lengths, 0.0)
+
+
+def test_design_margins_report_the_worst_of_both_checks() -> None:
+    """With a mounting space, g(Xi) holds the working-range and mounting rows; the worst is the worse of the two."""
+    from hiab_sim.crane.mounting import built_space, mounting_margins
+    from hiab_sim.crane.tolerance import design_margins
+
+    lengths = LinkLengths.from_array([1.25, 0.3, 0.7317, 1.24, 0.3, 0.6374])
+    both = design_margins(CRANE, built_space(CRANE))(lengths)
+    parts = [working_range_margins(CRANE, lengths), mounting_margins(built_space(CRANE), CRANE, lengths)]
+    assert both.names == parts[0].names + parts[1].names
+    assert both.worst()[1] == min(p.worst()[1] for p in parts)
+    assert design_margins(CRANE)(lengths).names == parts[0].names

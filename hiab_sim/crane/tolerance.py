@@ -37,7 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.config import Crane, LinkLengths
 from hiab_sim.crane import mechanism
-from hiab_sim.crane.mounting import Margins
+from hiab_sim.crane.mounting import Margins, MountingSpace, mounting_margins
 from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
@@ -164,6 +164,21 @@ def working_range_margins(crane: Crane, lengths: LinkLengths) -> Margins:
         values.append(xi.Lc - float(x[1]) + slack)
         rows.append(_unit(col + 2) - dx[1])
     return Margins(tuple(names), np.asarray(values), np.asarray(rows))
+
+
+def design_margins(crane: Crane, space: MountingSpace | None = None) -> MarginFunction:
+    """g(Xi) for :func:`check_tolerance`: the working-range margins, then (with ``space``) the mounting rows."""
+
+    def g(lengths: LinkLengths) -> Margins:
+        wr = working_range_margins(crane, lengths)
+        if space is None:
+            return wr
+        mm = mounting_margins(space, crane, lengths)
+        return Margins(
+            wr.names + mm.names, np.concatenate([wr.values, mm.values]), np.vstack([wr.jacobian, mm.jacobian])
+        )
+
+    return g
 
 
 def _unit(j: int) -> Array:
