@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hiab_sim.config import load_crane
+from hiab_sim.crane.loader import load_crane
 from hiab_sim.study.csv_reference import CsvReference, read_table
 from hiab_sim.study.references import PickAndPlace
 from hiab_sim.study.trajectory import TcpKinematics

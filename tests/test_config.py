@@ -168,7 +168,7 @@ def test_cli_bad_crane_file_exits_2_without_traceback(tmp_path: Path) -> None:
 def test_cli_help_lists_subcommands_and_version() -> None:
     """--help lists every subcommand; --version prints the package version."""
     result = subprocess.run([sys.executable, "-m", "hiab_sim", "--help"], capture_output=True, text=True, check=True)
-    for name in ("crane", "mjcf", "validate", "emla-map", "optimize", "render"):
+    for name in ("crane", "mjcf", "validate", "emla-map", "optimize", "render", "compare"):
         assert name in result.stdout
     version = subprocess.run(
         [sys.executable, "-m", "hiab_sim", "--version"], capture_output=True, text=True, check=True

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import yaml
 
-from hiab_sim.config import load_crane
+from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla import ACTUATOR_NAMES, envelope_margins, load_emla_set

@@ -12,8 +12,9 @@ from hypothesis import strategies as st
 
 from hiab_sim.crane import kinematics
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.resources import DEFAULT_STUDY, shipped
 from hiab_sim.study import trajectory as tr
-from hiab_sim.study.config import DEFAULT_STUDY, load_study
+from hiab_sim.study.config import load_study
 from hiab_sim.study.references import PickAndPlace, Spiral, reference_from_mapping, septic_law
 from hiab_sim.study.workspace import initial_joints, planar_ik
 
@@ -28,8 +29,9 @@ TASK = PickAndPlace(
 
 def test_spiral_from_the_default_study_block_is_the_loaders_spiral() -> None:
     """The default study's reference block read as a ``spiral`` kind has the loader's fields and today's samples."""
-    block = yaml.safe_load(DEFAULT_STUDY.read_text())["reference"]
-    spiral = reference_from_mapping(block, "reference", DEFAULT_STUDY.parent, STUDY.grid.duration)
+    default = shipped("study", DEFAULT_STUDY)
+    block = yaml.safe_load(default.read_text())["reference"]
+    spiral = reference_from_mapping(block, "reference", Path(str(default.file)).parent, STUDY.grid.duration)
     assert isinstance(spiral, Spiral) and spiral.duration == STUDY.grid.duration
     assert {f: getattr(spiral, f) for f in vars(STUDY.reference)} == vars(STUDY.reference)
     t = STUDY.grid.fine_times()

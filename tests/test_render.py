@@ -97,16 +97,16 @@ def test_clip_has_one_frame_per_tick_at_the_video_size(frames: np.ndarray) -> No
 
 
 def test_frames_show_both_cranes(frames: np.ndarray) -> None:
-    """Every frame is lit (not black); each half holds crane pixels, the right half's tinted blue."""
+    """Every frame is lit (not black); each half holds crane pixels, the right half's tinted green (optimal)."""
     half = SIZE[0] // 2
     for image in frames:
         assert image.mean() > 60
         body = image[30:]  # below the captions
-        assert _saturated(body[:, :half]).sum() > 300  # initial design, orange
-        assert _saturated(body[:, half:]).sum() > 300  # optimal design, blue
+        assert _saturated(body[:, :half]).sum() > 300  # initial design, blue
+        assert _saturated(body[:, half:]).sum() > 300  # optimal design, bluish green
         left, right = body[:, :half][_saturated(body[:, :half])], body[:, half:][_saturated(body[:, half:])]
-        blue_over_red = [int(p[:, 2].sum()) - int(p[:, 0].sum()) for p in (left, right)]
-        assert blue_over_red[1] - blue_over_red[0] > 30 * 300  # the right crane is the blue one
+        green_over_blue = [(int(p[:, 1].sum()) - int(p[:, 2].sum())) / len(p) for p in (left, right)]
+        assert green_over_blue[1] - green_over_blue[0] > 20  # the right crane is the green one
 
 
 def test_consecutive_frames_differ_where_the_crane_moves(frames: np.ndarray) -> None:
@@ -142,6 +142,35 @@ def test_overlay_draws_both_designs_in_one_view(result_dir: Path) -> None:
         image = renderer.frame(0)
     assert image.shape == (SIZE[1], SIZE[0], 3)
     assert _saturated(image[30:]).sum() > 600
+
+
+def test_stacked_layout_puts_one_design_above_the_other(result_dir: Path) -> None:
+    """Stacked, the frame keeps its size and each half (top: initial, bottom: optimal) holds crane pixels."""
+    with playback_renderer(load_playback(result_dir), fps=FPS, size=SIZE, layout="stacked") as renderer:
+        image = renderer.frame(0)
+    assert image.shape == (SIZE[1], SIZE[0], 3)
+    half = SIZE[1] // 2
+    for panel in (image[:half], image[half:]):
+        assert _saturated(panel[25:]).sum() > 200
+
+
+def test_energy_notes_integrate_the_power_in_time() -> None:
+    """Constant 1 kW for 2 s: the notes read 0, 1 and 2 kJ of 2 kJ at 0, 1 and 2 s; without power only the time."""
+    from hiab_sim.render.video import energy_notes
+
+    time = np.linspace(0.0, 2.0, 9)
+    notes = energy_notes(time, np.array([0.0, 1.0, 2.0]), np.full(9, 1000.0))
+    assert [n.split("E =")[1].split()[0] for n in notes] == ["0.000", "1.000", "2.000"]
+    assert all(n.endswith("of 2.000 kJ") for n in notes)
+    assert energy_notes(time, np.array([0.5]), None) == ("t =  0.50 s",)
+
+
+def test_caption_bitmap_is_transparent_around_the_glyphs() -> None:
+    """A caption stamps only its glyphs: most of its bitmap is transparent, so it hides nothing behind it."""
+    from hiab_sim.render.labels import caption_bitmap
+
+    bitmap = caption_bitmap("t = 3.00 s   E = 2.722 of 4.107 kJ", (0.0, 0.0, 1.0), 14)
+    assert bitmap[..., 3].min() == 0.0 and bitmap[..., 3].mean() < 0.5
 
 
 def test_fitted_camera_sees_every_point() -> None:

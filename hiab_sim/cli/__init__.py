@@ -27,6 +27,7 @@ SUBCOMMANDS: dict[str, str] = {
     "emla-map": "emla_map",
     "optimize": "optimize",
     "render": "render",
+    "compare": "compare",
 }
 
 

@@ -7,6 +7,9 @@ target folder, then ``os.replace``), loads with ``mujoco.MjModel.from_xml_path``
 middle of its working ranges, loop-consistent, with the motors' ``ctrl`` set to the static
 actuator forces that hold it against gravity (load it in the viewer's "Key" panel; the open-loop
 crane drifts away from it slowly, as any unstabilised crane would).
+
+``--from-result RUN_DIR [--design optimal|initial]`` exports the exact (full-precision) design of
+an optimisation result, with the crane the result was computed for.
 """
 
 from __future__ import annotations
@@ -35,6 +38,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--lengths",
         metavar="L,Lc0,Lc,L,Lc0,Lc",
         help="link lengths [m], lift chain then tilt chain (default: the crane's own)",
+    )
+    parser.add_argument(
+        "--from-result",
+        metavar="RUN_DIR",
+        help="export a design of an optimisation result folder (exact lengths and its crane)",
+    )
+    parser.add_argument(
+        "--design",
+        choices=("optimal", "initial"),
+        default="optimal",
+        help="with --from-result: which design (default: optimal)",
     )
     parser.add_argument("-o", "--output", default="crane.xml", metavar="FILE.xml", help="default: crane.xml")
     parser.set_defaults(run=run)
@@ -69,20 +83,32 @@ def home_keyframe(crane: Crane, lengths: LinkLengths) -> tuple[np.ndarray, np.nd
     return qpos[0], dynamics(rest).force[0]
 
 
+def _crane_and_lengths(args: argparse.Namespace) -> tuple[Crane, LinkLengths]:
+    """The crane and design to export: from ``--from-result`` or from ``--crane`` and ``--lengths``."""
+    if args.from_result is None:
+        crane = load_crane(args.crane)
+        return crane, parse_lengths(args.lengths) if args.lengths else crane.default_lengths
+    if args.lengths:
+        raise InvalidInputError("--lengths", args.lengths, "cannot be combined with --from-result")
+    from hiab_sim.study.result_read import design_lengths, read_result, result_crane
+
+    result = read_result(args.from_result)
+    return result_crane(args.from_result, result), design_lengths(result, args.design, args.from_result)
+
+
 def run(args: argparse.Namespace) -> int:
     """Build the model, write it and print a one-line summary."""
     import mujoco
 
     from hiab_sim.model.mjcf import to_xml
 
-    crane = load_crane(args.crane)
-    lengths = parse_lengths(args.lengths) if args.lengths else crane.default_lengths
+    crane, lengths = _crane_and_lengths(args)
     text = to_xml(crane, lengths, keyframes={"home": home_keyframe(crane, lengths)})
     model = mujoco.MjModel.from_xml_string(text)  # what the file will load as
     output = Path(args.output)
     if not output.parent.is_dir():
         raise InvalidInputError("--output", str(output), "its folder must exist")
     write_atomic(output, text)
-    xi = ", ".join(f"{v:.4g}" for v in lengths.as_array())
+    xi = ", ".join(f"{v:.10g}" for v in lengths.as_array())
     print(f"wrote {output}: {crane.name}, Xi = [{xi}] m, {model.nbody - 1} bodies, {model.nv} dofs")
     return 0

@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from hiab_sim.errors import BackendUnavailableError, InvalidInputError
+from hiab_sim.errors import BackendUnavailableError
 
 if TYPE_CHECKING:
     from hiab_sim.study.result import Decomposition, Result
@@ -35,7 +35,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<study name>)")
     parser.add_argument("--resume", action="store_true", help="continue from the output folder's last checkpoint")
-    parser.add_argument("--starts", type=int, default=1, metavar="K", help="number of feasible starts (default: 1)")
+    parser.add_argument(
+        "--starts", type=int, metavar="K", help="number of feasible starts (default: 1; with --resume the run's own)"
+    )
+    parser.add_argument("--force", action="store_true", help="write into a folder that belongs to another study")
     parser.add_argument("--id", choices=("mujoco", "analytic"), help="inverse-dynamics path (default: the study's)")
     parser.add_argument("--no-video", action="store_true", help="do not render the playback video")
     parser.add_argument("--no-figures", action="store_true", help="do not draw the figures (quick runs)")
@@ -109,16 +112,16 @@ def run(args: argparse.Namespace) -> int:
     """Run the study and print a summary; return the exit status."""
     from hiab_sim.study.config import DEFAULT_STUDY, load_study
     from hiab_sim.study.run import run_study
+    from hiab_sim.study.run_safety import resolve_starts
 
-    if args.starts < 1:
-        raise InvalidInputError("--starts", args.starts, "must be >= 1")
     study = load_study(args.study or DEFAULT_STUDY)
     out = Path(args.out) if args.out else Path("runs") / study.name
     output = run_study(
         study,
         out,
-        starts=args.starts,
+        starts=resolve_starts(out, args.starts, args.resume),
         resume=args.resume,
+        force=args.force,
         id_path=args.id,
         progress=None if args.quiet else sys.stderr,
         figures=not args.no_figures,

@@ -48,9 +48,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--layout",
-        choices=("side-by-side", "overlay"),
-        default="side-by-side",
-        help="designs in two viewports, or overlaid (initial translucent) (default: side-by-side)",
+        choices=("stacked", "side-by-side", "overlay"),
+        default="stacked",
+        help="designs in two viewports, one above the other or side by side, or overlaid (initial translucent) "
+        "(default: stacked)",
     )
     parser.add_argument(
         "--still",

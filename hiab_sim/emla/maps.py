@@ -7,12 +7,15 @@ the Agg canvas (no pyplot, no display, no global backend switch); CSV/NPZ writer
 from __future__ import annotations
 
 import textwrap
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from matplotlib import colormaps
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 from numpy.typing import ArrayLike, NDArray
 
@@ -20,10 +23,14 @@ from hiab_sim.emla.config import EmlaParams
 from hiab_sim.emla.envelope import ENVELOPE_LIMIT_NAMES
 from hiab_sim.emla.model import operating_point, peak_force, top_speed
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.style import MARKERS, colour
 
 #: Filled efficiency levels of the map; the labelled contour lines are a subset.
 EFFICIENCY_LEVELS: tuple[float, ...] = (0.0, 0.3, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.92, 0.94, 0.96, 1.0)
 LABELLED_LEVELS: tuple[float, ...] = (0.5, 0.7, 0.8, 0.85, 0.9, 0.92, 0.94)
+#: Efficiency field under design overlays: light greys (darker = more efficient), so that the
+#: designs' colours (:mod:`hiab_sim.style`) are the only colours on the map.
+DESIGN_BACKGROUND = ListedColormap(colormaps["Greys"](np.linspace(0.04, 0.5, 256)), name="light_greys")
 
 
 @dataclass(frozen=True)
@@ -105,6 +112,7 @@ def plot_efficiency_map(
     emap: EfficiencyMap,
     operating_points: tuple[ArrayLike, ArrayLike] | None = None,
     ax: Axes | None = None,
+    designs: Mapping[str, tuple[ArrayLike, ArrayLike]] | None = None,
 ) -> Figure:
     """Draw the efficiency map: filled contours with labelled levels, the envelope and references.
 
@@ -117,6 +125,9 @@ def plot_efficiency_map(
         emap: Map data from :func:`efficiency_map`.
         operating_points: Optional (f_x [N], v_x [m/s]) arrays of one shape to overlay as dots.
         ax: Axes to draw into; a new Agg-backed figure is made when None.
+        designs: Optional design name (``initial``, ``optimal``, ``rounded``...) -> (f_x [N],
+            v_x [m/s]): each design's operating points in its colour and marker of
+            :mod:`hiab_sim.style`, over a light-grey efficiency field.
 
     Returns:
         The figure holding the axes.
@@ -131,8 +142,9 @@ def plot_efficiency_map(
     v = emap.velocity
     f_kn = emap.force / 1e3
     eta = np.where(emap.within_envelope, emap.efficiency, np.nan)
-    filled = ax.contourf(v, f_kn, np.clip(eta, 0.0, 1.0), levels=list(EFFICIENCY_LEVELS), cmap="viridis")
-    lines = ax.contour(v, f_kn, eta, levels=list(LABELLED_LEVELS), colors="white", linewidths=0.7)
+    cmap = DESIGN_BACKGROUND if designs else colormaps["viridis"]
+    filled = ax.contourf(v, f_kn, np.clip(eta, 0.0, 1.0), levels=list(EFFICIENCY_LEVELS), cmap=cmap)
+    lines = ax.contour(v, f_kn, eta, levels=list(LABELLED_LEVELS), colors="0.3" if designs else "white", linewidths=0.7)
     ax.clabel(lines, fmt="%.2f", fontsize=7)
     drawing = emap.within_envelope & (emap.mechanical_power < 0) & (emap.efficiency < 0)
     if np.any(drawing):
@@ -142,16 +154,19 @@ def plot_efficiency_map(
     if np.any(drawing):
         ax.fill_between([], [], color="0.6", hatch="///", label="generating, drive still draws power")
     if emap.hydraulic_push_force is not None:
-        ax.axhline(emap.hydraulic_push_force / 1e3, color="tab:red", linestyle="--", linewidth=1.2)
-        ax.plot([], [], color="tab:red", linestyle="--", label="hydraulic cylinder push / pull")
+        ax.axhline(emap.hydraulic_push_force / 1e3, color=colour("hydraulic"), linestyle="--", linewidth=1.2)
+        ax.plot([], [], color=colour("hydraulic"), linestyle="--", label="hydraulic cylinder push / pull")
     if emap.hydraulic_pull_force is not None:
-        ax.axhline(-emap.hydraulic_pull_force / 1e3, color="tab:red", linestyle="--", linewidth=1.2)
+        ax.axhline(-emap.hydraulic_pull_force / 1e3, color=colour("hydraulic"), linestyle="--", linewidth=1.2)
     if operating_points is not None:
-        f_op = np.asarray(operating_points[0], dtype=float).ravel()
-        v_op = np.asarray(operating_points[1], dtype=float).ravel()
-        if f_op.shape != v_op.shape:
-            raise InvalidInputError("operating_points", f"shapes {f_op.shape}, {v_op.shape}", "must match")
+        f_op, v_op = _points(operating_points, "operating_points")
         ax.plot(v_op, f_op / 1e3, ".", color="tab:orange", markersize=3, label="operating points")
+    for name, points in (designs or {}).items():
+        f_op, v_op = _points(points, f"designs[{name!r}]")
+        ax.plot(
+            v_op, f_op / 1e3, MARKERS.get(name, "o"), color=colour(name), markersize=3.5,
+            markeredgecolor="black", markeredgewidth=0.3, label=f"{name} design", linestyle="none",
+        )  # fmt: skip
     ax.axhline(0.0, color="0.3", linewidth=0.5)
     ax.axvline(0.0, color="0.3", linewidth=0.5)
     for sx, sy, text in (
@@ -175,6 +190,15 @@ def plot_efficiency_map(
     ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.035 + 0.035 * title_lines), ncol=2, fontsize=7, frameon=False)
     fig.colorbar(filled, ax=ax, label="efficiency: $f_x v_x / P_{elec}$ motoring, $P_{elec} / f_x v_x$ generating")
     return fig
+
+
+def _points(points: tuple[ArrayLike, ArrayLike], field: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(f_x, v_x) as flat float arrays of one shape."""
+    f_op = np.asarray(points[0], dtype=float).ravel()
+    v_op = np.asarray(points[1], dtype=float).ravel()
+    if f_op.shape != v_op.shape:
+        raise InvalidInputError(field, f"shapes {f_op.shape}, {v_op.shape}", "must match")
+    return f_op, v_op
 
 
 def save_csv(emap: EfficiencyMap, path: str | Path) -> None:

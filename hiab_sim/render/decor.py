@@ -14,12 +14,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.render.camera import camera_axes
+from hiab_sim.style import rgba
 
 Array = NDArray[np.float64]
 
-#: Design colours (RGBA): initial orange, optimal blue; the reference curve grey.
-INITIAL_RGBA = (0.93, 0.49, 0.13, 1.0)
-OPTIMAL_RGBA = (0.16, 0.44, 0.85, 1.0)
+#: Design colours (RGBA) of :mod:`hiab_sim.style`: initial blue, optimal bluish green; the reference curve grey.
+INITIAL_RGBA = rgba("initial")
+OPTIMAL_RGBA = rgba("optimal")
 REFERENCE_RGBA = (0.35, 0.35, 0.35, 1.0)
 BACKDROP_RGBA = (0.93, 0.95, 0.97, 1.0)
 #: Most segments drawn per polyline (longer curves are decimated) and line width [px].

@@ -1,10 +1,12 @@
 """Frames of one or two crane designs moving through qpos sequences, rendered off-screen.
 
-A :class:`PlaybackRenderer` draws each :class:`Design` either side by side (one viewport each)
-or overlaid in one viewport (the later designs as translucent ghosts showing only the parts
-that differ), with the reference TCP curve and each design's TCP trail as line geoms and the
-design's name as a caption. One free camera, fitted once to the whole motion of all designs
-(:func:`~hiab_sim.render.camera.fit_camera`), looks onto the crane's x-z plane of motion.
+A :class:`PlaybackRenderer` draws each :class:`Design` either side by side or stacked (one
+viewport each; stacked suits a crane whose motion is wider than tall) or overlaid in one
+viewport (the later designs as translucent ghosts showing only the parts that differ), with the
+reference TCP curve and each design's TCP trail as line geoms, the design's name as a caption
+and, if given, a per-frame note under it (time, cumulative energy). One free camera, fitted once
+to the whole motion of all designs (:func:`~hiab_sim.render.camera.fit_camera`), looks onto the
+crane's x-z plane of motion.
 
 Visuals are chosen for CPU rendering through OSMesa (:func:`~hiab_sim.render.decor.set_fast_visuals`):
 no shadows, reflections, skybox or multisampling; a self-lit backdrop instead of a sky.
@@ -28,8 +30,8 @@ from hiab_sim.render.labels import caption_bitmap, stamp
 
 Array = NDArray[np.float64]
 Image = NDArray[np.uint8]
-Layout = Literal["side-by-side", "overlay"]
-LAYOUTS: tuple[str, ...] = ("side-by-side", "overlay")
+Layout = Literal["side-by-side", "stacked", "overlay"]
+LAYOUTS: tuple[str, ...] = ("side-by-side", "stacked", "overlay")
 GHOST_ALPHA = 0.5
 
 
@@ -46,6 +48,7 @@ class Design:
     qpos: Array
     rgba: tuple[float, float, float, float]
     caption: str | None = None  # top-left of the design's viewport; default: the name
+    notes: tuple[str, ...] = ()  # one text per frame under the caption (time, energy); () for none
     tcp_site: str = "tcp"
     #: TCP position per frame (N, 3) in the MuJoCo world [m], computed from ``qpos``.
     tcp: Array = field(init=False, repr=False)
@@ -65,6 +68,10 @@ class Design:
             data.qpos[:] = q
             mujoco.mj_kinematics(self.model, data)
             tcp[k] = data.site_xpos[site]
+        if self.notes and len(self.notes) != len(qpos):
+            raise InvalidInputError(
+                f"{self.name}.notes", len(self.notes), f"must hold one text per frame ({len(qpos)})"
+            )
         object.__setattr__(self, "qpos", qpos)
         object.__setattr__(self, "tcp", tcp)
 
@@ -77,10 +84,11 @@ class PlaybackRenderer:
 
     Args:
         designs: the designs, all with the same number of frames (side by side: left to right;
-            overlaid: the first opaque, the others translucent).
+            stacked: top to bottom; overlaid: the first opaque, the others translucent).
         reference: the reference TCP curve (M, 3) in the MuJoCo world [m], or None.
-        size: image (width, height) [px]; side by side each design gets width / len(designs).
-        layout: ``"side-by-side"`` or ``"overlay"``.
+        size: image (width, height) [px]; side by side each design gets width / len(designs),
+            stacked height / len(designs).
+        layout: ``"side-by-side"``, ``"stacked"`` or ``"overlay"``.
         shadows: draw shadows and reflections (several times slower on CPU; for comparison).
 
     """
@@ -100,9 +108,10 @@ class PlaybackRenderer:
         if len({len(d) for d in designs}) != 1:
             raise InvalidInputError("designs", [len(d) for d in designs], "must all have the same number of frames")
         width, height = size
-        panels = len(designs) if layout == "side-by-side" else 1
-        if width % panels or width < 16 * panels or height < 16:
-            raise InvalidInputError("size", f"{width}x{height}", f"width must split into {panels} panels >= 16 px")
+        panels = 1 if layout == "overlay" else len(designs)
+        along, side = (height, "height") if layout == "stacked" else (width, "width")
+        if along % panels or along < 16 * panels or min(width, height) < 16:
+            raise InvalidInputError("size", f"{width}x{height}", f"{side} must split into {panels} panels >= 16 px")
         self.designs = tuple(designs)
         self.reference = None if reference is None else np.asarray(reference, dtype=float).reshape(-1, 3)
         self.size = (width, height)
@@ -110,13 +119,14 @@ class PlaybackRenderer:
         self._data = [mujoco.MjData(d.model) for d in self.designs]
         self._option = mujoco.MjvOption()
         self._perturb = mujoco.MjvPerturb()
-        panel_width = width // panels
+        panel_width = width // panels if layout == "side-by-side" else width
+        panel_height = height // panels if layout == "stacked" else height
         max_geom = sum(d.model.ngeom for d in self.designs) + decor.MAX_SEGMENTS * (len(self.designs) + 1) + 16
         self._renderers: list[mujoco.Renderer] = []
         try:
-            for design in self.designs if layout == "side-by-side" else self.designs[:1]:
+            for design in self.designs if layout != "overlay" else self.designs[:1]:
                 decor.prepare_model(design.model)
-                renderer = open_renderer(design.model, panel_width, height, max_geom=max_geom)
+                renderer = open_renderer(design.model, panel_width, panel_height, max_geom=max_geom)
                 decor.set_fast_visuals(renderer.scene, shadows)
                 self._renderers.append(renderer)
         except BaseException:
@@ -124,12 +134,13 @@ class PlaybackRenderer:
             raise
         points = self._motion_points()
         fovy = float(self.designs[0].model.vis.global_.fovy)
-        self.camera = fit_camera(points, aspect=panel_width / height, fovy=fovy)
+        self.camera = fit_camera(points, aspect=panel_width / panel_height, fovy=fovy)
         forward, _, _ = camera_axes(float(self.camera.azimuth), float(self.camera.elevation))
         depth = float(np.max((points - self.camera.lookat) @ forward)) + 1.0
-        self._backdrop = (depth, 4.0 * (self.camera.distance + depth) * np.tan(np.radians(fovy)) * width / height)
-        line = max(12, height // 26)
-        self._captions = [caption_bitmap(d.caption or d.name, d.rgba[:3], line) for d in self.designs]
+        aspect = panel_width / panel_height
+        self._backdrop = (depth, 4.0 * (self.camera.distance + depth) * np.tan(np.radians(fovy)) * max(aspect, 1.0))
+        self._line = max(12, panel_height // 16 if layout == "stacked" else height // 26)
+        self._captions = [caption_bitmap(d.caption or d.name, d.rgba[:3], self._line) for d in self.designs]
 
     def __len__(self) -> int:
         return len(self.designs[0])
@@ -169,9 +180,19 @@ class PlaybackRenderer:
             decor.tint_geoms(renderer.scene, 0, design.rgba)
             self._decorate(renderer.scene, [design], index)
             image = renderer.render()
-            stamp(image, caption)
+            self._label(image, design, caption, index, top=8)
             images.append(image)
-        return np.concatenate(images, axis=1)
+        return np.concatenate(images, axis=0 if self.layout == "stacked" else 1)
+
+    def _label(self, image: Image, design: Design, caption: NDArray[np.float32], index: int, top: int) -> int:
+        """Stamp the caption and the frame's note of a design from ``top`` [px]; return the next free row."""
+        stamp(image, caption, top=top)
+        top += caption.shape[0] + 6
+        if design.notes:
+            note = caption_bitmap(design.notes[index], design.rgba[:3], max(10, int(0.8 * self._line)))
+            stamp(image, note, top=top)
+            top += note.shape[0] + 6
+        return top
 
     def _overlay_frame(self, index: int) -> Image:
         renderer = self._renderers[0]
@@ -186,9 +207,8 @@ class PlaybackRenderer:
         self._decorate(scene, self.designs, index)
         image = renderer.render()
         top = 8
-        for caption in self._captions:
-            stamp(image, caption, top=top)
-            top += caption.shape[0] + 6
+        for design, caption in zip(self.designs, self._captions, strict=True):
+            top = self._label(image, design, caption, index, top)
         return image
 
     def close(self) -> None:

@@ -21,6 +21,7 @@ def caption_bitmap(text: str, rgb: Sequence[float], height: int = 18) -> NDArray
 
     dpi = 100.0
     figure = Figure(figsize=(max(len(text), 1) * height * 0.9 / dpi, height * 1.8 / dpi), dpi=dpi)
+    figure.patch.set_alpha(0.0)  # transparent: only the glyphs are stamped, not a white box
     canvas = FigureCanvasAgg(figure)
     figure.text(0.02, 0.5, text, color=tuple(rgb), fontsize=height * 0.75 * 72 / dpi, weight="bold", va="center")
     canvas.draw()

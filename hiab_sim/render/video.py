@@ -1,4 +1,11 @@
-"""``render_result``: a playback video (or a still frame) of an optimisation result folder."""
+"""``render_result``: a playback video (or a still frame) of an optimisation result folder.
+
+Each design's viewport names it and shows, per frame, the time and the design's cumulative net
+electrical energy E(t) = integral of sum_i P_elec,i dt [kJ] (trapezoidal on the result's fine
+grid, whose total is the result's ``net_electrical_energy_J``) next to its total. Colours are
+those of :mod:`hiab_sim.style`. The default layout stacks the designs, so that each viewport is
+wider than tall like the crane's motion.
+"""
 
 from __future__ import annotations
 
@@ -6,8 +13,9 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
-from hiab_sim.errors import InvalidInputError
+from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.model.mjcf import build_model, source_to_world
 from hiab_sim.render.backend import check_gl_backend, check_output_path, ffmpeg_path, video_sink, write_image
 from hiab_sim.render.decor import INITIAL_RGBA, OPTIMAL_RGBA
@@ -23,8 +31,12 @@ from hiab_sim.render.playback import (
     simulated_qpos,
 )
 
+Array = NDArray[np.float64]
+
 #: Default file name of the playback video inside a result folder.
 VIDEO_NAME = "playback.mp4"
+#: Default arrangement of the designs.
+DEFAULT_LAYOUT: Layout = "stacked"
 _COLOURS = {"initial": INITIAL_RGBA, "optimal": OPTIMAL_RGBA}
 
 
@@ -35,11 +47,14 @@ def playback_renderer(
     mode: Mode = "kinematic",
     layout: Layout = "side-by-side",
     shadows: bool = False,
+    energy: dict[str, Array] | None = None,
 ) -> PlaybackRenderer:
     """A :class:`~hiab_sim.render.scene.PlaybackRenderer` of both designs of ``data`` at ``fps``.
 
-    Side by side, the initial design is on the left; overlaid, the initial design is drawn
-    translucent over the optimal one.
+    Side by side, the initial design is on the left (stacked: on top); overlaid, the initial
+    design is drawn translucent over the optimal one. ``energy`` maps a design name to its net
+    electrical power summed over the actuators at ``data.time`` [W]: its frames then show the
+    cumulative energy (:func:`energy_notes`); every design's frames show the time.
     """
     if mode not in MODES:
         raise InvalidInputError("mode", mode, f"must be one of {', '.join(MODES)}")
@@ -56,10 +71,46 @@ def playback_renderer(
         caption = f"{motion.name} ({mode})"
         if layout == "overlay" and motion.name == "initial":
             caption = f"{motion.name} (translucent, {mode})"
-        designs.append(Design(motion.name, model, qpos, _COLOURS.get(motion.name, OPTIMAL_RGBA), caption))
+        power = None if energy is None else energy.get(motion.name)
+        notes = energy_notes(data.time, at, power)
+        designs.append(Design(motion.name, model, qpos, _COLOURS.get(motion.name, OPTIMAL_RGBA), caption, notes))
     if layout == "overlay":
         designs.reverse()  # the optimal design opaque, the initial one as a translucent ghost
     return PlaybackRenderer(designs, source_to_world(data.reference_tcp), size, layout=layout, shadows=shadows)
+
+
+def energy_notes(time: Array, at: Array, power: Array | None) -> tuple[str, ...]:
+    """Per-frame texts: time [s] and, with ``power`` (W at ``time``), cumulative energy and its total [kJ]."""
+    if power is None:
+        return tuple(f"t = {t:5.2f} s" for t in at)
+    steps = 0.5 * (power[1:] + power[:-1]) * np.diff(time)
+    cumulative = np.concatenate([[0.0], np.cumsum(steps)])
+    total = cumulative[-1] / 1e3
+    return tuple(
+        f"t = {t:5.2f} s   E = {e / 1e3:6.3f} of {total:.3f} kJ"
+        for t, e in zip(at, np.interp(at, time, cumulative), strict=True)
+    )
+
+
+def load_power(result_dir: str | Path, data: PlaybackData) -> dict[str, Array]:
+    """Net electrical power summed over the actuators [W] per design, from ``trajectory.npz``.
+
+    Designs without a ``<design>_electrical_power`` array (K, actuators) are left out.
+    """
+    path = Path(result_dir) / "trajectory.npz"
+    out: dict[str, Array] = {}
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            for motion in data.designs:
+                key = f"{motion.name}_electrical_power"
+                if key in npz.files:
+                    power = np.asarray(npz[key], dtype=float)
+                    if power.ndim != 2 or len(power) != len(data.time) or not np.all(np.isfinite(power)):
+                        raise ConfigError(f"{path}: array '{key}' must be finite with shape (K, actuators)")
+                    out[motion.name] = power.sum(axis=1)
+    except (OSError, ValueError) as error:
+        raise ConfigError(f"{path}: cannot read electrical power: {error}") from None
+    return out
 
 
 def render_result(
@@ -68,7 +119,7 @@ def render_result(
     fps: float = 30.0,
     size: tuple[int, int] = (640, 480),
     mode: Mode = "kinematic",
-    layout: Layout = "side-by-side",
+    layout: Layout = DEFAULT_LAYOUT,
     progress: Callable[[int, int], None] | None = None,
 ) -> Path:
     """Render the playback video (.mp4, or .gif) of a result folder; return its path.
@@ -80,7 +131,7 @@ def render_result(
         size: (width, height) [px], both even for H.264.
         mode: ``"kinematic"`` (planned states) or ``"simulate"`` (forward simulation under the
             inverse-dynamics forces).
-        layout: ``"side-by-side"`` or ``"overlay"``.
+        layout: ``"stacked"``, ``"side-by-side"`` or ``"overlay"``.
         progress: called with (frames done, frames in all) after each frame.
 
     Raises:
@@ -94,7 +145,7 @@ def render_result(
     check_output_path(output, (".mp4", ".gif"), "video")
     ffmpeg_path()
     with (
-        playback_renderer(data, fps, size, mode, layout) as renderer,
+        playback_renderer(data, fps, size, mode, layout, energy=load_power(result_dir, data)) as renderer,
         video_sink(output, size, fps) as sink,
     ):
         for index in range(len(renderer)):
@@ -109,7 +160,7 @@ def render_still(
     output: str | Path,
     at_time: float | None = None,
     size: tuple[int, int] = (640, 480),
-    layout: Layout = "side-by-side",
+    layout: Layout = DEFAULT_LAYOUT,
 ) -> Path:
     """Render one frame (.png) of the kinematic playback at ``at_time`` [s] (default: the end)."""
     check_gl_backend()
@@ -117,7 +168,7 @@ def render_still(
     _check_size(size, even=False)
     output = check_output_path(Path(output), (".png",), "image")
     fps = 30.0
-    with playback_renderer(data, fps, size, "kinematic", layout) as renderer:
+    with playback_renderer(data, fps, size, "kinematic", layout, energy=load_power(result_dir, data)) as renderer:
         last = len(renderer) - 1
         index = last if at_time is None else int(np.clip(round((at_time - data.time[0]) * fps), 0, last))
         return write_image(output, renderer.frame(index))

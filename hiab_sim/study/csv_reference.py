@@ -30,7 +30,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.config import Crane
+from hiab_sim.crane.description import Crane
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study.trajectory import JointTrajectory, Reference, SplineBasis, TcpKinematics, fit_coefficients
 from hiab_sim.study.workspace import REASONS, check_workspace, dense_times, planar_ik

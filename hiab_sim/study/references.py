@@ -41,7 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import brentq
 
-from hiab_sim.config import Crane
+from hiab_sim.crane.description import Crane
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study.csv_reference import CsvReference
 from hiab_sim.study.trajectory import Reference, TcpKinematics, timing_law
@@ -232,7 +232,10 @@ class PickAndPlace:
         y0, y3, top = self.pick[1], self.place[1], self.clearance
         # y(s) = (1-s)^3 y0 + 3 s (1-s) h + s^3 y3: the weights sum to 1, so h = top gives max y < top,
         # and y(1/2) = (y0 + y3)/8 + 3h/4 = top at h = (8 top - y0 - y3)/6; the apex grows with h.
-        return float(brentq(lambda h: _apex(y0, y3, h) - top, top, (8.0 * top - y0 - y3) / 6.0, xtol=1e-14))
+        upper = (8.0 * top - y0 - y3) / 6.0
+        if _apex(y0, y3, upper) <= top:  # symmetric ends: the apex is y(1/2), at top to round-off
+            return float(upper)
+        return float(brentq(lambda h: _apex(y0, y3, h) - top, top, upper, xtol=1e-14))
 
     def path(self, s: Array) -> tuple[Array, Array, Array]:
         """Bezier point P(s), dP/ds and d2P/ds2, each (T, 2) [m]."""

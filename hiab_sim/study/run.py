@@ -10,6 +10,7 @@ from typing import TextIO
 
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.errors import SolverError
+from hiab_sim.study import run_safety
 from hiab_sim.study.config import Study, load_study
 from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.report import build_result, write_results
@@ -18,9 +19,9 @@ from hiab_sim.study.solve import (
     SolveResult,
     check_checkpoint,
     check_start,
-    remove_checkpoints,
     solve,
     start_points,
+    study_digest,
 )
 
 
@@ -41,12 +42,14 @@ def run_study(
     id_path: str | None = None,
     progress: TextIO | None = sys.stderr,
     figures: bool = True,
+    force: bool = False,
 ) -> RunOutput:
     """Optimise a study and write its result folder.
 
     Bad input (study, unreachable reference, infeasible start, with ``resume`` a checkpoint of
     another study, ID path or start) raises before anything is written. A fresh run (no
-    ``resume``) deletes the folder's checkpoints of earlier runs. A failure of SLSQP on the
+    ``resume``) deletes every output of earlier runs; a folder of another study is refused unless
+    ``force`` (:mod:`hiab_sim.study.run_safety`). A failure of SLSQP on the
     study's own start raises :class:`SolverError` after its checkpoint (the partial history) is
     on disk; failures of extra starts are reported (``multistart.failed_starts``).
     """
@@ -57,14 +60,14 @@ def run_study(
     check_start(problem, problem.initial_point(study.initial_lengths))
     initials = start_points(problem, starts)
     folder = Path(out)
+    run_safety.check_folder(folder, study_digest(problem), resume, force)
     if resume:
         for k, initial in enumerate(initials):
             check_checkpoint(problem, initial, folder, k)
-    else:
-        removed = remove_checkpoints(folder)
-        if removed and progress is not None:
-            progress.write(f"removed {len(removed)} checkpoint(s) of an earlier run in {folder}\n")
-    folder.mkdir(parents=True, exist_ok=True)
+    owner = run_safety.owner_record(study.path, study.name, study_digest(problem), starts)
+    removed = run_safety.claim_folder(folder, owner, resume)
+    if removed and progress is not None:
+        progress.write(f"removed {len(removed)} output file(s) of an earlier run in {folder}\n")
     results: list[SolveResult] = []
     for k, initial in enumerate(initials):
         try:

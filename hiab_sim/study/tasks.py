@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.config import Crane
+from hiab_sim.crane.description import Crane
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study.payload import Payload
 from hiab_sim.study.references import TaskReference, reference_from_mapping

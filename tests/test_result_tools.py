@@ -1,0 +1,98 @@
+"""Tools on result folders: ``mjcf --from-result`` exports the exact design, ``compare`` tables and figures."""
+
+from __future__ import annotations
+
+import csv
+import json
+import shutil
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+from test_study_small import small_study, write_study
+
+from hiab_sim.cli import main
+from hiab_sim.crane.loader import load_crane
+
+CRANE = load_crane("xs031")
+
+
+@pytest.fixture(scope="module")
+def solved(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The small study optimised once (no figures, no video)."""
+    folder = tmp_path_factory.mktemp("tools")
+    study = write_study(folder, small_study())
+    assert main(["optimize", str(study), "--out", str(folder / "out"), "--no-video", "--quiet", "--no-figures"]) == 0
+    return folder / "out"
+
+
+def _xi(result: dict, design: str) -> np.ndarray:
+    chains = result[design]["lengths"]
+    return np.array([chains[c][k] for c in ("lift", "tilt") for k in ("L", "Lc0", "Lc")])
+
+
+@pytest.mark.parametrize("design", ["optimal", "initial"])
+def test_mjcf_from_result_places_the_exact_design(solved: Path, tmp_path: Path, design: str) -> None:
+    """The exported model's base pivots, rod bodies and rod-end sites are the result's lengths to 1e-15 m."""
+    out = tmp_path / f"{design}.xml"
+    assert main(["mjcf", "--from-result", str(solved), "--design", design, "-o", str(out)]) == 0
+    xi = _xi(json.loads((solved / "result.json").read_text()), design)
+    model = mujoco.MjModel.from_xml_path(str(out))
+    for k, chain in enumerate(CRANE.chains):
+        L, Lc0, Lc = xi[3 * k : 3 * k + 3]
+        pivot = chain.boom_hinge - L * chain.base_axis
+        np.testing.assert_allclose(model.body(f"{chain.name}_cylinder").pos, pivot, atol=1e-15)
+        assert model.body(f"{chain.name}_rod").pos[0] == Lc0
+        assert model.site(f"{chain.name}_rod_end").pos[0] == Lc
+
+
+def test_mjcf_from_result_rejects_a_missing_folder_and_mixed_options(solved: Path, tmp_path: Path, capsys) -> None:
+    """A missing folder, a folder without result.json and --lengths with --from-result exit 2 with one line."""
+    for argv in (
+        ["mjcf", "--from-result", str(tmp_path / "nope")],
+        ["mjcf", "--from-result", str(tmp_path)],
+        ["mjcf", "--from-result", str(solved), "--lengths", "1,0.1,0.7,1.1,0.1,0.7"],
+    ):
+        assert main([*argv, "-o", str(tmp_path / "x.xml")]) == 2
+        assert len(capsys.readouterr().err.strip().splitlines()) == 1
+    assert not (tmp_path / "x.xml").exists()
+
+
+def test_compare_table_matches_each_result(solved: Path, tmp_path: Path, capsys) -> None:
+    """Compare writes one CSV row per run and design whose lengths, energies and savings are the results' own."""
+    second = tmp_path / "copy"
+    shutil.copytree(solved, second)
+    data = json.loads((second / "result.json").read_text())
+    data["name"] = "copy"
+    (second / "result.json").write_text(json.dumps(data))
+    out = tmp_path / "cmp"
+    assert main(["compare", str(solved), str(second), "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "saving vs initial" in printed and "copy" in printed
+    with (out / "comparison.csv").open() as handle:
+        table = list(csv.DictReader(handle))
+    assert [(r["run"], r["design"]) for r in table] == [
+        ("small", "initial"), ("small", "optimal"), ("copy", "initial"), ("copy", "optimal")
+    ]  # fmt: skip
+    result = json.loads((solved / "result.json").read_text())
+    for row in table[:2]:
+        lengths = [float(row[f"{c} {k} [mm]"]) for c in ("lift", "tilt") for k in ("L", "Lc0", "Lc")]
+        np.testing.assert_allclose(lengths, 1e3 * _xi(result, row["design"]), rtol=1e-15)
+        energy = result[row["design"]]["net_electrical_energy_J"]
+        assert float(row["net energy [kJ]"]) == pytest.approx(energy / 1e3, rel=1e-15)
+    saved = float(table[1]["saving vs initial [%]"])
+    assert saved == pytest.approx(result["improvement"]["net_energy_saved_percent"], rel=1e-9)
+    assert (out / "comparison.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_compare_rejects_bad_folders_with_one_line(solved: Path, tmp_path: Path, capsys) -> None:
+    """A missing folder, a folder without a result and a truncated result exit 2 with one line; nothing is written."""
+    broken = tmp_path / "broken"
+    broken.mkdir()
+    (broken / "result.json").write_text(json.dumps({"crane": "xs031", "optimal": {}}))
+    for folder in (tmp_path / "nope", tmp_path / "empty", broken):
+        folder.mkdir(exist_ok=True) if folder.name == "empty" else None
+        assert main(["compare", str(solved), str(folder), "--out", str(tmp_path / "cmp")]) == 2
+        assert len(capsys.readouterr().err.strip().splitlines()) == 1
+    assert not (tmp_path / "cmp").exists()
