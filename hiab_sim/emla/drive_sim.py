@@ -197,41 +197,36 @@ class DriveSimulator:
         d = self.drives
         omega = np.asarray(omega_m, dtype=float)
         requested = np.asarray(reference_q, dtype=float)
-        ref_q = np.clip(requested, -d.current_limit, d.current_limit)
-        current_limited = np.abs(requested) >= d.current_limit
-        ref_d = np.zeros_like(ref_q)
+        limit = d.current_limit
+        ref_q = np.minimum(np.maximum(requested, -limit), limit)
         i_d0, i_q0 = self.i_d, self.i_q
+        e_d, e_q = i_d0, i_q0 - ref_q  # errors to the references (i_d* = 0)
 
-        s = math.exp(-self.bandwidth * h)
-        e_d, e_q = i_d0 - ref_d, i_q0 - ref_q
-        i_d1, i_q1 = ref_d + e_d * s, ref_q + e_q * s
-        v_d0, v_q0 = self.command(i_d0, i_q0, ref_d, ref_q, omega)
-        v_d1, v_q1 = self.command(i_d1, i_q1, ref_d, ref_q, omega)
-        limit2 = d.voltage_limit**2
-        saturated = (v_d0**2 + v_q0**2 > limit2) | (v_d1**2 + v_q1**2 > limit2)
-
-        # Closed-form integrals of 1, s, s^2 over [0, h] (module docstring).
-        s1 = (1.0 - s) / self.bandwidth
-        s2 = (1.0 - s * s) / (2.0 * self.bandwidth)
+        # Unsaturated: i = i* + e s and v = a + b s with s = exp(-w_c t) (module docstring).
+        wc = self.bandwidth
+        s = math.exp(-wc * h)
+        s1 = (1.0 - s) / wc  # int_0^h s dt
+        s2 = (1.0 - s * s) / (2.0 * wc)  # int_0^h s^2 dt
         w_e = d.pole_pairs * omega
-        r, wc = d.resistance, self.bandwidth
-        a_d = r * ref_d - w_e * d.Lq * ref_q
-        b_d = (r - d.Ld * wc) * e_d - w_e * d.Lq * e_q
-        a_q = r * ref_q + w_e * (d.Ld * ref_d + d.flux)
+        r = d.resistance
+        lq_w = w_e * d.Lq
+        a_d = -lq_w * ref_q
+        b_d = (r - d.Ld * wc) * e_d - lq_w * e_q
+        a_q = r * ref_q + w_e * d.flux
         b_q = (r - d.Lq * wc) * e_q + w_e * d.Ld * e_d
-        energy = 1.5 * (
-            (a_d * ref_d + a_q * ref_q) * h
-            + (a_d * e_d + b_d * ref_d + a_q * e_q + b_q * ref_q) * s1
-            + (b_d * e_d + b_q * e_q) * s2
-        )
-        copper = 1.5 * r * ((ref_d**2 + ref_q**2) * h + 2.0 * (ref_d * e_d + ref_q * e_q) * s1 + (e_d**2 + e_q**2) * s2)
+        v_d, v_q = a_d + b_d * s, a_q + b_q * s
+        v_d0, v_q0 = a_d + b_d, a_q + b_q
+        limit2 = d.voltage_limit**2
+        saturated = (v_d0 * v_d0 + v_q0 * v_q0 > limit2) | (v_d * v_d + v_q * v_q > limit2)
+        energy = 1.5 * (a_q * ref_q * h + (a_d * e_d + a_q * e_q + b_q * ref_q) * s1 + (b_d * e_d + b_q * e_q) * s2)
+        copper = 1.5 * r * (ref_q * ref_q * h + 2.0 * ref_q * e_q * s1 + (e_d * e_d + e_q * e_q) * s2)
         mean_q = ref_q * h + e_q * s1
-        mean_dq = ref_d * ref_q * h + (ref_d * e_q + e_d * ref_q) * s1 + e_d * e_q * s2
+        mean_dq = ref_q * e_d * s1 + e_d * e_q * s2
         torque = 1.5 * d.pole_pairs * (d.flux * mean_q + (d.Ld - d.Lq) * mean_dq) / h
-        v_d, v_q = v_d1, v_q1
+        i_d1, i_q1 = e_d * s, ref_q + e_q * s
 
-        if np.any(saturated):
-            sat = self._saturated(i_d0, i_q0, ref_d, ref_q, omega, h)
+        if saturated.any():
+            sat = self._saturated(i_d0, i_q0, np.zeros_like(ref_q), ref_q, omega, h)
             i_d1 = np.where(saturated, sat[0], i_d1)
             i_q1 = np.where(saturated, sat[1], i_q1)
             v_d = np.where(saturated, sat[2], v_d)
@@ -241,7 +236,7 @@ class DriveSimulator:
             torque = np.where(saturated, sat[6], torque)
 
         self.i_d, self.i_q = i_d1, i_q1
-        friction = d.friction_torque(omega)
+        friction = d.coulomb * np.tanh(omega / d.smoothing)
         return DriveStep(
             i_d=i_d1,
             i_q=i_q1,
@@ -252,7 +247,7 @@ class DriveSimulator:
             torque=torque,
             friction_torque=friction,
             rod_force=d.ratio * (torque - friction),
-            current_limited=current_limited,
+            current_limited=np.abs(requested) >= limit,
             voltage_limited=saturated,
         )
 

@@ -43,7 +43,7 @@ def load(
     *,
     design: str = "optimal",
     payload_error: float = 0.0,
-    control_timestep: float = PHYSICS_TIMESTEP,
+    control_timestep: float = 2 * PHYSICS_TIMESTEP,
     physics_timestep: float = PHYSICS_TIMESTEP,
     current_bandwidth_hz: float = CURRENT_BANDWIDTH_HZ,
 ) -> control.Environment:

@@ -11,6 +11,10 @@ mass at the TCP, also scaled. :class:`CranePhysics` steps the drives of
 
 from __future__ import annotations
 
+import concurrent.futures.thread  # noqa: F401  (registers its exit hook first; see _free_live_physics)
+import threading
+import weakref
+
 import mujoco
 import numpy as np
 from dm_control import mujoco as dm_mujoco
@@ -26,6 +30,26 @@ from hiab_sim.model.mjcf import JOINTS, SLIDES, build_spec
 Array = NDArray[np.float64]
 
 
+#: Every live CranePhysics, freed before the interpreter stops dm-control's render thread.
+_LIVE: weakref.WeakSet[CranePhysics] = weakref.WeakSet()
+
+
+def _free_live_physics() -> None:
+    """Free the rendering contexts of every live Physics while dm-control's render executor still runs.
+
+    dm-control frees an OSMesa context from ``__del__`` through a thread pool; at interpreter exit
+    that pool is already shut down and Python prints "Exception ignored ... cannot schedule new
+    futures after shutdown". Hooks registered with ``threading._register_atexit`` run last-in
+    first-out before that shutdown, and this one is registered after the thread pool's own
+    hook (imported above), so it runs first.
+    """
+    for physics in list(_LIVE):
+        physics.free()
+
+
+threading._register_atexit(_free_live_physics)  # type: ignore[attr-defined]
+
+
 class CranePhysics(dm_mujoco.Physics):
     """dm-control Physics whose ``step`` runs the EMLA drives at the physics rate (module docstring)."""
 
@@ -39,6 +63,7 @@ class CranePhysics(dm_mujoco.Physics):
 
     def attach_drives(self, drives: DriveSimulator) -> None:
         """Attach the drives (order lift, tilt, telescope) and clear the energy counters."""
+        _LIVE.add(self)
         self.drives = drives
         self.slide_dofs = np.array([self.model.jnt_dofadr[self.model.name2id(s, "joint")] for s in SLIDES])
         self.tcp_site = int(self.model.name2id("tcp", "site"))
@@ -96,6 +121,8 @@ def crane_physics(
     )
     spec = build_spec(plan.crane, plan.lengths, drives, home)
     spec.option.timestep = timestep
+    # Implicit in the velocity-dependent forces (the slides' damping); 3x cheaper than the template's RK4.
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     _add_payload(spec, plan, payload_error)
     physics = CranePhysics.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
     physics.attach_drives(DriveSimulator(DriveArrays.from_params(plan.emlas), bandwidth_hz=bandwidth_hz))
