@@ -61,15 +61,33 @@ def load(
         InvalidInputError: a value out of range (the field is named).
 
     """
+    plan = read_plan(default_result_dir() if result_dir is None else result_dir, design)
+    return make_environment(
+        plan,
+        payload_error=payload_error,
+        control_timestep=control_timestep,
+        physics_timestep=physics_timestep,
+        current_bandwidth_hz=current_bandwidth_hz,
+    )
+
+
+def make_environment(
+    plan: DesignPlan,
+    *,
+    payload_error: float = 0.0,
+    control_timestep: float = 2 * PHYSICS_TIMESTEP,
+    physics_timestep: float = PHYSICS_TIMESTEP,
+    current_bandwidth_hz: float = CURRENT_BANDWIDTH_HZ,
+) -> control.Environment:
+    """Closed-loop environment of a plan (see :func:`load` for the arguments)."""
     if not (0.0 < physics_timestep <= 0.01):
         raise InvalidInputError("physics_timestep", physics_timestep, "must lie in (0, 0.01]", "s")
     n_sub = round(control_timestep / physics_timestep)
     if n_sub < 1 or abs(n_sub * physics_timestep - control_timestep) > 1e-9:
         raise InvalidInputError("control_timestep", control_timestep, "must be a multiple of the physics step", "s")
-    plan = read_plan(default_result_dir() if result_dir is None else result_dir, design)
     motion = planned_motion(plan, physics_timestep)
     physics = crane_physics(plan, motion, physics_timestep, payload_error, current_bandwidth_hz)
-    task = CraneTrackingTask(motion, physics.drives.drives.current_limit)
+    task = CraneTrackingTask(plan, motion, physics.drives.drives.current_limit)
     steps = round(plan.duration / control_timestep)
     return control.Environment(
         physics, task, time_limit=(steps - 0.5) * control_timestep, n_sub_steps=n_sub, flat_observation=False
@@ -83,6 +101,7 @@ __all__ = [
     "DesignPlan",
     "PlannedMotion",
     "load",
+    "make_environment",
     "planned_motion",
     "read_plan",
 ]

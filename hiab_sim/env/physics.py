@@ -124,9 +124,24 @@ def crane_physics(
     # Implicit in the velocity-dependent forces (the slides' damping); 3x cheaper than the template's RK4.
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     _add_payload(spec, plan, payload_error)
+    _add_view(spec, motion)
     physics = CranePhysics.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
     physics.attach_drives(DriveSimulator(DriveArrays.from_params(plan.emlas), bandwidth_hz=bandwidth_hz))
     return physics
+
+
+def _add_view(spec: mujoco.MjSpec, motion: PlannedMotion) -> None:
+    """Visual only: the TCP reference as grey dots and a camera ``closed_loop`` framing crane and path."""
+    path = motion.reference_tcp[:: max(1, len(motion.reference_tcp) // 120)]
+    for point in path:
+        geom = spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.012, 0.0, 0.0], pos=list(point))
+        geom.contype, geom.conaffinity, geom.group = 0, 0, 2
+        geom.rgba = [0.35, 0.35, 0.35, 1.0]
+    centre = 0.5 * (path.min(axis=0) + np.zeros(3))  # between the crane's base and the work area
+    centre[2] = 0.5 * (path[:, 2].max() + 0.0) + 0.2
+    spec.worldbody.add_camera(
+        name="closed_loop", pos=[centre[0] + 0.2, -7.0, centre[2]], xyaxes=[1, 0, 0, 0, 0, 1], fovy=40.0
+    )
 
 
 def _add_payload(spec: mujoco.MjSpec, plan: DesignPlan, payload_error: float) -> None:

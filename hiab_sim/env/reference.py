@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import mujoco
 import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
@@ -58,6 +59,7 @@ class PlannedMotion:
         force: Load-side f_x [N] from inverse dynamics.
         current: Steady-state q-current of each drive for (f_x, v_x, a_x) [A].
         reference_tcp: The study's TCP reference in MuJoCo world coordinates [m].
+        planned_tcp: The TCP of the planned motion (MuJoCo kinematics), world [m].
 
     """
 
@@ -70,6 +72,7 @@ class PlannedMotion:
     force: Array
     current: Array
     reference_tcp: Array
+    planned_tcp: Array
 
     def index(self, time: float) -> int:
         """Sample index nearest to ``time`` [s], clipped to the plan."""
@@ -95,6 +98,14 @@ def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
         axis=1,
     )
     tcp = CubicSpline(plan.time, plan.reference_tcp, axis=0)(times)
+    model = dynamics.model
+    data = mujoco.MjData(model)
+    site = model.site("tcp").id
+    planned_tcp = np.empty((count, 3))
+    for k in range(count):
+        data.qpos[:] = qpos[k]
+        mujoco.mj_kinematics(model, data)
+        planned_tcp[k] = data.site_xpos[site]
     return PlannedMotion(
         time=times - plan.time[0],
         qpos=qpos,
@@ -105,4 +116,5 @@ def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
         force=actuators.force,
         current=current,
         reference_tcp=source_to_world(tcp),
+        planned_tcp=planned_tcp,
     )

@@ -24,14 +24,16 @@ from dm_control.suite import base
 from dm_env import specs
 
 from hiab_sim.env.physics import CranePhysics
+from hiab_sim.env.plan import DesignPlan
 from hiab_sim.env.reference import PlannedMotion
 
 
 class CraneTrackingTask(base.Task):
     """Track the planned motion of one design with the EMLA drives (module docstring)."""
 
-    def __init__(self, motion: PlannedMotion, current_limit: np.ndarray) -> None:
+    def __init__(self, plan: DesignPlan, motion: PlannedMotion, current_limit: np.ndarray) -> None:
         super().__init__(random=None)
+        self.plan = plan
         self.motion = motion
         self.current_limit = np.asarray(current_limit, dtype=float)
 
