@@ -307,9 +307,14 @@ def _add_drives(
             actuator.ctrlrange = [low - x_home, high - x_home]
 
 
-def build_model(crane: Crane, lengths: LinkLengths | None = None) -> mujoco.MjModel:
+def build_model(
+    crane: Crane,
+    lengths: LinkLengths | None = None,
+    drives: SlideDrives | None = None,
+    home: HomePose | None = None,
+) -> mujoco.MjModel:
     """Compiled :class:`mujoco.MjModel` of the crane for link lengths Xi (see :func:`build_spec`)."""
-    return build_spec(crane, lengths).compile()
+    return build_spec(crane, lengths, drives, home).compile()
 
 
 def to_xml(
