@@ -93,8 +93,8 @@ def test_both_id_paths_give_the_load_side_force(crane: Crane, path: str) -> None
         forces = analytic_inverse_dynamics(crane, crane.default_lengths, joints).force
     else:
         forces = MujocoInverseDynamics(crane)(joints).force
-    assert _feedforward_drift(crane, forces, with_drives=True) < 2e-4
-    assert _feedforward_drift(crane, forces, with_drives=False) > 5e-3
+    assert _feedforward_drift(crane, forces, with_drives=True) < 1e-3  # 0.15 mm: soft loops, 0.5 ms steps
+    assert _feedforward_drift(crane, forces, with_drives=False) > 1e-2  # 51 mm
 
 
 def test_exported_model_opens_standing_at_home_and_a_slider_moves_it(tmp_path: Path) -> None:
