@@ -89,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.no_figures:
         from hiab_sim.env.figures import write_figures
 
-        written += [p.name for p in write_figures(out, runs)]
+        written += [p.name for p in write_figures(out, runs, nominal)]
     if not args.no_video:
         written.append(render_video(out / "closed_loop.mp4", runs, physics, quiet=args.quiet).name)
     for item in physics:

@@ -45,15 +45,25 @@ def _cumulative(power: np.ndarray, time: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(time))])
 
 
-def write_figures(folder: Path, runs: list[ClosedLoopRun]) -> list[Path]:
-    """Write the four figures of the module docstring for the runs; return their paths."""
+def _style(run: ClosedLoopRun) -> dict[str, object]:
+    return {"color": COLOURS.get(run.design, "k"), "linestyle": "-" if run.payload_error == 0 else "-."}
+
+
+def write_figures(folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedLoopRun] | None = None) -> list[Path]:
+    """Write the four figures of the module docstring; return their paths.
+
+    The drive figure shows ``runs``; the others also the ``nominal`` runs of a payload-error study.
+    """
     paths = []
+    every = [*(nominal or []), *runs]
     fig = _figure((8.0, 3.6))
     ax = fig.add_subplot()
+    for run in every:
+        ax.plot(run.time, 1000.0 * run.tcp_error, label=f"{_label(run)}: to the reference", **_style(run))
     for run in runs:
         colour = COLOURS.get(run.design, "k")
-        ax.plot(run.time, 1000.0 * run.tcp_error, color=colour, label=f"{_label(run)}: to the reference")
-        ax.plot(run.time, 1000.0 * run.plan_error, color=colour, linestyle=":", label=f"{_label(run)}: to the plan")
+        ax.plot(run.time, 1000.0 * run.plan_error, color=colour, linestyle=":", linewidth=0.9,
+                label=f"{_label(run)}: to the plan")
     ax.set(xlabel="time [s]", ylabel="TCP error [mm]", title="Closed-loop TCP tracking error")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
@@ -81,16 +91,12 @@ def write_figures(folder: Path, runs: list[ClosedLoopRun]) -> list[Path]:
 
     fig = _figure((8.0, 3.6))
     ax = fig.add_subplot()
+    for run in every:
+        ax.plot(run.time, run.electrical_power.sum(axis=1) / 1e3, label=f"{_label(run)}: closed loop", **_style(run))
     for run in runs:
         colour = COLOURS.get(run.design, "k")
-        ax.plot(run.time, run.electrical_power.sum(axis=1) / 1e3, color=colour, label=f"{_label(run)}: closed loop")
-        ax.plot(
-            run.plan_time,
-            run.predicted_power.sum(axis=1) / 1e3,
-            color=colour,
-            linestyle="--",
-            label=f"{run.design}: predicted",
-        )
+        predicted = run.predicted_power.sum(axis=1) / 1e3
+        ax.plot(run.plan_time, predicted, color=colour, linestyle="--", label=f"{run.design}: predicted")
     ax.set(xlabel="time [s]", ylabel="DC bus power [kW]", title="Electrical power, closed loop vs predicted")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
@@ -98,10 +104,12 @@ def write_figures(folder: Path, runs: list[ClosedLoopRun]) -> list[Path]:
 
     fig = _figure((8.0, 3.6))
     ax = fig.add_subplot()
+    for run in every:
+        energy = run.cumulative_energy.sum(axis=1) / 1e3
+        ax.plot(run.time, energy, label=f"{_label(run)}: closed loop", **_style(run))
     for run in runs:
-        colour = COLOURS.get(run.design, "k")
-        ax.plot(run.time, run.cumulative_energy.sum(axis=1) / 1e3, color=colour, label=f"{_label(run)}: closed loop")
         predicted = _cumulative(run.predicted_power.sum(axis=1), run.plan_time)
+        colour = COLOURS.get(run.design, "k")
         ax.plot(run.plan_time, predicted / 1e3, color=colour, linestyle="--", label=f"{run.design}: predicted")
     ax.set(xlabel="time [s]", ylabel="net electrical energy [kJ]", title="Cumulative net electrical energy")
     ax.grid(alpha=0.3)

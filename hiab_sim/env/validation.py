@@ -98,8 +98,8 @@ def table(report: dict[str, object]) -> str:
     """Markdown table of predicted vs closed-loop energy and tracking errors (the README's table)."""
     lines = [
         "| design | end mass | predicted energy [J] | closed-loop energy [J] | difference | TCP error rms / max [mm]"
-        " | at current limit | at voltage limit |",
-        "|---|---|---:|---:|---:|---:|---:|---:|",
+        " | at current limit | at voltage limit | extra energy [J] |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
     ]
     designs = report["designs"]
     assert isinstance(designs, dict)
@@ -112,7 +112,8 @@ def table(report: dict[str, object]) -> str:
                 f"| {design} | {mass} | {row['predicted_net_electrical_energy_J']:.1f} "
                 f"| {row['net_electrical_energy_J']:.1f} | {row['energy_difference_percent']:+.2f} % "
                 f"| {tcp['rms']:.2f} / {tcp['max']:.2f} | {100 * row['current_limit_fraction']:.1f} % "
-                f"| {100 * row['voltage_limit_fraction']:.1f} % |"
+                f"| {100 * row['voltage_limit_fraction']:.1f} % "
+                f"| {'' if 'extra_energy_J' not in row else format(row['extra_energy_J'], '+.1f')} |"
             )
     return "\n".join(lines)
 
