@@ -33,7 +33,9 @@ def _best(repeat: int, fn) -> tuple[float, float]:  # type: ignore[no-untyped-de
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("result_dir", nargs="?", help="folder of 'hiab-sim optimize' (default: optimise the default study)")
+    parser.add_argument(
+        "result_dir", nargs="?", help="folder of 'hiab-sim optimize' (default: optimise the default study)"
+    )
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
     plan = read_plan(args.result_dir or default_result_dir(), "optimal")
@@ -84,7 +86,8 @@ def main() -> None:
     for label, (wall, cpu) in rows:
         share = f"{100 * cpu / cycle_time[1]:8.1f}%" if label.startswith("  ") else ""
         print(f"{label:52s} {wall:9.3f} {cpu:9.3f} {share:>9s}")
-    print(f"real-time factor of the cycle: {simulated / cycle_time[0]:.1f}x (wall), {simulated / cycle_time[1]:.1f}x (CPU)")
+    wall_factor, cpu_factor = simulated / cycle_time[0], simulated / cycle_time[1]
+    print(f"real-time factor of the cycle: {wall_factor:.1f}x (wall), {cpu_factor:.1f}x (CPU)")
 
 
 if __name__ == "__main__":

@@ -48,7 +48,10 @@ def test_voltage_step_settles_with_the_stator_time_constant() -> None:
 
 @settings(max_examples=20, deadline=None)
 @given(
-    st.floats(-40.0, 40.0), st.floats(-40.0, 40.0), st.floats(-300.0, 300.0), st.floats(-400.0, 400.0),
+    st.floats(-40.0, 40.0),
+    st.floats(-40.0, 40.0),
+    st.floats(-300.0, 300.0),
+    st.floats(-400.0, 400.0),
     st.floats(-200.0, 200.0),
 )
 def test_plant_step_matches_a_numerical_integration_at_speed(
@@ -58,10 +61,15 @@ def test_plant_step_matches_a_numerical_integration_at_speed(
     dt = 1e-3
     sol = solve_ivp(
         lambda _t, y: np.array(current_derivatives(MOTOR, y[0], y[1], omega, v_d, v_q)),
-        (0.0, dt), [i_d, i_q], method="LSODA", rtol=1e-12, atol=1e-12,
+        (0.0, dt),
+        [i_d, i_q],
+        method="LSODA",
+        rtol=1e-12,
+        atol=1e-12,
     )
-    x1, x2, _, _ = plant_step(DRIVES, np.full(3, i_d), np.full(3, i_q), np.full(3, v_d), np.full(3, v_q),
-                              np.full(3, omega), dt)
+    x1, x2, _, _ = plant_step(
+        DRIVES, np.full(3, i_d), np.full(3, i_q), np.full(3, v_d), np.full(3, v_q), np.full(3, omega), dt
+    )
     np.testing.assert_allclose([x1[0], x2[0]], sol.y[:, -1], atol=1e-7)
 
 

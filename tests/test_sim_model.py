@@ -119,9 +119,9 @@ def test_exported_model_opens_standing_at_home_and_a_slider_moves_it(tmp_path: P
 
 def test_bad_drive_values_are_rejected() -> None:
     """Negative armature or a non-finite home pose name the field."""
-    with pytest.raises(InvalidInputError, match="drives.armature"):
+    with pytest.raises(InvalidInputError, match=r"drives\.armature"):
         SlideDrives(armature=(-1.0, 0.0, 0.0), damping=(0.0, 0.0, 0.0), force_limit=(1.0, 1.0, 1.0))
-    with pytest.raises(InvalidInputError, match="home.qpos.x1"):
+    with pytest.raises(InvalidInputError, match=r"home\.qpos\.x1"):
         HomePose(qpos={"x1": math.nan}, force=(0.0, 0.0, 0.0))
 
 

@@ -79,8 +79,13 @@ def test_default_study_validates_in_closed_loop(tmp_path: Path) -> None:
     designs = report["designs"]
     for design in ("initial", "optimal"):
         nominal, heavy = designs[design]["nominal"], designs[design]
-        assert nominal["net_electrical_energy_J"] == pytest.approx(nominal["predicted_net_electrical_energy_J"], rel=0.02)
+        assert nominal["net_electrical_energy_J"] == pytest.approx(
+            nominal["predicted_net_electrical_energy_J"], rel=0.02
+        )
         assert nominal["tcp_error_mm"]["rms"] <= 2.0 and nominal["tcp_error_mm"]["max"] <= 5.0
         assert heavy["tcp_error_mm"]["max"] <= 20.0 and heavy["simulated_time_s"] == pytest.approx(6.25)
         assert heavy["extra_energy_J"] > 0.0
-    assert designs["optimal"]["nominal"]["net_electrical_energy_J"] < designs["initial"]["nominal"]["net_electrical_energy_J"]
+    assert (
+        designs["optimal"]["nominal"]["net_electrical_energy_J"]
+        < designs["initial"]["nominal"]["net_electrical_energy_J"]
+    )

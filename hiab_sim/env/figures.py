@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import io
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -45,7 +46,7 @@ def _cumulative(power: np.ndarray, time: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(time))])
 
 
-def _style(run: ClosedLoopRun) -> dict[str, object]:
+def _style(run: ClosedLoopRun) -> dict[str, Any]:
     return {"color": COLOURS.get(run.design, "k"), "linestyle": "-" if run.payload_error == 0 else "-."}
 
 
@@ -62,8 +63,14 @@ def write_figures(folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedL
         ax.plot(run.time, 1000.0 * run.tcp_error, label=f"{_label(run)}: to the reference", **_style(run))
     for run in runs:
         colour = COLOURS.get(run.design, "k")
-        ax.plot(run.time, 1000.0 * run.plan_error, color=colour, linestyle=":", linewidth=0.9,
-                label=f"{_label(run)}: to the plan")
+        ax.plot(
+            run.time,
+            1000.0 * run.plan_error,
+            color=colour,
+            linestyle=":",
+            linewidth=0.9,
+            label=f"{_label(run)}: to the plan",
+        )
     ax.set(xlabel="time [s]", ylabel="TCP error [mm]", title="Closed-loop TCP tracking error")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)

@@ -84,7 +84,7 @@ class CranePhysics(dm_mujoco.Physics):
         return np.asarray(self.data.qvel[self.slide_dofs])
 
     def stroke(self) -> Array:
-        """x of the slides [m]."""
+        """Strokes x of the slides x1, x2, xt2 [m]."""
         return np.asarray(self.data.qpos[self.slide_dofs])
 
     def step(self, nstep: int = 1) -> None:

@@ -77,7 +77,9 @@ def read_plan(result_dir: str | Path, design: str) -> DesignPlan:
     folder = Path(result_dir)
     result_file, arrays_file = folder / "result.json", folder / "trajectory.npz"
     if not (result_file.is_file() and arrays_file.is_file()):
-        raise InvalidInputError("RESULT_DIR", str(folder), "must hold result.json and trajectory.npz of hiab-sim optimize")
+        raise InvalidInputError(
+            "RESULT_DIR", str(folder), "must hold result.json and trajectory.npz of hiab-sim optimize"
+        )
     try:
         result = json.loads(result_file.read_text())
         arrays = dict(np.load(arrays_file))
@@ -100,7 +102,7 @@ def read_plan(result_dir: str | Path, design: str) -> DesignPlan:
             reference_tcp=np.asarray(arrays["reference_tcp"], dtype=float),
             predicted_electrical_power=np.asarray(arrays[f"{design}_electrical_power"], dtype=float),
             predicted_net_energy=float(entry["net_electrical_energy_J"]),
-            payload=float(result.get("settings", {}).get("payload_kg", 0.0)),
+            payload=payload,
         )
     except (KeyError, ValueError, TypeError, OSError) as error:
         raise ConfigError(f"{folder}: not a readable hiab-sim optimize result ({error})") from None

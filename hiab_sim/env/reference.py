@@ -82,7 +82,7 @@ class PlannedMotion:
 
 def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
     """Sample the plan every ``timestep`` [s] (see the module docstring)."""
-    count = int(round(plan.duration / timestep)) + 1
+    count = round(plan.duration / timestep) + 1
     times = plan.time[0] + timestep * np.arange(count)
     pos, vel, acc = quintic_hermite(plan.time, plan.position, plan.velocity, plan.acceleration, times)
     joints = JointSamples(pos, vel, acc)

@@ -91,9 +91,7 @@ class ClosedLoopRun:
             "actuators": {
                 name: {
                     "net_electrical_energy_J": float(self.cumulative_energy[-1, i]),
-                    "predicted_net_electrical_energy_J": float(
-                        _trapezoid(self.predicted_power[:, i], self.plan_time)
-                    ),
+                    "predicted_net_electrical_energy_J": float(_trapezoid(self.predicted_power[:, i], self.plan_time)),
                     "current_limit_fraction": float(self.current_limit_fraction[i]),
                     "voltage_limit_fraction": float(self.voltage_limit_fraction[i]),
                     "peak_current_A": float(np.abs(self.current_dq[:, i, 1]).max()),

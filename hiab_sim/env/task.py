@@ -37,7 +37,7 @@ class CraneTrackingTask(base.Task):
         self.motion = motion
         self.current_limit = np.asarray(current_limit, dtype=float)
 
-    def initialize_episode(self, physics: CranePhysics) -> None:  # type: ignore[override]
+    def initialize_episode(self, physics: CranePhysics) -> None:
         """Start at the plan's first state with the drives at its feedforward currents."""
         physics.data.qpos[:] = self.motion.qpos[0]
         physics.data.qvel[:] = self.motion.qvel[0]
@@ -46,17 +46,17 @@ class CraneTrackingTask(base.Task):
         physics.reset_counters()
         physics.forward()
 
-    def action_spec(self, physics: CranePhysics) -> specs.BoundedArray:  # type: ignore[override]
+    def action_spec(self, physics: CranePhysics) -> specs.BoundedArray:
         """q-current references [A] within the drives' current limit."""
         return specs.BoundedArray(
             shape=(3,), dtype=np.float64, minimum=-self.current_limit, maximum=self.current_limit, name="i_q_ref"
         )
 
-    def before_step(self, action: np.ndarray, physics: CranePhysics) -> None:  # type: ignore[override]
+    def before_step(self, action: np.ndarray, physics: CranePhysics) -> None:
         """Hand the current references to the drives."""
         physics.current_reference = np.asarray(action, dtype=float).copy()
 
-    def get_observation(self, physics: CranePhysics) -> collections.OrderedDict:  # type: ignore[override]
+    def get_observation(self, physics: CranePhysics) -> collections.OrderedDict:
         """The observations of the module docstring."""
         data = physics.data
         time = float(data.time)
@@ -86,7 +86,7 @@ class CraneTrackingTask(base.Task):
         obs["bus_power"] = np.array([float(np.sum(power))])
         return obs
 
-    def get_reward(self, physics: CranePhysics) -> float:  # type: ignore[override]
+    def get_reward(self, physics: CranePhysics) -> float:
         """-1000 |p_tcp - p_ref| (TCP error in mm, negated)."""
         time = float(physics.data.time)
         error = physics.data.site_xpos[physics.tcp_site] - self.motion.reference_tcp[self.motion.index(time)]

@@ -56,7 +56,9 @@ class SlideDrives:
         """The slides' armature, damping and force limit of an EMLA set (module docstring)."""
         params = emlas.as_tuple()
         return cls(
-            armature=_as_triple([p.motor.rotor_inertia * p.transmission_ratio**2 + p.screw_moving_mass for p in params]),
+            armature=_as_triple(
+                [p.motor.rotor_inertia * p.transmission_ratio**2 + p.screw_moving_mass for p in params]
+            ),
             damping=_as_triple([p.viscous_friction for p in params]),
             force_limit=_as_triple([peak_force(p) for p in params]),
         )
