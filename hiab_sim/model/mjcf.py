@@ -366,6 +366,9 @@ def to_xml(
         _set(geom, pos=model.geom_pos[geom_id], quat=model.geom_quat[geom_id])
         if geom.get("type", "") != "plane":
             geom.set("size", _text(model.geom_size[geom_id][: len(geom.get("size", "0 0").split())]))
+    for joint in world.iter("joint"):  # joint ref = qpos0 of a hinge or slide (the home pose)
+        if joint.get("ref") is not None:
+            joint.set("ref", repr(float(model.qpos0[model.joint(joint.get("name", "")).qposadr[0]])))
     for site in world.iter("site"):
         site_id = model.site(site.get("name", "")).id
         _set(site, pos=model.site_pos[site_id], quat=model.site_quat[site_id])
