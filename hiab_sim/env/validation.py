@@ -121,20 +121,30 @@ def table(report: dict[str, object]) -> str:
 def render_video(path: Path, runs: list[ClosedLoopRun], physics: list[CranePhysics], quiet: bool = False) -> Path:
     """Render the logged runs side by side at :data:`FPS` through ``Physics.render`` (camera ``closed_loop``)."""
     from hiab_sim.render.backend import video_sink
+    from hiab_sim.render.labels import caption_bitmap, stamp
 
     width, height = VIEWPORT
+    captions = [
+        caption_bitmap(
+            f"{run.design}: closed loop" + (f", end mass +{100 * run.payload_error:g} %" if run.payload_error else ""),
+            (0.1, 0.1, 0.1),
+        )
+        for run in runs
+    ]
     for item in physics:
         item.model.light_castshadow[:] = 0  # software (OSMesa) shadows cost 3x the frame time
     duration = min(run.time[-1] for run in runs)
     frames = int(np.floor(duration * FPS)) + 1
     with video_sink(path, (width * len(runs), height), FPS) as sink:
         for frame in tqdm(range(frames), desc="video", unit="frame", disable=quiet, file=sys.stderr, leave=False):
-            images = []
+            images: list[np.ndarray] = []
             for run, item in zip(runs, physics, strict=True):
                 index = int(np.clip(np.searchsorted(run.time, frame / FPS), 0, len(run.time) - 1))
                 item.data.qpos[:] = run.qpos[index]
                 item.data.qvel[:] = 0.0
                 item.forward()
-                images.append(item.render(height, width, camera_id="closed_loop"))
+                image = np.array(item.render(height, width, camera_id="closed_loop"))
+                stamp(image, captions[len(images)])
+                images.append(image)
             sink.add(np.hstack(images))
     return path
