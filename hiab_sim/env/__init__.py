@@ -33,7 +33,7 @@ def default_result_dir() -> Path:
         from hiab_sim.study.run import run_study
 
         folder = Path(tempfile.mkdtemp(prefix="hiab_sim_default_"))
-        run_study(None, folder, figures=False)
+        run_study(None, folder, figures=False, progress=None)
         _DEFAULT_RESULT["dir"] = folder
     return _DEFAULT_RESULT["dir"]
 
