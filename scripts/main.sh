@@ -1,7 +1,11 @@
 #!/usr/bin/env bash
-# The main job: set up, then optimise the default crane (HIAB XS 031) on the default study.
+# The main job: set up, optimise the default crane (HIAB XS 031) on the default study, then validate
+# both designs in closed loop (simulated EMLA drives + tracking controller) and render the result.
+# Arguments go to `hiab-sim optimize`; RUN_DIR (default runs/xs031_spiral) is the result folder.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
+RUN_DIR="${RUN_DIR:-runs/xs031_spiral}"
 .venv/bin/hiab-sim crane
-.venv/bin/hiab-sim optimize --starts 3 "$@"
+.venv/bin/hiab-sim optimize --starts 3 --out "$RUN_DIR" "$@"
+.venv/bin/hiab-sim simulate "$RUN_DIR" --payload-error 0.2

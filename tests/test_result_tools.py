@@ -43,7 +43,8 @@ def test_mjcf_from_result_places_the_exact_design(solved: Path, tmp_path: Path, 
         L, Lc0, Lc = xi[3 * k : 3 * k + 3]
         pivot = chain.boom_hinge - L * chain.base_axis
         np.testing.assert_allclose(model.body(f"{chain.name}_cylinder").pos, pivot, atol=1e-15)
-        assert model.body(f"{chain.name}_rod").pos[0] == Lc0
+        x_home = model.qpos0[model.joint(f"x{k + 1}").qposadr[0]]  # bodies are placed at home (joint ref)
+        assert model.body(f"{chain.name}_rod").pos[0] - x_home == pytest.approx(Lc0, rel=1e-15, abs=1e-15)
         assert model.site(f"{chain.name}_rod_end").pos[0] == Lc
 
 

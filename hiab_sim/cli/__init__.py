@@ -17,7 +17,7 @@ from hiab_sim._gl import check_gl_backend
 from hiab_sim.errors import HiabSimError, SolverError
 
 #: Subcommands that import MuJoCo: its OpenGL backend is checked before they run.
-USES_MUJOCO = {"mjcf", "validate", "optimize", "render"}
+USES_MUJOCO = {"mjcf", "validate", "optimize", "render", "simulate"}
 
 #: Subcommand name -> module under ``hiab_sim.cli`` that implements it.
 SUBCOMMANDS: dict[str, str] = {
@@ -28,6 +28,7 @@ SUBCOMMANDS: dict[str, str] = {
     "optimize": "optimize",
     "render": "render",
     "compare": "compare",
+    "simulate": "simulate",
 }
 
 

@@ -3,10 +3,13 @@
 ``--lengths`` takes six numbers in metres, comma-separated, lift chain first:
 ``L,Lc0,Lc,L,Lc0,Lc`` (seed eq. Xi). The file is written atomically (a temporary file in the
 target folder, then ``os.replace``), loads with ``mujoco.MjModel.from_xml_path`` and opens in
-``python -m mujoco.viewer --mjcf=FILE``. The file carries a keyframe ``home``: the crane at the
-middle of its working ranges, loop-consistent, with the motors' ``ctrl`` set to the static
-actuator forces that hold it against gravity (load it in the viewer's "Key" panel; the open-loop
-crane drifts away from it slowly, as any unstabilised crane would).
+``python -m mujoco.viewer --mjcf=FILE`` standing at ``home``: the crane at the middle of its working
+ranges, loop-consistent, placed there by the joints' ``ref`` so that it is qpos0. The file is the
+simulation model (:mod:`hiab_sim.model.drives`): the EMLAs' reflected rotor inertia as armature, screw
+friction as damping, joint ranges at the stops, and actuators with the EMLA force range. Its
+actuators are stroke servos around home (ctrl = stroke change [m], 0 holds home with the static
+forces from inverse dynamics; critically damped at 1 Hz on the reflected inertia), so the
+viewer's sliders move the crane. The keyframe ``home`` holds the same pose.
 
 ``--from-result RUN_DIR [--design optimal|initial]`` exports the exact (full-precision) design of
 an optimisation result, with the crane the result was computed for.
@@ -24,6 +27,9 @@ from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.errors import InvalidInputError
+
+#: Natural frequency of the viewer file's stroke servos [Hz].
+SERVO_FREQUENCY_HZ = 1.0
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -103,7 +109,19 @@ def run(args: argparse.Namespace) -> int:
     from hiab_sim.model.mjcf import to_xml
 
     crane, lengths = _crane_and_lengths(args)
-    text = to_xml(crane, lengths, keyframes={"home": home_keyframe(crane, lengths)})
+    from hiab_sim.emla import load_emla_set
+    from hiab_sim.model.drives import HomePose, SlideDrives, servo_gains
+    from hiab_sim.model.mjcf import build_model
+
+    qpos, force = home_keyframe(crane, lengths)
+    names = [build_model(crane, lengths).joint(j).name for j in range(len(qpos))]
+    drives = SlideDrives.from_emla(load_emla_set())
+    home = HomePose(
+        qpos=dict(zip(names, map(float, qpos), strict=True)),
+        force=(float(force[0]), float(force[1]), float(force[2])),
+        servo=servo_gains(np.asarray(drives.armature), SERVO_FREQUENCY_HZ),
+    )
+    text = to_xml(crane, lengths, keyframes={"home": (qpos, np.zeros(3))}, drives=drives, home=home)
     model = mujoco.MjModel.from_xml_string(text)  # what the file will load as
     output = Path(args.output)
     if not output.parent.is_dir():

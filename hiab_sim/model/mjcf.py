@@ -63,10 +63,12 @@ from xml.etree import ElementTree
 import mujoco
 import numpy as np
 
+from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths, RigidBody
 from hiab_sim.crane.mechanism import check_lengths
 from hiab_sim.crane.names import ACTUATOR_NAMES, JOINT_NAMES
 from hiab_sim.errors import ConfigError
+from hiab_sim.model.drives import HomePose, SlideDrives
 from hiab_sim.resources import mjcf_template
 
 #: Independent joints (qpos equals the source's Θ1, Θ2, xt2) and the actuated slides, in order.
@@ -131,29 +133,42 @@ def _capsule(body: mujoco.MjsBody, start: np.ndarray, end: np.ndarray, cls: mujo
 
 
 def _add_chain(
-    spec: mujoco.MjSpec, parent: mujoco.MjsBody, chain: ClosedChain, lengths: LinkLengths, links: dict[str, list]
+    spec: mujoco.MjSpec,
+    parent: mujoco.MjsBody,
+    chain: ClosedChain,
+    lengths: LinkLengths,
+    links: dict[str, list],
+    ref: dict[str, float],
 ) -> mujoco.MjsBody:
-    """Add boom, cylinder and rod of one closed chain under ``parent``; return the boom body."""
+    """Add boom, cylinder and rod of one closed chain under ``parent``; return the boom body.
+
+    ``ref`` maps joint names to the value at which the bodies are placed (joint ``ref``, qpos0).
+    """
     xi = getattr(lengths, chain.name)
     hinge_name, slide_name = _CHAIN_JOINT[chain.name]
+    theta = ref.get(hinge_name, 0.0)
     boom = parent.add_body(
-        name=f"{chain.name}_boom", pos=chain.boom_hinge, quat=_quat_z(chain.base_axis_angle - chain.joint_offset)
+        name=f"{chain.name}_boom",
+        pos=chain.boom_hinge,
+        quat=_quat_z(chain.base_axis_angle - chain.joint_offset + theta),
     )
-    boom.add_joint(name=hinge_name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0.0, 0.0, 1.0])
+    boom.add_joint(name=hinge_name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0.0, 0.0, 1.0], ref=theta)
     boom.add_site(name=f"{chain.name}_boom_pivot", pos=[chain.L1, 0.0, 0.0])
     _set_inertial(boom, links[f"{chain.name}_boom"])
     _capsule(boom, np.zeros(3), np.array([chain.L1, 0.0, 0.0]), spec.find_default("boom"))
 
+    q1 = ref.get(f"{chain.name}_q1", 0.0)
     cylinder = parent.add_body(
-        name=f"{chain.name}_cylinder", pos=chain.base_pivot(xi), quat=_quat_z(chain.base_axis_angle)
+        name=f"{chain.name}_cylinder", pos=chain.base_pivot(xi), quat=_quat_z(chain.base_axis_angle + q1)
     )
-    cylinder.add_joint(name=f"{chain.name}_q1", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0.0, 0.0, 1.0])
+    cylinder.add_joint(name=f"{chain.name}_q1", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0.0, 0.0, 1.0], ref=q1)
     cylinder.add_site(name=f"{chain.name}_base_pivot")
     _set_inertial(cylinder, links[f"{chain.name}_cylinder"])
     _capsule(cylinder, np.zeros(3), np.array([xi.x0, 0.0, 0.0]), spec.find_default("barrel"))
 
-    rod = cylinder.add_body(name=f"{chain.name}_rod", pos=[xi.Lc0, 0.0, 0.0])
-    rod.add_joint(name=slide_name, type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1.0, 0.0, 0.0])
+    stroke = ref.get(slide_name, 0.0)
+    rod = cylinder.add_body(name=f"{chain.name}_rod", pos=[xi.Lc0 + stroke, 0.0, 0.0])
+    rod.add_joint(name=slide_name, type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1.0, 0.0, 0.0], ref=stroke)
     rod.add_site(name=f"{chain.name}_rod_end", pos=[xi.Lc, 0.0, 0.0])
     _set_inertial(rod, links[f"{chain.name}_rod"])
     _capsule(rod, np.zeros(3), np.array([xi.Lc, 0.0, 0.0]), spec.find_default("rod"))
@@ -170,8 +185,19 @@ def _add_chain(
     return boom
 
 
-def build_spec(crane: Crane, lengths: LinkLengths | None = None) -> mujoco.MjSpec:
+def build_spec(
+    crane: Crane,
+    lengths: LinkLengths | None = None,
+    drives: SlideDrives | None = None,
+    home: HomePose | None = None,
+) -> mujoco.MjSpec:
     """MjSpec of the crane for link lengths Xi (default: the crane's own), see the module docstring.
+
+    Without ``drives`` this is the inverse-dynamics model (no armature, damping, ranges or force
+    limits: its slide force is the load-side f_x). With ``drives`` it is the simulation model of
+    :mod:`hiab_sim.model.drives`; ``home`` places the bodies at that pose (joint ``ref``, so qpos0 is
+    the home pose and ``mj_resetData`` and the viewer open there) and, with servo gains, makes the
+    actuators stroke servos that hold it at ``ctrl`` = 0.
 
     Raises:
         InvalidInputError: the lengths are infeasible for the crane's working joint ranges
@@ -180,6 +206,7 @@ def build_spec(crane: Crane, lengths: LinkLengths | None = None) -> mujoco.MjSpe
     """
     lengths = crane.default_lengths if lengths is None else lengths
     check_lengths(crane, lengths)
+    ref = dict(home.qpos) if home is not None else {}
     links: dict[str, list[RigidBody]] = {}
     for body in crane.bodies_for(lengths):
         links.setdefault(body.link, []).append(body)
@@ -204,7 +231,7 @@ def build_spec(crane: Crane, lengths: LinkLengths | None = None) -> mujoco.MjSpe
         if chain is None:
             raise ConfigError(f"chain parent(s) {[c.parent for c in pending]} are not links of the crane")
         pending.remove(chain)
-        bodies[f"{chain.name}_boom"] = _add_chain(spec, bodies[chain.parent], chain, lengths, links)
+        bodies[f"{chain.name}_boom"] = _add_chain(spec, bodies[chain.parent], chain, lengths, links, ref)
         parent = bodies[chain.parent]
         if chain.parent != "base":
             _capsule(parent, np.zeros(3), chain.boom_hinge, spec.find_default("boom"))
@@ -223,8 +250,11 @@ def build_spec(crane: Crane, lengths: LinkLengths | None = None) -> mujoco.MjSpe
     _capsule(carrier, np.zeros(3), origin, spec.find_default("boom"))
     barrel_end = origin + rotation[:, 0] * (tele.rod_offset + tele.stroke)
     _capsule(carrier, origin, barrel_end, spec.find_default("boom"))
-    rod = carrier.add_body(name="telescope_rod", pos=origin + rotation[:, 0] * tele.rod_offset, quat=_quat(rotation))
-    rod.add_joint(name="xt2", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1.0, 0.0, 0.0])
+    xt2 = ref.get("xt2", 0.0)
+    rod = carrier.add_body(
+        name="telescope_rod", pos=origin + rotation[:, 0] * (tele.rod_offset + xt2), quat=_quat(rotation)
+    )
+    rod.add_joint(name="xt2", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1.0, 0.0, 0.0], ref=xt2)
     _set_inertial(rod, links["telescope_rod"])
     _capsule(rod, np.zeros(3), np.array([tele.rod_length, 0.0, 0.0]), spec.find_default("barrel"))
     tcp = crane.tcp_in_telescope_rod
@@ -236,18 +266,62 @@ def build_spec(crane: Crane, lengths: LinkLengths | None = None) -> mujoco.MjSpe
         motor = spec.add_actuator(name=name, target=joint, trntype=mujoco.mjtTrn.mjTRN_JOINT)
         motor.gear = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
         motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+    if drives is not None:
+        _add_drives(spec, crane, lengths, drives, home)
     return spec
 
 
-def build_model(crane: Crane, lengths: LinkLengths | None = None) -> mujoco.MjModel:
+def _add_drives(
+    spec: mujoco.MjSpec, crane: Crane, lengths: LinkLengths, drives: SlideDrives, home: HomePose | None
+) -> None:
+    """Armature, damping, stops and EMLA force limits of the simulation model (:mod:`hiab_sim.model.drives`)."""
+    stops: dict[str, tuple[float, float]] = {"xt2": (0.0, crane.telescope.stroke)}
+    for chain in crane.chains:
+        xi = getattr(lengths, chain.name)
+        hinge, slide = _CHAIN_JOINT[chain.name]
+        stops[slide] = (0.0, min(chain.stroke, xi.Lc))
+        stops[hinge] = mechanism.reachable_joint_range(chain, xi)
+    for name, (low, high) in stops.items():
+        joint = spec.joint(name)
+        joint.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+        joint.range = [low, high]
+    for index, (name, slide) in enumerate(zip(ACTUATORS, SLIDES, strict=True)):
+        joint = spec.joint(slide)
+        joint.armature = drives.armature[index]
+        joint.damping = [drives.damping[index], 0.0, 0.0]  # linear viscous term only
+        limit = drives.force_limit[index]
+        actuator = spec.actuator(name)
+        actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        actuator.forcerange = [-limit, limit]
+        actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        actuator.ctrlrange = [-limit, limit]
+        if home is not None and home.servo is not None:
+            kp, kv = home.servo[0][index], home.servo[1][index]
+            x_home = home.qpos[slide]
+            low, high = stops[slide]
+            actuator.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+            actuator.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+            actuator.gainprm[0] = kp
+            actuator.biasprm[:3] = [home.force[index] + kp * x_home, -kp, -kv]
+            actuator.ctrlrange = [low - x_home, high - x_home]
+
+
+def build_model(
+    crane: Crane,
+    lengths: LinkLengths | None = None,
+    drives: SlideDrives | None = None,
+    home: HomePose | None = None,
+) -> mujoco.MjModel:
     """Compiled :class:`mujoco.MjModel` of the crane for link lengths Xi (see :func:`build_spec`)."""
-    return build_spec(crane, lengths).compile()
+    return build_spec(crane, lengths, drives, home).compile()
 
 
 def to_xml(
     crane: Crane,
     lengths: LinkLengths | None = None,
     keyframes: dict[str, tuple[np.ndarray, np.ndarray]] | None = None,
+    drives: SlideDrives | None = None,
+    home: HomePose | None = None,
 ) -> str:
     """MJCF text of the crane for link lengths Xi; loads with ``mujoco.MjModel.from_xml_string``.
 
@@ -261,9 +335,11 @@ def to_xml(
         lengths: Link lengths Xi (default: the crane's own).
         keyframes: Optional named keyframes, name -> (qpos (nq,), ctrl (nu,)), written at full
             precision (e.g. a loop-consistent ``home`` pose with its gravity-holding forces).
+        drives: Optional EMLA drives (simulation model, see :func:`build_spec`).
+        home: Optional pose the model opens in (see :func:`build_spec`).
 
     """
-    spec = build_spec(crane, lengths)
+    spec = build_spec(crane, lengths, drives, home)
     model = spec.compile()
     root = ElementTree.fromstring(spec.to_xml())
     if keyframes:
@@ -289,6 +365,9 @@ def to_xml(
         _set(geom, pos=model.geom_pos[geom_id], quat=model.geom_quat[geom_id])
         if geom.get("type", "") != "plane":
             geom.set("size", _text(model.geom_size[geom_id][: len(geom.get("size", "0 0").split())]))
+    for joint in world.iter("joint"):  # joint ref = qpos0 of a hinge or slide (the home pose)
+        if joint.get("ref") is not None:
+            joint.set("ref", repr(float(model.qpos0[model.joint(joint.get("name", "")).qposadr[0]])))
     for site in world.iter("site"):
         site_id = model.site(site.get("name", "")).id
         _set(site, pos=model.site_pos[site_id], quat=model.site_quat[site_id])

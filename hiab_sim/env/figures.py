@@ -1,0 +1,125 @@
+"""Figures of the closed-loop validation (Agg backend, PNG written atomically).
+
+* ``closed_loop_tcp_error.png``: TCP error to the study's reference over time, per design;
+* ``closed_loop_drives.png``: q-currents with the current limit and |v_dq| with the voltage limit;
+* ``closed_loop_power.png``: closed-loop vs predicted electrical power on the DC bus;
+* ``closed_loop_energy.png``: cumulative net electrical energy, closed loop vs predicted.
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from hiab_sim.atomic_io import write_atomic
+from hiab_sim.emla.config import ACTUATOR_NAMES
+from hiab_sim.env.rollout import ClosedLoopRun
+
+COLOURS = {"initial": "tab:blue", "optimal": "tab:red"}
+DRIVE_COLOURS = ("tab:green", "tab:purple", "tab:orange")
+
+
+def _figure(size: tuple[float, float]) -> Figure:
+    fig = Figure(figsize=size, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _save(fig: Figure, path: Path) -> Path:
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=110)
+    write_atomic(path, buffer.getvalue())
+    return path
+
+
+def _label(run: ClosedLoopRun) -> str:
+    extra = f", end mass +{100 * run.payload_error:g} %" if run.payload_error else ""
+    return f"{run.design}{extra}"
+
+
+def _cumulative(power: np.ndarray, time: np.ndarray) -> np.ndarray:
+    return np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(time))])
+
+
+def _style(run: ClosedLoopRun) -> dict[str, Any]:
+    return {"color": COLOURS.get(run.design, "k"), "linestyle": "-" if run.payload_error == 0 else "-."}
+
+
+def write_figures(folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedLoopRun] | None = None) -> list[Path]:
+    """Write the four figures of the module docstring; return their paths.
+
+    The drive figure shows ``runs``; the others also the ``nominal`` runs of a payload-error study.
+    """
+    paths = []
+    every = [*(nominal or []), *runs]
+    fig = _figure((8.0, 3.6))
+    ax = fig.add_subplot()
+    for run in every:
+        ax.plot(run.time, 1000.0 * run.tcp_error, label=f"{_label(run)}: to the reference", **_style(run))
+    for run in runs:
+        colour = COLOURS.get(run.design, "k")
+        ax.plot(
+            run.time,
+            1000.0 * run.plan_error,
+            color=colour,
+            linestyle=":",
+            linewidth=0.9,
+            label=f"{_label(run)}: to the plan",
+        )
+    ax.set(xlabel="time [s]", ylabel="TCP error [mm]", title="Closed-loop TCP tracking error")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    paths.append(_save(fig, folder / "closed_loop_tcp_error.png"))
+
+    fig = _figure((4.2 * len(runs), 5.6))
+    axes = fig.subplots(2, len(runs), squeeze=False, sharex=True)
+    for column, run in enumerate(runs):
+        top, bottom = axes[0, column], axes[1, column]
+        for i, name in enumerate(ACTUATOR_NAMES):
+            colour = DRIVE_COLOURS[i]
+            top.plot(run.time, run.current_dq[:, i, 1], color=colour, label=f"{name} i_q")
+            top.plot(run.time, run.current_dq[:, i, 0], color=colour, linestyle=":", linewidth=0.8)
+            magnitude = np.hypot(run.voltage_dq[:, i, 0], run.voltage_dq[:, i, 1])
+            bottom.plot(run.time, magnitude, color=colour, label=f"{name} |v_dq|")
+        for sign in (1.0, -1.0):
+            top.axhline(sign * run.current_limit[0], color="k", linestyle="--", linewidth=0.8)
+        bottom.axhline(run.voltage_limit[0], color="k", linestyle="--", linewidth=0.8, label="inverter limit")
+        top.set(ylabel="current [A] (dotted: i_d)", title=_label(run))
+        bottom.set(xlabel="time [s]", ylabel="voltage |v_dq| [V]")
+        for ax in (top, bottom):
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7)
+    paths.append(_save(fig, folder / "closed_loop_drives.png"))
+
+    fig = _figure((8.0, 3.6))
+    ax = fig.add_subplot()
+    for run in every:
+        ax.plot(run.time, run.electrical_power.sum(axis=1) / 1e3, label=f"{_label(run)}: closed loop", **_style(run))
+    for run in runs:
+        colour = COLOURS.get(run.design, "k")
+        predicted = run.predicted_power.sum(axis=1) / 1e3
+        ax.plot(run.plan_time, predicted, color=colour, linestyle="--", label=f"{run.design}: predicted")
+    ax.set(xlabel="time [s]", ylabel="DC bus power [kW]", title="Electrical power, closed loop vs predicted")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    paths.append(_save(fig, folder / "closed_loop_power.png"))
+
+    fig = _figure((8.0, 3.6))
+    ax = fig.add_subplot()
+    for run in every:
+        energy = run.cumulative_energy.sum(axis=1) / 1e3
+        ax.plot(run.time, energy, label=f"{_label(run)}: closed loop", **_style(run))
+    for run in runs:
+        predicted = _cumulative(run.predicted_power.sum(axis=1), run.plan_time)
+        colour = COLOURS.get(run.design, "k")
+        ax.plot(run.plan_time, predicted / 1e3, color=colour, linestyle="--", label=f"{run.design}: predicted")
+    ax.set(xlabel="time [s]", ylabel="net electrical energy [kJ]", title="Cumulative net electrical energy")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    paths.append(_save(fig, folder / "closed_loop_energy.png"))
+    return paths

@@ -1,0 +1,166 @@
+"""The crane ``Physics`` of the closed-loop environment: the MJCF simulation model plus the EMLA drives.
+
+:func:`crane_physics` builds the simulation model of :mod:`hiab_sim.model.drives` for a design's link
+lengths (armature J_m k^2, damping b_f, stops, EMLA force limits), placed at the plan's start pose
+(joint ``ref``, so ``reset`` lands there), with the end mass made heavier by ``payload_error`` (an
+extra body with the end mass's centre of mass and scaled inertia) and the study's payload as a point
+mass at the TCP, also scaled. :class:`CranePhysics` steps the drives of
+:mod:`hiab_sim.emla.drive_sim` once per physics step, at the speeds of the slides
+(omega_m = k v_x), and applies their rod forces as the actuators' ``ctrl`` before ``mj_step``.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures.thread  # noqa: F401  (registers its exit hook first; see _free_live_physics)
+import threading
+import weakref
+
+import mujoco
+import numpy as np
+from dm_control import mujoco as dm_mujoco
+from numpy.typing import NDArray
+
+from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator, DriveStep
+from hiab_sim.env.plan import DesignPlan
+from hiab_sim.env.reference import PlannedMotion
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.model.drives import HomePose, SlideDrives
+from hiab_sim.model.mjcf import JOINTS, SLIDES, build_spec
+
+Array = NDArray[np.float64]
+
+
+#: Every live CranePhysics, freed before the interpreter stops dm-control's render thread.
+_LIVE: weakref.WeakSet[CranePhysics] = weakref.WeakSet()
+
+
+def _free_live_physics() -> None:
+    """Free the rendering contexts of every live Physics while dm-control's render executor still runs.
+
+    dm-control frees an OSMesa context from ``__del__`` through a thread pool; at interpreter exit
+    that pool is already shut down and Python prints "Exception ignored ... cannot schedule new
+    futures after shutdown". Hooks registered with ``threading._register_atexit`` run last-in
+    first-out before that shutdown, and this one is registered after the thread pool's own
+    hook (imported above), so it runs first.
+    """
+    for physics in list(_LIVE):
+        physics.free()
+
+
+threading._register_atexit(_free_live_physics)  # type: ignore[attr-defined]
+
+
+class CranePhysics(dm_mujoco.Physics):
+    """dm-control Physics whose ``step`` runs the EMLA drives at the physics rate (module docstring)."""
+
+    drives: DriveSimulator
+    slide_dofs: NDArray[np.int64]
+    tcp_site: int
+    current_reference: Array
+    last: DriveStep | None
+    energy: Array
+    copper: Array
+
+    def attach_drives(self, drives: DriveSimulator) -> None:
+        """Attach the drives (order lift, tilt, telescope) and clear the energy counters."""
+        _LIVE.add(self)
+        self.drives = drives
+        self.slide_dofs = np.array([self.model.jnt_dofadr[self.model.name2id(s, "joint")] for s in SLIDES])
+        self.tcp_site = int(self.model.name2id("tcp", "site"))
+        self.current_reference = np.zeros(len(SLIDES))
+        self.reset_counters()
+
+    def reset_counters(self) -> None:
+        """Zero the accumulated electrical and copper energy and the limit counters."""
+        self.last = None
+        self.energy = np.zeros(len(SLIDES))
+        self.copper = np.zeros(len(SLIDES))
+        self.steps = 0
+        self.current_limited_steps = np.zeros(len(SLIDES))
+        self.voltage_limited_steps = np.zeros(len(SLIDES))
+
+    def rod_velocity(self) -> Array:
+        """v_x of the slides x1, x2, xt2 [m/s]."""
+        return np.asarray(self.data.qvel[self.slide_dofs])
+
+    def stroke(self) -> Array:
+        """Strokes x of the slides x1, x2, xt2 [m]."""
+        return np.asarray(self.data.qpos[self.slide_dofs])
+
+    def step(self, nstep: int = 1) -> None:
+        """Advance nstep physics steps, each: drives over the step, then ``mj_step`` with their rod forces."""
+        model, data = self.model.ptr, self.data.ptr
+        h = float(model.opt.timestep)
+        ratio = self.drives.drives.ratio
+        with self.check_invalid_state():
+            for _ in range(nstep):
+                result = self.drives.step(self.current_reference, ratio * data.qvel[self.slide_dofs], h)
+                data.ctrl[:] = result.rod_force
+                mujoco.mj_step(model, data)
+                self.energy += result.electrical_energy
+                self.copper += result.copper_energy
+                self.current_limited_steps += result.current_limited
+                self.voltage_limited_steps += result.voltage_limited
+                self.steps += 1
+                self.last = result
+            mujoco.mj_kinematics(model, data)  # site positions of the new state, for observations
+
+
+def crane_physics(
+    plan: DesignPlan, motion: PlannedMotion, timestep: float, payload_error: float, bandwidth_hz: float
+) -> CranePhysics:
+    """Build the simulation Physics of a design at its plan's start (module docstring)."""
+    if not (np.isfinite(payload_error) and 0.0 <= payload_error <= 2.0):
+        raise InvalidInputError("payload_error", payload_error, "must lie in [0, 2] (end mass heavier than planned)")
+    drives = SlideDrives.from_emla(plan.emlas)
+    spec = build_spec(plan.crane, plan.lengths, drives)
+    names = [spec.joints[i].name for i in range(len(spec.joints))]
+    home = HomePose(
+        qpos={name: float(motion.qpos[0, i]) for i, name in enumerate(names)},
+        force=(float(motion.force[0, 0]), float(motion.force[0, 1]), float(motion.force[0, 2])),
+    )
+    spec = build_spec(plan.crane, plan.lengths, drives, home)
+    spec.option.timestep = timestep
+    # Implicit in the velocity-dependent forces (the slides' damping); 3x cheaper than the template's RK4.
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    _add_payload(spec, plan, payload_error)
+    _add_view(spec, motion)
+    physics = CranePhysics.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
+    physics.attach_drives(DriveSimulator(DriveArrays.from_params(plan.emlas), bandwidth_hz=bandwidth_hz))
+    return physics
+
+
+def _add_view(spec: mujoco.MjSpec, motion: PlannedMotion) -> None:
+    """Visual only: the TCP reference as grey dots and a camera ``closed_loop`` framing crane and path."""
+    path = motion.reference_tcp[:: max(1, len(motion.reference_tcp) // 120)]
+    for point in path:
+        geom = spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.012, 0.0, 0.0], pos=list(point))
+        geom.contype, geom.conaffinity, geom.group = 0, 0, 2
+        geom.rgba = [0.35, 0.35, 0.35, 1.0]
+    centre = 0.5 * (path.min(axis=0) + np.zeros(3))  # between the crane's base and the work area
+    centre[2] = 0.5 * (path[:, 2].max() + 0.0) + 0.2
+    spec.worldbody.add_camera(
+        name="closed_loop", pos=[centre[0] + 0.2, -7.0, centre[2]], xyaxes=[1, 0, 0, 0, 0, 1], fovy=40.0
+    )
+
+
+def _add_payload(spec: mujoco.MjSpec, plan: DesignPlan, payload_error: float) -> None:
+    """Extra end mass (payload_error x end mass) and the study's payload x (1 + payload_error) at the TCP."""
+    rod = spec.body("telescope_rod")
+    if payload_error != 0.0:
+        end = next(body for body in plan.crane.bodies if body.name == "end_mass")
+        extra = rod.add_body(name="end_mass_error", pos=list(end.com))
+        inertia = np.asarray(end.inertia) * payload_error
+        extra.explicitinertial = True
+        extra.mass = end.mass * payload_error
+        extra.ipos = [0.0, 0.0, 0.0]
+        extra.fullinertia = [inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]]
+    if plan.payload > 0.0:
+        tcp = plan.crane.tcp_in_telescope_rod
+        body = rod.add_body(name="payload", pos=list(tcp.position))
+        body.explicitinertial = True
+        body.mass = plan.payload * (1.0 + payload_error)
+        body.inertia = [1e-6, 1e-6, 1e-6]
+
+
+__all__ = ["JOINTS", "CranePhysics", "crane_physics"]

@@ -1,0 +1,120 @@
+"""The planned motion at the physics rate: joints, actuator strokes, ID forces and feedforward currents.
+
+The fine-grid samples of the plan (positions, rates and accelerations of Θ1, Θ2, xt2) are joined by
+quintic Hermite interpolation, which matches position, rate and acceleration at every sample (exact
+for the quintic B-spline between knots). MuJoCo inverse dynamics (:mod:`hiab_sim.dynamics.mujoco_id`,
+on the model without drives) then gives the load-side actuator force f_x, velocity, acceleration and
+stroke at every physics step (eq. ``dynamics``), and :func:`hiab_sim.emla.drive_state` the q-current
+that produces them in steady electrical state (eqs. ``torque_force``, ``torque_torque``, ``dq0voltage``).
+The TCP reference is interpolated with a cubic spline.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+from scipy.interpolate import CubicSpline
+
+from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
+from hiab_sim.dynamics.samples import JointSamples
+from hiab_sim.emla.drive import drive_state
+from hiab_sim.env.plan import DesignPlan
+from hiab_sim.model.mjcf import source_to_world
+
+Array = NDArray[np.float64]
+
+
+def quintic_hermite(
+    grid: Array, position: Array, velocity: Array, acceleration: Array, times: Array
+) -> tuple[Array, Array, Array]:
+    """Position, rate and acceleration at ``times`` of the quintic Hermite interpolant of (K, n) samples."""
+    index = np.clip(np.searchsorted(grid, times, side="right") - 1, 0, len(grid) - 2)
+    h = (grid[index + 1] - grid[index])[:, None]
+    s = ((times - grid[index])[:, None]) / h
+    p0, p1 = position[index], position[index + 1]
+    v0, v1 = velocity[index] * h, velocity[index + 1] * h
+    a0, a1 = acceleration[index] * h * h, acceleration[index + 1] * h * h
+    # Coefficients of p(s) = sum c_k s^k on [0, 1] matching p, p', p'' at both ends.
+    c0, c1, c2 = p0, v0, 0.5 * a0
+    c3 = 10 * (p1 - p0) - 6 * v0 - 4 * v1 - 1.5 * a0 + 0.5 * a1
+    c4 = -15 * (p1 - p0) + 8 * v0 + 7 * v1 + 1.5 * a0 - a1
+    c5 = 6 * (p1 - p0) - 3 * v0 - 3 * v1 - 0.5 * a0 + 0.5 * a1
+    pos = c0 + s * (c1 + s * (c2 + s * (c3 + s * (c4 + s * c5))))
+    vel = (c1 + s * (2 * c2 + s * (3 * c3 + s * (4 * c4 + s * 5 * c5)))) / h
+    acc = (2 * c2 + s * (6 * c3 + s * (12 * c4 + s * 20 * c5))) / (h * h)
+    return pos, vel, acc
+
+
+@dataclass(frozen=True)
+class PlannedMotion:
+    """The plan sampled every physics step; arrays (N, .) over times k * timestep, k = 0 .. N-1.
+
+    Attributes:
+        time: [s].
+        qpos, qvel: Loop-consistent full MuJoCo state of the planned motion.
+        stroke, rod_velocity, rod_acceleration: Actuator x [m], v_x [m/s], a_x [m/s^2] (lift, tilt, telescope).
+        force: Load-side f_x [N] from inverse dynamics.
+        current: Steady-state q-current of each drive for (f_x, v_x, a_x) [A].
+        reference_tcp: The study's TCP reference in MuJoCo world coordinates [m].
+        planned_tcp: The TCP of the planned motion (MuJoCo kinematics), world [m].
+
+    """
+
+    time: Array
+    qpos: Array
+    qvel: Array
+    stroke: Array
+    rod_velocity: Array
+    rod_acceleration: Array
+    force: Array
+    current: Array
+    reference_tcp: Array
+    planned_tcp: Array
+
+    def index(self, time: float) -> int:
+        """Sample index nearest to ``time`` [s], clipped to the plan."""
+        step = self.time[1] - self.time[0]
+        return int(min(max(round(time / step), 0), len(self.time) - 1))
+
+
+def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
+    """Sample the plan every ``timestep`` [s] (see the module docstring)."""
+    count = round(plan.duration / timestep) + 1
+    times = plan.time[0] + timestep * np.arange(count)
+    pos, vel, acc = quintic_hermite(plan.time, plan.position, plan.velocity, plan.acceleration, times)
+    joints = JointSamples(pos, vel, acc)
+    dynamics = MujocoInverseDynamics(plan.crane, plan.lengths)
+    tcp_force = None if plan.payload == 0.0 else np.array([0.0, -plan.payload * plan.crane.gravity, 0.0])
+    actuators = dynamics(joints, tcp_force)
+    qpos, qvel, _ = dynamics.state(joints)
+    current = np.stack(
+        [
+            drive_state(params, actuators.force[:, i], actuators.velocity[:, i], actuators.acceleration[:, i]).i_q
+            for i, params in enumerate(plan.emlas)
+        ],
+        axis=1,
+    )
+    tcp = CubicSpline(plan.time, plan.reference_tcp, axis=0)(times)
+    model = dynamics.model
+    data = mujoco.MjData(model)
+    site = model.site("tcp").id
+    planned_tcp = np.empty((count, 3))
+    for k in range(count):
+        data.qpos[:] = qpos[k]
+        mujoco.mj_kinematics(model, data)
+        planned_tcp[k] = data.site_xpos[site]
+    return PlannedMotion(
+        time=times - plan.time[0],
+        qpos=qpos,
+        qvel=qvel,
+        stroke=actuators.stroke,
+        rod_velocity=actuators.velocity,
+        rod_acceleration=actuators.acceleration,
+        force=actuators.force,
+        current=current,
+        reference_tcp=source_to_world(tcp),
+        planned_tcp=planned_tcp,
+    )

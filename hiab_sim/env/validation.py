@@ -1,0 +1,150 @@
+"""Closed-loop validation of a result: simulate designs, report against the prediction, render a video.
+
+Used by ``hiab-sim simulate`` (:mod:`hiab_sim.cli.simulate`); see there for the outputs.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from hiab_sim.control.cascade import CascadeGains
+from hiab_sim.env import CURRENT_BANDWIDTH_HZ, PHYSICS_TIMESTEP
+from hiab_sim.env.physics import CranePhysics
+from hiab_sim.env.plan import read_plan
+from hiab_sim.env.rollout import ClosedLoopRun, run_closed_loop
+
+#: Video frame rate [1/s] and the size of one design's viewport (width, height) [px].
+FPS = 30.0
+VIEWPORT = (480, 480)
+
+
+def simulate_designs(
+    result_dir: str | Path, designs: Sequence[str], payload_error: float, quiet: bool = False
+) -> tuple[list[ClosedLoopRun], list[ClosedLoopRun], list[CranePhysics]]:
+    """Run every design at ``payload_error`` (and, when it is not 0, nominally too).
+
+    Returns:
+        The runs at ``payload_error``, the nominal runs (empty when payload_error is 0) and the
+        Physics of the first list (for rendering; free them when done).
+
+    """
+    runs, nominal, physics = [], [], []
+    for design in designs:
+        plan = read_plan(result_dir, design)
+        conditions = [payload_error] if payload_error == 0.0 else [0.0, payload_error]
+        for error in conditions:
+            label = design if error == 0.0 else f"{design} end mass +{100 * error:g} %"
+            with tqdm(total=1, desc=label, unit="step", disable=quiet, file=sys.stderr, leave=False) as bar:
+
+                def progress(done: int, total: int, bar: tqdm = bar) -> None:
+                    if bar.total != total:
+                        bar.reset(total=total)
+                    if done % 50 == 0 or done == total:
+                        bar.n = done
+                        bar.refresh()
+
+                run, item = run_closed_loop(plan, error, progress=progress)
+            if error == payload_error:
+                runs.append(run)
+                physics.append(item)
+            else:
+                nominal.append(run)
+                item.free()
+    return runs, nominal, physics
+
+
+def simulation_report(
+    result_dir: str | Path, runs: list[ClosedLoopRun], nominal: list[ClosedLoopRun]
+) -> dict[str, object]:
+    """The content of ``simulation.json``."""
+    designs: dict[str, object] = {}
+    for run in runs:
+        entry = run.summary()
+        match = next((n for n in nominal if n.design == run.design), None)
+        if match is not None:
+            entry["nominal"] = match.summary()
+            entry["extra_energy_J"] = run.net_energy - match.net_energy
+            entry["extra_energy_vs_predicted_J"] = run.net_energy - run.predicted_net_energy
+        designs[run.design] = entry
+    gains = CascadeGains()
+    report: dict[str, object] = {
+        "result_dir": str(Path(result_dir).resolve()),
+        "designs": designs,
+        "settings": {
+            "physics_timestep_s": PHYSICS_TIMESTEP,
+            "control_timestep_s": float(runs[0].time[1] - runs[0].time[0]),
+            "current_loop_bandwidth_Hz": CURRENT_BANDWIDTH_HZ,
+            "cascade_bandwidths_rad_per_s": {
+                "position": gains.position,
+                "velocity": gains.velocity,
+                "integral": gains.integral,
+            },
+            "energy": "closed loop: int 3/2 (v_d i_d + v_q i_q) dt over the cycle, summed over the drives",
+            "tcp_error": "distance of the simulated TCP to the study's TCP reference at the same time",
+        },
+    }
+    by_design = {run.design: run for run in runs}
+    if {"initial", "optimal"} <= by_design.keys():
+        report["optimal_below_initial"] = by_design["optimal"].net_energy < by_design["initial"].net_energy
+    return report
+
+
+def table(report: dict[str, object]) -> str:
+    """Markdown table of predicted vs closed-loop energy and tracking errors (the README's table)."""
+    lines = [
+        "| design | end mass | predicted energy [J] | closed-loop energy [J] | difference | TCP error rms / max [mm]"
+        " | at current limit | at voltage limit | extra energy [J] |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    designs = report["designs"]
+    assert isinstance(designs, dict)
+    for design, entry in designs.items():
+        rows = [entry["nominal"], entry] if "nominal" in entry else [entry]
+        for row in rows:
+            tcp = row["tcp_error_mm"]
+            mass = "planned" if row["payload_error"] == 0 else f"+{100 * row['payload_error']:g} %"
+            lines.append(
+                f"| {design} | {mass} | {row['predicted_net_electrical_energy_J']:.1f} "
+                f"| {row['net_electrical_energy_J']:.1f} | {row['energy_difference_percent']:+.2f} % "
+                f"| {tcp['rms']:.2f} / {tcp['max']:.2f} | {100 * row['current_limit_fraction']:.1f} % "
+                f"| {100 * row['voltage_limit_fraction']:.1f} % "
+                f"| {'' if 'extra_energy_J' not in row else format(row['extra_energy_J'], '+.1f')} |"
+            )
+    return "\n".join(lines)
+
+
+def render_video(path: Path, runs: list[ClosedLoopRun], physics: list[CranePhysics], quiet: bool = False) -> Path:
+    """Render the logged runs side by side at :data:`FPS` through ``Physics.render`` (camera ``closed_loop``)."""
+    from hiab_sim.render.backend import video_sink
+    from hiab_sim.render.labels import caption_bitmap, stamp
+
+    width, height = VIEWPORT
+    captions = [
+        caption_bitmap(
+            f"{run.design}: closed loop" + (f", end mass +{100 * run.payload_error:g} %" if run.payload_error else ""),
+            (0.1, 0.1, 0.1),
+        )
+        for run in runs
+    ]
+    for item in physics:
+        item.model.light_castshadow[:] = 0  # software (OSMesa) shadows cost 3x the frame time
+    duration = min(run.time[-1] for run in runs)
+    frames = int(np.floor(duration * FPS)) + 1
+    with video_sink(path, (width * len(runs), height), FPS) as sink:
+        for frame in tqdm(range(frames), desc="video", unit="frame", disable=quiet, file=sys.stderr, leave=False):
+            images: list[np.ndarray] = []
+            for run, item in zip(runs, physics, strict=True):
+                index = int(np.clip(np.searchsorted(run.time, frame / FPS), 0, len(run.time) - 1))
+                item.data.qpos[:] = run.qpos[index]
+                item.data.qvel[:] = 0.0
+                item.forward()
+                image = np.array(item.render(height, width, camera_id="closed_loop"))
+                stamp(image, captions[len(images)])
+                images.append(image)
+            sink.add(np.hstack(images))
+    return path

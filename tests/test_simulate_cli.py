@@ -1,0 +1,91 @@
+"""``hiab-sim simulate``: closed-loop validation of an optimisation result, its files and its bad input."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from test_study_small import small_study, write_study
+
+from hiab_sim.cli import main
+from hiab_sim.study.run import run_study
+
+
+@pytest.fixture(scope="module")
+def small_result(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The small study optimised once (analytic ID path, no figures)."""
+    folder = tmp_path_factory.mktemp("small_closed_loop")
+    study = write_study(folder, small_study())
+    return run_study(study, folder / "out", progress=None, figures=False).folder
+
+
+def test_simulate_writes_the_validation_of_one_design(small_result: Path, tmp_path: Path) -> None:
+    """simulation.json holds the closed-loop and predicted energies, TCP errors and limit fractions; 4 figures."""
+    out = tmp_path / "sim"
+    assert main(["simulate", str(small_result), "--design", "optimal", "--no-video", "--quiet", "--out", str(out)]) == 0
+    report = json.loads((out / "simulation.json").read_text())
+    entry = report["designs"]["optimal"]
+    predicted = json.loads((small_result / "result.json").read_text())["optimal"]["net_electrical_energy_J"]
+    assert entry["predicted_net_electrical_energy_J"] == predicted
+    assert entry["net_electrical_energy_J"] == pytest.approx(predicted, rel=0.02)
+    assert entry["tcp_error_mm"]["rms"] <= 2.0 and entry["tcp_error_mm"]["max"] <= 5.0
+    assert entry["current_limit_fraction"] == 0.0 and entry["voltage_limit_fraction"] == 0.0
+    assert sorted(p.name for p in out.glob("closed_loop_*.png")) == [
+        "closed_loop_drives.png",
+        "closed_loop_energy.png",
+        "closed_loop_power.png",
+        "closed_loop_tcp_error.png",
+    ]
+    assert not list(out.glob(".*part*"))  # atomic writes leave no temporary files
+
+
+@pytest.mark.parametrize(
+    ("extra", "field"),
+    [
+        (["--payload-error", "-0.5"], "--payload-error"),
+        (["--payload-error", "nan"], "--payload-error"),
+    ],
+)
+def test_bad_input_exits_2_with_one_line(
+    small_result: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], extra: list[str], field: str
+) -> None:
+    """Out-of-range values exit 2 with one line naming the field, and write nothing."""
+    out = tmp_path / "sim"
+    assert main(["simulate", str(small_result), "--no-video", "--quiet", "--out", str(out), *extra]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and field in err[0] and "Traceback" not in err[0]
+    assert not out.exists()
+
+
+def test_a_folder_without_a_result_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """RESULT_DIR without result.json is named in a one-line error, exit 2."""
+    assert main(["simulate", str(tmp_path), "--no-video", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "RESULT_DIR" in err[0]
+
+
+@pytest.mark.slow
+def test_default_study_validates_in_closed_loop(tmp_path: Path) -> None:
+    """Issue 11's claims on the default study, both designs, and with the end mass 20 % heavier.
+
+    Energy within 2 % of the prediction, TCP error rms <= 2 mm and max <= 5 mm, the optimal design
+    cheaper than the initial one in closed loop too; with +20 % end mass the cycle completes within
+    20 mm and the extra energy is reported.
+    """
+    result = run_study(None, tmp_path / "run", progress=None, figures=False).folder
+    assert main(["simulate", str(result), "--no-video", "--quiet", "--payload-error", "0.2"]) == 0
+    report = json.loads((result / "simulation.json").read_text())
+    designs = report["designs"]
+    for design in ("initial", "optimal"):
+        nominal, heavy = designs[design]["nominal"], designs[design]
+        assert nominal["net_electrical_energy_J"] == pytest.approx(
+            nominal["predicted_net_electrical_energy_J"], rel=0.02
+        )
+        assert nominal["tcp_error_mm"]["rms"] <= 2.0 and nominal["tcp_error_mm"]["max"] <= 5.0
+        assert heavy["tcp_error_mm"]["max"] <= 20.0 and heavy["simulated_time_s"] == pytest.approx(6.25)
+        assert heavy["extra_energy_J"] > 0.0
+    assert (
+        designs["optimal"]["nominal"]["net_electrical_energy_J"]
+        < designs["initial"]["nominal"]["net_electrical_energy_J"]
+    )
