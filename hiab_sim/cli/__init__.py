@@ -17,7 +17,7 @@ from hiab_sim._gl import check_gl_backend
 from hiab_sim.errors import HiabSimError, SolverError
 
 #: Subcommands that import MuJoCo: its OpenGL backend is checked before they run.
-USES_MUJOCO = {"mjcf", "validate", "optimize", "render"}
+USES_MUJOCO = {"mjcf", "validate", "optimize", "render", "sweep"}
 
 #: Subcommand name -> module under ``hiab_sim.cli`` that implements it.
 SUBCOMMANDS: dict[str, str] = {
@@ -27,6 +27,8 @@ SUBCOMMANDS: dict[str, str] = {
     "emla-map": "emla_map",
     "optimize": "optimize",
     "render": "render",
+    "energy-map": "energy_map",
+    "sweep": "sweep",
 }
 
 
