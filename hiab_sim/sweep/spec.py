@@ -188,7 +188,7 @@ def load_sweep(path: str | Path) -> Sweep:
         study, emla = copy.deepcopy(base), copy.deepcopy(emla_base)
         assignments = list(fixed.items()) + [(p, values[p]) for p in paths]
         for p, v in assignments:
-            _assign(study, emla, p, v)
+            _assign(study, emla, p, copy.deepcopy(v))
         _validate(study, emla, study_file, assignments)
         points.append(Point(point_key(values), values, study, emla))
     content = json.dumps({"sweep": data, "study": base, "emla": emla_base}, sort_keys=True, default=str)
