@@ -74,7 +74,10 @@ def test_sweep_table_has_a_row_per_point_with_energies(local_run: tuple[Path, pd
     _, frame = local_run
     assert len(frame) == 4 and (frame["status"] == "ok").all()
     assert sorted(zip(frame["payload"], frame["emla.lift.gear_ratio"], strict=True)) == [
-        (0.0, 4.0), (0.0, 5.0), (150.0, 4.0), (150.0, 5.0)
+        (0.0, 4.0),
+        (0.0, 5.0),
+        (150.0, 4.0),
+        (150.0, 5.0),
     ]
     assert (frame["opt_cost_W2s"] <= frame["start_cost_W2s"]).all()
     assert (frame["opt_net_energy_J"] > 0).all() and (frame["iterations"] > 0).all()
@@ -94,7 +97,7 @@ def test_dask_cluster_gives_the_local_table(local_run: tuple[Path, pd.DataFrame]
     assert_same_table(frame, local)
 
 
-class Stop(Exception):
+class StopSweepError(Exception):
     """Raised by the test hook to interrupt a sweep."""
 
 
@@ -107,9 +110,9 @@ def test_resume_after_interruption_runs_each_point_once(local_run: tuple[Path, p
     def stop_after_two(row: dict[str, Any]) -> None:
         seen.append(row["key"])
         if len(seen) == 2:
-            raise Stop
+            raise StopSweepError
 
-    with make_executor(workers=1) as executor, pytest.raises(Stop):
+    with make_executor(workers=1) as executor, pytest.raises(StopSweepError):
         run_sweep(sweep, tmp_path, executor, progress=False, on_row=stop_after_two)
     partial, _ = read_table(tmp_path / "sweep.parquet")
     assert sorted(partial["key"]) == sorted(seen)
@@ -150,7 +153,8 @@ def _initial() -> dict[str, Any]:
     lengths = load_crane("xs031").default_lengths
     return {
         "initial_lengths": {
-            name: {k: float(getattr(getattr(lengths, name), k)) for k in ("L", "Lc0", "Lc")} for name in ("lift", "tilt")
+            name: {k: float(getattr(getattr(lengths, name), k)) for k in ("L", "Lc0", "Lc")}
+            for name in ("lift", "tilt")
         }
     }
 

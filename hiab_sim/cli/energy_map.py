@@ -18,7 +18,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "Infeasible cells are coloured by their binding constraint."
         ),
     )
-    parser.add_argument("study", nargs="?", metavar="STUDY.yaml", help="study file (default: optimize/xs031_spiral.yaml)")
+    parser.add_argument(
+        "study", nargs="?", metavar="STUDY.yaml", help="study file (default: optimize/xs031_spiral.yaml)"
+    )
     parser.add_argument(
         "--vars",
         default="lift.L,lift.Lc0",

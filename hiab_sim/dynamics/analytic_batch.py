@@ -35,7 +35,9 @@ def stacked_model(crane: Crane, xi: Array, samples: int) -> PlanarModel:
     """Planar model of designs xi (D, 6) [m], each constant repeated ``samples`` times: fields (D samples,)."""
     xi = np.asarray(xi, dtype=float)
     if xi.ndim != 2 or xi.shape[1] != 6:
-        raise InvalidInputError("xi", f"shape {xi.shape}", "must have shape (D, 6): lift L, Lc0, Lc, tilt L, Lc0, Lc", "m")
+        raise InvalidInputError(
+            "xi", f"shape {xi.shape}", "must have shape (D, 6): lift L, Lc0, Lc, tilt L, Lc0, Lc", "m"
+        )
     if not np.all(np.isfinite(xi)) or np.any(xi <= 0.0):
         raise InvalidInputError("xi", "a non-positive or non-finite length", "every length must be finite and > 0", "m")
     default = planar_model(crane, crane.default_lengths)
@@ -48,7 +50,11 @@ def stacked_model(crane: Crane, xi: Array, samples: int) -> PlanarModel:
         ref = chain.default_lengths
         for link, factor in ((f"{chain.name}_cylinder", (Lc0 + Lc) / ref.x0), (f"{chain.name}_rod", Lc / ref.Lc)):
             base = default.links[link]
-            links[link] = PlanarInertia(mass=base.mass * factor, com=base.com * factor, inertia=base.inertia * factor**3)
+            links[link] = PlanarInertia(
+                mass=base.mass * factor,
+                com=np.asarray(base.com * factor, dtype=np.complex128),
+                inertia=base.inertia * factor**3,
+            )
         pivot[chain.name] = default.hinge[chain.name] - L * np.exp(1j * chain.base_axis_angle)
         x0[chain.name] = Lc0 + Lc
         lc0[chain.name] = Lc0

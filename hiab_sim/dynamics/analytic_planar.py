@@ -181,7 +181,7 @@ def _chain(
     ddx = ea.real + s * omega**2
     alpha = (ea.imag - 2.0 * dx * omega) / s
     cylinder = _Frame(pivot, dpivot, ddpivot, e, omega, alpha)
-    rod = cylinder.slider(Lc0 + s - x0 + 0j, 1.0 + 0j, dx, ddx)
+    rod = cylinder.slider(np.asarray(Lc0 + s - x0, dtype=np.complex128), 1.0 + 0j, dx, ddx)
     return boom, cylinder, rod, (s - x0, dx, ddx)
 
 

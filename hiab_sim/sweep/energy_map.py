@@ -28,6 +28,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -188,7 +189,7 @@ class EnergyMap:
     low: Array  # study bounds of Xi [m]
     up: Array
 
-    def grid(self, array: Array) -> Array:
+    def grid(self, array: NDArray[Any]) -> NDArray[Any]:
         """Reshape a per-design array (D,) to the grid (n0, n1)."""
         return np.asarray(array).reshape(len(self.axes[0]), len(self.axes[1]))
 

@@ -23,7 +23,9 @@ def make_executor(workers: int | None = None, dask: str | None = None) -> Iterat
     """
     if dask is not None:
         if workers is not None:
-            raise InvalidInputError("--workers", workers, "cannot be combined with --dask (the cluster has its workers)")
+            raise InvalidInputError(
+                "--workers", workers, "cannot be combined with --dask (the cluster has its workers)"
+            )
         try:
             from distributed import Client
         except ImportError:

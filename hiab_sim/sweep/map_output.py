@@ -32,8 +32,8 @@ def summary(m: EnergyMap) -> dict[str, Any]:
             "net_electrical_energy_J": float(v.net_energy[k]),
         }
     counts: dict[str, int] = {}
-    for k in np.flatnonzero(~feasible):
-        name = v.names[int(v.binding[k])]
+    for cell in np.flatnonzero(~feasible):
+        name = v.names[int(v.binding[cell])]
         counts[name] = counts.get(name, 0) + 1
     b = m.at_base
     return {
@@ -113,7 +113,13 @@ def figure_png(m: EnergyMap) -> bytes:
         if labels:
             cmap = ListedColormap([palette(n % 10) for n in range(len(labels))])
             ax.pcolormesh(
-                m.axes[0], m.axes[1], category.T, shading="nearest", cmap=cmap, alpha=0.35, vmin=-0.5,
+                m.axes[0],
+                m.axes[1],
+                category.T,
+                shading="nearest",
+                cmap=cmap,
+                alpha=0.35,
+                vmin=-0.5,
                 vmax=len(labels) - 0.5,
             )
         ax.plot(m.start_xi[i], m.start_xi[j], "wo", mec="k", ms=8, label="start")

@@ -1,4 +1,4 @@
-"""Dotted paths into a YAML mapping: ``bounds.lift.up``, ``payload``, ``bounds.lift.up[0]``, ``emla.lift.gear_ratio``."""
+"""Dotted paths into a YAML mapping: ``bounds.lift.up``, ``payload``, ``bounds.lift.up[0]``."""
 
 from __future__ import annotations
 

@@ -182,7 +182,7 @@ def load_sweep(path: str | Path) -> Sweep:
         raise ConfigError("set: expected a mapping of paths to values")
     columns, raw = _grid_points(data["grid"]) if "grid" in data else _sample_points(data["sample"])
     paths = [c for c in columns if c not in _axis_names(data)]
-    emla_base = _emla_document(base, study_file) if any(p.startswith("emla.") for p in [*fixed, *paths]) else None
+    emla_base = _emla_document(base) if any(p.startswith("emla.") for p in [*fixed, *paths]) else None
     points = []
     for values in raw:
         study, emla = copy.deepcopy(base), copy.deepcopy(emla_base)
@@ -209,7 +209,7 @@ def _axis_names(data: dict[str, Any]) -> set[str]:
     return {str(k) for k, v in grid.items() if isinstance(v, dict) and "values" in v}
 
 
-def _emla_document(study: dict[str, Any], study_file: Path) -> dict[str, Any]:
+def _emla_document(study: dict[str, Any]) -> dict[str, Any]:
     emla = study.get("emla")
     file = DEFAULT_EMLA_PRESET if emla in (None, "default") else Path(str(emla))
     document = read_yaml(file, "EMLA config")
@@ -234,7 +234,7 @@ def _assign(study: dict[str, Any], emla: dict[str, Any] | None, path: str, value
         if not isinstance(node, dict) or step not in node:
             raise ConfigError(f"{path}: the EMLA file has no {step!r} there")
         node = node[step]
-    if not isinstance(node, dict) or rest[-1] not in node and rest[-1] != "pmsm":
+    if not isinstance(node, dict) or (rest[-1] not in node and rest[-1] != "pmsm"):
         raise ConfigError(f"{path}: the EMLA file has no key {rest[-1]!r} there")
     set_path(emla, path, value, rest)
 
