@@ -54,9 +54,7 @@ def main() -> None:
         except HiabSimError:
             continue
     t_loop = (time.perf_counter() - t0) / max(done, 1) * cells
-    print(
-        f"{args.grid} x {args.grid} energy map of {study.name} (lift.L x lift.Lc0, start design), best of {args.repeats}"
-    )
+    print(f"{args.grid} x {args.grid} energy map of {study.name} (lift.L x lift.Lc0, start), best of {args.repeats}")
     print(f"stacked designs: {t_map:.3f} s wall ({t_map / cells * 1e6:.0f} us/cell; goal <= 2 s)")
     print(f"per-design loop: {t_loop:.1f} s for {cells} cells (from {done} designs); ratio {t_loop / t_map:.0f}x")
     print(f"feasible cells: {int(m.values.feasible.sum())} of {cells}")
