@@ -200,6 +200,7 @@ def test_zipped_axis_moves_its_paths_together(tmp_path: Path) -> None:
     axis = {"values": [0, 10], "bounds.lift.up[0]": [1.1, 1.2], "bounds.tilt.up[0]": [1.2, 1.3]}
     sweep = load_sweep(write_sweep(tmp_path, {"grid": {"opening": axis, "payload": [0.0, 10.0]}}))
     assert sweep.columns == ("opening", "bounds.lift.up[0]", "bounds.tilt.up[0]", "payload")
+    assert sweep.axes == ("opening", "payload")
     assert len(sweep.points) == 4
     for p in sweep.points:
         k = axis["values"].index(p.values["opening"])

@@ -43,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
     with make_executor(args.workers, args.dask) as executor:
         outcome = run_sweep(sweep, out, executor, resume=args.resume, progress=not args.quiet)
     frame, _ = read_table(outcome.table)
-    figures = summary_figures(frame, list(sweep.columns), out, sweep.name)
+    figures = summary_figures(frame, list(sweep.axes), out, sweep.name)
     ok = frame["status"] == "ok"
     print(
         f"ran {len(outcome.ran)} point(s), skipped {len(outcome.skipped)} finished, {len(outcome.failed)} failed now; "

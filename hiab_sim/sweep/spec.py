@@ -63,6 +63,7 @@ class Sweep:
     digest: str
     columns: tuple[str, ...]
     points: tuple[Point, ...]
+    axes: tuple[str, ...]  # one column per independent axis (a zipped axis: its values or first path)
 
 
 def resolve_study(name: str, sweep_file: Path) -> Path:
@@ -112,8 +113,9 @@ def _axes(grid: Any, where: str) -> list[tuple[str | None, dict[str, list[Any]]]
     return axes
 
 
-def _grid_points(grid: Any) -> tuple[list[str], list[dict[str, Any]]]:
+def _grid_points(grid: Any) -> tuple[list[str], list[dict[str, Any]], list[str]]:
     axes = _axes(grid, "grid")
+    main = [str(name) if name is not None and "values" in paths else next(iter(paths)) for name, paths in axes]
     columns: list[str] = []
     for name, paths in axes:
         columns += [name] if name is not None and "values" in paths else []
@@ -125,10 +127,10 @@ def _grid_points(grid: Any) -> tuple[list[str], list[dict[str, Any]]]:
             for path, items in paths.items():
                 values[str(name) if path == "values" else path] = items[k]
         points.append({c: values[c] for c in columns})
-    return columns, points
+    return columns, points, main
 
 
-def _sample_points(sample: Any) -> tuple[list[str], list[dict[str, Any]]]:
+def _sample_points(sample: Any) -> tuple[list[str], list[dict[str, Any]], list[str]]:
     from scipy.stats import qmc
 
     if not isinstance(sample, dict) or set(sample) - {"points", "seed", "ranges"} or "ranges" not in sample:
@@ -148,7 +150,7 @@ def _sample_points(sample: Any) -> tuple[list[str], list[dict[str, Any]]]:
     unit = qmc.LatinHypercube(d=len(ranges), seed=int(seed)).random(n)
     scaled = qmc.scale(unit, low, high)
     columns = [str(p) for p in ranges]
-    return columns, [{c: float(row[k]) for k, c in enumerate(columns)} for row in scaled]
+    return columns, [{c: float(row[k]) for k, c in enumerate(columns)} for row in scaled], columns
 
 
 def point_key(values: dict[str, Any]) -> str:
@@ -180,7 +182,7 @@ def load_sweep(path: str | Path) -> Sweep:
     fixed = data.get("set", {}) or {}
     if not isinstance(fixed, dict):
         raise ConfigError("set: expected a mapping of paths to values")
-    columns, raw = _grid_points(data["grid"]) if "grid" in data else _sample_points(data["sample"])
+    columns, raw, axes = _grid_points(data["grid"]) if "grid" in data else _sample_points(data["sample"])
     paths = [c for c in columns if c not in _axis_names(data)]
     emla_base = _emla_document(base) if any(p.startswith("emla.") for p in [*fixed, *paths]) else None
     points = []
@@ -199,6 +201,7 @@ def load_sweep(path: str | Path) -> Sweep:
         digest=hashlib.sha256(content.encode()).hexdigest(),
         columns=tuple(columns),
         points=tuple(points),
+        axes=tuple(axes),
     )
 
 
