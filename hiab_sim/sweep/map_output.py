@@ -122,8 +122,8 @@ def figure_png(m: EnergyMap) -> bytes:
                 vmin=-0.5,
                 vmax=len(labels) - 0.5,
             )
-        ax.plot(m.start_xi[i], m.start_xi[j], "wo", mec="k", ms=8, label="start")
         ax.plot(m.base.xi[i], m.base.xi[j], "r*", mec="k", ms=14, label="base (" + m.base.source.split(" (")[0] + ")")
+        ax.plot(m.start_xi[i], m.start_xi[j], "wo", mec="k", ms=5, label="start")
         lo, hi = m.low[[i, j]], m.up[[i, j]]
         ax.plot([lo[0], hi[0], hi[0], lo[0], lo[0]], [lo[1], lo[1], hi[1], hi[1], lo[1]], "k--", lw=1, label="bounds")
         ax.set_xlabel(f"{m.variables[0]} [m]")
