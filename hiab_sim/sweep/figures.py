@@ -31,7 +31,8 @@ def summary_figures(frame: pd.DataFrame, parameters: list[str], out: Path, title
         ):
             ax = axes[row, col]
             scale = 1e-3 if y.endswith("_J") else 1.0
-            sc = ax.scatter(frame.loc[ok, p], frame.loc[ok, y] * scale, c=colour, cmap="viridis", s=36)
+            style = {"c": colour, "cmap": "viridis"} if colour is not None else {"c": "C0"}
+            sc = ax.scatter(frame.loc[ok, p], frame.loc[ok, y] * scale, s=36, **style)
             if (~ok).any():
                 bottom = np.nanmin(frame.loc[ok, y] * scale) if ok.any() else 0.0
                 ax.scatter(frame.loc[~ok, p], np.full((~ok).sum(), bottom), marker="x", c="red", label="failed")
@@ -52,9 +53,11 @@ def summary_figures(frame: pd.DataFrame, parameters: list[str], out: Path, title
         for (yv, xv), v in np.ndenumerate(pivot.to_numpy()):
             if np.isfinite(v):
                 ax.text(pivot.columns[xv], pivot.index[yv], f"{v:.1f}", ha="center", va="center", fontsize=8, c="w")
+        for _, row in frame[~ok].iterrows():
+            ax.text(row[numeric[0]], row[numeric[1]], "failed", ha="center", va="center", fontsize=8, c="red")
         ax.set_xlabel(numeric[0])
         ax.set_ylabel(numeric[1])
-        ax.set_title(title)
+        ax.set_title(f"{title}: net energy saved [%] (failed: start outside the EMLA envelope or solver)")
         paths.append(out / "sweep_saving_map.png")
         _save(fig, paths[1])
     return paths
