@@ -60,12 +60,14 @@ def assert_same_table(a: pd.DataFrame, b: pd.DataFrame) -> None:
 
 @pytest.fixture(scope="module")
 def local_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, pd.DataFrame]:
-    """The 4-point sweep on 2 local processes, uninterrupted."""
+    """The 4-point sweep on 2 local processes, uninterrupted, through the CLI."""
     folder = tmp_path_factory.mktemp("sweep")
     path = write_sweep(folder, {"grid": GRID})
-    with make_executor(workers=2) as executor:
-        outcome = run_sweep(load_sweep(path), folder / "local", executor, progress=False)
-    frame, _ = read_table(outcome.table)
+    assert main(["sweep", str(path), "--workers", "2", "--out", str(folder / "local"), "--quiet"]) == 0
+    assert (folder / "local" / "sweep_summary.png").is_file() and (folder / "local" / "sweep_saving_map.png").is_file()
+    frame, _ = read_table(folder / "local" / "sweep.parquet")
+    for key in frame["key"]:
+        assert (folder / "local" / "points" / key / "result.json").is_file()
     return path, frame
 
 
