@@ -74,9 +74,10 @@ def batched_inverse_dynamics(
     Args:
         crane: The crane.
         xi: Link-length sets (D, 6) [m] (lift L, Lc0, Lc, tilt L, Lc0, Lc).
-        position: Joint samples (T, 3) (theta1, theta2 [rad], xt2 [m]), shared by every design.
-        velocity: Their rates (T, 3).
-        acceleration: Their second derivatives (T, 3).
+        position: Joint samples (T, 3) (theta1, theta2 [rad], xt2 [m]) shared by every design, or
+            (D, T, 3), one trajectory per design.
+        velocity: Their rates, same shape.
+        acceleration: Their second derivatives, same shape.
         tcp_force: Force of the environment on the TCP in {W} [N], (3,) or None.
 
     Returns:
@@ -87,17 +88,16 @@ def batched_inverse_dynamics(
     q = np.asarray(position, dtype=float)
     dq = np.asarray(velocity, dtype=float)
     ddq = np.asarray(acceleration, dtype=float)
-    D, T = xi.shape[0], q.shape[0]
+    D, T = xi.shape[0], q.shape[-2]
     force = np.zeros(3) if tcp_force is None else np.asarray(tcp_force, dtype=float)
     if force.shape != (3,):
         raise InvalidInputError("tcp_force", f"shape {force.shape}", "must have shape (3,)", "N")
     model = stacked_model(crane, xi, T)
-    out = planar_solve(
-        crane,
-        model,
-        np.tile(q, (D, 1)),
-        np.tile(dq, (D, 1)),
-        np.tile(ddq, (D, 1)),
-        np.broadcast_to(force, (D * T, 3)),
-    )
+    if q.ndim == 3:
+        if q.shape != (D, T, 3) or dq.shape != q.shape or ddq.shape != q.shape:
+            raise InvalidInputError("position", f"shape {q.shape}", f"must be ({D}, T, 3) like velocity, acceleration")
+        q, dq, ddq = (x.reshape(D * T, 3) for x in (q, dq, ddq))
+    else:
+        q, dq, ddq = (np.tile(x, (D, 1)) for x in (q, dq, ddq))
+    out = planar_solve(crane, model, q, dq, ddq, np.broadcast_to(force, (D * T, 3)))
     return tuple(a.reshape(D, T, 3) for a in out)  # type: ignore[return-value]
