@@ -19,7 +19,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         ),
     )
     parser.add_argument(
-        "study", nargs="?", metavar="STUDY.yaml", help="study file (default: optimize/xs031_spiral.yaml)"
+        "study",
+        nargs="?",
+        metavar="STUDY.yaml",
+        help="study file (default: the --result run's study, else optimize/xs031_spiral.yaml)",
     )
     parser.add_argument(
         "--vars",
@@ -37,11 +40,11 @@ def run(args: argparse.Namespace) -> int:
     """Compute and write the map; return the exit status."""
     from hiab_sim.study.config import DEFAULT_STUDY, load_study
     from hiab_sim.study.problem import LinkLengthProblem
-    from hiab_sim.sweep.energy_map import energy_map, optimum_design, parse_variables, start_design
+    from hiab_sim.sweep.energy_map import energy_map, optimum_design, parse_variables, result_study, start_design
     from hiab_sim.sweep.map_output import TRAJECTORY_NOTE, summary, write_map
 
     variables = parse_variables(args.vars)
-    study = load_study(args.study or DEFAULT_STUDY)
+    study = load_study(args.study or (result_study(args.result) if args.result else DEFAULT_STUDY))
     problem = LinkLengthProblem(study, id_path="analytic")
     base = optimum_design(args.result) if args.result else start_design(problem)
     m = energy_map(problem, base, variables, args.grid)

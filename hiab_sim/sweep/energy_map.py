@@ -99,6 +99,14 @@ def optimum_design(folder: str | Path) -> BaseDesign:
     )
 
 
+def result_study(folder: str | Path) -> str:
+    """The study file a result folder was optimised from (``result.json``'s ``study``)."""
+    try:
+        return str(json.loads((Path(folder) / "result.json").read_text())["study"])
+    except (OSError, ValueError, KeyError) as error:
+        raise ConfigError(f"--result {folder}: not a result folder of hiab-sim optimize ({error})") from None
+
+
 @dataclass(frozen=True)
 class DesignValues:
     """Values of D designs on the fixed trajectory (see the module docstring)."""
