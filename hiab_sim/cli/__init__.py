@@ -17,7 +17,7 @@ from hiab_sim._gl import check_gl_backend
 from hiab_sim.errors import HiabSimError, SolverError
 
 #: Subcommands that import MuJoCo: its OpenGL backend is checked before they run.
-USES_MUJOCO = {"mjcf", "validate", "optimize", "render", "simulate"}
+USES_MUJOCO = {"mjcf", "validate", "optimize", "render", "simulate", "sweep", "pareto"}
 
 #: Subcommand name -> module under ``hiab_sim.cli`` that implements it.
 SUBCOMMANDS: dict[str, str] = {
@@ -29,6 +29,9 @@ SUBCOMMANDS: dict[str, str] = {
     "render": "render",
     "compare": "compare",
     "simulate": "simulate",
+    "energy-map": "energy_map",
+    "sweep": "sweep",
+    "pareto": "pareto",
 }
 
 

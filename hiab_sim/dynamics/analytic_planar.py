@@ -37,20 +37,30 @@ Complex = NDArray[np.complex128]
 
 @dataclass(frozen=True)
 class PlanarInertia:
-    """A link's mass [kg], in-plane centre of mass in its planar frame [m] and I_zz about it [kg m^2]."""
+    """A link's mass [kg], in-plane centre of mass in its planar frame [m] and I_zz about it [kg m^2].
 
-    mass: float
-    com: complex
-    inertia: float
+    Scalars for one design; per-sample arrays (T,) in a stacked model of many designs
+    (:mod:`hiab_sim.dynamics.analytic_batch`), where they broadcast against the samples.
+    """
+
+    mass: float | Array
+    com: complex | Complex
+    inertia: float | Array
 
 
 @dataclass(frozen=True)
 class PlanarModel:
-    """Constant planar data of a crane for one link-length set (built once, cached)."""
+    """Constant planar data of a crane for one link-length set (built once, cached).
+
+    The length-dependent fields (``links`` of cylinders and rods, ``pivot``, ``x0``, ``Lc0``) are
+    scalars for one design or per-sample arrays (T,) for a stack of designs.
+    """
 
     links: dict[str, PlanarInertia]
     hinge: dict[str, complex]  # boom hinge of each chain in its parent's planar frame [m]
-    pivot: dict[str, complex]  # cylinder base pivot of each chain in its parent's planar frame [m]
+    pivot: dict[str, complex | Complex]  # cylinder base pivot of each chain in its parent's planar frame [m]
+    x0: dict[str, float | Array]  # retracted pin-to-pin length Lc0 + Lc of each chain [m]
+    Lc0: dict[str, float | Array]  # piston frame offset of each chain [m]
     telescope_origin: complex  # {P22} origin in the tilt boom's planar frame [m]
     telescope_axis: complex  # unit slide direction in the tilt boom's planar frame
     tcp: complex  # TCP in the telescope rod's planar frame (axes of the tilt boom) [m]
@@ -87,6 +97,8 @@ def planar_model(crane: Crane, lengths: LinkLengths) -> PlanarModel:
         links=links,
         hinge={c.name: _complex(c.boom_hinge) for c in crane.chains},
         pivot={c.name: _complex(c.base_pivot(getattr(lengths, c.name))) for c in crane.chains},
+        x0={c.name: getattr(lengths, c.name).x0 for c in crane.chains},
+        Lc0={c.name: getattr(lengths, c.name).Lc0 for c in crane.chains},
         telescope_origin=_complex(np.asarray(tele.cylinder_frame.position)),
         telescope_axis=_complex(axis) / abs(_complex(axis)),
         tcp=_complex(R0 @ np.asarray(crane.tcp_in_telescope_rod.position)),
@@ -138,7 +150,6 @@ def _wrench(frame: _Frame, body: PlanarInertia, gravity: float) -> tuple[Complex
 def _chain(
     model: PlanarModel,
     chain: ClosedChain,
-    lengths: LinkLengths,
     parent: _Frame,
     theta: Array,
     dtheta: Array,
@@ -157,7 +168,7 @@ def _chain(
     which are eqs. qus_a, dq__ and 04 (x, dq1 = k2 dx, ddq1 = dk2 dx + k2 ddx) written for the
     triangle's side vector instead of its angles.
     """
-    xi = getattr(lengths, chain.name)
+    x0, Lc0 = model.x0[chain.name], model.Lc0[chain.name]
     turn = np.exp(1j * (chain.base_axis_angle - chain.joint_offset + theta))
     boom = parent.child(model.hinge[chain.name], turn, dtheta, ddtheta)
     pivot, dpivot, ddpivot = parent.point(model.pivot[chain.name])
@@ -171,8 +182,8 @@ def _chain(
     ddx = ea.real + s * omega**2
     alpha = (ea.imag - 2.0 * dx * omega) / s
     cylinder = _Frame(pivot, dpivot, ddpivot, e, omega, alpha)
-    rod = cylinder.slider(xi.Lc0 + s - xi.x0 + 0j, 1.0 + 0j, dx, ddx)
-    return boom, cylinder, rod, (s - xi.x0, dx, ddx)
+    rod = cylinder.slider(np.asarray(Lc0 + s - x0, dtype=np.complex128), 1.0 + 0j, dx, ddx)
+    return boom, cylinder, rod, (s - x0, dx, ddx)
 
 
 def _actuator_force(
@@ -200,13 +211,19 @@ def planar_inverse_dynamics(
 
     ``tcp_force`` (T, 3) in {W} [N]; only its x, y components do work in the plane.
     """
-    model = planar_model(crane, lengths)
+    return planar_solve(crane, planar_model(crane, lengths), position, velocity, acceleration, tcp_force)
+
+
+def planar_solve(
+    crane: Crane, model: PlanarModel, position: Array, velocity: Array, acceleration: Array, tcp_force: Array
+) -> tuple[Array, Array, Array, Array]:
+    """:func:`planar_inverse_dynamics` on a planar model (one design, or a stack of designs per sample)."""
     T = position.shape[0]
     zero = np.zeros(T)
     origin = np.zeros(T, complex)
     base = _Frame(origin, origin, origin, np.ones(T, complex), zero, zero)
-    lift = _chain(model, crane.lift, lengths, base, position[:, 0], velocity[:, 0], acceleration[:, 0])
-    tilt = _chain(model, crane.tilt, lengths, lift[0], position[:, 1], velocity[:, 1], acceleration[:, 1])
+    lift = _chain(model, crane.lift, base, position[:, 0], velocity[:, 0], acceleration[:, 0])
+    tilt = _chain(model, crane.tilt, lift[0], position[:, 1], velocity[:, 1], acceleration[:, 1])
     tilt_boom = tilt[0]
     slide = np.asarray(
         model.telescope_origin + model.telescope_axis * (crane.telescope.rod_offset + position[:, 2]),
@@ -233,13 +250,13 @@ def planar_inverse_dynamics(
         return sum(wrench[n][0] for n in names), sum(wrench[n][1] for n in names)  # type: ignore[return-value]
 
     tilt_sub = (wrench["tilt_boom"][0] + f_rod, wrench["tilt_boom"][1] + m_rod)
-    s_tilt = lengths.tilt.x0 + tilt[3][0]
+    s_tilt = model.x0["tilt"] + tilt[3][0]
     f_tilt = _actuator_force(
         crane.tilt, tilt_boom, tilt[1], s_tilt, tilt_sub, add("tilt_cylinder", "tilt_rod"), wrench["tilt_rod"][0]
     )
     tilt_all = add("lift_boom", "tilt_cylinder", "tilt_rod")
     lift_sub = (tilt_all[0] + tilt_sub[0], tilt_all[1] + tilt_sub[1])
-    s_lift = lengths.lift.x0 + lift[3][0]
+    s_lift = model.x0["lift"] + lift[3][0]
     f_lift = _actuator_force(
         crane.lift, lift[0], lift[1], s_lift, lift_sub, add("lift_cylinder", "lift_rod"), wrench["lift_rod"][0]
     )

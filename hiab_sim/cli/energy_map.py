@@ -1,0 +1,73 @@
+"""``hiab-sim energy-map``: the objective, net energy and binding constraint over a grid of two link lengths."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Register the subcommand."""
+    parser = subparsers.add_parser(
+        "energy-map",
+        help="Map the objective and net energy over two link lengths (the rest and the trajectory fixed).",
+        description=(
+            "Evaluate the study's objective (eq. costf2), net electrical energy and Xi-dependent constraints on an "
+            "N x N grid of two link lengths over their bounds, the other four and the joint trajectory fixed at "
+            "the optimum of --result (or the study's start), on the analytic ID path, vectorised over designs. "
+            "Infeasible cells are coloured by their binding constraint."
+        ),
+    )
+    parser.add_argument(
+        "study",
+        nargs="?",
+        metavar="STUDY.yaml",
+        help="study file (default: the --result run's study, else optimize/xs031_spiral.yaml)",
+    )
+    parser.add_argument(
+        "--vars",
+        default="lift.L,lift.Lc0",
+        help="two link lengths, e.g. lift.L,tilt.L (default lift.L,lift.Lc0: with working_range crane a "
+        "chain's L and Lc0 together keep its stroke on the joint range, so their map has a feasible region)",
+    )
+    parser.add_argument("--grid", type=int, default=50, metavar="N", help="grid points per axis (default 50)")
+    parser.add_argument("--result", metavar="DIR", help="result folder of hiab-sim optimize: map around its optimum")
+    parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<study name>/energy_map)")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Compute and write the map; return the exit status."""
+    from hiab_sim.study.config import DEFAULT_STUDY, load_study
+    from hiab_sim.study.problem import LinkLengthProblem
+    from hiab_sim.sweep.energy_map import energy_map, optimum_design, parse_variables, result_study, start_design
+    from hiab_sim.sweep.map_output import TRAJECTORY_NOTE, summary, write_map
+
+    variables = parse_variables(args.vars)
+    study = load_study(args.study or (result_study(args.result) if args.result else DEFAULT_STUDY))
+    problem = LinkLengthProblem(study, id_path="analytic")
+    base = optimum_design(args.result) if args.result else start_design(problem)
+    m = energy_map(problem, base, variables, args.grid)
+    out = Path(args.out) if args.out else Path("runs") / study.name / "energy_map"
+    paths = write_map(m, out)
+    s = summary(m)
+    print(f"energy map {m.variables[0]} x {m.variables[1]}, {args.grid} x {args.grid} cells; base: {m.base.source}")
+    print(f"fixed: {', '.join(f'{k} = {v:.4f} m' for k, v in s['fixed'].items())}; {TRAJECTORY_NOTE}")
+    at = s["at_base"]
+    print(
+        f"at the base: objective {at['objective']:.6f}, net energy {at['net_electrical_energy_J'] / 1e3:.3f} kJ, "
+        f"binding {at['binding_constraint']} (margin {at['smallest_margin']:.2e})"
+    )
+    best = s["best_feasible_cell"]
+    if best is None:
+        print(f"no feasible cell (of {s['cells']})")
+    else:
+        xi = best["xi_m"]
+        i0, i1 = variables
+        print(
+            f"{s['feasible_cells']} of {s['cells']} cells feasible; best: {m.variables[0]} = {xi[i0]:.4f} m, "
+            f"{m.variables[1]} = {xi[i1]:.4f} m, objective {best['objective']:.6f}, "
+            f"net energy {best['net_electrical_energy_J'] / 1e3:.3f} kJ"
+        )
+    print(f"wrote {', '.join(str(p) for p in paths)}")
+    return 0

@@ -1,0 +1,140 @@
+"""Files of an energy map: the figure (objective and net energy, infeasible cells by binding constraint), NPZ, JSON."""
+
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hiab_sim.atomic_io import write_atomic
+from hiab_sim.sweep.energy_map import FEASIBILITY_TOLERANCE, VARIABLES, EnergyMap
+
+TRAJECTORY_NOTE = (
+    "joint trajectory fixed at the base design's (the optimum's spline or the start's inverse-kinematics fit); "
+    "tracking, joint-range and joint-velocity rows depend on it only and hold over the whole map"
+)
+
+
+def summary(m: EnergyMap) -> dict[str, Any]:
+    """JSON-ready summary: variables, base design, trajectory note, value at the base, best feasible cell."""
+    v = m.values
+    feasible = v.feasible
+    best: dict[str, Any] | None = None
+    if feasible.any():
+        k = int(np.flatnonzero(feasible)[np.argmin(v.objective[feasible])])
+        best = {
+            "xi_m": v.xi[k].tolist(),
+            "objective": float(v.objective[k]),
+            "cost_W2s": float(v.cost[k]),
+            "net_electrical_energy_J": float(v.net_energy[k]),
+        }
+    counts: dict[str, int] = {}
+    for cell in np.flatnonzero(~feasible):
+        name = v.names[int(v.binding[cell])]
+        counts[name] = counts.get(name, 0) + 1
+    b = m.at_base
+    return {
+        "variables": list(m.variables),
+        "axes_m": [a.tolist() for a in m.axes],
+        "base": m.base.source,
+        "base_xi_m": m.base.xi.tolist(),
+        "fixed": {name: float(m.base.xi[i]) for i, name in enumerate(VARIABLES) if name not in m.variables},
+        "trajectory": TRAJECTORY_NOTE,
+        "objective_note": "cost of eq. costf2 on the collocation grid divided by its value at the study's start",
+        "at_base": {
+            "objective": float(b.objective[0]),
+            "cost_W2s": float(b.cost[0]),
+            "net_electrical_energy_J": float(b.net_energy[0]),
+            "drawn_energy_without_regeneration_J": float(b.drawn_energy[0]),
+            "smallest_margin": float(b.margins.min()),
+            "binding_constraint": b.names[int(b.binding[0])],
+        },
+        "feasible_cells": int(feasible.sum()),
+        "cells": len(feasible),
+        "feasibility_tolerance": FEASIBILITY_TOLERANCE,
+        "best_feasible_cell": best,
+        "infeasible_cells_by_binding_constraint": counts,
+        "battery_energy": "not available: hiab-sim has no battery model yet (hook DesignValues.battery_energy)",
+    }
+
+
+def write_map(m: EnergyMap, out: Path) -> list[Path]:
+    """Write energy_map.json, energy_map.npz and energy_map.png into ``out`` (atomically); return the paths."""
+    out.mkdir(parents=True, exist_ok=True)
+    v = m.values
+    arrays = {
+        "axis0_m": m.axes[0],
+        "axis1_m": m.axes[1],
+        "objective": m.grid(v.objective),
+        "cost_W2s": m.grid(v.cost),
+        "net_energy_J": m.grid(v.net_energy),
+        "drawn_energy_J": m.grid(v.drawn_energy),
+        "feasible": m.grid(v.feasible),
+        "binding": m.grid(v.binding),
+        "smallest_margin": m.grid(v.margins.min(axis=1)),
+        "constraint_names": np.array(v.names),
+    }
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, **arrays)  # type: ignore[arg-type]
+    paths = [out / "energy_map.json", out / "energy_map.npz", out / "energy_map.png"]
+    write_atomic(paths[0], json.dumps(summary(m), indent=2) + "\n")
+    write_atomic(paths[1], buffer.getvalue())
+    write_atomic(paths[2], figure_png(m))
+    return paths
+
+
+def figure_png(m: EnergyMap) -> bytes:
+    """PNG of two panels (objective, net energy) with infeasible cells coloured by binding constraint."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    v = m.values
+    i, j = VARIABLES.index(m.variables[0]), VARIABLES.index(m.variables[1])
+    feasible = m.grid(v.feasible)
+    binding = m.grid(v.binding)
+    labels = sorted({v.names[int(k)] for k in binding[~feasible]})
+    palette = plt.get_cmap("tab10")
+    category = np.full(feasible.shape, np.nan)
+    for n, name in enumerate(labels):
+        category[(~feasible) & (binding == v.names.index(name))] = n
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5.2), constrained_layout=True)
+    panels = ((v.objective, "objective f / f_start (eq. costf2)"), (v.net_energy / 1e3, "net electrical energy [kJ]"))
+    for ax, (values, title) in zip(axes, panels, strict=True):
+        grid = np.ma.masked_where(~feasible, m.grid(values))
+        mesh = ax.pcolormesh(m.axes[0], m.axes[1], grid.T, shading="nearest", cmap="viridis")
+        fig.colorbar(mesh, ax=ax, label=title)
+        if labels:
+            cmap = ListedColormap([palette(n % 10) for n in range(len(labels))])
+            ax.pcolormesh(
+                m.axes[0],
+                m.axes[1],
+                category.T,
+                shading="nearest",
+                cmap=cmap,
+                alpha=0.35,
+                vmin=-0.5,
+                vmax=len(labels) - 0.5,
+            )
+        ax.plot(m.base.xi[i], m.base.xi[j], "r*", mec="k", ms=14, label="base (" + m.base.source.split(" (")[0] + ")")
+        ax.plot(m.start_xi[i], m.start_xi[j], "wo", mec="k", ms=5, label="start")
+        lo, hi = m.low[[i, j]], m.up[[i, j]]
+        ax.plot([lo[0], hi[0], hi[0], lo[0], lo[0]], [lo[1], lo[1], hi[1], hi[1], lo[1]], "k--", lw=1, label="bounds")
+        ax.set_xlabel(f"{m.variables[0]} [m]")
+        ax.set_ylabel(f"{m.variables[1]} [m]")
+        ax.set_title(title)
+    handles, names = axes[0].get_legend_handles_labels()
+    handles += [Patch(color=palette(n % 10), alpha=0.35) for n in range(len(labels))]
+    names += [f"infeasible: {name}" for name in labels]
+    fig.legend(handles, names, loc="outside lower center", ncol=3, fontsize=8)
+    fig.suptitle(f"Energy map over {m.variables[0]} x {m.variables[1]}; others and trajectory at the {m.base.source}")
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=110)
+    plt.close(fig)
+    return buffer.getvalue()

@@ -1,0 +1,124 @@
+"""One sweep point on a worker: write its study, run the optimisation, return one table row.
+
+:func:`run_point` is what an executor (local process or Dask worker) runs; it takes and returns
+plain picklable data. A point that fails (an infeasible start, a solver failure, anything else)
+returns a row with ``status = "failed"`` and the message, so the sweep goes on.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tempfile
+import time
+import traceback
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from hiab_sim.crane.description import CHAIN_NAMES
+from hiab_sim.study.result import Result
+
+#: Result columns of a row, in table order (the parameter columns come first, then these).
+RESULT_COLUMNS = (
+    "status",
+    "message",
+    "iterations",
+    "wall_time_s",
+    *(f"opt_{c}_{k}_m" for c in CHAIN_NAMES for k in ("L", "Lc0", "Lc")),
+    "start_net_energy_J",
+    "opt_net_energy_J",
+    "start_drawn_energy_J",
+    "opt_drawn_energy_J",
+    "start_cost_W2s",
+    "opt_cost_W2s",
+    "net_energy_saved_percent",
+    "max_violation",
+    "recheck_max_violation",
+    "worst_constraint",
+    "smallest_margin",
+)
+#: Columns that differ between two runs of the same point (timing only).
+TIMING_COLUMNS = ("wall_time_s",)
+
+
+@dataclass(frozen=True)
+class PointTask:
+    """What a worker needs: the point's key and values, its study mapping and EMLA mapping (or None)."""
+
+    key: str
+    values: dict[str, Any]
+    study: dict[str, Any]
+    emla: dict[str, Any] | None
+    study_file: str  # the base study's path (names the study; relative paths are already absolute)
+
+
+@dataclass(frozen=True)
+class PointOutcome:
+    """A row for the table and the run's result.json text (None for a failed point)."""
+
+    key: str
+    row: dict[str, Any]
+    result_json: str | None
+
+
+def row_from_result(result: Result) -> dict[str, Any]:
+    """The result columns of one finished run (the one place a sweep reads a run's result)."""
+    start, opt, solver = result.initial, result.optimal, result.solver
+    row: dict[str, Any] = {
+        "status": "ok",
+        "message": solver.message,
+        "iterations": solver.iterations,
+        "wall_time_s": solver.total_wall_time_s,
+    }
+    for c in CHAIN_NAMES:
+        chain = getattr(opt.lengths, c)
+        for k in ("L", "Lc0", "Lc"):
+            row[f"opt_{c}_{k}_m"] = float(getattr(chain, k))
+    row.update(
+        start_net_energy_J=start.net_electrical_energy_J,
+        opt_net_energy_J=opt.net_electrical_energy_J,
+        start_drawn_energy_J=start.drawn_energy_without_regeneration_J,
+        opt_drawn_energy_J=opt.drawn_energy_without_regeneration_J,
+        start_cost_W2s=start.collocation_cost_W2s,
+        opt_cost_W2s=opt.collocation_cost_W2s,
+        net_energy_saved_percent=result.improvement.net_energy_saved_percent,
+        max_violation=solver.max_violation_scaled,
+        recheck_max_violation=result.recheck.max_violation_scaled,
+        worst_constraint=opt.worst_constraint.name,
+        smallest_margin=opt.worst_constraint.scaled_margin,
+    )
+    return row
+
+
+def failed_row(message: str, wall_time: float) -> dict[str, Any]:
+    """The result columns of a failed point: its message, NaN numbers."""
+    row: dict[str, Any] = {c: math.nan for c in RESULT_COLUMNS}
+    row.update(status="failed", message=message, iterations=-1, wall_time_s=wall_time, worst_constraint="")
+    return row
+
+
+def run_point(task: PointTask) -> PointOutcome:
+    """Optimise one point's study (no figures, no video) and return its row."""
+    from hiab_sim.study.config import study_from_dict
+    from hiab_sim.study.run import run_study
+
+    t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="hiab-sweep-") as tmp:
+        folder = Path(tmp)
+        try:
+            study_map = dict(task.study)
+            if task.emla is not None:
+                emla_file = folder / "emla.yaml"
+                emla_file.write_text(yaml.safe_dump(task.emla, sort_keys=False))
+                study_map["emla"] = str(emla_file)
+            study = study_from_dict(study_map, task.study_file)
+            output = run_study(study, folder / "run", progress=None, figures=False)
+            row = row_from_result(output.result)
+            text: str | None = json.dumps(output.result.to_json(), indent=2) + "\n"
+        except Exception as error:  # any failure of one point is recorded, the sweep goes on
+            message = f"{type(error).__name__}: {error}" if str(error) else traceback.format_exc(limit=1)
+            row, text = failed_row(message.splitlines()[0], time.perf_counter() - t0), None
+    return PointOutcome(task.key, {**task.values, **row}, text)
