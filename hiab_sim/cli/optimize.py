@@ -126,7 +126,11 @@ def run(args: argparse.Namespace) -> int:
         progress=None if args.quiet else sys.stderr,
         figures=not args.no_figures,
     )
-    for line in summary_lines(output.result):
+    from hiab_sim.study.codesign import codesign_lines
+    from hiab_sim.study.energy_report import energy_lines
+
+    codesign = [] if output.result.codesign is None else codesign_lines(output.result.codesign)
+    for line in [*summary_lines(output.result), *energy_lines(output.result), *codesign]:
         print(line)
     print(f"wrote {output.folder}/result.json, trajectory.npz and {len(output.figures)} figures")
     if not args.no_video:
