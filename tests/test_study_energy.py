@@ -189,3 +189,44 @@ def test_negative_thermal_resistance_in_the_emla_file_exits_2(
     assert "thermal.thermal_resistance = -0.6865" in capsys.readouterr().err
     with pytest.raises(InvalidInputError, match="thermal_resistance"):
         study_from_dict(small_study(emla=str(emla)), tmp_path / "s.yaml")
+
+
+def _losses_on(tmp_path: Path) -> Path:
+    """The default EMLA file with ``drive_losses`` enabled and the battery's inverter efficiency 1."""
+    from hiab_sim.resources import locate
+
+    text = locate("default", "emla").read_bytes().decode()
+    text = text.replace("drive_losses:\n  enabled: false", "drive_losses:\n  enabled: true")
+    text = text.replace("value: 0.97\n", "value: 1.0\n", 1)
+    path = tmp_path / "emla_losses.yaml"
+    path.write_text(text)
+    return path
+
+
+def test_drive_losses_enabled_in_the_emla_file_flow_into_the_objective_and_the_report(tmp_path: Path) -> None:
+    """Losses on: the NLP's battery energy rises, its gradient still matches differences, the report names them."""
+    from hiab_sim.study.energy_report import design_energy
+
+    study_on = _study(objective="battery_energy", emla=str(_losses_on(tmp_path)))
+    study_off = _study(objective="battery_energy")
+    assert study_on.emlas.lift.losses.inverter_on and study_on.emlas.battery.inverter_efficiency == 1.0
+    on, off = (LinkLengthProblem(s, cost_scale=1.0) for s in (study_on, study_off))
+    z = on.initial_point(study_on.initial_lengths)
+    assert on.cost(z) > off.cost(z)
+    g = on.cost_gradient(z)
+    for d in _directions(on.n, 2):
+        h = 1e-5
+        fd = (on.cost(z + h * d) - on.cost(z - h * d)) / (2 * h)
+        assert abs(fd - g @ d) <= 1e-5 * max(1.0, abs(fd))
+    fine = LinkLengthProblem(study_on, times=study_on.grid.fine_times(), tightened=False, cost_scale=1.0)
+    e = design_energy(fine, fine.evaluate(z))
+    assert e.drive_loss_energy_J is not None
+    assert e.drive_loss_energy_J["lift"]["transmission_loss"] > 0 and e.drive_loss_energy_J["lift"]["inverter_loss"] > 0
+    assert abs(e.battery_energy_J - e.battery_energy_smooth_J) < 0.01 * e.battery_energy_J
+    assert (
+        design_energy(
+            LinkLengthProblem(study_off, times=study_off.grid.fine_times(), tightened=False, cost_scale=1.0),
+            fine.evaluate(z),
+        ).drive_loss_energy_J
+        is None
+    )

@@ -2,12 +2,14 @@
 
 Every result reports both objectives, whichever the solver minimised:
 
-* the battery energy E_bat [J] (:func:`hiab_sim.emla.battery_energy`, exact kinks, trapezoid rule on
-  the fine grid): what the battery delivers through the DC bus the drives share, regeneration of
-  one drive feeding the others first. This is the number that is the battery's;
+* the battery energy E_bat [J] (:func:`hiab_sim.emla.battery_energy`, exact kinks and exact drive
+  losses (:func:`hiab_sim.emla.operating_point` with ``exact=True``), trapezoid rule on the fine
+  grid): what the battery delivers through the DC bus the drives share, regeneration of one drive
+  feeding the others first. This is the number that is the battery's;
 * the paper's cost ``costf2`` = 1/2 Dt sum_k (sum_i P_i)^2 [W^2 s] on the fine grid (a squared
   power, not an energy);
-* per actuator the drawn energy int max(P_i, 0) dt and the net energy int P_i dt [J];
+* per actuator the drawn energy int max(P_i, 0) dt and the net energy int P_i dt [J], and with the
+  EMLA file's ``drive_losses`` enabled the energy of each loss (transmission, inverter, brake);
 * per motor the RMS torque and peak periodic winding temperature over the study's duty
   (back-to-back cycles, no rest, when the study gives none), exact switching;
 * the hydraulic baseline: the crane's own cylinders (crane file ``hydraulic_cylinders``) for the
@@ -22,9 +24,10 @@ from __future__ import annotations
 import numpy as np
 
 from hiab_sim.crane.names import ACTUATOR_NAMES
-from hiab_sim.emla import battery_energy, thermal_check
+from hiab_sim.emla import battery_energy, operating_point, thermal_check
 from hiab_sim.emla.thermal import Duty
 from hiab_sim.hydraulics import SupplyResult, hydraulic_baseline
+from hiab_sim.quadrature import trapezoid
 from hiab_sim.study.energy_result import (
     ActuatorThermal,
     DesignEnergy,
@@ -37,6 +40,10 @@ from hiab_sim.study.nlp import SampleState
 from hiab_sim.study.objectives import SquaredPowerCost
 from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.result import Result
+
+#: Drive-loss energies reported per actuator when an option of :mod:`hiab_sim.emla.losses` is on
+#: (electrical = mechanical + copper + rotor friction + screw viscous + inertial + these).
+DRIVE_LOSS_PARTS = ("transmission_loss", "inverter_loss", "brake_coil_power", "brake_held_power")
 
 BATTERY_NOTE = (
     "battery_energy_J is the battery's energy: exact, on the fine grid, through the DC bus the drives share "
@@ -60,11 +67,19 @@ def costf2(problem: LinkLengthProblem, state: SampleState) -> float:
 
 def design_energy(problem: LinkLengthProblem, state: SampleState) -> DesignEnergy:
     """Battery energy (exact and smooth), costf2, per-actuator energies and thermal state of one design."""
-    t, battery = state.joints.time, problem.emlas.battery
-    exact = battery_energy(t, state.power, battery)
+    t, battery, act = state.joints.time, problem.emlas.battery, state.actuators
+    ops = [
+        operating_point(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], exact=True)
+        for i, p in enumerate(problem.emlas)
+    ]
+    exact = battery_energy(t, np.column_stack([op.electrical_power for op in ops]), battery)
     smooth = battery_energy(t, state.power, battery, smooth=True)
     duty, _ = study_duty(problem)
-    act = state.actuators
+    losses = {
+        p.name: {key: float(trapezoid(getattr(op, key), t)) for key in DRIVE_LOSS_PARTS}
+        for p, op in zip(problem.emlas, ops, strict=True)
+        if p.losses.transmission_on or p.losses.inverter_on or p.losses.brake_on
+    }
     thermal = {}
     for i, p in enumerate(problem.emlas):
         if p.thermal is None:
@@ -86,6 +101,7 @@ def design_energy(problem: LinkLengthProblem, state: SampleState) -> DesignEnerg
         drawn_energy_J=dict(zip(ACTUATOR_NAMES, map(float, exact.drawn_energy), strict=True)),
         net_energy_J=dict(zip(ACTUATOR_NAMES, map(float, exact.net_energy), strict=True)),
         thermal=thermal or None,
+        drive_loss_energy_J=losses or None,
     )
 
 

@@ -44,6 +44,7 @@ class DesignEnergy:
     drawn_energy_J: dict[str, float]
     net_energy_J: dict[str, float]
     thermal: dict[str, ActuatorThermal] | None = optional()
+    drive_loss_energy_J: dict[str, dict[str, float]] | None = optional()  # only with drive_losses enabled
 
 
 @dataclass(frozen=True)
