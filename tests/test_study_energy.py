@@ -158,6 +158,8 @@ def test_codesign_lists_a_transmission_too_fast_for_the_motor_as_an_infeasible_s
         ({"objective": "energy"}, "objective = 'energy'"),
         ({"duty": {}}, "duty = "),
         ({"duty": {"cycles_per_hour": 0}}, "duty.cycles_per_hour"),
+        ({"duty": {"cycles_per_hour": 1000}}, "duty.cycles_per_hour = 1000"),
+        ({"duty": {"rest_time": -1.0}}, "duty.rest_time"),
         ({"transmission": {}}, "transmission = "),
         ({"transmission": {"lift": []}}, "transmission.lift = "),
         ({"transmission": {"lift": [{"gear_ratio": 1.0, "screw_lead": 0.01}]}}, "transmission.lift[0].gear_ratio"),

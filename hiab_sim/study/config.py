@@ -240,6 +240,8 @@ class Study:
 
     def __post_init__(self) -> None:
         check_range("payload", self.payload, 0.0, unit="kg")
+        if self.energy.duty is not None:
+            self.energy.duty.duty(self.grid.duration)  # the duty must fit the cycle (named error otherwise)
         for name in CHAIN_NAMES:
             for i, key in enumerate(("L", "Lc0", "Lc")):
                 k = 3 * CHAIN_NAMES.index(name) + i
