@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from scipy.integrate import trapezoid
 from test_study_small import small_study, write_study
 
@@ -232,3 +234,14 @@ def test_drive_losses_enabled_in_the_emla_file_flow_into_the_objective_and_the_r
         ).drive_loss_energy_J
         is None
     )
+
+
+@given(cycle=st.floats(0.5, 600.0), fraction=st.floats(1e-3, 1.0))
+def test_cycles_per_hour_give_a_duty_period_of_3600_over_n(cycle: float, fraction: float) -> None:
+    """N cycles an hour of a T-second cycle: rest 3600/n - T >= 0 and period 3600/n [s]."""
+    from hiab_sim.study.energy_config import DutySettings
+
+    n = fraction * 3600.0 / cycle
+    duty = DutySettings(cycles_per_hour=n).duty(cycle)
+    assert duty.rest_time >= 0.0
+    assert duty.period == pytest.approx(max(3600.0 / n, cycle), rel=1e-12)
