@@ -27,7 +27,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description=(
             "Minimise the seed's cost (eq. costf2: 1/2 Dt sum (sum_i P_i)^2 with EMLA electrical power) over "
             "both chains' link lengths and the B-spline joint trajectory, subject to inverse dynamics, TCP "
-            "tracking of a spiral, the EMLA envelope, stroke, triangle and joint limits (SLSQP)."
+            "tracking of a spiral, the EMLA envelope, stroke, triangle and joint limits (SLSQP). A study may "
+            "instead minimise the battery's energy (objective: battery_energy), add the motors' thermal limits "
+            "(duty:) and enumerate a transmission catalogue (transmission:); every result reports the battery "
+            "energy, costf2, thermal margins and the hydraulic baseline."
         ),
     )
     parser.add_argument(
@@ -73,8 +76,8 @@ def summary_lines(r: Result) -> list[str]:
         lines.append(
             f"{name:8s} lift L={lift.L:.4f} Lc0={lift.Lc0:.4f} Lc={lift.Lc:.4f}  "
             f"tilt L={tilt.L:.4f} Lc0={tilt.Lc0:.4f} Lc={tilt.Lc:.4f} m  "
-            f"net energy {entry.net_electrical_energy_J / 1e3:.3f} kJ  "
-            f"drawn {entry.drawn_energy_without_regeneration_J / 1e3:.3f} kJ"
+            f"net motor energy {entry.net_electrical_energy_J / 1e3:.3f} kJ  "
+            f"drawn {entry.drawn_energy_without_regeneration_J / 1e3:.3f} kJ (motor side; battery below)"
         )
     sol, rc = r.solver, r.recheck
     lines.append(
@@ -126,7 +129,11 @@ def run(args: argparse.Namespace) -> int:
         progress=None if args.quiet else sys.stderr,
         figures=not args.no_figures,
     )
-    for line in summary_lines(output.result):
+    from hiab_sim.study.codesign import codesign_lines
+    from hiab_sim.study.energy_report import energy_lines
+
+    codesign = [] if output.result.codesign is None else codesign_lines(output.result.codesign)
+    for line in [*summary_lines(output.result), *energy_lines(output.result), *codesign]:
         print(line)
     print(f"wrote {output.folder}/result.json, trajectory.npz and {len(output.figures)} figures")
     if not args.no_video:

@@ -24,6 +24,7 @@ from hiab_sim.crane.loader import load_crane
 from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import DEFAULT_STUDY, Source, locate
+from hiab_sim.study.energy_config import ENERGY_KEYS, EnergySettings, energy_settings
 from hiab_sim.yaml_fields import mapping, number, positive, read_yaml, section, vector
 
 ID_PATHS = ("mujoco", "analytic")
@@ -235,9 +236,12 @@ class Study:
     solver: SolverSettings
     payload: float = 0.0  # kg hanging at the TCP
     crane_file: Source | None = field(default=None, repr=False, compare=False)
+    energy: EnergySettings = field(default_factory=EnergySettings)  # objective, duty, transmission (issue 13)
 
     def __post_init__(self) -> None:
         check_range("payload", self.payload, 0.0, unit="kg")
+        if self.energy.duty is not None:
+            self.energy.duty.duty(self.grid.duration)  # the duty must fit the cycle (named error otherwise)
         for name in CHAIN_NAMES:
             for i, key in enumerate(("L", "Lc0", "Lc")):
                 k = 3 * CHAIN_NAMES.index(name) + i
@@ -268,6 +272,7 @@ _TOP = {
     "bounds",
     "solver",
     "payload",
+    *ENERGY_KEYS,
 }
 _REQUIRED_TOP = {"crane", "reference", "bounds"}
 
@@ -315,6 +320,7 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
         solver=SolverSettings(**section(SolverSettings, top.get("solver"), "solver")),
         payload=number(top.get("payload", 0.0), "payload"),
         crane_file=crane_file,
+        energy=energy_settings(top),
     )
 
 

@@ -22,6 +22,7 @@ from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.kinematics import forward_kinematics
 from hiab_sim.emla import EmlaSet
+from hiab_sim.study.energy_figure import hydraulic_figure
 from hiab_sim.study.problem import ACTUATORS
 from hiab_sim.study.report import DesignCheck
 from hiab_sim.study.result import ENERGY_PARTS, HistoryRow, Result
@@ -217,4 +218,5 @@ def write_figures(
     actuator_figure(arrays["time"], checks, paths["actuators"])
     efficiency_figure(emlas, checks, paths["maps"])
     energy_figure(checks, paths["energy"])
-    return list(paths.values())
+    hydraulic = hydraulic_figure(out / "energy_emla_vs_hydraulic.png", crane, result, checks["optimal"].evaluation)
+    return list(paths.values()) + hydraulic

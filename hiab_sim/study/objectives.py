@@ -4,6 +4,12 @@
   f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 [W^2 s], a rectangle sum over every sample of the squared
   summed EMLA electrical power P_i (:mod:`hiab_sim.emla`, never f v / eta). It is a
   squared-power integral, not an energy.
+* :class:`BatteryEnergyCost` (``battery_energy``): the energy the battery delivers over the cycle
+  through a DC bus shared by the drives (:func:`hiab_sim.emla.battery_energy`: inverter, bus,
+  battery charge/discharge efficiencies; regeneration of one drive feeds the others first),
+  trapezoid rule on the sample grid [J]. The solver sees the softplus-smoothed kinks (width
+  ``battery.smoothing_power`` of the EMLA set, error <= :meth:`BatteryParams.smoothing_bound`);
+  reports use the exact value (:mod:`hiab_sim.study.energy_report`).
 
 An objective is chosen by name with :func:`make_objective`; a new one is a class with ``name``,
 ``unit``, ``value(state)`` and ``gradient(state, partials)`` plus one entry in :data:`OBJECTIVES`.
@@ -15,7 +21,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from hiab_sim.emla import EmlaSet, electrical_power_partials
+from hiab_sim.emla import EmlaSet, battery_energy, electrical_power_partials
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.nlp import Array, Objective, SamplePartials, SampleState
 
@@ -43,19 +49,51 @@ class SquaredPowerCost:
 
     def gradient(self, state: SampleState, partials: SamplePartials) -> tuple[Array, Array]:
         """Dt (sum_i P_i) dP/d(f, v, a) chained through the inverse dynamics' partials."""
-        act = state.actuators
-        K = len(state.power)
-        dP = np.zeros((K, 3, 9))  # power of actuator i w.r.t. Y = (f0 f1 f2 v0 v1 v2 a0 a1 a2)
-        for i, p in enumerate(self.emlas):
-            pf, pv, pa = electrical_power_partials(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
-            dP[:, i, i], dP[:, i, 3 + i], dP[:, i, 6 + i] = pf, pv, pa
         total = state.power.sum(axis=1)
-        dcost_dY = self.dt * total[:, None] * dP.sum(axis=1)  # (K, 9)
-        return np.einsum("ky,kyq->kq", dcost_dY, partials.id_q), np.einsum("ky,kyx->x", dcost_dY, partials.id_xi)
+        return _chain(self.emlas, state, partials, self.dt * np.repeat(total[:, None], 3, axis=1))
+
+
+class BatteryEnergyCost:
+    """E_bat = int P_bat dt over the sample grid (trapezoid), smooth kinks [J] (:mod:`hiab_sim.emla.battery`).
+
+    Args:
+        emlas: the EMLA set (its ``battery`` section gives the efficiencies and the smoothing).
+        dt: the sample step Dt [s] (unused: the trapezoid weights come from the state's times).
+
+    """
+
+    name = "battery_energy"
+    unit = "J"
+
+    def __init__(self, emlas: EmlaSet, dt: float) -> None:
+        self.emlas = emlas
+        self.dt = dt
+
+    def value(self, state: SampleState) -> float:
+        """Smooth battery energy [J] (within the smoothing bound of the exact one)."""
+        return battery_energy(state.joints.time, state.power, self.emlas.battery, smooth=True).energy
+
+    def gradient(self, state: SampleState, partials: SamplePartials) -> tuple[Array, Array]:
+        """dE/dP_i (per sample and drive) chained through dP/d(f, v, a) and the inverse dynamics' partials."""
+        dE_dP = battery_energy(state.joints.time, state.power, self.emlas.battery, smooth=True).gradient
+        return _chain(self.emlas, state, partials, dE_dP)
+
+
+def _chain(emlas: EmlaSet, state: SampleState, partials: SamplePartials, df_dP: Array) -> tuple[Array, Array]:
+    """(d/dq9 (K, 9), d/dXi (6,)) of an objective from its partials w.r.t. each drive's power, df_dP (K, 3)."""
+    act = state.actuators
+    dY = np.zeros((len(state.power), 9))  # w.r.t. Y = (f0 f1 f2 v0 v1 v2 a0 a1 a2)
+    for i, p in enumerate(emlas):
+        pf, pv, pa = electrical_power_partials(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
+        dY[:, i], dY[:, 3 + i], dY[:, 6 + i] = df_dP[:, i] * pf, df_dP[:, i] * pv, df_dP[:, i] * pa
+    return np.einsum("ky,kyq->kq", dY, partials.id_q), np.einsum("ky,kyx->x", dY, partials.id_xi)
 
 
 #: Objectives by the name a study gives, each built from (EMLA set, sample step Dt [s]).
-OBJECTIVES: dict[str, Callable[[EmlaSet, float], Objective]] = {"costf2": SquaredPowerCost}
+OBJECTIVES: dict[str, Callable[[EmlaSet, float], Objective]] = {
+    "costf2": SquaredPowerCost,
+    "battery_energy": BatteryEnergyCost,
+}
 
 
 def make_objective(name: str, emlas: EmlaSet, dt: float) -> Objective:

@@ -62,6 +62,7 @@ from hiab_sim.study.nlp import (
     SampleState,
 )
 from hiab_sim.study.objectives import make_objective
+from hiab_sim.study.thermal_blocks import thermal_blocks
 
 #: Scale of the link-length variables [m per unit].
 XI_SCALE = 1.0
@@ -110,7 +111,7 @@ class LinkLengthProblem:
         cost_scale: Divisor of the cost [W^2 s] (default: its value at the study's start).
         tightened: Hold the tracking bands times ``collocation_fraction`` and the envelope margins
             >= ``envelope_margin`` (the optimiser's grid); False for the nominal re-check.
-        objective: Name of the objective (:data:`hiab_sim.study.objectives.OBJECTIVES`; default ``costf2``).
+        objective: Name of the objective (:data:`hiab_sim.study.objectives.OBJECTIVES`; default: the study's).
 
     """
 
@@ -122,7 +123,7 @@ class LinkLengthProblem:
         times: Array | None = None,
         cost_scale: float | None = None,
         tightened: bool = True,
-        objective: str = "costf2",
+        objective: str | None = None,
     ) -> None:
         self.study = study
         self.tightened = tightened
@@ -178,7 +179,7 @@ class LinkLengthProblem:
         self.n = self.n_xi + self.n_c
         self.lower = np.concatenate([np.asarray(study.bounds.xi_low) / XI_SCALE, np.full(self.n_c, -np.inf)])
         self.upper = np.concatenate([np.asarray(study.bounds.xi_up) / XI_SCALE, np.full(self.n_c, np.inf)])
-        self.objective = make_objective(objective, self.emlas, self.dt)
+        self.objective = make_objective(objective or study.energy.objective, self.emlas, self.dt)
         self.layout = BlockLayout(self._build_blocks())
         self.constraint_names = self.layout.names
         #: added to the solver's rows gives the nominal scaled margins (each block owns its clearance)
@@ -212,6 +213,7 @@ class LinkLengthProblem:
             bl.JointLimits(t, self.theta_low, self.theta_up),
             bl.JointVelocityLimits(t, np.asarray(self.study.bounds.joint_velocity)),
             bl.WorkingRange(self.crane.chains, self.working, self.working_clearance),
+            *thermal_blocks(self.emlas, self.study.energy.duty, self.study.grid.duration),
         ]
 
     # -- variables ---------------------------------------------------------------------------

@@ -26,6 +26,8 @@ from hiab_sim.atomic_io import write_atomic
 from hiab_sim.emla import energy_summary, operating_point
 from hiab_sim.errors import HiabSimError
 from hiab_sim.quadrature import trapezoid
+from hiab_sim.study.energy_report import energy_report, hydraulic_report
+from hiab_sim.study.objectives import SquaredPowerCost
 from hiab_sim.study.problem import ACTUATORS, Evaluation, LinkLengthProblem
 from hiab_sim.study.result import (
     ENERGY_PARTS,
@@ -103,7 +105,7 @@ def design_summary(problem: LinkLengthProblem, z: Array) -> DesignCheck:
         lengths=ev.lengths,
         id_path=problem.id_path,
         grid_points=len(t),
-        cost_W2s=ev.cost,
+        cost_W2s=SquaredPowerCost(problem.emlas, problem.dt).value(ev),
         cost_note="1/2 Dt sum_k (sum_i P_i(t_k))^2 on this grid: a squared-power integral, not an energy",
         net_electrical_energy_J=float(net_total),
         drawn_energy_without_regeneration_J=float(drawn_total),
@@ -158,7 +160,7 @@ def build_result(
     designs = {
         name: replace(
             checks[name].summary,
-            collocation_cost_W2s=colloc[name].cost,
+            collocation_cost_W2s=SquaredPowerCost(problem.emlas, problem.dt).value(colloc[name]),
             collocation_max_violation=problem.max_violation(colloc[name].z),
         )
         for name in ("initial", "optimal")
@@ -218,6 +220,7 @@ def build_result(
         envelope_margin=study.bounds.envelope_margin,
         payload_kg=study.payload,
     )
+    energy = energy_report(fine, checks["initial"].evaluation, checks["optimal"].evaluation)
     result = Result(
         crane=study.crane_source,
         study=study.path,
@@ -233,6 +236,8 @@ def build_result(
             HistoryRow(h.iteration, h.cost, h.scaled_cost, h.max_violation, tuple(h.xi), h.wall_time)
             for h in main.history
         ),
+        energy=energy,
+        hydraulic_baseline=hydraulic_report(fine, checks["initial"].evaluation, checks["optimal"].evaluation, energy),
     )
     arrays: dict[str, Array] = {"time": fine.times, "reference_tcp": fine.reference.tcp()}
     for name in ("initial", "optimal"):
@@ -278,7 +283,7 @@ def energy_decomposition(
         z = np.concatenate([source[xi_from][:n], source[c_from][n:]])
         try:
             summary = design_summary(fine, z).summary
-            collocation_cost = problem.evaluate(z).cost
+            collocation_cost = SquaredPowerCost(problem.emlas, problem.dt).value(problem.evaluate(z))
         except HiabSimError as error:  # a mixed design may leave the model's domain
             designs[key] = DecompositionDesign(xi_from, c_from, evaluable=False, error=str(error))
             energy[key] = float("nan")
@@ -330,7 +335,7 @@ def multistart_summary(problem: LinkLengthProblem, results: list[SolveResult], t
         optimal, cost = None, None
         if r.success:
             ev = problem.evaluate(r.z)
-            optimal, cost = ev.lengths, ev.cost
+            optimal, cost = ev.lengths, SquaredPowerCost(problem.emlas, problem.dt).value(ev)
         else:
             failed.append(FailedStart(r.start, tuple(r.initial_lengths.as_array().tolist()), r.message))
         rows.append(StartRow(r.start, r.initial_lengths, optimal, cost, r.success, r.message, r.iterations))

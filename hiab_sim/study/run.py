@@ -11,6 +11,7 @@ from typing import TextIO
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.errors import SolverError
 from hiab_sim.study import run_safety
+from hiab_sim.study.codesign import run_codesign
 from hiab_sim.study.config import Study, load_study
 from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.report import build_result, write_results
@@ -56,6 +57,10 @@ def run_study(
     t0 = time.perf_counter()
     if not isinstance(study, Study):
         study = load_study(study)
+    codesign = None
+    if study.energy.transmission is not None:  # issue 13: mounting x transmission catalogue, then the best
+        codesign, emlas = run_codesign(study, progress=progress)
+        study = replace(study, emlas=emlas)
     problem = LinkLengthProblem(study, id_path=id_path)
     check_start(problem, problem.initial_point(study.initial_lengths))
     initials = start_points(problem, starts)
@@ -84,6 +89,8 @@ def run_study(
             failed.message = str(error)
             results.append(failed)
     result, arrays, checks = build_result(problem, results, time.perf_counter() - t0)
+    if codesign is not None:
+        result = replace(result, codesign=codesign)
     crane_file = study.crane_file
     if crane_file is not None and not (crane_file.shipped and crane_file.label == study.crane_source):
         write_atomic(folder / "crane.yaml", crane_file.read_bytes())  # a crane file, not a preset name

@@ -37,7 +37,7 @@ START_TOLERANCE = 1e-9
 
 @dataclass
 class Iterate:
-    """One row of the history: SQP iteration, cost [W^2 s], scaled cost, max violation, Xi [m]."""
+    """One row of the history: iteration, objective (W^2 s costf2, J battery_energy), scaled, violation, Xi [m]."""
 
     iteration: int
     cost: float
@@ -283,7 +283,8 @@ def solve(
         if progress is not None:
             xi = " ".join(f"{v:.4f}" for v in row.xi)
             progress.write(
-                f"[start {start}] iter {row.iteration:3d}  cost {row.cost:.6e} W^2 s ({row.scaled_cost:.6f})"
+                f"[start {start}] iter {row.iteration:3d}  cost {row.cost:.6e} {problem.objective.unit} "
+                f"({row.scaled_cost:.6f})"
                 f"  viol {row.max_violation:.1e}  Xi [{xi}] m  {row.wall_time:.1f} s\n"
             )
             progress.flush()
