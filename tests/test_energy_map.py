@@ -68,7 +68,20 @@ def test_map_at_the_optimum_equals_the_optimisers_objective(optimum: tuple) -> N
     assert at.cost[0] == pytest.approx(result.optimal.collocation_cost_W2s, rel=1e-10)
     assert at.net_energy[0] == pytest.approx(result.optimal.net_electrical_energy_J, rel=1e-10)
     assert at.objective[0] == pytest.approx(result.history[-1].scaled_cost, rel=1e-10)
+    assert at.battery_energy[0] == pytest.approx(result.energy.optimal.battery_energy_J, rel=1e-10)
     assert at.feasible[0]
+
+
+def test_map_of_a_battery_energy_study_is_its_objective(tmp_path: Path) -> None:
+    """With ``objective: battery_energy`` the map's objective at the optimum is the optimiser's final scaled cost."""
+    study = load_study(write_study(tmp_path, {**small_study(**TINY), "objective": "battery_energy"}))
+    output = run_study(study, tmp_path / "run", progress=None, figures=False)
+    problem = LinkLengthProblem(study, id_path="analytic")
+    base = optimum_design(output.folder)
+    at = evaluate_designs(problem, base, base.xi[None])
+    assert problem.objective.name == "battery_energy"
+    assert at.objective[0] == pytest.approx(output.result.history[-1].scaled_cost, rel=1e-9)
+    assert at.battery_energy[0] == pytest.approx(output.result.energy.optimal.battery_energy_J, rel=1e-10)
 
 
 @pytest.mark.parametrize("variables", [(0, 1), (1, 2), (0, 2)])

@@ -139,6 +139,31 @@ def kinked_gain(x: Array, alpha: float, beta: float, eps: float | None) -> tuple
     return beta * x + (alpha - beta) * soft, beta + (alpha - beta) * sigmoid
 
 
+def battery_power(power: ArrayLike, params: BatteryParams, smooth: bool = False) -> tuple[Array, Array, Array, Array]:
+    """Return the DC-bus and battery power of per-drive electrical powers, with their derivatives.
+
+    Each drive's power P_i passes its inverter (P_i / eta_inv motoring, P_i eta_inv generating), the
+    DC powers add on the bus (one drive's regeneration feeds the others first), and the battery
+    delivers P_bus / eta_dis or takes P_bus eta_ch.
+
+    Args:
+        power: Motor electrical power P_i [W], shape (..., n): any leading axes (samples, designs).
+        params: Efficiencies and smoothing.
+        smooth: Softplus kinks of width ``params.smoothing_power`` (the solver's) or exact ones.
+
+    Returns:
+        (bus power (...), battery power (...), dP_bat/dP_bus (...), dP_dc,i/dP_i (..., n)) [W, W, -, -].
+
+    """
+    p = np.asarray(power, dtype=float)
+    eps = params.smoothing_power if smooth else None
+    eta = params.inverter_efficiency
+    dc, d_dc = kinked_gain(p, 1.0 / eta, eta, eps)
+    bus = dc.sum(axis=-1)
+    p_bat, d_bat = kinked_gain(bus, 1.0 / params.discharge_efficiency, params.charge_efficiency, eps)
+    return bus, p_bat, d_bat, d_dc
+
+
 def battery_energy(time: ArrayLike, power: ArrayLike, params: BatteryParams, smooth: bool = False) -> BatteryEnergy:
     """Return the battery energy of per-drive electrical powers on a time grid, with its gradient.
 
@@ -154,11 +179,7 @@ def battery_energy(time: ArrayLike, power: ArrayLike, params: BatteryParams, smo
     p = np.asarray(power, dtype=float)
     if p.ndim != 2 or p.shape[0] != w.size:
         raise InvalidInputError("power", f"shape {p.shape}", f"must be (K, n) with K = {w.size} time samples")
-    eps = params.smoothing_power if smooth else None
-    eta = params.inverter_efficiency
-    dc, d_dc = kinked_gain(p, 1.0 / eta, eta, eps)
-    bus = dc.sum(axis=1)
-    p_bat, d_bat = kinked_gain(bus, 1.0 / params.discharge_efficiency, params.charge_efficiency, eps)
+    bus, p_bat, d_bat, d_dc = battery_power(p, params, smooth)
     return BatteryEnergy(
         energy=float(w @ p_bat),
         gradient=(w * d_bat)[:, None] * d_dc,

@@ -12,8 +12,8 @@ Per design, on the analytic path with all designs stacked into the sample axis
 * the objective of eq. ``costf2``, f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 [W^2 s] on the collocation
   grid, and f / f_start (the optimiser's scaled objective, ``objective``);
 * the net electrical energy and the energy drawn without regeneration [J], trapezoid on the fine
-  grid (as in ``result.json``); ``battery_energy`` is a hook left None until hiab-sim has a
-  battery model;
+  grid (as in ``result.json``); ``battery_energy`` is the energy the battery delivers
+  (:func:`hiab_sim.emla.battery.battery_power`, exact kinks, fine grid);
 * the scaled margins of every constraint row that depends on Xi, as the optimiser holds them on
   the collocation grid: EMLA envelope (const_e, const_f, >= envelope_margin), strokes (const_j)
   at every sample and at both ends of the working range. Rows that depend on the trajectory only
@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.emla import ENVELOPE_LIMIT_NAMES, electrical_power, energy_summary, envelope_margins
+from hiab_sim.emla.battery import battery_power, trapezoid_weights
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study import trajectory as tr
 from hiab_sim.study.problem import ACTUATORS, STROKE_SCALE, LinkLengthProblem
@@ -109,12 +110,12 @@ class DesignValues:
 
     xi: Array  # (D, 6) [m]
     cost: Array  # (D,) [W^2 s], collocation grid
-    objective: Array  # (D,) cost / cost at the study's start
+    objective: Array  # (D,) the study's objective (costf2 or battery energy) / its value at the study's start
     net_energy: Array  # (D,) [J], fine grid
     drawn_energy: Array  # (D,) [J], fine grid, without regeneration
     margins: Array  # (D, R) scaled, min over time per row
     names: tuple[str, ...]  # R row names
-    battery_energy: Array | None = None  # hook: filled once hiab-sim has a battery model
+    battery_energy: Array  # (D,) [J], fine grid, exact (hiab_sim.emla.battery: shared DC bus, efficiencies)
 
     @property
     def binding(self) -> NDArray[np.int64]:
@@ -157,6 +158,8 @@ def evaluate_designs(problem: LinkLengthProblem, base: BaseDesign, xi: Array) ->
     tcp = problem.tcp_force
     strokes = np.array([chain.stroke for chain in crane.chains])
     working = np.array([[w[0] for w in problem.working] + [0.0], [w[1] for w in problem.working] + [0.0]])
+    weights = trapezoid_weights(base.time)
+    colloc_weights = trapezoid_weights(base.time[::ff])
     parts: list[tuple[Array, ...]] = []
     for lo in range(0, len(xi), CHUNK):
         block = xi[lo : lo + CHUNK]
@@ -165,7 +168,13 @@ def evaluate_designs(problem: LinkLengthProblem, base: BaseDesign, xi: Array) ->
         total = power.sum(axis=0)  # (D, K)
         colloc = total[:, ::ff]
         cost = 0.5 * problem.dt * np.sum(colloc**2, axis=1)
+        if problem.objective.name == "battery_energy":  # the optimiser's value: smooth, collocation grid
+            drives = np.moveaxis(power[..., ::ff], 0, -1)
+            objective = battery_power(drives, problem.emlas.battery, smooth=True)[1] @ colloc_weights
+        else:
+            objective = cost
         net, drawn = energy_summary(base.time, total)
+        battery = battery_power(np.moveaxis(power, 0, -1), problem.emlas.battery)[1] @ weights  # (D,) exact [J]
         fc, vc, ac = f[:, ::ff], v[:, ::ff], a[:, ::ff]
         env = np.stack(
             [envelope_margins(p, fc[..., i], vc[..., i], ac[..., i]) for i, p in enumerate(problem.emlas)], axis=1
@@ -175,9 +184,10 @@ def evaluate_designs(problem: LinkLengthProblem, base: BaseDesign, xi: Array) ->
         stroke_rows = _stroke_rows(block, x[:, ::ff, :2], strokes).min(axis=1)
         _, _, _, xw = batched_inverse_dynamics(crane, block, working, np.zeros((2, 3)), np.zeros((2, 3)))
         work_rows = _stroke_rows(block, xw[..., :2], strokes).reshape(len(block), 12)
-        parts.append((cost, net, drawn, np.concatenate([env_rows, stroke_rows, work_rows], axis=1)))
-    cost, net, drawn, margins = (np.concatenate([p[k] for p in parts]) for k in range(4))
-    return DesignValues(xi, cost, cost / problem.cost_scale, net, drawn, margins, margin_names())
+        margins = np.concatenate([env_rows, stroke_rows, work_rows], axis=1)
+        parts.append((cost, objective / problem.cost_scale, net, drawn, margins, battery))
+    cost, objective, net, drawn, margins, battery = (np.concatenate([p[k] for p in parts]) for k in range(6))
+    return DesignValues(xi, cost, objective, net, drawn, margins, margin_names(), battery)
 
 
 @dataclass(frozen=True)
@@ -192,6 +202,7 @@ class EnergyMap:
     start_xi: Array
     low: Array  # study bounds of Xi [m]
     up: Array
+    objective: str  # the study's objective (costf2 or battery_energy)
 
     def grid(self, array: NDArray[Any]) -> NDArray[Any]:
         """Reshape a per-design array (D,) to the grid (n0, n1)."""
@@ -225,6 +236,7 @@ def energy_map(problem: LinkLengthProblem, base: BaseDesign, variables: tuple[in
         problem.study.initial_lengths.as_array(),
         low,
         up,
+        problem.objective.name,
     )
 
 

@@ -43,12 +43,15 @@ def summary(m: EnergyMap) -> dict[str, Any]:
         "base_xi_m": m.base.xi.tolist(),
         "fixed": {name: float(m.base.xi[i]) for i, name in enumerate(VARIABLES) if name not in m.variables},
         "trajectory": TRAJECTORY_NOTE,
-        "objective_note": "cost of eq. costf2 on the collocation grid divided by its value at the study's start",
+        "objective_note": (
+            f"the study's objective ({m.objective}) on the collocation grid divided by its value at the study's start"
+        ),
         "at_base": {
             "objective": float(b.objective[0]),
             "cost_W2s": float(b.cost[0]),
             "net_electrical_energy_J": float(b.net_energy[0]),
             "drawn_energy_without_regeneration_J": float(b.drawn_energy[0]),
+            "battery_energy_J": float(b.battery_energy[0]),
             "smallest_margin": float(b.margins.min()),
             "binding_constraint": b.names[int(b.binding[0])],
         },
@@ -57,7 +60,7 @@ def summary(m: EnergyMap) -> dict[str, Any]:
         "feasibility_tolerance": FEASIBILITY_TOLERANCE,
         "best_feasible_cell": best,
         "infeasible_cells_by_binding_constraint": counts,
-        "battery_energy": "not available: hiab-sim has no battery model yet (hook DesignValues.battery_energy)",
+        "battery_energy_note": "energy the battery delivers through the shared DC bus (hiab_sim.emla.battery)",
     }
 
 
@@ -72,6 +75,7 @@ def write_map(m: EnergyMap, out: Path) -> list[Path]:
         "cost_W2s": m.grid(v.cost),
         "net_energy_J": m.grid(v.net_energy),
         "drawn_energy_J": m.grid(v.drawn_energy),
+        "battery_energy_J": m.grid(v.battery_energy),
         "feasible": m.grid(v.feasible),
         "binding": m.grid(v.binding),
         "smallest_margin": m.grid(v.margins.min(axis=1)),
