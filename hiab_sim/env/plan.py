@@ -16,12 +16,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.crane.description import Crane, LinkLengths
-from hiab_sim.crane.loader import load_crane
 from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.resources import Source
 from hiab_sim.study.config import load_study
 from hiab_sim.study.result import read_result
+from hiab_sim.study.result_read import result_crane
 
 Array = NDArray[np.float64]
 
@@ -84,8 +83,7 @@ def read_plan(result_dir: str | Path, design: str) -> DesignPlan:
         )
     result = read_result(folder)
     summary = result.optimal if design == "optimal" else result.initial
-    # a preset name, or a crane file relative to the result folder (hiab_sim.resources.locate)
-    crane = load_crane(result.crane, relative_to=Source(str(result_file), result_file, False))
+    crane = result_crane(folder, result.crane)
     try:
         arrays = dict(np.load(arrays_file))
         return DesignPlan(

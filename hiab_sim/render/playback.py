@@ -28,11 +28,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.crane.description import Crane, LinkLengths
-from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.resources import Source
 from hiab_sim.study.result import RESULT_FILE, PlaybackView, read_json_as
+from hiab_sim.study.result_read import result_crane
 
 Array = NDArray[np.float64]
 Mode = Literal["kinematic", "simulate"]
@@ -78,8 +77,7 @@ def load_playback(result_dir: str | Path) -> PlaybackData:
         if not (folder / name).is_file():
             raise ConfigError(f"result folder {folder} has no {name} ({_HINT})")
     view = read_json_as(PlaybackView, folder / RESULT_FILE)
-    # a preset name, or a crane file relative to the result folder (hiab_sim.resources.locate)
-    crane = load_crane(view.crane, relative_to=Source(str(folder / RESULT_FILE), folder / RESULT_FILE, False))
+    crane = result_crane(folder, view.crane)
     arrays = _read_npz(folder / TRAJECTORY_FILE)
     time = _array(arrays, "time", 1, folder)
     if len(time) < 2 or not np.all(np.diff(time) > 0):

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +33,7 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("tilt Lc", "mm"),
     ("net energy", "kJ"),
     ("drawn energy", "kJ"),
+    ("battery energy", "kJ"),
     ("lift peak force", "kN"),
     ("tilt peak force", "kN"),
     ("lift peak power", "kW"),
@@ -62,6 +64,7 @@ def rows(runs: Sequence[RunSummary]) -> list[Row]:
                 *(1e3 * v for v in d.lengths.as_array()),
                 d.net_energy_J / 1e3,
                 d.drawn_energy_J / 1e3,
+                math.nan if d.battery_energy_J is None else d.battery_energy_J / 1e3,
                 d.peak_force_N["lift"] / 1e3,
                 d.peak_force_N["tilt"] / 1e3,
                 d.peak_power_W["lift"] / 1e3,
@@ -74,7 +77,7 @@ def rows(runs: Sequence[RunSummary]) -> list[Row]:
     return out
 
 
-_FORMATS = ("{:.1f}",) * 6 + ("{:.3f}",) * 2 + ("{:.2f}",) * 4 + ("{:.3f}", "{:.1e}", "{:.2f}")
+_FORMATS = ("{:.1f}",) * 6 + ("{:.3f}",) * 3 + ("{:.2f}",) * 4 + ("{:.3f}", "{:.1e}", "{:.2f}")
 
 
 def header() -> list[str]:
