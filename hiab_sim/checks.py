@@ -42,6 +42,16 @@ def check_range(
     raise InvalidInputError(where, value, allowed, unit)
 
 
+def check_positive(where: str, value: Any, unit: str = "") -> None:
+    """Raise :class:`InvalidInputError` unless ``value`` is a finite number > 0."""
+    check_range(where, value, 0.0, unit=unit, low_open=True)
+
+
+def check_non_negative(where: str, value: Any, unit: str = "") -> None:
+    """Raise :class:`InvalidInputError` unless ``value`` is a finite number >= 0."""
+    check_range(where, value, 0.0, unit=unit)
+
+
 def check_choice(where: str, value: Any, choices: tuple[str, ...]) -> None:
     """Raise :class:`InvalidInputError` unless ``value`` is one of ``choices``."""
     if value not in choices:

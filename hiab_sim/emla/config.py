@@ -8,6 +8,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+from hiab_sim.checks import check_non_negative, check_positive
 from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.emla.battery import BatteryParams
 from hiab_sim.emla.losses import DriveLosses
@@ -18,16 +19,6 @@ from hiab_sim.yaml_fields import mapping, read_yaml, sourced_number
 
 #: First words allowed in a ``source`` provenance label.
 PROVENANCE_KINDS: tuple[str, ...] = ("read", "estimate", "derived", "model")
-
-
-def _positive(field: str, value: float, unit: str = "") -> None:
-    if not (math.isfinite(value) and value > 0):
-        raise InvalidInputError(field, value, "must be finite and > 0", unit)
-
-
-def _non_negative(field: str, value: float, unit: str = "") -> None:
-    if not (math.isfinite(value) and value >= 0):
-        raise InvalidInputError(field, value, "must be finite and >= 0", unit)
 
 
 @dataclass(frozen=True)
@@ -70,15 +61,15 @@ class PmsmParams:
         pp = self.pole_pairs
         if isinstance(pp, bool) or not isinstance(pp, int) or pp <= 0:
             raise InvalidInputError(f"{self.label}.pole_pairs", pp, "must be a positive integer")
-        _positive(f"{self.label}.flux_linkage", self.flux_linkage, "Wb")
-        _non_negative(f"{self.label}.stator_resistance", self.stator_resistance, "ohm")
-        _positive(f"{self.label}.Ld", self.Ld, "H")
-        _positive(f"{self.label}.Lq", self.Lq, "H")
-        _positive(f"{self.label}.rated_speed_rpm", self.rated_speed_rpm, "rev/min")
-        _positive(f"{self.label}.rated_torque", self.rated_torque, "N m")
-        _positive(f"{self.label}.peak_torque", self.peak_torque, "N m")
-        _non_negative(f"{self.label}.rotor_inertia", self.rotor_inertia, "kg m^2")
-        _non_negative(f"{self.label}.rotor_coulomb_friction", self.rotor_coulomb_friction, "N m")
+        check_positive(f"{self.label}.flux_linkage", self.flux_linkage, "Wb")
+        check_non_negative(f"{self.label}.stator_resistance", self.stator_resistance, "ohm")
+        check_positive(f"{self.label}.Ld", self.Ld, "H")
+        check_positive(f"{self.label}.Lq", self.Lq, "H")
+        check_positive(f"{self.label}.rated_speed_rpm", self.rated_speed_rpm, "rev/min")
+        check_positive(f"{self.label}.rated_torque", self.rated_torque, "N m")
+        check_positive(f"{self.label}.peak_torque", self.peak_torque, "N m")
+        check_non_negative(f"{self.label}.rotor_inertia", self.rotor_inertia, "kg m^2")
+        check_non_negative(f"{self.label}.rotor_coulomb_friction", self.rotor_coulomb_friction, "N m")
         if self.rotor_coulomb_friction >= self.peak_torque:
             raise InvalidInputError(
                 f"{self.label}.rotor_coulomb_friction",
@@ -86,8 +77,8 @@ class PmsmParams:
                 f"must be < peak_torque = {self.peak_torque:g} N m",
                 "N m",
             )
-        _positive(f"{self.label}.max_line_voltage_rms", self.max_line_voltage_rms, "V")
-        _positive(f"{self.label}.friction_smoothing_speed", self.friction_smoothing_speed, "rad/s")
+        check_positive(f"{self.label}.max_line_voltage_rms", self.max_line_voltage_rms, "V")
+        check_positive(f"{self.label}.friction_smoothing_speed", self.friction_smoothing_speed, "rad/s")
 
     @property
     def rated_speed(self) -> float:
@@ -135,13 +126,13 @@ class EmlaParams:
     def __post_init__(self) -> None:
         if not (math.isfinite(self.gear_ratio) and self.gear_ratio > 1.0):
             raise InvalidInputError(f"{self.name}.gear_ratio", self.gear_ratio, "must be finite and > 1 (a reduction)")
-        _positive(f"{self.name}.screw_lead", self.screw_lead, "m")
-        _non_negative(f"{self.name}.screw_moving_mass", self.screw_moving_mass, "kg")
-        _non_negative(f"{self.name}.viscous_friction", self.viscous_friction, "N s/m")
+        check_positive(f"{self.name}.screw_lead", self.screw_lead, "m")
+        check_non_negative(f"{self.name}.screw_moving_mass", self.screw_moving_mass, "kg")
+        check_non_negative(f"{self.name}.viscous_friction", self.viscous_friction, "N s/m")
         for key in ("hydraulic_push_force", "hydraulic_pull_force"):
             value = getattr(self, key)
             if value is not None:
-                _positive(f"{self.name}.{key}", value, "N")
+                check_positive(f"{self.name}.{key}", value, "N")
 
     @property
     def transmission_ratio(self) -> float:

@@ -47,6 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.checks import check_non_negative, check_positive
 from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
@@ -55,16 +56,6 @@ Array = NDArray[np.float64]
 def _efficiency(field: str, value: float) -> None:
     if not (math.isfinite(value) and 0.0 < value <= 1.0):
         raise InvalidInputError(field, value, "must be in (0, 1]")
-
-
-def _non_negative(field: str, value: float, unit: str) -> None:
-    if not (math.isfinite(value) and value >= 0):
-        raise InvalidInputError(field, value, "must be finite and >= 0", unit)
-
-
-def _positive(field: str, value: float, unit: str) -> None:
-    if not (math.isfinite(value) and value > 0):
-        raise InvalidInputError(field, value, "must be finite and > 0", unit)
 
 
 @dataclass(frozen=True)
@@ -99,13 +90,13 @@ class DriveLosses:
     def __post_init__(self) -> None:
         _efficiency(f"{self.label}.transmission_efficiency_forward", self.transmission_efficiency_forward)
         _efficiency(f"{self.label}.transmission_efficiency_backdriven", self.transmission_efficiency_backdriven)
-        _positive(f"{self.label}.force_smoothing", self.force_smoothing, "N")
-        _non_negative(f"{self.label}.inverter_constant_loss", self.inverter_constant_loss, "W")
-        _non_negative(f"{self.label}.inverter_current_loss", self.inverter_current_loss, "W/A")
-        _non_negative(f"{self.label}.inverter_resistance", self.inverter_resistance, "ohm")
-        _positive(f"{self.label}.current_smoothing", self.current_smoothing, "A")
-        _non_negative(f"{self.label}.brake_speed", self.brake_speed, "m/s")
-        _non_negative(f"{self.label}.brake_coil_power", self.brake_coil_power, "W")
+        check_positive(f"{self.label}.force_smoothing", self.force_smoothing, "N")
+        check_non_negative(f"{self.label}.inverter_constant_loss", self.inverter_constant_loss, "W")
+        check_non_negative(f"{self.label}.inverter_current_loss", self.inverter_current_loss, "W/A")
+        check_non_negative(f"{self.label}.inverter_resistance", self.inverter_resistance, "ohm")
+        check_positive(f"{self.label}.current_smoothing", self.current_smoothing, "A")
+        check_non_negative(f"{self.label}.brake_speed", self.brake_speed, "m/s")
+        check_non_negative(f"{self.label}.brake_coil_power", self.brake_coil_power, "W")
 
     @property
     def transmission_on(self) -> bool:

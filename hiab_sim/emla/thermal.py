@@ -34,14 +34,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hiab_sim.checks import check_positive
 from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
-
-
-def _positive(field: str, value: float, unit: str) -> None:
-    if not (math.isfinite(value) and value > 0):
-        raise InvalidInputError(field, value, "must be finite and > 0", unit)
 
 
 @dataclass(frozen=True)
@@ -66,9 +62,9 @@ class ThermalParams:
     label: str = "thermal"
 
     def __post_init__(self) -> None:
-        _positive(f"{self.label}.continuous_torque", self.continuous_torque, "N m")
-        _positive(f"{self.label}.thermal_resistance", self.thermal_resistance, "K/W")
-        _positive(f"{self.label}.time_constant", self.time_constant, "s")
+        check_positive(f"{self.label}.continuous_torque", self.continuous_torque, "N m")
+        check_positive(f"{self.label}.thermal_resistance", self.thermal_resistance, "K/W")
+        check_positive(f"{self.label}.time_constant", self.time_constant, "s")
         if not math.isfinite(self.ambient_temperature):
             raise InvalidInputError(f"{self.label}.ambient_temperature", self.ambient_temperature, "must be finite")
         t_max = self.max_winding_temperature
@@ -89,14 +85,14 @@ class Duty:
     rest_time: float = 0.0
 
     def __post_init__(self) -> None:
-        _positive("duty.cycle_time", self.cycle_time, "s")
+        check_positive("duty.cycle_time", self.cycle_time, "s")
         if not (math.isfinite(self.rest_time) and self.rest_time >= 0):
             raise InvalidInputError("duty.rest_time", self.rest_time, "must be finite and >= 0", "s")
 
     @classmethod
     def from_cycles_per_hour(cls, cycle_time: float, cycles_per_hour: float) -> Duty:
         """Return the duty of ``cycles_per_hour`` cycles of ``cycle_time`` [s] each hour."""
-        _positive("duty.cycle_time", cycle_time, "s")
+        check_positive("duty.cycle_time", cycle_time, "s")
         limit = 3600.0 / cycle_time
         if not (math.isfinite(cycles_per_hour) and 0 < cycles_per_hour <= limit):
             raise InvalidInputError("duty.cycles_per_hour", cycles_per_hour, f"must be in (0, {limit:g}]", "1/h")

@@ -7,21 +7,12 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
+from hiab_sim.checks import check_non_negative, check_positive
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.yaml_fields import mapping, number
 
 #: Cylinder names, in the order of the crane's actuators.
 CYLINDER_NAMES: tuple[str, ...] = ("lift", "tilt", "telescope")
-
-
-def _positive(field: str, value: float, unit: str) -> None:
-    if not (math.isfinite(value) and value > 0):
-        raise InvalidInputError(field, value, "must be finite and > 0", unit)
-
-
-def _non_negative(field: str, value: float, unit: str) -> None:
-    if not (math.isfinite(value) and value >= 0):
-        raise InvalidInputError(field, value, "must be finite and >= 0", unit)
 
 
 @dataclass(frozen=True)
@@ -42,13 +33,13 @@ class Cylinder:
     stroke: float
 
     def __post_init__(self) -> None:
-        _positive(f"hydraulic_cylinders.{self.name}.bore", self.bore, "m")
-        _positive(f"hydraulic_cylinders.{self.name}.rod", self.rod, "m")
+        check_positive(f"hydraulic_cylinders.{self.name}.bore", self.bore, "m")
+        check_positive(f"hydraulic_cylinders.{self.name}.rod", self.rod, "m")
         if self.rod >= self.bore:
             raise InvalidInputError(
                 f"hydraulic_cylinders.{self.name}.rod", self.rod, f"must be < bore = {self.bore:g} m", "m"
             )
-        _positive(f"hydraulic_cylinders.{self.name}.stroke", self.stroke, "m")
+        check_positive(f"hydraulic_cylinders.{self.name}.stroke", self.stroke, "m")
 
     @property
     def piston_area(self) -> float:
@@ -83,9 +74,9 @@ class HydraulicCylinders:
     viscous_friction: float = 0.0
 
     def __post_init__(self) -> None:
-        _positive("hydraulic_cylinders.supply_pressure", self.supply_pressure, "Pa")
-        _non_negative("hydraulic_cylinders.friction.coulomb", self.coulomb_friction, "N")
-        _non_negative("hydraulic_cylinders.friction.viscous", self.viscous_friction, "N s/m")
+        check_positive("hydraulic_cylinders.supply_pressure", self.supply_pressure, "Pa")
+        check_non_negative("hydraulic_cylinders.friction.coulomb", self.coulomb_friction, "N")
+        check_non_negative("hydraulic_cylinders.friction.viscous", self.viscous_friction, "N s/m")
 
     def __iter__(self) -> Iterator[Cylinder]:
         return iter((self.lift, self.tilt, self.telescope))
