@@ -62,6 +62,9 @@ from hiab_sim.study.nlp import (
     SampleState,
 )
 from hiab_sim.study.objectives import make_objective
+from hiab_sim.study.references import Spiral, TaskReference
+from hiab_sim.study.tasks import Task
+from hiab_sim.study.workspace import initial_joints
 
 #: Scale of the link-length variables [m per unit].
 XI_SCALE = 1.0
@@ -123,29 +126,37 @@ class LinkLengthProblem:
         cost_scale: float | None = None,
         tightened: bool = True,
         objective: str = "costf2",
+        task: Task | None = None,
     ) -> None:
+        if task is None:
+            if len(study.tasks) != 1:
+                raise InvalidInputError("task", len(study.tasks), "a study of several tasks needs a task per problem")
+            task = study.tasks[0]
         self.study = study
+        self.task = task
         self.tightened = tightened
         self.band_fraction = study.tracking.collocation_fraction if tightened else 1.0
         self.envelope_margin = study.bounds.envelope_margin if tightened else 0.0
         self.working_clearance = WORKING_CLEARANCE / STROKE_SCALE if tightened else 0.0
         self.emlas = emlas if emlas is not None else study.emlas
         self.id_path = id_path or study.solver.id_path
-        self.times = study.grid.times() if times is None else np.asarray(times, dtype=float)
+        # the task's collocation grid: the study's step over the task's duration (the study's grid for
+        # one task of the grid's duration), its spline: the study's density of control points
+        self.collocation_times = task.times(study.grid.dt)
+        self.times = self.collocation_times if times is None else np.asarray(times, dtype=float)
         self.dt = float(self.times[1] - self.times[0])
-        self.basis = tr.SplineBasis(study.spline.control_points, study.spline.degree, study.grid.duration)
+        duration = task.reference.duration
+        points = task.spline_points(study.spline.control_points, study.grid.duration, study.spline.degree)
+        self.basis = tr.SplineBasis(points, study.spline.degree, duration)
         self.B = np.stack(self.basis.matrices(self.times))  # (3 orders, K, N)
         self.kin = tr.TcpKinematics(study.crane)
-        self.reference = tr.spiral_reference(self.kin, study.reference, study.grid.duration, self.times)
-        self.tcp_force = study.tcp_force
+        self.reference = task.reference.sample(self.kin, self.times)
+        self.tcp_force = payload_force(task, self.kin, study.crane.gravity, self.times)
         self.fd_step = study.solver.fd_step
         self.xi_path = "analytic" if study.solver.xi_derivatives == "analytic" else self.id_path
         # initial fit: inverse kinematics on the fine grid, least-squares spline at rest at both ends
-        fine = study.grid.fine_times()
-        fine_ref = tr.spiral_reference(self.kin, study.reference, study.grid.duration, fine)
-        assert study.reference.centre_joints is not None or study.reference.centre_tcp is not None
-        guess = study.reference.centre_joints or _centre_guess(study)
-        ik = tr.inverse_kinematics(self.kin, fine_ref, guess)
+        fine_ref = task.reference.sample(self.kin, self.fine_times())
+        ik = tr.inverse_kinematics(self.kin, fine_ref, _ik_guess(study, task.reference, self.kin, fine_ref))
         self.reference_joints = ik
         self.c_ref = tr.fit_coefficients(self.basis, ik)
         margin = study.bounds.triangle_margin
@@ -199,6 +210,11 @@ class LinkLengthProblem:
                     f"the start is not an admissible crane: {error.allowed}",
                 ) from None
         self.cost_scale = max(float(cost_scale), 1e-300)
+
+    def fine_times(self) -> Array:
+        """The task's re-check grid: ``grid.fine_factor`` times denser than its collocation grid [s]."""
+        intervals = len(self.collocation_times) - 1
+        return np.linspace(0.0, self.task.reference.duration, self.study.grid.fine_factor * intervals + 1)
 
     def _build_blocks(self) -> list[ConstraintBlock]:
         """The inequality blocks in row order: the one list that defines the NLP's rows."""
@@ -375,6 +391,29 @@ class LinkLengthProblem:
             self._grad_cache.clear()
         self._grad_cache[key] = (grad, jac)
         return grad, jac
+
+
+def payload_force(task: Task, kin: tr.TcpKinematics, gravity: float, times: Array) -> Array | None:
+    """The payload's force on the TCP for the inverse dynamics [N] in {W}: None, (3,) or (K, 3).
+
+    A constant weight without inertia (a single-reference study's plain ``payload: <kg>``) is the
+    constant vector (0, -m g, 0) as before; a schedule or a payload with inertia is the per-sample
+    F(t) = m(t) (g - a_tcp) of :meth:`hiab_sim.study.payload.Payload.tcp_force` at the reference's
+    acceleration (so it does not depend on the decision variables).
+    """
+    payload = task.payload
+    if payload.mass == 0.0:
+        return None
+    if payload.pick is None and payload.release is None and not payload.inertia:
+        return np.array([0.0, -payload.mass * gravity, 0.0])
+    return task.tcp_force(kin, gravity, times)
+
+
+def _ik_guess(study: Study, reference: TaskReference, kin: tr.TcpKinematics, fine: tr.Reference) -> tuple[float, float]:
+    """Start of the Newton IK: a spiral's centre joints (or the joint ranges' middle), else closed-form IK."""
+    if isinstance(reference, Spiral):
+        return reference.centre_joints or _centre_guess(study)
+    return initial_joints(kin, study.crane, fine)
 
 
 def _centre_guess(study: Study) -> tuple[float, float]:

@@ -130,9 +130,10 @@ def fine_problem(problem: LinkLengthProblem, id_path: str | None = None) -> Link
         problem.study,
         emlas=problem.emlas,
         id_path=id_path or problem.id_path,
-        times=problem.study.grid.fine_times(),
+        times=problem.fine_times(),
         cost_scale=problem.cost_scale,
         tightened=False,
+        task=problem.task,
     )
 
 
