@@ -168,6 +168,8 @@ class SolverSettings:
         xi_derivatives: ``analytic``: d(f_x, v_x)/dXi by central differences on the analytic ID
             path (no model rebuild; it agrees with the MuJoCo path to ~1e-14 relative, re-checked
             in every result); ``rebuild``: on the optimisation's own path with model rebuilds.
+        method: ``slsqp`` (scipy, dense; the single-task default) or ``ipopt`` (CasADi's IPOPT
+            with sparse Jacobians, for duty mixes: :mod:`hiab_sim.study.ipopt`).
 
     """
 
@@ -176,6 +178,7 @@ class SolverSettings:
     id_path: str = "mujoco"
     fd_step: float = 1e-6
     xi_derivatives: str = "analytic"
+    method: str = "slsqp"
 
     def __post_init__(self) -> None:
         check_range("solver.maxiter", self.maxiter, 1, integral=True)
@@ -183,6 +186,7 @@ class SolverSettings:
         check_choice("solver.id_path", self.id_path, ID_PATHS)
         check_range("solver.fd_step", self.fd_step, 0.0, low_open=True)
         check_choice("solver.xi_derivatives", self.xi_derivatives, ("analytic", "rebuild"))
+        check_choice("solver.method", self.method, ("slsqp", "ipopt"))
 
 
 @dataclass(frozen=True)
