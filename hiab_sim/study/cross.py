@@ -27,6 +27,10 @@ from hiab_sim.study.result import CrossEvaluation
 from hiab_sim.study.solve import solve
 
 
+#: Largest scaled violation of a design's re-optimised trajectory that counts as serving the task.
+FEASIBLE = 1e-6
+
+
 def fixed_lengths_optimum(
     problem: LinkLengthProblem, lengths: LinkLengths, coefficients: Array | None = None
 ) -> tuple[Array, bool, str]:
@@ -38,7 +42,9 @@ def fixed_lengths_optimum(
         coefficients: Start coefficients (3, N) (default: the inverse-kinematics fit).
 
     Returns:
-        (z of the task's NLP, success, solver message).
+        (z of the task's NLP, success, solver message). SLSQP started at an optimum may stop with
+        "positive directional derivative" (it cannot improve): the point is still used when it
+        is feasible (:data:`FEASIBLE`), its cost then an upper bound of the fixed-Xi optimum.
 
     """
     z0 = problem.initial_point(lengths, coefficients)
@@ -93,9 +99,9 @@ def cross_evaluation(mix: MixProblem, z_mix: Array, alone: list[LinkLengths] | N
             start = mix_c[k] if d == len(alone) else None
             values: tuple[float | None, ...] = (None, None, None, None)
             try:
-                z, ok, _ = fixed_lengths_optimum(p, xi, start)
+                z, _, _ = fixed_lengths_optimum(p, xi, start)
                 summary = design_summary(fine, z).summary
-                if ok and p.max_violation(z) <= 1e-6:
+                if p.max_violation(z) <= FEASIBLE:
                     values = (
                         summary.net_electrical_energy_J,
                         summary.drawn_energy_without_regeneration_J,
