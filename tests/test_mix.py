@@ -21,7 +21,7 @@ SCHEDULE = {"mass": 120.0, "pick": 1.5, "release": 4.5}
 
 
 def two_tasks(**solver: Any) -> dict[str, Any]:
-    """The small study as two tasks: its spiral (weight 1) and a smaller one elsewhere with a payload schedule (weight 2)."""
+    """The small study as two tasks: its spiral (weight 1) and a smaller one with a payload schedule (weight 2)."""
     data = small_study()
     spiral = {"kind": "spiral", **data.pop("reference")}
     data["tasks"] = [

@@ -14,18 +14,20 @@ up to the solver's tolerance).
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 from scipy.optimize import minimize
 
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import HiabSimError
+from hiab_sim.study.ipopt import solve_ipopt
 from hiab_sim.study.mix import MixProblem
 from hiab_sim.study.nlp import N_XI, Array
 from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.report import design_summary, fine_problem
 from hiab_sim.study.result import CrossEvaluation
 from hiab_sim.study.solve import solve
-
 
 #: Largest scaled violation of a design's re-optimised trajectory that counts as serving the task.
 FEASIBLE = 1e-6
@@ -34,7 +36,10 @@ FEASIBLE = 1e-6
 def fixed_lengths_optimum(
     problem: LinkLengthProblem, lengths: LinkLengths, coefficients: Array | None = None
 ) -> tuple[Array, bool, str]:
-    """The task's best trajectory for fixed link lengths: SLSQP over the coefficients only.
+    """The task's best trajectory for fixed link lengths: the task's NLP with Xi fixed.
+
+    With ``solver.method: slsqp`` SLSQP runs over the coefficients only; with ``ipopt`` IPOPT runs
+    on the task's NLP with the Xi bounds collapsed to the design (a fixed variable).
 
     Args:
         problem: The task's NLP (collocation grid, tightened bands).
@@ -49,11 +54,17 @@ def fixed_lengths_optimum(
     """
     z0 = problem.initial_point(lengths, coefficients)
     xi = z0[:N_XI]
+    settings = problem.study.solver
+    if settings.method == "ipopt":
+        fixed = copy.copy(problem)  # the same NLP (and caches) with the Xi bounds collapsed to the design
+        fixed.lower, fixed.upper = problem.lower.copy(), problem.upper.copy()
+        fixed.lower[:N_XI] = fixed.upper[:N_XI] = xi
+        outcome = solve_ipopt(fixed, z0, settings.maxiter, settings.ftol)
+        return outcome.z, outcome.success, outcome.message
 
     def full(zc: Array) -> Array:
         return np.concatenate([xi, zc])
 
-    settings = problem.study.solver
     res = minimize(
         lambda zc: problem.cost(full(zc)),
         z0[N_XI:],

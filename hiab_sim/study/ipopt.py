@@ -93,6 +93,7 @@ def solve_ipopt(
 
     """
     ca = _casadi()
+    Base: Any = ca.Callback
     n = problem.n
     pattern = sparse.vstack([sparse.csr_matrix(problem.equalities_jacobian(z0) != 0.0), jacobian_sparsity(problem)])
     pattern = sparse.csc_matrix(pattern)
@@ -112,7 +113,7 @@ def solve_ipopt(
         dense = np.vstack([problem.equalities_jacobian(z), problem.constraints_jacobian(z)])
         return dense[rows_csc, cols_csc]
 
-    class JacG(ca.Callback):  # type: ignore[misc]
+    class JacG(Base):
         def __init__(self) -> None:
             ca.Callback.__init__(self)
             self.construct("jac_g", {})
@@ -132,7 +133,7 @@ def solve_ipopt(
         def eval(self, arg: list[Any]) -> list[Any]:
             return [ca.DM(jac_sparsity, jac_values(np.asarray(arg[0]).ravel()))]
 
-    class G(ca.Callback):  # type: ignore[misc]
+    class G(Base):
         def __init__(self) -> None:
             ca.Callback.__init__(self)
             self.construct("g", {"enable_fd": False})
@@ -165,7 +166,7 @@ def solve_ipopt(
             keep.append(JacG())
             return keep[-1]
 
-    class GradF(ca.Callback):  # type: ignore[misc]
+    class GradF(Base):
         def __init__(self) -> None:
             ca.Callback.__init__(self)
             self.construct("grad_f", {})
@@ -185,7 +186,7 @@ def solve_ipopt(
         def eval(self, arg: list[Any]) -> list[Any]:
             return [problem.cost_gradient(np.asarray(arg[0]).ravel())[None, :]]
 
-    class F(ca.Callback):  # type: ignore[misc]
+    class F(Base):
         def __init__(self) -> None:
             ca.Callback.__init__(self)
             self.construct("f", {"enable_fd": False})
@@ -214,7 +215,7 @@ def solve_ipopt(
 
     iterates: list[Array] = []
 
-    class Iteration(ca.Callback):  # type: ignore[misc]
+    class Iteration(Base):
         def __init__(self, solver_outputs: int, sparsities: list[Any]) -> None:
             ca.Callback.__init__(self)
             self.outputs, self.sparsities = solver_outputs, sparsities

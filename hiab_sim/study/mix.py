@@ -26,6 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.emla import EmlaSet
@@ -106,7 +107,7 @@ class MixProblem:
         self.n = n
         self.lower = np.concatenate([first.lower[:N_XI], np.full(n - N_XI, -np.inf)])
         self.upper = np.concatenate([first.upper[:N_XI], np.full(n - N_XI, np.inf)])
-        self.rows = [self._kept_rows(k) for k in range(len(self.problems))]
+        self.rows: list[NDArray[np.intp]] = [self._kept_rows(k) for k in range(len(self.problems))]
         self.constraint_names = [
             f"{task.name}: {p.constraint_names[i]}"
             for task, p, rows in zip(self.tasks, self.problems, self.rows, strict=True)
@@ -117,7 +118,7 @@ class MixProblem:
         self.cost_scale = 1.0
         self.cost_scale = max(self.evaluate(self.initial_point(study.initial_lengths)).cost, 1e-300)
 
-    def _kept_rows(self, k: int) -> Array:
+    def _kept_rows(self, k: int) -> NDArray[np.intp]:
         """Row indices of task k's rows in the mix: all, less the Xi-only rows task 0 already has."""
         p = self.problems[k]
         keep = np.ones(len(p.constraint_names), dtype=bool)
@@ -214,7 +215,7 @@ class MixProblem:
         """D e / dz (constant), (12 T, n)."""
         return self._stack([p.equalities_jacobian(self.task_z(z, k)) for k, (p, _) in self._pairs()])
 
-    def _pairs(self) -> list[tuple[int, tuple[LinkLengthProblem, Array]]]:
+    def _pairs(self) -> list[tuple[int, tuple[LinkLengthProblem, NDArray[np.intp]]]]:
         return list(enumerate(zip(self.problems, self.rows, strict=True)))
 
     def _stack(self, parts: list[Array]) -> Array:
