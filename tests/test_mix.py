@@ -150,6 +150,7 @@ def test_cross_evaluation_is_consistent(solved: Path) -> None:
     """The mix optimum costs the mix no more than any task's optimum; each task's optimum is best on its task."""
     from hiab_sim.study.result import read_result
 
+    pytest.importorskip("casadi")  # the fixed-Xi re-optimisations run on IPOPT
     cross = read_result(solved).cross_evaluation
     assert cross is not None and cross.designs == ("spiral alone", "second alone", "mix")
     mix_cost = [c for c in cross.mix_cost_W2s if c is not None]
@@ -158,3 +159,21 @@ def test_cross_evaluation_is_consistent(solved: Path) -> None:
         own, on_mix = cross.cost_W2s[k][k], cross.cost_W2s[-1][k]
         assert own is not None and on_mix is not None and own <= on_mix * (1 + 1e-6)
     assert cross.mix_energy_lost_J[-1] == 0.0
+
+
+@pytest.mark.slow
+def test_duty_mix_converges_from_the_built_crane_and_three_starts_agree(tmp_path: Path) -> None:
+    """The shipped duty mix: violation <= 1e-6 on every task (fine grid, other ID path); 3 starts, one Xi."""
+    from hiab_sim.study.config import load_study
+    from hiab_sim.study.result import read_result
+
+    pytest.importorskip("casadi")
+    run_study(load_study("xs031_duty_mix"), tmp_path, starts=3, progress=None, figures=False, cross=False)
+    r = read_result(tmp_path)
+    assert r.solver.success and r.tasks is not None and len(r.tasks) == 3
+    assert r.optimal.lengths == r.multistart.starts[0].optimal_lengths
+    for task in r.tasks:
+        assert task.optimal.collocation_max_violation is not None and task.optimal.collocation_max_violation <= 1e-6
+        assert task.recheck.max_violation_scaled <= 1e-6 and task.recheck.id_path == "analytic"
+    assert r.multistart.converged_starts == 3
+    assert r.multistart.same_optimum, [d.xi for d in r.multistart.distinct_optima]

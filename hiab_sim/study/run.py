@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import TextIO
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.errors import SolverError
+from hiab_sim.errors import ConfigError, SolverError
 from hiab_sim.study import run_safety
 from hiab_sim.study.config import Study, load_study
 from hiab_sim.study.cross import cross_evaluation
@@ -89,7 +89,13 @@ def run_study(
             failed.message = str(error)
             results.append(failed)
     if isinstance(problem, MixProblem):
-        evaluation = cross_evaluation(problem, results[0].z) if cross else None
+        evaluation = None
+        if cross:
+            try:
+                evaluation = cross_evaluation(problem, results[0].z)
+            except ConfigError as error:  # CasADi (IPOPT) is an optional dependency
+                if progress is not None:
+                    progress.write(f"no cross-evaluation: {error}\n")
         result, arrays, checks = build_mix_result(problem, results, time.perf_counter() - t0, evaluation)
     else:
         result, arrays, checks = build_result(problem, results, time.perf_counter() - t0)
