@@ -334,7 +334,8 @@ def solve(
         _save_checkpoint(out, result, result.z, done=result.success, identity=identity)
     if not result.success:
         raise SolverError(
-            f"start {start}: SLSQP status {result.status}: {result.message} after {result.iterations} iterations "
+            f"start {start}: {problem.study.solver.method.upper()} status {result.status}: {result.message} "
+            f"after {result.iterations} iterations "
             "(partial history kept in the output folder)"
         )
     return result
