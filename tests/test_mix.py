@@ -16,6 +16,8 @@ from hiab_sim.study.payload import Payload
 from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.run import run_study
 
+#: Relative cost spread of the NLP's local optima on the two-task study (measured 1.3e-5).
+LOCAL_SPREAD = 1e-4
 #: Held from 1.5 s to 4.5 s of the second task (weight and inertia).
 SCHEDULE = {"mass": 120.0, "pick": 1.5, "release": 4.5}
 
@@ -153,11 +155,13 @@ def test_cross_evaluation_is_consistent(solved: Path) -> None:
     pytest.importorskip("casadi")  # the fixed-Xi re-optimisations run on IPOPT
     cross = read_result(solved).cross_evaluation
     assert cross is not None and cross.designs == ("spiral alone", "second alone", "mix")
+    # The NLP is not convex: its local optima (here tilt L ~ 1.20 m or ~ 1.13 m) differ by ~1e-5 in
+    # cost, so "no more" holds to LOCAL_SPREAD, not to the solver's tolerance.
     mix_cost = [c for c in cross.mix_cost_W2s if c is not None]
-    assert len(mix_cost) == 3 and all(mix_cost[-1] <= c * (1 + 1e-6) for c in mix_cost)
+    assert len(mix_cost) == 3 and all(mix_cost[-1] <= c * (1 + LOCAL_SPREAD) for c in mix_cost)
     for k in range(2):
         own, on_mix = cross.cost_W2s[k][k], cross.cost_W2s[-1][k]
-        assert own is not None and on_mix is not None and own <= on_mix * (1 + 1e-6)
+        assert own is not None and on_mix is not None and own <= on_mix * (1 + LOCAL_SPREAD)
     assert cross.mix_energy_lost_J[-1] == 0.0
 
 

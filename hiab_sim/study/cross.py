@@ -7,9 +7,10 @@ as well as it can on that task. Evaluating it on the mix is the weighted sum ove
 mix's NLP decouples into the tasks once Xi is fixed). The matrix rows are the designs, the columns
 the tasks: net electrical energy and energy drawn on each task's fine grid (nominal bands), the
 cost of eq. ``costf2`` on its collocation grid, and the largest violation. ``mix_energy_lost``
-is what a single-task design costs the mix in net energy over the mix optimum (the optimum
-minimises the squared-power cost, so an energy "loss" may be negative; the cost loss may not,
-up to the solver's tolerance).
+is what a single-task design costs the mix in net energy over the mix optimum. The optimum
+minimises the squared-power cost, so an energy "loss" may be negative; so may the cost loss, by
+the spread of the non-convex NLP's local optima (~1e-5 relative on the test studies): each
+optimum is local, from its own start.
 """
 
 from __future__ import annotations
