@@ -181,3 +181,18 @@ def test_duty_mix_converges_from_the_built_crane_and_three_starts_agree(tmp_path
         assert task.recheck.max_violation_scaled <= 1e-6 and task.recheck.id_path == "analytic"
     assert r.multistart.converged_starts == 3
     assert r.multistart.same_optimum, [d.xi for d in r.multistart.distinct_optima]
+
+
+def test_study_file_with_tasks_loads_them_and_one_without_either_form_is_refused() -> None:
+    """``tasks:`` gives the Study its tasks in order; a study with neither ``tasks:`` nor ``reference:`` is refused."""
+    from hiab_sim.errors import ConfigError
+    from hiab_sim.study.config import load_study
+
+    mix = load_study("xs031_duty_mix")
+    assert [t.name for t in mix.tasks] == ["spiral", "pick_and_place", "loading_cycle"]
+    assert [t.reference.kind for t in mix.tasks] == ["spiral", "pick_and_place", "csv"]
+    assert mix.tasks[1].payload.inertia and mix.tasks[1].payload.pick is not None
+    data = small_study()
+    del data["reference"]
+    with pytest.raises(ConfigError, match="'tasks:'"):
+        study_from_dict(data, "none.yaml")
