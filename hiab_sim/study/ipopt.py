@@ -280,7 +280,7 @@ def solve_ipopt(
     return IpoptOutcome(
         z=z,
         success=stats.get("return_status") in SUCCESS,
-        message=f"IPOPT: {stats.get('return_status', '')}",
+        message=str(stats.get("return_status", "")),
         iterations=int(stats.get("iter_count", len(iterates))),
         iterates=iterates,
     )
