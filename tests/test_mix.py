@@ -167,7 +167,7 @@ def test_cross_evaluation_is_consistent(solved: Path) -> None:
 
 @pytest.mark.slow
 def test_duty_mix_converges_from_the_built_crane_and_three_starts_agree(tmp_path: Path) -> None:
-    """The shipped duty mix: violation <= 1e-6 on every task (fine grid, other ID path); 3 starts agree or are listed."""
+    """The shipped duty mix: violation <= 1e-6 on every task (fine grid, other ID path); 3 starts agree or listed."""
     from hiab_sim.study.config import load_study
     from hiab_sim.study.result import read_result
 
