@@ -32,8 +32,8 @@ def _run(study: Study, maxiter: int | None = None) -> dict[str, object]:
     try:
         result = solve(problem, study.initial_lengths, progress=None, maxiter=maxiter)
         message, z, iterations = result.message, result.z, result.iterations
-    except SolverError as error:
-        message, z, iterations = str(error), None, -1
+    except SolverError as error:  # e.g. the iteration limit of the dense SLSQP probe
+        message, z, iterations = str(error), None, maxiter or -1
     wall = time.perf_counter() - t0
     out: dict[str, object] = {"build": build, "wall": wall, "iterations": iterations, "message": message}
     out["variables"], out["rows"] = problem.n, len(problem.constraint_names)
