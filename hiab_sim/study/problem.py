@@ -103,7 +103,7 @@ def working_range(crane: Crane, joints: Array, margin: float) -> tuple[tuple[flo
 
 
 class LinkLengthProblem:
-    """The scaled NLP of one study on a time grid (collocation grid by default).
+    """The scaled NLP of one task of a study on a time grid (its collocation grid by default).
 
     Args:
         study: The study.
@@ -114,6 +114,10 @@ class LinkLengthProblem:
         tightened: Hold the tracking bands times ``collocation_fraction`` and the envelope margins
             >= ``envelope_margin`` (the optimiser's grid); False for the nominal re-check.
         objective: Name of the objective (:data:`hiab_sim.study.objectives.OBJECTIVES`; default ``costf2``).
+        task: The task whose NLP this is (default: the study's only task). Its grid is the study's
+            step over the task's duration, its spline the study's density of control points (or
+            the task's own), its reference and payload force its own (:func:`payload_force`);
+            :class:`hiab_sim.study.mix.MixProblem` composes one problem per task.
 
     """
 
