@@ -13,7 +13,6 @@ from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study import trajectory as tr
 from hiab_sim.study.config import load_study
 from hiab_sim.study.csv_reference import CsvReference
-from hiab_sim.study.problem import payload_force
 from hiab_sim.study.references import PickAndPlace, Spiral
 from hiab_sim.study.tasks import check_tasks, tasks_from_mapping
 
@@ -42,7 +41,7 @@ def test_single_reference_study_is_one_task_with_the_studys_spiral_and_payload()
     np.testing.assert_allclose(force[[0, -1]], np.tile(weight, (2, 1)), atol=1e-9)  # at rest: the weight
     # the loader keeps today's meaning of a plain number in this form: the weight only, no inertia
     assert STUDY.tasks[0].payload.inertia is False and task.payload.inertia is True
-    held = payload_force(STUDY.tasks[0], KIN, STUDY.crane.gravity, times)
+    held = STUDY.tasks[0].id_force(KIN, STUDY.crane.gravity, times)
     assert held is not None and held.shape == (3,)
     np.testing.assert_array_equal(held, weight)
 

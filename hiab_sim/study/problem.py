@@ -62,9 +62,8 @@ from hiab_sim.study.nlp import (
     SampleState,
 )
 from hiab_sim.study.objectives import make_objective
-from hiab_sim.study.references import Spiral, TaskReference
+from hiab_sim.study.references import ik_start
 from hiab_sim.study.tasks import Task
-from hiab_sim.study.workspace import initial_joints
 
 #: Scale of the link-length variables [m per unit].
 XI_SCALE = 1.0
@@ -116,7 +115,7 @@ class LinkLengthProblem:
         objective: Name of the objective (:data:`hiab_sim.study.objectives.OBJECTIVES`; default ``costf2``).
         task: The task whose NLP this is (default: the study's only task). Its grid is the study's
             step over the task's duration, its spline the study's density of control points (or
-            the task's own), its reference and payload force its own (:func:`payload_force`);
+            the task's own), its reference and payload force its own (:meth:`Task.id_force`);
             :class:`hiab_sim.study.mix.MixProblem` composes one problem per task.
 
     """
@@ -155,12 +154,12 @@ class LinkLengthProblem:
         self.B = np.stack(self.basis.matrices(self.times))  # (3 orders, K, N)
         self.kin = tr.TcpKinematics(study.crane)
         self.reference = task.reference.sample(self.kin, self.times)
-        self.tcp_force = payload_force(task, self.kin, study.crane.gravity, self.times)
+        self.tcp_force = task.id_force(self.kin, study.crane.gravity, self.times)
         self.fd_step = study.solver.fd_step
         self.xi_path = "analytic" if study.solver.xi_derivatives == "analytic" else self.id_path
         # initial fit: inverse kinematics on the fine grid, least-squares spline at rest at both ends
         fine_ref = task.reference.sample(self.kin, self.fine_times())
-        ik = tr.inverse_kinematics(self.kin, fine_ref, _ik_guess(study, task.reference, self.kin, fine_ref))
+        ik = tr.inverse_kinematics(self.kin, fine_ref, ik_start(task.reference, self.kin, study.crane, fine_ref))
         self.reference_joints = ik
         self.c_ref = tr.fit_coefficients(self.basis, ik)
         margin = study.bounds.triangle_margin
@@ -395,33 +394,3 @@ class LinkLengthProblem:
             self._grad_cache.clear()
         self._grad_cache[key] = (grad, jac)
         return grad, jac
-
-
-def payload_force(task: Task, kin: tr.TcpKinematics, gravity: float, times: Array) -> Array | None:
-    """The payload's force on the TCP for the inverse dynamics [N] in {W}: None, (3,) or (K, 3).
-
-    A constant weight without inertia (a single-reference study's plain ``payload: <kg>``) is the
-    constant vector (0, -m g, 0) as before; a schedule or a payload with inertia is the per-sample
-    F(t) = m(t) (g - a_tcp) of :meth:`hiab_sim.study.payload.Payload.tcp_force` at the reference's
-    acceleration (so it does not depend on the decision variables).
-    """
-    payload = task.payload
-    if payload.mass == 0.0:
-        return None
-    if payload.pick is None and payload.release is None and not payload.inertia:
-        return np.array([0.0, -payload.mass * gravity, 0.0])
-    return task.tcp_force(kin, gravity, times)
-
-
-def _ik_guess(study: Study, reference: TaskReference, kin: tr.TcpKinematics, fine: tr.Reference) -> tuple[float, float]:
-    """Start of the Newton IK: a spiral's centre joints (or the joint ranges' middle), else closed-form IK."""
-    if isinstance(reference, Spiral):
-        return reference.centre_joints or _centre_guess(study)
-    return initial_joints(kin, study.crane, fine)
-
-
-def _centre_guess(study: Study) -> tuple[float, float]:
-    """Initial joint guess for a spiral centred at a TCP point: the middle of the joint ranges."""
-    lo1, hi1 = study.crane.lift.joint_range
-    lo2, hi2 = study.crane.tilt.joint_range
-    return (0.5 * (lo1 + hi1), 0.5 * (lo2 + hi2))
