@@ -24,4 +24,4 @@ if [ ! -x .venv/bin/python ]; then
   python3 -m venv .venv
 fi
 .venv/bin/python -m pip install -q --upgrade pip >/dev/null
-.venv/bin/python -m pip install -q -e ".[test,dev,dask]"
+.venv/bin/python -m pip install -q -e ".[test,dev,dask,ipopt]"

@@ -20,7 +20,7 @@ CRANE = STUDY.crane
 KIN = tr.TcpKinematics(CRANE)
 DURATION = STUDY.grid.duration
 ROWS = np.linspace(0.0, DURATION, 251)  # a 40 Hz recording of the spiral
-SPIRAL = tr.spiral_reference(KIN, STUDY.reference, DURATION, ROWS)
+SPIRAL = STUDY.reference.sample(KIN, ROWS)
 assert STUDY.reference.centre_joints is not None
 SPIRAL_JOINTS = tr.inverse_kinematics(KIN, SPIRAL, STUDY.reference.centre_joints).position
 
@@ -43,7 +43,7 @@ def test_csv_of_the_spiral_reproduces_the_spiral_within_the_collocation_bands(tm
     reference.check_reach(KIN, CRANE)
     fine = STUDY.grid.fine_times()
     fitted = reference.sample(KIN, fine)
-    spiral = tr.spiral_reference(KIN, STUDY.reference, DURATION, fine)
+    spiral = STUDY.reference.sample(KIN, fine)
     band = STUDY.tracking
     for name, tol in (("position", band.position), ("velocity", band.velocity), ("acceleration", band.acceleration)):
         error = np.abs(getattr(fitted, name) - getattr(spiral, name)).max()

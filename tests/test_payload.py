@@ -25,7 +25,7 @@ PAYLOAD = Payload(mass=250.0, pick=1.9, release=4.4)
 
 
 def _spiral(times: np.ndarray) -> tuple[tr.Reference, JointSamples]:
-    ref = tr.spiral_reference(KIN, STUDY.reference, STUDY.grid.duration, times)
+    ref = STUDY.reference.sample(KIN, times)
     assert STUDY.reference.centre_joints is not None
     ik = tr.inverse_kinematics(KIN, ref, STUDY.reference.centre_joints)
     return ref, JointSamples(ik.position, ik.velocity, ik.acceleration)

@@ -188,9 +188,9 @@ def test_a_file_written_before_schema_version_reads_as_schema_1_and_writes_back_
 
 def test_unknown_top_level_keys_are_kept_and_written_back() -> None:
     """A section of a newer writer (e.g. a later issue's) is kept in extra and round-trips."""
-    data = {**_minimal_result_json(), "schema_version": 1, "cross_evaluation": {"energy_J": [[1.0, 2.0]]}}
+    data = {**_minimal_result_json(), "schema_version": 1, "future_section": {"energy_J": [[1.0, 2.0]]}}
     result = Result.from_json(data)
-    assert result.extra == {"cross_evaluation": {"energy_J": [[1.0, 2.0]]}}
+    assert result.extra == {"future_section": {"energy_J": [[1.0, 2.0]]}}
     assert result.to_json() == data
 
 

@@ -17,7 +17,7 @@ from hiab_sim.study.references import PickAndPlace, Spiral
 from hiab_sim.study.tasks import check_tasks, tasks_from_mapping
 
 OPTIMIZE = Path(__file__).resolve().parents[1] / "optimize"
-DRAFT = yaml.safe_load((OPTIMIZE / "xs031_duty_mix.yaml").read_text())
+MIX = yaml.safe_load((OPTIMIZE / "xs031_duty_mix.yaml").read_text())
 STUDY = load_study(OPTIMIZE / "xs031_spiral_payload.yaml")
 KIN = tr.TcpKinematics(STUDY.crane)
 
@@ -36,32 +36,38 @@ def test_single_reference_study_is_one_task_with_the_studys_spiral_and_payload()
     assert task.spline_points(22, 6.25, 5) == STUDY.spline.control_points
     np.testing.assert_allclose(task.times(STUDY.grid.dt), times, atol=1e-12)
     force = task.tcp_force(KIN, STUDY.crane.gravity, times)
-    assert force is not None and STUDY.tcp_force is not None
-    np.testing.assert_allclose(force[[0, -1]], np.tile(STUDY.tcp_force, (2, 1)), atol=1e-9)  # at rest: the weight
+    weight = np.array([0.0, -150.0 * STUDY.crane.gravity, 0.0])
+    assert force is not None
+    np.testing.assert_allclose(force[[0, -1]], np.tile(weight, (2, 1)), atol=1e-9)  # at rest: the weight
+    # the loader keeps today's meaning of a plain number in this form: the weight only, no inertia
+    assert STUDY.tasks[0].payload.inertia is False and task.payload.inertia is True
+    held = STUDY.tasks[0].id_force(KIN, STUDY.crane.gravity, times)
+    assert held is not None and held.shape == (3,)
+    np.testing.assert_array_equal(held, weight)
 
 
-def test_draft_duty_mix_reads_three_reachable_tasks() -> None:
-    """The draft duty mix gives the spiral, the pick-and-place and the CSV cycle, all reachable."""
-    tasks = _tasks(DRAFT)
+def test_duty_mix_reads_three_reachable_tasks() -> None:
+    """The duty mix gives the spiral, the pick-and-place and the CSV cycle, all reachable."""
+    tasks = _tasks(MIX)
     assert [type(t.reference) for t in tasks] == [Spiral, PickAndPlace, CsvReference]
     assert [t.weight for t in tasks] == [10.0, 20.0, 30.0]
     assert [t.payload.mass for t in tasks] == [0.0, 200.0, 300.0]
     check_tasks(tasks, KIN, STUDY.crane)
     assert tasks[0].tcp_force(KIN, 9.81, np.zeros(3)) is None
-    assert [t.spline_points(22, 6.25, 5) for t in tasks] == [22, 30, 60]
+    assert [t.spline_points(22, 6.25, 5) for t in tasks] == [22, 30, 100]
 
 
 def test_payload_force_of_a_task_is_zero_before_pick_weight_while_resting_and_zero_after_release() -> None:
     """Pick-and-place with its payload: no force before pick, exactly m g at rest holding it, none after release."""
-    task = _tasks(DRAFT)[1]
+    task = _tasks(MIX)[1]
     times = np.array([0.5, 1.0, 14.0, 14.5])  # dwell at pick (before, after pick); dwell at place (before, after)
     force = task.tcp_force(KIN, 9.8066, times)
     assert force is not None
     np.testing.assert_allclose(force[:, 1], [0.0, -200.0 * 9.8066, -200.0 * 9.8066, 0.0], atol=1e-9)
 
 
-def _draft_with(change: dict, index: int = 1) -> dict:
-    top = copy.deepcopy(DRAFT)
+def _mix_with(change: dict, index: int = 1) -> dict:
+    top = copy.deepcopy(MIX)
     top["tasks"][index] |= change
     return top
 
@@ -69,15 +75,15 @@ def _draft_with(change: dict, index: int = 1) -> dict:
 @pytest.mark.parametrize(
     ("top", "error", "match"),
     [
-        (DRAFT | {"reference": {}}, ConfigError, "either 'tasks:' or 'reference:'"),
-        (DRAFT | {"tasks": []}, ConfigError, "non-empty list"),
-        (_draft_with({"name": "spiral"}), ConfigError, "'spiral' is used twice"),
-        (_draft_with({"weight": 0.0}), InvalidInputError, r"tasks\[1\].weight = 0 is out of range"),
-        (_draft_with({"payload": {"mass": 200.0, "pick": 1.0, "release": 30.0}}), InvalidInputError, r"release = 30 s"),
-        (_draft_with({"payload": -5.0}), InvalidInputError, r"tasks\[1\].payload.mass = -5 kg"),
-        (_draft_with({"control_points": 3}), InvalidInputError, r"tasks\[1\].control_points"),
-        (_draft_with({"colour": "red"}), ConfigError, r"tasks\[1\]: unknown key"),
-        (_draft_with({"reference": {"kind": "csv", "file": "missing.csv"}}), ConfigError, "missing.csv"),
+        (MIX | {"reference": {}}, ConfigError, "either 'tasks:' or 'reference:'"),
+        (MIX | {"tasks": []}, ConfigError, "non-empty list"),
+        (_mix_with({"name": "spiral"}), ConfigError, "'spiral' is used twice"),
+        (_mix_with({"weight": 0.0}), InvalidInputError, r"tasks\[1\].weight = 0 is out of range"),
+        (_mix_with({"payload": {"mass": 200.0, "pick": 1.0, "release": 30.0}}), InvalidInputError, r"release = 30 s"),
+        (_mix_with({"payload": -5.0}), InvalidInputError, r"tasks\[1\].payload.mass = -5 kg"),
+        (_mix_with({"control_points": 3}), InvalidInputError, r"tasks\[1\].control_points"),
+        (_mix_with({"colour": "red"}), ConfigError, r"tasks\[1\]: unknown key"),
+        (_mix_with({"reference": {"kind": "csv", "file": "missing.csv"}}), ConfigError, "missing.csv"),
     ],
     ids=["both-forms", "empty", "duplicate-name", "weight", "release-late", "mass", "control-points", "key", "csv"],
 )
@@ -89,6 +95,6 @@ def test_bad_task_list_raises_naming_the_task(top: dict, error: type, match: str
 
 def test_unreachable_task_names_the_task_and_time() -> None:
     """A pick-and-place beyond the crane's reach names the task, its index and the time."""
-    top = _draft_with({"reference": DRAFT["tasks"][1]["reference"] | {"place": [5.5, 0.2]}})
+    top = _mix_with({"reference": MIX["tasks"][1]["reference"] | {"place": [5.5, 0.2]}})
     with pytest.raises(InvalidInputError, match=r"tasks\[1\] \(pick_and_place\) reference at t = [\d.]+ s"):
         check_tasks(_tasks(top), KIN, STUDY.crane)

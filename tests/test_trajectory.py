@@ -9,7 +9,8 @@ from hiab_sim.crane import kinematics
 from hiab_sim.crane.description import Crane
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study import trajectory as tr
-from hiab_sim.study.config import SpiralReference, load_study
+from hiab_sim.study.config import load_study
+from hiab_sim.study.references import Spiral
 
 STUDY = load_study()
 
@@ -66,7 +67,7 @@ def test_spiral_starts_and_ends_at_rest_and_is_consistent() -> None:
     """Velocity and acceleration vanish at both ends; they are the time derivatives of the path."""
     kin = tr.TcpKinematics(STUDY.crane)
     t = np.linspace(0.0, 6.25, 2001)
-    ref = tr.spiral_reference(kin, STUDY.reference, 6.25, t)
+    ref = STUDY.reference.sample(kin, t)
     for rate in (ref.velocity, ref.acceleration):
         np.testing.assert_allclose(rate[[0, -1]], 0.0, atol=1e-12)
     dt = t[1] - t[0]
@@ -80,7 +81,7 @@ def test_inverse_kinematics_puts_the_tcp_on_the_reference() -> None:
     """IK joints reproduce the reference position, velocity and acceleration exactly."""
     kin = tr.TcpKinematics(STUDY.crane)
     t = np.linspace(0.0, 6.25, 101)
-    ref = tr.spiral_reference(kin, STUDY.reference, 6.25, t)
+    ref = STUDY.reference.sample(kin, t)
     ik = tr.inverse_kinematics(kin, ref, (0.6, -1.3))
     s = kin.samples(ik.position, ik.velocity, ik.acceleration)
     np.testing.assert_allclose(s.position, ref.position, atol=1e-10)
@@ -93,7 +94,7 @@ def test_fitted_spline_is_at_rest_and_tracks_within_a_millimetre() -> None:
     kin = tr.TcpKinematics(STUDY.crane)
     basis = tr.SplineBasis(22, 5, 6.25)
     t = STUDY.grid.fine_times()
-    ref = tr.spiral_reference(kin, STUDY.reference, 6.25, t)
+    ref = STUDY.reference.sample(kin, t)
     c = tr.fit_coefficients(basis, tr.inverse_kinematics(kin, ref, (0.6, -1.3)))
     joints = tr.evaluate(basis, c, t)
     np.testing.assert_allclose(joints.velocity[[0, -1]], 0.0, atol=1e-10)
@@ -105,7 +106,8 @@ def test_fitted_spline_is_at_rest_and_tracks_within_a_millimetre() -> None:
 def test_unreachable_reference_is_rejected() -> None:
     """A spiral beyond the crane's reach raises the named-field error."""
     kin = tr.TcpKinematics(STUDY.crane)
-    spec = SpiralReference(
+    spec = Spiral(
+        duration=6.25,
         start_radius=0.05,
         end_radius=6.0,
         turns=1.0,
@@ -114,6 +116,6 @@ def test_unreachable_reference_is_rejected() -> None:
         telescope_amplitude=0.0,
         centre_joints=(0.6, -1.3),
     )
-    ref = tr.spiral_reference(kin, spec, 6.25, np.linspace(0.0, 6.25, 60))
+    ref = spec.sample(kin, np.linspace(0.0, 6.25, 60))
     with pytest.raises(InvalidInputError, match="reference"):
         tr.inverse_kinematics(kin, ref, (0.6, -1.3))

@@ -81,7 +81,7 @@ def summary_lines(r: Result) -> list[str]:
         )
     sol, rc = r.solver, r.recheck
     lines.append(
-        f"SLSQP: {sol.message} ({sol.iterations} iterations, {sol.wall_time_s:.1f} s, "
+        f"{sol.method.split()[0]}: {sol.message} ({sol.iterations} iterations, {sol.wall_time_s:.1f} s, "
         f"max violation {sol.max_violation_scaled:.1e}); cost ratio {r.improvement.cost_ratio:.4f}, "
         f"net energy -{r.improvement.net_energy_saved_percent:.2f} %"
     )

@@ -1,4 +1,4 @@
-"""Study YAML -> frozen dataclasses: crane, EMLAs, spline, grid, spiral reference, bounds, solver.
+"""Study YAML -> frozen dataclasses: crane, EMLAs, spline, grid, tasks (references, payloads), bounds, solver.
 
 A study file names everything the optimiser of seed eqs. ``costf2`` / ``const_a``..``const_m``
 needs; every unknown or missing key raises :class:`~hiab_sim.errors.ConfigError` and every
@@ -7,12 +7,18 @@ by :mod:`hiab_sim.yaml_fields`; each dataclass checks its own ranges in ``__post
 holds the only copy of its defaults (a key a file omits takes the dataclass default). The crane
 and the EMLA set are a preset name or a path, resolved by :func:`hiab_sim.resources.locate`:
 relative paths next to the study file (inside the installed package for a shipped study).
+
+The study's work is a tuple of tasks (:mod:`hiab_sim.study.tasks`): a ``tasks:`` list, or today's
+single ``reference:`` (+ ``payload:``), which is one task named after the study with weight 1. In
+that single-reference form a plain ``payload: <kg>`` keeps today's meaning, the payload's weight
+only (``Payload(mass, inertia=False)``), so the results of existing study files do not change;
+within ``tasks:`` a plain number is a constant mass with its inertia (see :mod:`.payload`).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +31,8 @@ from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import DEFAULT_STUDY, Source, locate
 from hiab_sim.study.energy_config import ENERGY_KEYS, EnergySettings, energy_settings
+from hiab_sim.study.references import TaskReference
+from hiab_sim.study.tasks import Task, tasks_from_mapping
 from hiab_sim.yaml_fields import mapping, number, positive, read_yaml, section, vector
 
 ID_PATHS = ("mujoco", "analytic")
@@ -80,40 +88,6 @@ class GridSettings:
     def fine_times(self) -> np.ndarray:
         """Re-check times, ``fine_factor`` times denser, shape (fine_factor M + 1,) [s]."""
         return np.linspace(0.0, self.duration, self.fine_factor * self.intervals + 1)
-
-
-@dataclass(frozen=True)
-class SpiralReference:
-    """TCP spiral in the vertical plane of {W} with a prescribed telescope schedule.
-
-    The TCP goes around ``centre`` with a radius growing linearly from ``start_radius`` to
-    ``end_radius`` over ``turns`` turns; the path parameter follows the rest-to-rest quintic
-    s(t) = 10 tau^3 - 15 tau^4 + 6 tau^5 (tau = t / duration), so velocity and acceleration are
-    zero at both ends. The telescope follows xt2(t) = ``telescope_start`` +
-    ``telescope_amplitude`` sin(pi s(t)) (out and back). Exactly one of ``centre_joints``
-    (theta1, theta2) [rad] at xt2 = ``telescope_start``, or ``centre_tcp`` (x, y) [m] is given.
-    """
-
-    start_radius: float
-    end_radius: float
-    turns: float
-    telescope_start: float
-    start_angle: float = 0.0
-    telescope_amplitude: float = 0.0
-    centre_joints: tuple[float, float] | None = None
-    centre_tcp: tuple[float, float] | None = None
-
-    def __post_init__(self) -> None:
-        if (self.centre_joints is None) == (self.centre_tcp is None):
-            raise ConfigError("reference: give exactly one of centre_joints [theta1, theta2] or centre_tcp [x, y]")
-        check_range("reference.start_radius", self.start_radius, 0.0, unit="m")
-        check_range("reference.end_radius", self.end_radius, 0.0, unit="m", low_open=True)
-        check_range("reference.turns", self.turns, -10.0, 10.0)
-        if self.turns == 0.0:
-            raise InvalidInputError("reference.turns", self.turns, "must be nonzero with |turns| <= 10")
-        check_range("reference.telescope_start", self.telescope_start, 0.0, unit="m")
-        check_range("reference.start_angle", self.start_angle, unit="rad")
-        check_range("reference.telescope_amplitude", self.telescope_amplitude, unit="m")
 
 
 @dataclass(frozen=True)
@@ -195,6 +169,8 @@ class SolverSettings:
         xi_derivatives: ``analytic``: d(f_x, v_x)/dXi by central differences on the analytic ID
             path (no model rebuild; it agrees with the MuJoCo path to ~1e-14 relative, re-checked
             in every result); ``rebuild``: on the optimisation's own path with model rebuilds.
+        method: ``slsqp`` (scipy, dense; the single-task default) or ``ipopt`` (CasADi's IPOPT
+            with sparse Jacobians, for duty mixes: :mod:`hiab_sim.study.ipopt`).
 
     """
 
@@ -203,6 +179,7 @@ class SolverSettings:
     id_path: str = "mujoco"
     fd_step: float = 1e-6
     xi_derivatives: str = "analytic"
+    method: str = "slsqp"
 
     def __post_init__(self) -> None:
         check_range("solver.maxiter", self.maxiter, 1, integral=True)
@@ -210,6 +187,7 @@ class SolverSettings:
         check_choice("solver.id_path", self.id_path, ID_PATHS)
         check_range("solver.fd_step", self.fd_step, 0.0, low_open=True)
         check_choice("solver.xi_derivatives", self.xi_derivatives, ("analytic", "rebuild"))
+        check_choice("solver.method", self.method, ("slsqp", "ipopt"))
 
 
 @dataclass(frozen=True)
@@ -230,18 +208,19 @@ class Study:
     initial_lengths: LinkLengths
     spline: SplineSettings
     grid: GridSettings
-    reference: SpiralReference
+    tasks: tuple[Task, ...]
     tracking: Tracking
     bounds: Bounds
     solver: SolverSettings
-    payload: float = 0.0  # kg hanging at the TCP
     crane_file: Source | None = field(default=None, repr=False, compare=False)
     energy: EnergySettings = field(default_factory=EnergySettings)  # objective, duty, transmission (issue 13)
 
     def __post_init__(self) -> None:
-        check_range("payload", self.payload, 0.0, unit="kg")
+        if not self.tasks:
+            raise InvalidInputError("tasks", 0, "a study needs at least one task")
         if self.energy.duty is not None:
-            self.energy.duty.duty(self.grid.duration)  # the duty must fit the cycle (named error otherwise)
+            for task in self.tasks:  # the duty must fit each task's cycle (named error otherwise)
+                self.energy.duty.duty(task.reference.duration)
         for name in CHAIN_NAMES:
             for i, key in enumerate(("L", "Lc0", "Lc")):
                 k = 3 * CHAIN_NAMES.index(name) + i
@@ -253,11 +232,14 @@ class Study:
                     )
 
     @property
-    def tcp_force(self) -> np.ndarray | None:
-        """Force of the payload on the TCP in {W} [N], or None without payload."""
-        if self.payload == 0.0:
-            return None
-        return np.array([0.0, -self.payload * self.crane.gravity, 0.0])
+    def reference(self) -> TaskReference:
+        """The reference of a single-task study (the first task's otherwise)."""
+        return self.tasks[0].reference
+
+    @property
+    def payload(self) -> float:
+        """Payload mass of a single-task study [kg] (the largest over the tasks otherwise)."""
+        return max(task.payload.mass for task in self.tasks)
 
 
 _TOP = {
@@ -273,8 +255,9 @@ _TOP = {
     "solver",
     "payload",
     *ENERGY_KEYS,
+    "tasks",
 }
-_REQUIRED_TOP = {"crane", "reference", "bounds"}
+_REQUIRED_TOP = {"crane", "bounds"}
 
 
 def load_study(path: str | Path | Source | None = None) -> Study:
@@ -304,8 +287,16 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
     emlas = load_emla_set(locate(emla_source, "emla", relative_to=file))
     initial = _lengths(top.get("initial_lengths"), crane)
     bounds = _bounds(top["bounds"])
+    grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
+    name = str(top.get("name", Path(str(file.file)).stem))
+    if "tasks" not in top and "reference" not in top:
+        raise ConfigError("study: give 'tasks:' (a list of tasks) or 'reference:' (one task)")
+    tasks = tasks_from_mapping(top, Path(str(file.file)).parent, grid.duration, name)
+    if "tasks" not in top and isinstance(top.get("payload", 0.0), int | float):
+        # single-reference form: a plain number is today's payload, its weight only (module docstring)
+        tasks = (replace(tasks[0], payload=replace(tasks[0].payload, inertia=False)),)
     return Study(
-        name=str(top.get("name", Path(str(file.file)).stem)),
+        name=name,
         path=str(file.file),
         crane_source=crane_source,
         crane=crane,
@@ -313,12 +304,11 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
         emlas=emlas,
         initial_lengths=initial,
         spline=SplineSettings(**section(SplineSettings, top.get("spline"), "spline")),
-        grid=GridSettings(**section(GridSettings, top.get("grid"), "grid")),
-        reference=_reference(top["reference"]),
+        grid=grid,
+        tasks=tasks,
         tracking=Tracking(**section(Tracking, top.get("tracking"), "tracking")),
         bounds=bounds,
         solver=SolverSettings(**section(SolverSettings, top.get("solver"), "solver")),
-        payload=number(top.get("payload", 0.0), "payload"),
         crane_file=crane_file,
         energy=energy_settings(top),
     )
@@ -334,10 +324,6 @@ def _lengths(data: Any, crane: Crane) -> LinkLengths:
         values = [positive(d[k], f"initial_lengths.{name}.{k}", "m") for k in ("L", "Lc0", "Lc")]
         chains.append(ChainLengths(*values))
     return LinkLengths(chains[0], chains[1])
-
-
-def _reference(data: Any) -> SpiralReference:
-    return SpiralReference(**section(SpiralReference, data, "reference"))
 
 
 def _bounds(data: Any) -> Bounds:

@@ -62,6 +62,8 @@ from hiab_sim.study.nlp import (
     SampleState,
 )
 from hiab_sim.study.objectives import make_objective
+from hiab_sim.study.references import ik_start
+from hiab_sim.study.tasks import Task
 from hiab_sim.study.thermal_blocks import thermal_blocks
 
 #: Scale of the link-length variables [m per unit].
@@ -101,7 +103,7 @@ def working_range(crane: Crane, joints: Array, margin: float) -> tuple[tuple[flo
 
 
 class LinkLengthProblem:
-    """The scaled NLP of one study on a time grid (collocation grid by default).
+    """The scaled NLP of one task of a study on a time grid (its collocation grid by default).
 
     Args:
         study: The study.
@@ -112,6 +114,10 @@ class LinkLengthProblem:
         tightened: Hold the tracking bands times ``collocation_fraction`` and the envelope margins
             >= ``envelope_margin`` (the optimiser's grid); False for the nominal re-check.
         objective: Name of the objective (:data:`hiab_sim.study.objectives.OBJECTIVES`; default: the study's).
+        task: The task whose NLP this is (default: the study's only task). Its grid is the study's
+            step over the task's duration, its spline the study's density of control points (or
+            the task's own), its reference and payload force its own (:meth:`Task.id_force`);
+            :class:`hiab_sim.study.mix.MixProblem` composes one problem per task.
 
     """
 
@@ -124,29 +130,37 @@ class LinkLengthProblem:
         cost_scale: float | None = None,
         tightened: bool = True,
         objective: str | None = None,
+        task: Task | None = None,
     ) -> None:
+        if task is None:
+            if len(study.tasks) != 1:
+                raise InvalidInputError("task", len(study.tasks), "a study of several tasks needs a task per problem")
+            task = study.tasks[0]
         self.study = study
+        self.task = task
         self.tightened = tightened
         self.band_fraction = study.tracking.collocation_fraction if tightened else 1.0
         self.envelope_margin = study.bounds.envelope_margin if tightened else 0.0
         self.working_clearance = WORKING_CLEARANCE / STROKE_SCALE if tightened else 0.0
         self.emlas = emlas if emlas is not None else study.emlas
         self.id_path = id_path or study.solver.id_path
-        self.times = study.grid.times() if times is None else np.asarray(times, dtype=float)
+        # the task's collocation grid: the study's step over the task's duration (the study's grid for
+        # one task of the grid's duration), its spline: the study's density of control points
+        self.collocation_times = task.times(study.grid.dt)
+        self.times = self.collocation_times if times is None else np.asarray(times, dtype=float)
         self.dt = float(self.times[1] - self.times[0])
-        self.basis = tr.SplineBasis(study.spline.control_points, study.spline.degree, study.grid.duration)
+        duration = task.reference.duration
+        points = task.spline_points(study.spline.control_points, study.grid.duration, study.spline.degree)
+        self.basis = tr.SplineBasis(points, study.spline.degree, duration)
         self.B = np.stack(self.basis.matrices(self.times))  # (3 orders, K, N)
         self.kin = tr.TcpKinematics(study.crane)
-        self.reference = tr.spiral_reference(self.kin, study.reference, study.grid.duration, self.times)
-        self.tcp_force = study.tcp_force
+        self.reference = task.reference.sample(self.kin, self.times)
+        self.tcp_force = task.id_force(self.kin, study.crane.gravity, self.times)
         self.fd_step = study.solver.fd_step
         self.xi_path = "analytic" if study.solver.xi_derivatives == "analytic" else self.id_path
         # initial fit: inverse kinematics on the fine grid, least-squares spline at rest at both ends
-        fine = study.grid.fine_times()
-        fine_ref = tr.spiral_reference(self.kin, study.reference, study.grid.duration, fine)
-        assert study.reference.centre_joints is not None or study.reference.centre_tcp is not None
-        guess = study.reference.centre_joints or _centre_guess(study)
-        ik = tr.inverse_kinematics(self.kin, fine_ref, guess)
+        fine_ref = task.reference.sample(self.kin, self.fine_times())
+        ik = tr.inverse_kinematics(self.kin, fine_ref, ik_start(task.reference, self.kin, study.crane, fine_ref))
         self.reference_joints = ik
         self.c_ref = tr.fit_coefficients(self.basis, ik)
         margin = study.bounds.triangle_margin
@@ -201,6 +215,11 @@ class LinkLengthProblem:
                 ) from None
         self.cost_scale = max(float(cost_scale), 1e-300)
 
+    def fine_times(self) -> Array:
+        """The task's re-check grid: ``grid.fine_factor`` times denser than its collocation grid [s]."""
+        intervals = len(self.collocation_times) - 1
+        return np.linspace(0.0, self.task.reference.duration, self.study.grid.fine_factor * intervals + 1)
+
     def _build_blocks(self) -> list[ConstraintBlock]:
         """The inequality blocks in row order: the one list that defines the NLP's rows."""
         tol, ref, t = self.study.tracking, self.reference, self.times
@@ -213,7 +232,7 @@ class LinkLengthProblem:
             bl.JointLimits(t, self.theta_low, self.theta_up),
             bl.JointVelocityLimits(t, np.asarray(self.study.bounds.joint_velocity)),
             bl.WorkingRange(self.crane.chains, self.working, self.working_clearance),
-            *thermal_blocks(self.emlas, self.study.energy.duty, self.study.grid.duration),
+            *thermal_blocks(self.emlas, self.study.energy.duty, self.task.reference.duration),
         ]
 
     # -- variables ---------------------------------------------------------------------------
@@ -377,10 +396,3 @@ class LinkLengthProblem:
             self._grad_cache.clear()
         self._grad_cache[key] = (grad, jac)
         return grad, jac
-
-
-def _centre_guess(study: Study) -> tuple[float, float]:
-    """Initial joint guess for a spiral centred at a TCP point: the middle of the joint ranges."""
-    lo1, hi1 = study.crane.lift.joint_range
-    lo2, hi2 = study.crane.tilt.joint_range
-    return (0.5 * (lo1 + hi1), 0.5 * (lo2 + hi2))

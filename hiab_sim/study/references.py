@@ -320,6 +320,20 @@ def reference_from_mapping(data: Any, where: str, folder: Path, default_duration
     raise InvalidInputError(f"{where}.kind", kind, f"must be one of {', '.join(KINDS)}")
 
 
+def ik_start(reference: TaskReference, kin: TcpKinematics, crane: Crane, sampled: Reference) -> tuple[float, float]:
+    """(theta1, theta2) [rad] that starts the Newton IK of ``sampled``.
+
+    A spiral's ``centre_joints`` (today's start), or the middle of the joint ranges for a spiral
+    given by its TCP centre; any other kind: the closed-form IK of its first sample.
+    """
+    if isinstance(reference, Spiral):
+        if reference.centre_joints is not None:
+            return reference.centre_joints
+        (lo1, hi1), (lo2, hi2) = crane.lift.joint_range, crane.tilt.joint_range
+        return (0.5 * (lo1 + hi1), 0.5 * (lo2 + hi2))
+    return initial_joints(kin, crane, sampled)
+
+
 def _check(ok: bool, field: str, value: float, allowed: str, unit: str = "") -> None:
     if not ok or (isinstance(value, float) and not math.isfinite(value)):
         raise InvalidInputError(field, value, allowed, unit)
@@ -337,6 +351,7 @@ __all__ = [
     "Spiral",
     "TaskReference",
     "check_workspace",
+    "ik_start",
     "initial_joints",
     "reference_from_mapping",
     "septic_law",

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import io
 import json
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -27,6 +28,7 @@ from hiab_sim.emla import energy_summary, operating_point
 from hiab_sim.errors import HiabSimError
 from hiab_sim.quadrature import trapezoid
 from hiab_sim.study.energy_report import energy_report, hydraulic_report
+from hiab_sim.study.mix import Problem
 from hiab_sim.study.objectives import SquaredPowerCost
 from hiab_sim.study.problem import ACTUATORS, Evaluation, LinkLengthProblem
 from hiab_sim.study.result import (
@@ -132,9 +134,10 @@ def fine_problem(problem: LinkLengthProblem, id_path: str | None = None) -> Link
         problem.study,
         emlas=problem.emlas,
         id_path=id_path or problem.id_path,
-        times=problem.study.grid.fine_times(),
+        times=problem.fine_times(),
         cost_scale=problem.cost_scale,
         tightened=False,
+        task=problem.task,
     )
 
 
@@ -186,21 +189,7 @@ def build_result(
         function_evaluations=main.n_evaluations,
         gradient_evaluations=main.n_gradients,
     )
-    rc = checks["recheck_optimal"].summary
-    force_difference = np.abs(
-        checks["optimal"].evaluation.actuators.force - checks["recheck_optimal"].evaluation.actuators.force
-    )
-    recheck_summary = Recheck(
-        id_path=recheck.id_path,
-        grid_points=len(recheck.times),
-        note="optimal design re-evaluated on the 10x finer grid with the other ID path and nominal bands",
-        max_violation_scaled=rc.max_violation,
-        worst_constraint=rc.worst_constraint,
-        tracking_error=rc.tracking_error,
-        net_electrical_energy_J=rc.net_electrical_energy_J,
-        initial_max_violation_scaled=checks["recheck_initial"].summary.max_violation,
-        force_difference_between_paths_N=float(np.max(force_difference)),
-    )
+    recheck_summary = recheck_section(checks, recheck)
     study = problem.study
     settings = Settings(
         spline_control_points=problem.basis.n,
@@ -251,6 +240,25 @@ def build_result(
         arrays[f"{name}_actuator_stroke"] = ev.actuators.stroke
         arrays[f"{name}_electrical_power"] = ev.power
     return result, arrays, checks
+
+
+def recheck_section(checks: dict[str, DesignCheck], recheck: LinkLengthProblem) -> Recheck:
+    """The re-check section from the fine-grid checks (keys optimal, recheck_initial, recheck_optimal)."""
+    rc = checks["recheck_optimal"].summary
+    force_difference = np.abs(
+        checks["optimal"].evaluation.actuators.force - checks["recheck_optimal"].evaluation.actuators.force
+    )
+    return Recheck(
+        id_path=recheck.id_path,
+        grid_points=len(recheck.times),
+        note="optimal design re-evaluated on the 10x finer grid with the other ID path and nominal bands",
+        max_violation_scaled=rc.max_violation,
+        worst_constraint=rc.worst_constraint,
+        tracking_error=rc.tracking_error,
+        net_electrical_energy_J=rc.net_electrical_energy_J,
+        initial_max_violation_scaled=checks["recheck_initial"].summary.max_violation,
+        force_difference_between_paths_N=float(np.max(force_difference)),
+    )
 
 
 #: The four designs of :func:`energy_decomposition`: (key, lengths from, trajectory from).
@@ -323,11 +331,14 @@ def energy_decomposition(
     )
 
 
-def multistart_summary(problem: LinkLengthProblem, results: list[SolveResult], tolerance: float) -> MultiStart:
+def multistart_summary(
+    problem: Problem, results: list[SolveResult], tolerance: float, energy: Callable[[Array], float] | None = None
+) -> MultiStart:
     """Whether every converged start reached the same Xi within ``tolerance`` [m]; else the distinct optima.
 
     A start whose solver failed is no optimum: it is left out of ``distinct_optima`` and listed
-    under ``failed_starts`` with its message (its row has no optimal lengths or cost).
+    under ``failed_starts`` with its message (its row has no optimal lengths or cost). ``energy``
+    gives a design's net energy [J] (default: on the task's fine grid; a mix passes its own).
     """
     rows: list[StartRow] = []
     failed: list[FailedStart] = []
@@ -335,7 +346,11 @@ def multistart_summary(problem: LinkLengthProblem, results: list[SolveResult], t
         optimal, cost = None, None
         if r.success:
             ev = problem.evaluate(r.z)
-            optimal, cost = ev.lengths, SquaredPowerCost(problem.emlas, problem.dt).value(ev)
+            optimal = ev.lengths
+            if isinstance(problem, LinkLengthProblem) and isinstance(ev, Evaluation):  # costf2 whatever the objective
+                cost = SquaredPowerCost(problem.emlas, problem.dt).value(ev)
+            else:  # a mix: its weighted cost
+                cost = ev.cost
         else:
             failed.append(FailedStart(r.start, tuple(r.initial_lengths.as_array().tolist()), r.message))
         rows.append(StartRow(r.start, r.initial_lengths, optimal, cost, r.success, r.message, r.iterations))
@@ -350,16 +365,19 @@ def multistart_summary(problem: LinkLengthProblem, results: list[SolveResult], t
                 break
         else:
             groups.append((xi, row.cost_W2s, [r.start]))
-    fine = fine_problem(problem) if len(results) > 1 else None
+    if energy is None and len(results) > 1 and isinstance(problem, LinkLengthProblem):
+        fine = fine_problem(problem)
+
+        def energy(z: Array) -> float:
+            return design_summary(fine, z).summary.net_electrical_energy_J
+
     by_start = {r.start: r for r in results}
     distinct = tuple(
         DistinctOptimum(
             xi=tuple(xi.tolist()),
             cost_W2s=cost,
             starts=tuple(starts),
-            net_electrical_energy_J=(
-                None if fine is None else design_summary(fine, by_start[starts[0]].z).summary.net_electrical_energy_J
-            ),
+            net_electrical_energy_J=None if energy is None or len(results) < 2 else energy(by_start[starts[0]].z),
         )
         for xi, cost, starts in groups
     )

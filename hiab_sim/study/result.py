@@ -268,6 +268,52 @@ class HistoryRow:
 
 
 @dataclass(frozen=True)
+class TaskResult:
+    """One task of a duty mix (:mod:`hiab_sim.study.mix_report`): share, load, grid, designs on its fine grid, re-check.
+
+    ``telescope`` says how the crane's redundancy is set for the task (prescribed by the reference).
+    """
+
+    name: str
+    weight: float
+    kind: str
+    duration_s: float
+    payload_kg: float
+    telescope: str
+    spline_control_points: int
+    collocation_points: int
+    initial: DesignSummary
+    optimal: DesignSummary
+    recheck: Recheck
+
+
+@dataclass(frozen=True)
+class CrossEvaluation:
+    """The price of robustness (:mod:`hiab_sim.study.cross`): designs x tasks, trajectories re-optimised at fixed Xi.
+
+    Rows are the designs (each task's optimum alone, then the mix optimum), columns the tasks; the
+    ``mix_*`` entries are the weighted sums over the tasks; None where a design cannot serve a task.
+    Energies [J] on each task's fine grid (nominal bands, the optimisation's ID path), costs of eq.
+    ``costf2`` [W^2 s] on the collocation grid (what the optimiser minimises).
+    """
+
+    note: str
+    tasks: tuple[str, ...]
+    weights: tuple[float, ...]
+    designs: tuple[str, ...]
+    lengths: tuple[LinkLengths, ...]
+    net_energy_J: tuple[tuple[float | None, ...], ...]
+    drawn_energy_J: tuple[tuple[float | None, ...], ...]
+    cost_W2s: tuple[tuple[float | None, ...], ...]
+    max_violation: tuple[tuple[float | None, ...], ...]
+    mix_net_energy_J: tuple[float | None, ...]
+    mix_cost_W2s: tuple[float | None, ...]
+    mix_energy_lost_J: tuple[float | None, ...]
+    mix_energy_lost_percent: tuple[float | None, ...]
+    mix_cost_lost_percent: tuple[float | None, ...]
+
+
+@dataclass(frozen=True)
 class Result:
     """What ``hiab-sim optimize`` writes to ``result.json``.
 
@@ -291,6 +337,8 @@ class Result:
     energy: EnergyReport | None = optional()  # battery energy and costf2, thermal (issue 13)
     hydraulic_baseline: HydraulicBaseline | None = optional()
     codesign: Codesign | None = optional()
+    tasks: tuple[TaskResult, ...] | None = optional()
+    cross_evaluation: CrossEvaluation | None = optional()
     extra: dict[str, Any] = field(default_factory=dict)  # keys of a newer writer, kept verbatim
 
     def __post_init__(self) -> None:

@@ -9,11 +9,13 @@ from pathlib import Path
 from typing import TextIO
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.errors import SolverError
+from hiab_sim.errors import ConfigError, SolverError
 from hiab_sim.study import run_safety
 from hiab_sim.study.codesign import run_codesign
 from hiab_sim.study.config import Study, load_study
-from hiab_sim.study.problem import LinkLengthProblem
+from hiab_sim.study.cross import cross_evaluation
+from hiab_sim.study.mix import MixProblem, make_problem
+from hiab_sim.study.mix_report import build_mix_result
 from hiab_sim.study.report import build_result, write_results
 from hiab_sim.study.result import Result
 from hiab_sim.study.solve import (
@@ -44,13 +46,16 @@ def run_study(
     progress: TextIO | None = sys.stderr,
     figures: bool = True,
     force: bool = False,
+    cross: bool = True,
 ) -> RunOutput:
     """Optimise a study and write its result folder.
 
     Bad input (study, unreachable reference, infeasible start, with ``resume`` a checkpoint of
     another study, ID path or start) raises before anything is written. A fresh run (no
     ``resume``) deletes every output of earlier runs; a folder of another study is refused unless
-    ``force`` (:mod:`hiab_sim.study.run_safety`). A failure of SLSQP on the
+    ``force`` (:mod:`hiab_sim.study.run_safety`). A study of several tasks is solved as one
+    :class:`~hiab_sim.study.mix.MixProblem` and reported by :mod:`hiab_sim.study.mix_report`, with
+    the cross-evaluation of :mod:`hiab_sim.study.cross` unless ``cross`` is False. A failure of SLSQP on the
     study's own start raises :class:`SolverError` after its checkpoint (the partial history) is
     on disk; failures of extra starts are reported (``multistart.failed_starts``).
     """
@@ -61,7 +66,7 @@ def run_study(
     if study.energy.transmission is not None:  # issue 13: mounting x transmission catalogue, then the best
         codesign, emlas = run_codesign(study, progress=progress)
         study = replace(study, emlas=emlas)
-    problem = LinkLengthProblem(study, id_path=id_path)
+    problem = make_problem(study, id_path)
     check_start(problem, problem.initial_point(study.initial_lengths))
     initials = start_points(problem, starts)
     folder = Path(out)
@@ -88,7 +93,17 @@ def run_study(
             failed.success = False
             failed.message = str(error)
             results.append(failed)
-    result, arrays, checks = build_result(problem, results, time.perf_counter() - t0)
+    if isinstance(problem, MixProblem):
+        evaluation = None
+        if cross:
+            try:
+                evaluation = cross_evaluation(problem, results[0].z)
+            except ConfigError as error:  # CasADi (IPOPT) is an optional dependency
+                if progress is not None:
+                    progress.write(f"no cross-evaluation: {error}\n")
+        result, arrays, checks = build_mix_result(problem, results, time.perf_counter() - t0, evaluation)
+    else:
+        result, arrays, checks = build_result(problem, results, time.perf_counter() - t0)
     if codesign is not None:
         result = replace(result, codesign=codesign)
     crane_file = study.crane_file
@@ -98,7 +113,11 @@ def run_study(
     write_results(folder, result, arrays)
     paths: list[Path] = []
     if figures:
+        from hiab_sim.study.cross_figure import cross_figure
         from hiab_sim.study.figures import write_figures
 
         paths = write_figures(folder, problem.study.crane, problem.emlas, result, arrays, checks)
+        if result.cross_evaluation is not None:
+            paths.append(folder / "cross_evaluation.png")
+            cross_figure(result.cross_evaluation, paths[-1])
     return RunOutput(folder, result, paths)

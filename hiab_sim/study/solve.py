@@ -22,12 +22,13 @@ from typing import Any, TextIO
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import minimize
+from scipy.optimize import OptimizeResult, minimize
 
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
 from hiab_sim.errors import HiabSimError, InvalidInputError, SolverError
-from hiab_sim.study.problem import LinkLengthProblem
+from hiab_sim.study.ipopt import solve_ipopt
+from hiab_sim.study.mix import Problem
 
 Array = NDArray[np.float64]
 #: Largest violation [scaled units] of a nominal constraint (:meth:`LinkLengthProblem.margins`) a start
@@ -65,7 +66,7 @@ class SolveResult:
     n_gradients: int = 0
 
 
-def check_start(problem: LinkLengthProblem, z: Array, label: str = "initial_lengths") -> None:
+def check_start(problem: Problem, z: Array, label: str = "initial_lengths") -> None:
     """Raise :class:`InvalidInputError` naming the worst violated constraint at a start point."""
     try:
         ev = problem.evaluate(z)
@@ -83,7 +84,7 @@ def check_start(problem: LinkLengthProblem, z: Array, label: str = "initial_leng
         )
 
 
-def start_points(problem: LinkLengthProblem, count: int, seed: int = 6) -> list[LinkLengths]:
+def start_points(problem: Problem, count: int, seed: int = 6) -> list[LinkLengths]:
     """The study's start and ``count - 1`` other feasible starts, drawn in the Xi bounds.
 
     Per chain: L uniform in its bounds, the retracted length x0 = Lc0 + Lc so that the stroke is
@@ -128,7 +129,7 @@ def _checkpoint_path(out: Path, start: int) -> Path:
     return out / f"checkpoint_{start}.json"
 
 
-def study_digest(problem: LinkLengthProblem) -> str:
+def study_digest(problem: Problem) -> str:
     """SHA-256 of the study's content: every setting, the crane and the EMLA set.
 
     The file path is recorded separately, and ``solver.maxiter`` is left out: it is the run's
@@ -141,7 +142,7 @@ def study_digest(problem: LinkLengthProblem) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def checkpoint_identity(problem: LinkLengthProblem, initial: LinkLengths) -> dict[str, Any]:
+def checkpoint_identity(problem: Problem, initial: LinkLengths) -> dict[str, Any]:
     """What a checkpoint belongs to: study path and content hash, ID path, start Xi [m]."""
     return {
         "study": str(Path(problem.study.path).resolve()),
@@ -151,7 +152,7 @@ def checkpoint_identity(problem: LinkLengthProblem, initial: LinkLengths) -> dic
     }
 
 
-def check_checkpoint(problem: LinkLengthProblem, initial: LinkLengths, out: Path, start: int) -> dict[str, Any] | None:
+def check_checkpoint(problem: Problem, initial: LinkLengths, out: Path, start: int) -> dict[str, Any] | None:
     """The checkpoint of a start if it belongs to this run, None if there is none.
 
     Raises:
@@ -213,7 +214,7 @@ def load_checkpoint(out: Path, start: int) -> dict[str, Any] | None:
 
 
 def solve(
-    problem: LinkLengthProblem,
+    problem: Problem,
     initial: LinkLengths,
     start: int = 0,
     out: Path | None = None,
@@ -301,16 +302,19 @@ def solve(
     bounds = list(zip(problem.lower, problem.upper, strict=True))
     bounds = [(lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None) for lo, hi in bounds]
     try:
-        res = minimize(
-            problem.cost,
-            z_begin,
-            jac=problem.cost_gradient if use_gradients else None,
-            method="SLSQP",
-            bounds=bounds,
-            constraints=[eq, ineq],
-            callback=record,
-            options={"maxiter": limit, "ftol": problem.study.solver.ftol},
-        )
+        if problem.study.solver.method == "ipopt":
+            res = _ipopt(problem, z_begin, limit, record)
+        else:
+            res = minimize(
+                problem.cost,
+                z_begin,
+                jac=problem.cost_gradient if use_gradients else None,
+                method="SLSQP",
+                bounds=bounds,
+                constraints=[eq, ineq],
+                callback=record,
+                options={"maxiter": limit, "ftol": problem.study.solver.ftol},
+            )
     except HiabSimError as error:
         result.message = f"a trial point left the model's domain: {error}"
         if out is not None:
@@ -331,10 +335,25 @@ def solve(
         _save_checkpoint(out, result, result.z, done=result.success, identity=identity)
     if not result.success:
         raise SolverError(
-            f"start {start}: SLSQP status {result.status}: {result.message} after {result.iterations} iterations "
+            f"start {start}: {problem.study.solver.method.upper()} status {result.status}: {result.message} "
+            f"after {result.iterations} iterations "
             "(partial history kept in the output folder)"
         )
     return result
+
+
+def _ipopt(problem: Problem, z: Array, limit: int, record: Callable[[Array], None]) -> OptimizeResult:
+    """IPOPT (:mod:`hiab_sim.study.ipopt`) in SLSQP's result shape; every iterate after the start is recorded."""
+    seen: list[int] = []
+
+    def on_iterate(x: Array) -> None:
+        if seen:  # IPOPT's iteration 0 is the start, already recorded
+            record(x)
+        seen.append(1)
+
+    outcome = solve_ipopt(problem, z, limit, problem.study.solver.ftol, on_iterate)
+    status = 0 if outcome.success else 1
+    return OptimizeResult(x=outcome.z, success=outcome.success, status=status, message=outcome.message)
 
 
 def xi_table(lengths: LinkLengths) -> dict[str, dict[str, float]]:

@@ -85,6 +85,21 @@ class Task:
         acceleration = self.reference.sample(kin, times).acceleration[:, :2]
         return self.payload.tcp_force(times, acceleration, gravity)
 
+    def id_force(self, kin: TcpKinematics, gravity: float, times: Array) -> Array | None:
+        """The payload's force on the TCP as the inverse dynamics takes it [N] in {W}: None, (3,) or (K, 3).
+
+        A constant weight without inertia (a single-reference study's plain ``payload: <kg>``) is
+        the constant vector (0, -m g, 0), as before tasks; a schedule or a payload with inertia is
+        the per-sample F(t) of :meth:`tcp_force` (at the reference's acceleration, so it does not
+        depend on the NLP's variables).
+        """
+        payload = self.payload
+        if payload.mass == 0.0:
+            return None
+        if payload.pick is None and payload.release is None and not payload.inertia:
+            return np.array([0.0, -payload.mass * gravity, 0.0])
+        return self.tcp_force(kin, gravity, times)
+
 
 def tasks_from_mapping(top: Mapping[str, Any], folder: Path, grid_duration: float, study_name: str) -> tuple[Task, ...]:
     """The study's tasks from its top-level mapping (``tasks:`` or today's ``reference:`` + ``payload:``).

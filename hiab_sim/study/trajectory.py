@@ -1,11 +1,12 @@
-"""B-spline joint trajectories, the spiral TCP reference, planar TCP kinematics and inverse kinematics.
+"""B-spline joint trajectories, the reference samples, planar TCP kinematics and inverse kinematics.
 
 * :class:`SplineBasis`: theta(t, c) = B(t) c and its time derivatives (eqs. ``matrix_basis``,
   ``matrix_basis_d``, ``matrix_basis_dd``) with scipy's B-splines (clamped uniform knots).
 * :class:`TcpKinematics`: the TCP's position, velocity and acceleration in the vertical plane of
   {W} (x, y; y up) and their exact partials with respect to (theta, dtheta, ddtheta). They enter
   the tracking constraints ``const_b``..``const_d``; J and dJ of the seed are implicit in them.
-* :func:`spiral_reference`: the rest-to-rest spiral with its prescribed telescope schedule.
+* :class:`Reference` and :func:`timing_law`: what every reference kind samples
+  (the kinds themselves, the spiral among them, are :mod:`hiab_sim.study.references`).
 * :func:`inverse_kinematics` and :func:`fit_coefficients`: the initial spline coefficients.
 
 The TCP does not depend on the link lengths Xi (the boom hinges are fixed), so nothing here does.
@@ -23,7 +24,6 @@ from scipy.interpolate import BSpline
 
 from hiab_sim.crane.description import Crane
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.study.config import SpiralReference
 
 Array = NDArray[np.float64]
 
@@ -191,7 +191,7 @@ class TcpKinematics:
 
 
 # ---------------------------------------------------------------------------------------------
-# Spiral reference
+# Reference samples
 # ---------------------------------------------------------------------------------------------
 
 
@@ -218,44 +218,6 @@ def timing_law(times: Array, duration: float) -> tuple[Array, Array, Array]:
     ds = 30.0 * tau**2 * (1.0 - tau) ** 2 / duration
     dds = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau) / duration**2
     return s, ds, dds
-
-
-def spiral_centre(kin: TcpKinematics, spec: SpiralReference) -> tuple[float, float]:
-    """Spiral centre in {W} (x, y) [m]: given, or the TCP at the given centre joints."""
-    if spec.centre_tcp is not None:
-        return spec.centre_tcp
-    assert spec.centre_joints is not None
-    p = kin.position(np.array([[*spec.centre_joints, spec.telescope_start]]))[0]
-    return float(p[0]), float(p[1])
-
-
-def spiral_reference(kin: TcpKinematics, spec: SpiralReference, duration: float, times: Array) -> Reference:
-    """Sample the spiral reference (see :class:`~hiab_sim.study.config.SpiralReference`)."""
-    s, ds, dds = timing_law(times, duration)
-    cx, cy = spiral_centre(kin, spec)
-    omega = 2.0 * np.pi * spec.turns
-    phi = spec.start_angle + omega * s
-    dr = spec.end_radius - spec.start_radius
-    r = spec.start_radius + dr * s
-    radial = np.column_stack([np.cos(phi), np.sin(phi)])
-    tangent = np.column_stack([-np.sin(phi), np.cos(phi)])
-    p_s = dr * radial + (r * omega)[:, None] * tangent
-    p_ss = 2.0 * dr * omega * tangent - (r * omega**2)[:, None] * radial
-    xy = np.array([cx, cy]) + r[:, None] * radial
-    v = p_s * ds[:, None]
-    a = p_ss * (ds**2)[:, None] + p_s * dds[:, None]
-    amp = spec.telescope_amplitude
-    xt = spec.telescope_start + amp * np.sin(np.pi * s)
-    dxt = amp * np.pi * np.cos(np.pi * s) * ds
-    ddxt = -amp * np.pi**2 * np.sin(np.pi * s) * ds**2 + amp * np.pi * np.cos(np.pi * s) * dds
-    return Reference(
-        time=np.asarray(times, dtype=float),
-        position=np.column_stack([xy, xt]),
-        velocity=np.column_stack([v, dxt]),
-        acceleration=np.column_stack([a, ddxt]),
-        z=kin.z,
-        centre=(cx, cy),
-    )
 
 
 # ---------------------------------------------------------------------------------------------

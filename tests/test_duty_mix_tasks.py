@@ -1,4 +1,4 @@
-"""The shipped loading cycle and the draft duty-mix tasks: regenerable, reachable, carriable by the EMLAs."""
+"""The shipped loading cycle and the duty-mix tasks: regenerable, reachable, carriable by the EMLAs."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from hiab_sim.study.references import reference_from_mapping
 from hiab_sim.study.workspace import initial_joints
 
 OPTIMIZE = Path(__file__).resolve().parents[1] / "optimize"
-DRAFT = yaml.safe_load((OPTIMIZE / "xs031_duty_mix.yaml").read_text())
+MIX = yaml.safe_load((OPTIMIZE / "xs031_duty_mix.yaml").read_text())
 CRANE = load_crane("xs031")
 KIN = tr.TcpKinematics(CRANE)
 
@@ -33,18 +33,18 @@ def test_shipped_loading_cycle_is_what_its_script_writes() -> None:
     assert module.render(KIN) == (OPTIMIZE / "xs031_loading_cycle.csv").read_text(encoding="utf-8")
 
 
-@pytest.mark.parametrize("index", range(len(DRAFT["tasks"])), ids=[t["name"] for t in DRAFT["tasks"]])
-def test_draft_task_is_reachable_and_within_the_emla_envelope_with_its_payload(index: int) -> None:
-    """Each draft task is reachable, within the joint-rate bounds and EMLA margins >= 0.2 at the built crane."""
-    task = DRAFT["tasks"][index]
+@pytest.mark.parametrize("index", range(len(MIX["tasks"])), ids=[t["name"] for t in MIX["tasks"]])
+def test_duty_mix_task_is_reachable_and_within_the_emla_envelope_with_its_payload(index: int) -> None:
+    """Each duty-mix task is reachable, within the joint-rate bounds and EMLA margins >= 0.2 at the built crane."""
+    task = MIX["tasks"][index]
     where = f"tasks[{index}]"
-    reference = reference_from_mapping(task["reference"], f"{where}.reference", OPTIMIZE, DRAFT["grid"]["duration"])
+    reference = reference_from_mapping(task["reference"], f"{where}.reference", OPTIMIZE, MIX["grid"]["duration"])
     payload = Payload.from_value(task["payload"], f"{where}.payload")
     reference.check_reach(KIN, CRANE)
     t = np.linspace(0.0, reference.duration, int(reference.duration / 0.05) + 1)
     ref = reference.sample(KIN, t)
     ik = tr.inverse_kinematics(KIN, ref, initial_joints(KIN, CRANE, ref))
-    assert np.all(np.abs(ik.velocity).max(axis=0) <= DRAFT["bounds"]["joint_velocity"])
+    assert np.all(np.abs(ik.velocity).max(axis=0) <= MIX["bounds"]["joint_velocity"])
     force = payload.tcp_force(t, ref.acceleration[:, :2], CRANE.gravity)
     joints = JointSamples(ik.position, ik.velocity, ik.acceleration)
     out = analytic_inverse_dynamics(CRANE, CRANE.default_lengths, joints, tcp_force=force)

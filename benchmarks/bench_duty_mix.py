@@ -1,0 +1,70 @@
+"""Benchmark: the duty-mix study (single start) against the default single-task study in the same run.
+
+Three solves from the built XS 031's lengths: the default study (``xs031_spiral``, dense SLSQP, its
+result unchanged by the tasks loader), the duty mix with its own solver (IPOPT, sparse Jacobians)
+and, with ``--slsqp N``, the duty mix with dense SLSQP for at most N iterations (its seconds per
+iteration are the measure of whether dense SLSQP serves the mix). Goals (issue 12): the duty mix
+<= 10 s wall on 2 cores and <= 100 iterations; the default study no slower than before (~0.6-1 s).
+Wall times depend on the machine's load: compare them with the default study's in the same run.
+
+Run: .venv/bin/python benchmarks/bench_duty_mix.py [--slsqp 10]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from hiab_sim.errors import SolverError
+from hiab_sim.study.config import DEFAULT_STUDY, Study, load_study
+from hiab_sim.study.mix import make_problem
+from hiab_sim.study.solve import solve
+
+
+def _run(study: Study, maxiter: int | None = None) -> dict[str, object]:
+    t0 = time.perf_counter()
+    problem = make_problem(study)
+    build = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    try:
+        result = solve(problem, study.initial_lengths, progress=None, maxiter=maxiter)
+        message, z, iterations = result.message, result.z, result.iterations
+    except SolverError as error:  # e.g. the iteration limit of the dense SLSQP probe
+        message, z, iterations = str(error), None, maxiter or -1
+    wall = time.perf_counter() - t0
+    out: dict[str, object] = {"build": build, "wall": wall, "iterations": iterations, "message": message}
+    out["variables"], out["rows"] = problem.n, len(problem.constraint_names)
+    if z is not None:
+        out["cost"] = problem.cost(z)
+        out["violation"] = problem.max_violation(z)
+        out["xi"] = np.round(problem.unpack(z)[0].as_array(), 4).tolist()
+    return out
+
+
+def main() -> None:
+    """Run the solves and print wall time, iterations, size, cost and Xi of each."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--slsqp", type=int, default=0, help="also run dense SLSQP on the mix for N iterations")
+    args = parser.parse_args()
+    mix = load_study("xs031_duty_mix")
+    runs = {
+        "default study (SLSQP)": _run(load_study(str(DEFAULT_STUDY))),
+        f"duty mix ({mix.solver.method.upper()})": _run(mix),
+    }
+    if args.slsqp:
+        dense = replace(mix, solver=replace(mix.solver, method="slsqp"))
+        runs[f"duty mix (SLSQP, {args.slsqp} it.)"] = _run(dense, maxiter=args.slsqp)
+    for name, r in runs.items():
+        per = float(r["wall"]) / max(1, int(r["iterations"]))  # type: ignore[call-overload]
+        print(
+            f"{name:28s} n {r['variables']:4d} rows {r['rows']:5d}  build {r['build']:5.2f} s  wall {r['wall']:7.2f} s"
+            f"  iterations {r['iterations']:4d} ({per:.2f} s/it.)  cost {r.get('cost', float('nan')):.6f}"
+            f"  violation {r.get('violation', float('nan')):.1e}  Xi {r.get('xi')}  [{r['message']}]"
+        )
+
+
+if __name__ == "__main__":
+    main()
