@@ -21,9 +21,11 @@ import numpy as np
 from hiab_sim.checks import check_choice, check_range
 from hiab_sim.crane.description import CHAIN_NAMES, ChainLengths, Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
+from hiab_sim.crane.mounting import MountingSpace
 from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import DEFAULT_STUDY, Source, locate
+from hiab_sim.study.build_settings import BuildSettings
 from hiab_sim.yaml_fields import mapping, number, positive, read_yaml, section, vector
 
 ID_PATHS = ("mujoco", "analytic")
@@ -234,6 +236,8 @@ class Study:
     bounds: Bounds
     solver: SolverSettings
     payload: float = 0.0  # kg hanging at the TCP
+    build: BuildSettings = BuildSettings()  # manufacturing tolerance and stroke margin (issue 14)
+    mounting: MountingSpace | None = None  # optional mounting polygons of the base pivots (issue 14)
     crane_file: Source | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -268,6 +272,8 @@ _TOP = {
     "bounds",
     "solver",
     "payload",
+    "build",
+    "mounting",
 }
 _REQUIRED_TOP = {"crane", "reference", "bounds"}
 
@@ -297,8 +303,8 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
     crane = load_crane(crane_file)
     emla_source = "default" if top.get("emla") is None else str(top["emla"])
     emlas = load_emla_set(locate(emla_source, "emla", relative_to=file))
-    initial = _lengths(top.get("initial_lengths"), crane)
     bounds = _bounds(top["bounds"])
+    initial = _lengths(top.get("initial_lengths"), crane, bounds)
     return Study(
         name=str(top.get("name", Path(str(file.file)).stem)),
         path=str(file.file),
@@ -314,13 +320,16 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
         bounds=bounds,
         solver=SolverSettings(**section(SolverSettings, top.get("solver"), "solver")),
         payload=number(top.get("payload", 0.0), "payload"),
+        build=BuildSettings.from_mapping(top.get("build")),
+        mounting=None if top.get("mounting") is None else MountingSpace.from_mapping(top["mounting"]),
         crane_file=crane_file,
     )
 
 
-def _lengths(data: Any, crane: Crane) -> LinkLengths:
-    if data is None:
-        return crane.default_lengths
+def _lengths(data: Any, crane: Crane, bounds: Bounds) -> LinkLengths:
+    if data is None:  # the crane's own lengths, clipped into the bounds (the feasibility phase moves on from there)
+        xi = np.clip(crane.default_lengths.as_array(), bounds.xi_low, bounds.xi_up)
+        return LinkLengths.from_array(xi)
     top = mapping(data, "initial_lengths", set(CHAIN_NAMES), set(CHAIN_NAMES))
     chains = []
     for name in CHAIN_NAMES:
