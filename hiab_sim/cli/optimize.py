@@ -87,6 +87,9 @@ def summary_lines(r: Result) -> list[str]:
         f"re-check ({rc.id_path}, {rc.grid_points} points): max violation {rc.max_violation_scaled:.1e}, "
         f"TCP tracking error {rc.tracking_error.position_m * 1e3:.3f} mm"
     )
+    from hiab_sim.study.report_extra import extra_lines
+
+    lines += extra_lines(r)
     ms = r.multistart
     if len(ms.starts) > 1:
         converged = ms.converged_starts

@@ -192,7 +192,7 @@ def _unit(j: int) -> Array:
 DEFAULT_STROKE_MARGIN = 4e-3
 
 
-def buildable_crane(crane: Crane, stroke_margin: float = DEFAULT_STROKE_MARGIN) -> Crane:
+def buildable_crane(crane: Crane, stroke_margin: float = DEFAULT_STROKE_MARGIN, field: str = "build.stroke_margin") -> Crane:
     """The crane with each chain's working joint range shortened by a stroke margin at both ends.
 
     The new range is the part of the crane's joint range over which its own cylinders (the
@@ -206,14 +206,14 @@ def buildable_crane(crane: Crane, stroke_margin: float = DEFAULT_STROKE_MARGIN) 
     the crane unchanged.
     """
     if not (math.isfinite(stroke_margin) and stroke_margin >= 0.0):
-        raise InvalidInputError("build.stroke_margin", stroke_margin, "must be a finite length >= 0", "m")
+        raise InvalidInputError(field, stroke_margin, "must be a finite length >= 0", "m")
     if stroke_margin == 0.0:
         return crane
     chains = {}
     for chain in crane.chains:
         if not 2.0 * stroke_margin < chain.stroke:
             raise InvalidInputError(
-                "build.stroke_margin", stroke_margin, f"must be < half the {chain.name} stroke {chain.stroke:.6g}", "m"
+                field, stroke_margin, f"must be < half the {chain.name} stroke {chain.stroke:.6g}", "m"
             )
         theta = mechanism.stroke_to_joint(
             chain, chain.default_lengths, np.array([stroke_margin, chain.stroke - stroke_margin])

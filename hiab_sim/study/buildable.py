@@ -40,13 +40,15 @@ import numpy as np
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.tolerance import buildable_crane, round_lengths
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.study.blocks import WorkingRange
+from hiab_sim.study.blocks import STROKE_SCALE, WorkingRange
 from hiab_sim.study.mounting_block import MountingRows
 from hiab_sim.study.nlp import N_XI, Array, ConstraintBlock, DenseRows, SamplePartials, SampleState
 
 if TYPE_CHECKING:
     from hiab_sim.study.config import Study
 
+#: Clearance [m] the robust stroke rows keep beyond their first-order worst case.
+ROBUST_CLEARANCE = 1e-6
 #: Step of the central differences of a block's Jacobian w.r.t. Xi [m].
 HESSIAN_STEP = 1e-5
 
@@ -149,7 +151,8 @@ def buildable_blocks(study: Study, working: Sequence[tuple[float, float]], tight
     t = study.build.tolerance
     blocks: list[ConstraintBlock] = []
     if tightened:
-        wr = WorkingRange(study.crane.chains, buildable_working_range(study, working), 0.0)
+        # the clearance covers the first-order error of the robust rows (<= t^2 / (2 s), module docstring)
+        wr = WorkingRange(study.crane.chains, buildable_working_range(study, working), ROBUST_CLEARANCE / STROKE_SCALE)
         blocks.append(RobustXi(wr, t, "buildable_range"))
     if study.mounting is not None:
         rows = MountingRows(study.mounting, study.crane)

@@ -23,6 +23,7 @@ from typing import Any, TypeVar
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import ConfigError
 from hiab_sim.study.codec import from_json, optional, to_json
+from hiab_sim.study.result_sections import Buildable, FeasibilityPhase, Sensitivity
 
 #: Version of the result.json layout; files without the key are version 1 (the same keys).
 SCHEMA_VERSION = 1
@@ -287,6 +288,9 @@ class Result:
     history: tuple[HistoryRow, ...]
     schema_version: int = SCHEMA_VERSION
     crane_source: str | None = optional()
+    buildable: Buildable | None = optional()
+    feasibility: tuple[FeasibilityPhase, ...] | None = optional()
+    sensitivity: Sensitivity | None = optional()
     extra: dict[str, Any] = field(default_factory=dict)  # keys of a newer writer, kept verbatim
 
     def __post_init__(self) -> None:

@@ -12,15 +12,15 @@ from hiab_sim.atomic_io import write_atomic
 from hiab_sim.errors import SolverError
 from hiab_sim.study import run_safety
 from hiab_sim.study.config import Study, load_study
+from hiab_sim.study.feasibility import feasible_starts, phase_lines
 from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.report import build_result, write_results
+from hiab_sim.study.report_extra import issue14_sections
 from hiab_sim.study.result import Result
 from hiab_sim.study.solve import (
     SolveResult,
     check_checkpoint,
-    check_start,
     solve,
-    start_points,
     study_digest,
 )
 
@@ -57,8 +57,8 @@ def run_study(
     if not isinstance(study, Study):
         study = load_study(study)
     problem = LinkLengthProblem(study, id_path=id_path)
-    check_start(problem, problem.initial_point(study.initial_lengths))
-    initials = start_points(problem, starts)
+    points, phases = feasible_starts(problem, starts)
+    initials = [problem.unpack(z)[0] for z in points]
     folder = Path(out)
     run_safety.check_folder(folder, study_digest(problem), resume, force)
     if resume:
@@ -71,14 +71,20 @@ def run_study(
     results: list[SolveResult] = []
     for k, initial in enumerate(initials):
         try:
-            results.append(solve(problem, initial, start=k, out=folder, resume=resume, progress=progress))
+            if progress is not None:
+                for phase in phases:
+                    if phase.start == k:
+                        progress.write("\n".join(phase_lines(phase)) + "\n")
+            results.append(
+                solve(problem, initial, start=k, out=folder, resume=resume, progress=progress, z0=points[k])
+            )
         except SolverError as error:
             if k == 0:
                 raise
             if progress is not None:
                 progress.write(f"[start {k}] {error}\n")
             failed = SolveResult(
-                start=k, initial_lengths=initial, z0=problem.initial_point(initial), z=problem.initial_point(initial)
+                start=k, initial_lengths=initial, z0=points[k], z=points[k]
             )
             failed.success = False
             failed.message = str(error)
@@ -88,6 +94,8 @@ def run_study(
     if crane_file is not None and not (crane_file.shipped and crane_file.label == study.crane_source):
         write_atomic(folder / "crane.yaml", crane_file.read_bytes())  # a crane file, not a preset name
         result = replace(result, crane="crane.yaml", crane_source=study.crane_source)
+    crane_label = study.crane_source if result.crane != "crane.yaml" else str(folder / "crane.yaml")
+    result = replace(result, **issue14_sections(problem, results[0].z, result, crane_label, phases))
     write_results(folder, result, arrays)
     paths: list[Path] = []
     if figures:

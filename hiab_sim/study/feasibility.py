@@ -1,0 +1,159 @@
+"""Feasibility phase: from a start that violates constraints to the nearest feasible point, or a named limit.
+
+Least violation within the bounds: minimise
+
+    phi(z) = 1/2 sum_i min(0, g_i(z) - delta)^2 + 1/2 sum_j e_j(z)^2
+
+over z with Xi in its bounds (L-BFGS-B with the problem's exact gradients, grad phi = J^T min(0,
+g - delta) + E^T e), g the solver's scaled rows (tightened bands, clearances, robust rows) and
+delta = :data:`TARGET` a small positive target, so phi = 0 is reached at a point strictly inside.
+If the least violation stays > 0, no feasible point was found: :class:`InfeasibleStudyError`
+names the row that is violated most at the best point, where and by how much in physical units
+(:func:`describe_violation`). A trial point outside the model's domain (a chain that cannot close)
+counts as a large phi, so the line search steps back.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.optimize import minimize
+
+from hiab_sim.crane.description import LinkLengths
+from hiab_sim.errors import HiabSimError, InfeasibleStudyError
+from hiab_sim.study.blocks import STROKE_SCALE
+from hiab_sim.study.problem import LinkLengthProblem
+from hiab_sim.study.result_sections import FeasibilityPhase
+from hiab_sim.study.sensitivity import XI_NAMES
+
+Array = np.ndarray
+#: Scaled margin the phase aims for on every row.
+TARGET = 1e-4
+#: A start whose nominal rows are all >= -this needs no feasibility phase (round-off only).
+START_TOLERANCE = 1e-9
+_REMEDY = {
+    "peak_torque": "a larger motor or gear ratio is needed",
+    "rated_speed": "a faster motor or a longer screw lead is needed",
+    "voltage": "a higher bus voltage is needed",
+}
+
+
+def describe_violation(problem: LinkLengthProblem, index: int, value: float) -> str:
+    """A row's violation in words and physical units ("lift EMLA peak torque exceeded by 28 % at t = 2.5 s")."""
+    name = problem.constraint_names[index]
+    where = ""
+    if " at t=" in name:
+        name, t = name.split(" at t=")
+        where = f" at t = {t}"
+    block = name.split(".")[0]
+    if block == "envelope":
+        _, actuator, limit = name.split(".")
+        m = problem.envelope_margin
+        g = value * (1.0 - m) + m
+        ratio = math.sqrt(max(1.0 - g, 0.0))
+        return (
+            f"{actuator} EMLA {limit.replace('_', ' ')} exceeded by {100.0 * (ratio - 1.0):.0f} %{where} "
+            f"even at the best lengths: {_REMEDY.get(limit, 'a larger EMLA is needed')}"
+        )
+    if block in ("stroke", "working_range", "buildable_range"):
+        return f"{name}{where} violated by {-value * STROKE_SCALE * 1e3:.1f} mm even at the best lengths"
+    if block == "tracking":
+        return f"{name}{where}: the TCP leaves its tracking band by {-value * 100:.0f} % of the band"
+    return f"{name}{where} violated by {-value:.3g} (scaled) even at the best lengths"
+
+
+def _phi(problem: LinkLengthProblem, z: Array) -> tuple[float, Array]:
+    try:
+        g = problem.constraints(z)
+        e = problem.equalities(z)
+        short = np.minimum(0.0, g - TARGET)
+        value = 0.5 * float(short @ short + e @ e)
+        grad = problem.constraints_jacobian(z).T @ short + problem.equalities_jacobian(z).T @ e
+    except HiabSimError:
+        return 1e10, np.zeros_like(z)
+    return value, grad
+
+
+def changes(before: LinkLengths, after: LinkLengths) -> tuple[str, ...]:
+    """What the phase changed, one line per moved length [mm]."""
+    a, b = before.as_array(), after.as_array()
+    return tuple(
+        f"{n}: {x * 1e3:.1f} -> {y * 1e3:.1f} mm ({(y - x) * 1e3:+.1f} mm)"
+        for n, x, y in zip(XI_NAMES, a, b, strict=True)
+        if abs(y - x) > 1e-6
+    )
+
+
+def feasible_start(problem: LinkLengthProblem, z0: Array, start: int = 0, maxiter: int = 500) -> tuple[Array, FeasibilityPhase | None]:
+    """The start itself if it is feasible, else the feasibility phase's point and what it changed.
+
+    Raises:
+        InfeasibleStudyError: the least violation within the bounds is > 0 (message: the binding limit).
+
+    """
+    z0 = np.asarray(z0, dtype=float)
+    try:
+        margins = problem.margins(z0)
+        worst = int(np.argmin(margins))
+        violation0 = max(0.0, -float(margins[worst]), float(np.abs(problem.equalities(z0)).max()))
+        worst_name = problem.constraint_names[worst]
+    except HiabSimError as error:
+        violation0, worst_name = math.inf, f"not an admissible crane: {error}"
+    if violation0 <= START_TOLERANCE:
+        return z0, None
+    bounds = [(lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None) for lo, hi in zip(problem.lower, problem.upper, strict=True)]
+    res = minimize(lambda z: _phi(problem, z), z0, jac=True, method="L-BFGS-B", bounds=bounds, options={"maxiter": maxiter, "ftol": 1e-15, "gtol": 1e-12})
+    z = np.asarray(res.x, dtype=float)
+    g = problem.constraints(z)
+    if g.min() < 0.0 or np.abs(problem.equalities(z)).max() > 1e-9:
+        k = int(np.argmin(g))
+        raise InfeasibleStudyError(
+            f"no feasible point within the bounds (least violation found by the feasibility phase from start {start}): "
+            + describe_violation(problem, k, float(g[k]))
+        )
+    before, _ = problem.unpack(z0)
+    after, _ = problem.unpack(z)
+    return z, FeasibilityPhase(
+        start=start,
+        initial_max_violation=violation0,
+        initial_worst=worst_name,
+        final_max_violation=problem.max_violation(z),
+        lengths_before=before,
+        lengths_after=after,
+        changes=changes(before, after) or ("only the trajectory (spline coefficients) changed",),
+        iterations=int(res.nit),
+    )
+
+
+def feasible_starts(problem: LinkLengthProblem, count: int, seed: int = 6) -> tuple[list[Array], list[FeasibilityPhase]]:
+    """The study's start and ``count - 1`` starts drawn uniformly in the Xi bounds, each made feasible.
+
+    A draw the feasibility phase cannot repair is skipped (at most 20 ``count`` draws); the
+    study's own start raises :class:`InfeasibleStudyError` if it cannot be repaired.
+    """
+    z, phase = feasible_start(problem, problem.initial_point(problem.study.initial_lengths), 0)
+    points, phases = [z], [phase] if phase else []
+    rng = np.random.default_rng(seed)
+    low, up = problem.lower[: problem.n_xi], problem.upper[: problem.n_xi]
+    for _ in range(20 * count):
+        if len(points) >= count:
+            break
+        xi = rng.uniform(low, up)
+        try:
+            z, phase = feasible_start(problem, problem.initial_point(LinkLengths.from_array(xi)), len(points))
+        except HiabSimError:
+            continue
+        points.append(z)
+        if phase is not None:
+            phases.append(phase)
+    return points, phases
+
+
+def phase_lines(phase: FeasibilityPhase) -> list[str]:
+    """Lines for stdout: what the phase started from and what it changed."""
+    return [
+        f"feasibility phase (start {phase.start}): max violation {phase.initial_max_violation:.2e} "
+        f"({phase.initial_worst}) -> {phase.final_max_violation:.1e} in {phase.iterations} iterations; changed:",
+        *(f"  {c}" for c in phase.changes),
+    ]
