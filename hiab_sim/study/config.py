@@ -328,8 +328,7 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
 
 def _lengths(data: Any, crane: Crane, bounds: Bounds) -> LinkLengths:
     if data is None:  # the crane's own lengths, clipped into the bounds (the feasibility phase moves on from there)
-        xi = np.clip(crane.default_lengths.as_array(), bounds.xi_low, bounds.xi_up)
-        return LinkLengths.from_array(xi)
+        return _clipped_lengths(crane, bounds)
     top = mapping(data, "initial_lengths", set(CHAIN_NAMES), set(CHAIN_NAMES))
     chains = []
     for name in CHAIN_NAMES:
@@ -337,6 +336,28 @@ def _lengths(data: Any, crane: Crane, bounds: Bounds) -> LinkLengths:
         values = [positive(d[k], f"initial_lengths.{name}.{k}", "m") for k in ("L", "Lc0", "Lc")]
         chains.append(ChainLengths(*values))
     return LinkLengths(chains[0], chains[1])
+
+
+def _clipped_lengths(crane: Crane, bounds: Bounds) -> LinkLengths:
+    """The crane's lengths if inside the bounds; else L clipped and x0 = Lc0 + Lc centring the joint range's stroke.
+
+    A clipped L moves the strokes at the ends of the joint range (eq. qus_a); x0 is chosen so the
+    stroke used, s(theta_up) - s(theta_low), sits in the middle of [0, stroke], and Lc takes what
+    Lc0 (clipped) leaves, within its bounds. The feasibility phase starts from this point.
+    """
+    xi = crane.default_lengths.as_array()
+    low, up = np.asarray(bounds.xi_low), np.asarray(bounds.xi_up)
+    if np.all((low <= xi) & (xi <= up)):
+        return crane.default_lengths
+    out = np.clip(xi, low, up)
+    for j, chain in enumerate(crane.chains):
+        if out[3 * j] == xi[3 * j]:
+            continue
+        q = chain.joint_offset - math.pi - np.asarray(chain.joint_range)  # hinge angle (eq. thetas)
+        s = np.sqrt(out[3 * j] ** 2 + chain.L1**2 - 2.0 * out[3 * j] * chain.L1 * np.cos(q))
+        x0 = 0.5 * (float(s.min() + s.max()) - chain.stroke)
+        out[3 * j + 2] = float(np.clip(x0 - out[3 * j + 1], low[3 * j + 2], up[3 * j + 2]))
+    return LinkLengths.from_array(out)
 
 
 def _reference(data: Any) -> SpiralReference:

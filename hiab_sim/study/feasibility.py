@@ -30,6 +30,8 @@ from hiab_sim.study.sensitivity import XI_NAMES
 Array = np.ndarray
 #: Scaled margin the phase aims for on every row.
 TARGET = 1e-4
+#: Least violation [scaled] below which the penalty's point is projected onto the feasible set by SLSQP.
+POLISH = 1e-2
 #: A start whose nominal rows are all >= -this needs no feasibility phase (round-off only).
 START_TOLERANCE = 1e-9
 _REMEDY = {
@@ -75,6 +77,24 @@ def _phi(problem: LinkLengthProblem, z: Array) -> tuple[float, Array]:
     return value, grad
 
 
+def _project(problem: LinkLengthProblem, z: Array, bounds: list[tuple[float | None, float | None]]) -> Array:
+    """The nearest point to z that satisfies the rows to SLSQP's accuracy (the penalty approaches them only asymptotically)."""
+    target = np.array(z)
+    res = minimize(
+        lambda x: (0.5 * float((x - target) @ (x - target)), x - target),
+        target,
+        jac=True,
+        method="SLSQP",
+        bounds=bounds,
+        constraints=[
+            {"type": "ineq", "fun": problem.constraints, "jac": problem.constraints_jacobian},
+            {"type": "eq", "fun": problem.equalities, "jac": problem.equalities_jacobian},
+        ],
+        options={"maxiter": 100, "ftol": 1e-14},
+    )
+    return np.asarray(res.x, dtype=float)
+
+
 def changes(before: LinkLengths, after: LinkLengths) -> tuple[str, ...]:
     """What the phase changed, one line per moved length [mm]."""
     a, b = before.as_array(), after.as_array()
@@ -106,7 +126,10 @@ def feasible_start(problem: LinkLengthProblem, z0: Array, start: int = 0, maxite
     res = minimize(lambda z: _phi(problem, z), z0, jac=True, method="L-BFGS-B", bounds=bounds, options={"maxiter": maxiter, "ftol": 1e-15, "gtol": 1e-12})
     z = np.asarray(res.x, dtype=float)
     g = problem.constraints(z)
-    if g.min() < 0.0 or np.abs(problem.equalities(z)).max() > 1e-9:
+    if g.min() < 0.0 and g.min() > -POLISH:
+        z = _project(problem, z, bounds)
+        g = problem.constraints(z)
+    if g.min() < -START_TOLERANCE or np.abs(problem.equalities(z)).max() > 1e-9:
         k = int(np.argmin(g))
         raise InfeasibleStudyError(
             f"no feasible point within the bounds (least violation found by the feasibility phase from start {start}): "
