@@ -32,7 +32,9 @@ def solved() -> tuple[LinkLengthProblem, np.ndarray]:
     return problem, result.z
 
 
-def test_every_design_within_the_tolerance_serves_the_buildable_range(solved: tuple[LinkLengthProblem, np.ndarray]) -> None:
+def test_every_design_within_the_tolerance_serves_the_buildable_range(
+    solved: tuple[LinkLengthProblem, np.ndarray],
+) -> None:
     """Each of the 64 corners Xi +- t of the optimum passes the crane's own check over the buildable range."""
     problem, z = solved
     study = problem.study
@@ -41,13 +43,15 @@ def test_every_design_within_the_tolerance_serves_the_buildable_range(solved: tu
     t = study.build.tolerance
     for signs in itertools.product((-1.0, 1.0), repeat=6):
         check_lengths(short, LinkLengths.from_array(xi + t * np.array(signs)))  # raises if a stroke leaves [0, stroke]
-    rounded = rounded_design(LinkLengths.from_array(xi), t, np.asarray(study.bounds.xi_low), np.asarray(study.bounds.xi_up))
+    rounded = rounded_design(
+        LinkLengths.from_array(xi), t, np.asarray(study.bounds.xi_low), np.asarray(study.bounds.xi_up)
+    )
     assert np.all(np.abs(rounded.as_array() - xi) <= t / 2 + 1e-12)
     check_lengths(short, rounded)
 
 
 def test_robust_rows_match_the_worst_corner_to_second_order(solved: tuple[LinkLengthProblem, np.ndarray]) -> None:
-    """g - |dg/dXi| t of the buildable-range rows equals the least margin over the 64 corners within t^2 / s."""
+    """G - |dg/dXi| t of the buildable-range rows equals the least margin over the 64 corners within t^2 / s."""
     problem, z = solved
     block = next(b for b in problem.layout.blocks if isinstance(b, RobustXi) and b.name == "buildable_range")
     ev = problem.evaluate(z)

@@ -114,9 +114,8 @@ def run(args: argparse.Namespace) -> int:
     """Build the model, write it and print a one-line summary."""
     import mujoco
 
-    from hiab_sim.model.mjcf import to_xml
-
     from hiab_sim.crane.tolerance import buildable_crane
+    from hiab_sim.model.mjcf import to_xml
 
     crane, lengths = _crane_and_lengths(args)
     crane = buildable_crane(crane, args.stroke_margin, field="--stroke-margin")

@@ -192,7 +192,9 @@ def _unit(j: int) -> Array:
 DEFAULT_STROKE_MARGIN = 4e-3
 
 
-def buildable_crane(crane: Crane, stroke_margin: float = DEFAULT_STROKE_MARGIN, field: str = "build.stroke_margin") -> Crane:
+def buildable_crane(
+    crane: Crane, stroke_margin: float = DEFAULT_STROKE_MARGIN, field: str = "build.stroke_margin"
+) -> Crane:
     """The crane with each chain's working joint range shortened by a stroke margin at both ends.
 
     The new range is the part of the crane's joint range over which its own cylinders (the

@@ -31,7 +31,6 @@ file accepts the optimum.
 from __future__ import annotations
 
 import math
-
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -93,7 +92,7 @@ class RobustXi(ConstraintBlock):
         return np.asarray(jac.dxi, dtype=float)
 
     def values(self, state: SampleState) -> Array:
-        """g - |dg/dXi| t, (m,)."""
+        """G - |dg/dXi| t, (m,)."""
         return self.inner.values(state) - np.abs(self._dxi(state)).sum(axis=1) * self.tolerance
 
     def jacobian(self, state: SampleState, partials: SamplePartials) -> DenseRows:
@@ -133,11 +132,12 @@ def rounded_design(lengths: LinkLengths, tolerance: float, low: Array, up: Array
     return LinkLengths.from_array(np.round(np.clip(xi, low_grid, up_grid), digits))
 
 
-
 def buildable_working_range(study: Study, working: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
     """The working range the robust rows serve: ``working`` within the study crane's buildable range [rad]."""
     short = buildable_crane(study.crane, study.build.stroke_margin)
-    return tuple((max(w[0], c.joint_range[0]), min(w[1], c.joint_range[1])) for w, c in zip(working, short.chains))
+    return tuple(
+        (max(w[0], c.joint_range[0]), min(w[1], c.joint_range[1])) for w, c in zip(working, short.chains, strict=True)
+    )
 
 
 def buildable_blocks(study: Study, working: Sequence[tuple[float, float]], tightened: bool) -> list[ConstraintBlock]:

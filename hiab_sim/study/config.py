@@ -236,7 +236,7 @@ class Study:
     bounds: Bounds
     solver: SolverSettings
     payload: float = 0.0  # kg hanging at the TCP
-    build: BuildSettings = BuildSettings()  # manufacturing tolerance and stroke margin (issue 14)
+    build: BuildSettings = field(default_factory=BuildSettings)  # manufacturing tolerance, stroke margin (issue 14)
     mounting: MountingSpace | None = None  # optional mounting polygons of the base pivots (issue 14)
     crane_file: Source | None = field(default=None, repr=False, compare=False)
 

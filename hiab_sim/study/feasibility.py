@@ -78,7 +78,7 @@ def _phi(problem: LinkLengthProblem, z: Array) -> tuple[float, Array]:
 
 
 def _project(problem: LinkLengthProblem, z: Array, bounds: list[tuple[float | None, float | None]]) -> Array:
-    """The nearest point to z that satisfies the rows to SLSQP's accuracy (the penalty approaches them only asymptotically)."""
+    """The nearest point to z satisfying the rows to SLSQP's accuracy (the penalty only approaches them)."""
     target = np.array(z)
     res = minimize(
         lambda x: (0.5 * float((x - target) @ (x - target)), x - target),
@@ -105,7 +105,9 @@ def changes(before: LinkLengths, after: LinkLengths) -> tuple[str, ...]:
     )
 
 
-def feasible_start(problem: LinkLengthProblem, z0: Array, start: int = 0, maxiter: int = 500) -> tuple[Array, FeasibilityPhase | None]:
+def feasible_start(
+    problem: LinkLengthProblem, z0: Array, start: int = 0, maxiter: int = 500
+) -> tuple[Array, FeasibilityPhase | None]:
     """The start itself if it is feasible, else the feasibility phase's point and what it changed.
 
     Raises:
@@ -122,8 +124,18 @@ def feasible_start(problem: LinkLengthProblem, z0: Array, start: int = 0, maxite
         violation0, worst_name = math.inf, f"not an admissible crane: {error}"
     if violation0 <= START_TOLERANCE:
         return z0, None
-    bounds = [(lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None) for lo, hi in zip(problem.lower, problem.upper, strict=True)]
-    res = minimize(lambda z: _phi(problem, z), z0, jac=True, method="L-BFGS-B", bounds=bounds, options={"maxiter": maxiter, "ftol": 1e-15, "gtol": 1e-12})
+    bounds = [
+        (lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None)
+        for lo, hi in zip(problem.lower, problem.upper, strict=True)
+    ]
+    res = minimize(
+        lambda z: _phi(problem, z),
+        z0,
+        jac=True,
+        method="L-BFGS-B",
+        bounds=bounds,
+        options={"maxiter": maxiter, "ftol": 1e-15, "gtol": 1e-12},
+    )
     z = np.asarray(res.x, dtype=float)
     g = problem.constraints(z)
     if g.min() < 0.0 and g.min() > -POLISH:
@@ -149,7 +161,9 @@ def feasible_start(problem: LinkLengthProblem, z0: Array, start: int = 0, maxite
     )
 
 
-def feasible_starts(problem: LinkLengthProblem, count: int, seed: int = 6) -> tuple[list[Array], list[FeasibilityPhase]]:
+def feasible_starts(
+    problem: LinkLengthProblem, count: int, seed: int = 6
+) -> tuple[list[Array], list[FeasibilityPhase]]:
     """The study's start and ``count - 1`` starts drawn uniformly in the Xi bounds, each made feasible.
 
     A draw the feasibility phase cannot repair is skipped (at most 20 ``count`` draws); the

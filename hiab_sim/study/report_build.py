@@ -33,7 +33,9 @@ def rounded_point(problem: LinkLengthProblem, z: Array) -> tuple[LinkLengths, Ar
     """The rounded lengths of the optimum z and the point (rounded Xi, optimal trajectory)."""
     lengths, _ = problem.unpack(z)
     study = problem.study
-    rounded = rounded_design(lengths, study.build.tolerance, np.asarray(study.bounds.xi_low), np.asarray(study.bounds.xi_up))
+    rounded = rounded_design(
+        lengths, study.build.tolerance, np.asarray(study.bounds.xi_low), np.asarray(study.bounds.xi_up)
+    )
     z_rounded = np.array(z, dtype=float)
     z_rounded[: problem.n_xi] = rounded.as_array()
     return rounded, z_rounded

@@ -29,7 +29,7 @@ def issue14_sections(
 
 
 def extra_lines(r: Result) -> list[str]:
-    """stdout lines: the feasibility phases, the buildable design and the largest multipliers."""
+    """Stdout lines: the feasibility phases, the buildable design and the largest multipliers."""
     lines: list[str] = []
     for phase in r.feasibility or ():
         lines += phase_lines(phase)

@@ -75,17 +75,13 @@ def run_study(
                 for phase in phases:
                     if phase.start == k:
                         progress.write("\n".join(phase_lines(phase)) + "\n")
-            results.append(
-                solve(problem, initial, start=k, out=folder, resume=resume, progress=progress, z0=points[k])
-            )
+            results.append(solve(problem, initial, start=k, out=folder, resume=resume, progress=progress, z0=points[k]))
         except SolverError as error:
             if k == 0:
                 raise
             if progress is not None:
                 progress.write(f"[start {k}] {error}\n")
-            failed = SolveResult(
-                start=k, initial_lengths=initial, z0=points[k], z=points[k]
-            )
+            failed = SolveResult(start=k, initial_lengths=initial, z0=points[k], z=points[k])
             failed.success = False
             failed.message = str(error)
             results.append(failed)

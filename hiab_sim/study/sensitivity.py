@@ -42,9 +42,9 @@ _SAMPLE = re.compile(r" at t=[-0-9.e+]+ s$")
 XI_NAMES = ("lift.L", "lift.Lc0", "lift.Lc", "tilt.L", "tilt.Lc0", "tilt.Lc")
 
 
-def kkt_multipliers(problem: LinkLengthProblem, z: Array, active_tolerance: float = ACTIVE_TOLERANCE) -> tuple[
-    Array, Array, Array, float
-]:
+def kkt_multipliers(
+    problem: LinkLengthProblem, z: Array, active_tolerance: float = ACTIVE_TOLERANCE
+) -> tuple[Array, Array, Array, float]:
     """(lambda per row (m,), nu_low (6,), nu_up (6,), relative residual) by NNLS on the active set."""
     z = np.asarray(z, dtype=float)
     grad = problem.cost_gradient(z)
