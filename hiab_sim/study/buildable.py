@@ -40,7 +40,7 @@ from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.tolerance import buildable_crane, round_lengths
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.blocks import STROKE_SCALE, WorkingRange
-from hiab_sim.study.mounting_block import MountingRows
+from hiab_sim.study.mounting_block import MOUNTING_SCALE, MountingRows
 from hiab_sim.study.nlp import N_XI, Array, ConstraintBlock, DenseRows, SamplePartials, SampleState
 
 if TYPE_CHECKING:
@@ -155,6 +155,9 @@ def buildable_blocks(study: Study, working: Sequence[tuple[float, float]], tight
         wr = WorkingRange(study.crane.chains, buildable_working_range(study, working), ROBUST_CLEARANCE / STROKE_SCALE)
         blocks.append(RobustXi(wr, t, "buildable_range"))
     if study.mounting is not None:
-        rows = MountingRows(study.mounting, study.crane)
-        blocks.append(RobustXi(rows, t, "mounting") if tightened else rows)
+        if tightened:
+            rows = MountingRows(study.mounting, study.crane, ROBUST_CLEARANCE / MOUNTING_SCALE)
+            blocks.append(RobustXi(rows, t, "mounting"))
+        else:
+            blocks.append(MountingRows(study.mounting, study.crane))
     return blocks

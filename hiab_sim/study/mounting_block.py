@@ -22,11 +22,13 @@ class MountingRows(ConstraintBlock):
     Args:
         space: the polygons and the pin clearance.
         crane: the crane (boom hinges, booms and the working joint range swept for the boom clearance).
+        clearance: scaled margin the optimiser's rows keep (added back in the nominal margins).
 
     """
 
-    def __init__(self, space: MountingSpace, crane: Crane) -> None:
+    def __init__(self, space: MountingSpace, crane: Crane, clearance: float = 0.0) -> None:
         self.name = "mounting"
+        self._clearance = clearance
         self.space = space
         self.crane = crane
         self._names = list(mounting_margins(space, crane, crane.default_lengths).names)
@@ -37,8 +39,12 @@ class MountingRows(ConstraintBlock):
 
     def values(self, state: SampleState) -> Array:
         """Margins [m] / MOUNTING_SCALE."""
-        return mounting_margins(self.space, self.crane, state.lengths).values / MOUNTING_SCALE
+        return mounting_margins(self.space, self.crane, state.lengths).values / MOUNTING_SCALE - self._clearance
 
     def jacobian(self, state: SampleState, partials: SamplePartials) -> DenseRows:
         """Exact dg/dXi [per m] / MOUNTING_SCALE (rows of Xi only)."""
         return DenseRows(dxi=mounting_margins(self.space, self.crane, state.lengths).jacobian / MOUNTING_SCALE)
+
+    def clearance(self) -> float:
+        """The optimiser's clearance (scaled)."""
+        return self._clearance
