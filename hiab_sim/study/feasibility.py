@@ -21,11 +21,12 @@ import numpy as np
 from scipy.optimize import minimize
 
 from hiab_sim.crane.description import LinkLengths
-from hiab_sim.errors import HiabSimError, InfeasibleStudyError
+from hiab_sim.errors import HiabSimError, InfeasibleStudyError, InvalidInputError
 from hiab_sim.study.blocks import STROKE_SCALE
 from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.result_sections import FeasibilityPhase
 from hiab_sim.study.sensitivity import XI_NAMES
+from hiab_sim.study.solve import start_points
 
 Array = np.ndarray
 #: Scaled margin the phase aims for on every row.
@@ -171,6 +172,11 @@ def feasible_starts(
     """
     z, phase = feasible_start(problem, problem.initial_point(problem.study.initial_lengths), 0)
     points, phases = [z], [phase] if phase else []
+    if count > 1 and phase is None:
+        try:  # the solver's own draw of feasible starts (sensible retracted lengths) when the study's start is feasible
+            points += [problem.initial_point(lengths) for lengths in start_points(problem, count, seed)[1:]]
+        except InvalidInputError:
+            pass
     rng = np.random.default_rng(seed)
     low, up = problem.lower[: problem.n_xi], problem.upper[: problem.n_xi]
     for _ in range(20 * count):
@@ -184,6 +190,8 @@ def feasible_starts(
         points.append(z)
         if phase is not None:
             phases.append(phase)
+    if len(points) < count:
+        raise InvalidInputError("starts", count, f"only {len(points)} feasible starts found in the bounds")
     return points, phases
 
 
