@@ -149,3 +149,89 @@ def test_an_impossible_payload_exits_3_naming_the_limit(tmp_path: Path, capsys: 
     err = capsys.readouterr().err
     assert "EMLA" in err and "exceeded by" in err and "at t =" in err
     assert not (tmp_path / "run" / "result.json").exists()
+
+
+def test_each_length_moved_by_the_tolerance_keeps_every_nlp_row(solved: tuple[LinkLengthProblem, np.ndarray]) -> None:
+    """Each length moved by +-t (optimal trajectory kept): every nominal fine-grid row holds (bounds: the search box)."""
+    problem, z = solved
+    study = problem.study
+    short = dataclasses.replace(study, crane=buildable_crane(study.crane, study.build.stroke_margin))
+    fine = LinkLengthProblem(
+        short, id_path="mujoco", times=study.grid.fine_times(), cost_scale=problem.cost_scale, tightened=False
+    )
+    t = study.build.tolerance
+    for k in range(6):
+        for sign in (-1.0, 1.0):
+            moved = np.array(z)
+            moved[k] += sign * t
+            margins = fine.margins(moved)
+            assert margins.min() >= -1e-6, (k, sign, fine.constraint_names[int(np.argmin(margins))])
+
+
+def test_mounting_rows_hold_the_pivots_in_their_polygons_for_every_built_design() -> None:
+    """Built space shrunk to +-20 mm along the path: the lift pivot stops t from the edge; every corner stays inside."""
+    from hiab_sim.crane.loader import load_crane
+    from hiab_sim.crane.mounting import built_space, polygon_margins
+    from hiab_sim.crane.tolerance import check_tolerance
+
+    space = built_space(load_crane("xs031"), along=0.02, across=0.05)
+    mounting = {"lift": [list(v) for v in space.lift or ()], "tilt": [list(v) for v in space.tilt or ()]}
+    study = study_from_dict(small_study(mounting=mounting), "m.yaml")
+    problem = LinkLengthProblem(study)
+    z = solve(problem, study.initial_lengths, progress=None).z
+    lengths = problem.unpack(z)[0]
+    shift = lengths.as_array() - study.initial_lengths.as_array()
+    assert abs(shift[0]) <= 0.02 + 1e-9 and abs(shift[3]) <= 0.02 + 1e-9
+    # the lift pivot wants a longer L: it stops the tolerance (|dg/dL| = 1 along the path) and 1 um from the edge
+    assert abs(shift[0]) == pytest.approx(0.02 - study.build.tolerance - 1e-6, abs=1e-8)
+    check = check_tolerance(lambda x: polygon_margins(space, study.crane, x), lengths, study.build.tolerance)
+    assert check.ok, check.summary()
+    block = next(b for b in problem.layout.blocks if b.name == "mounting")
+    ev = problem.evaluate(z)
+    from hiab_sim.study.buildable import replace_lengths
+
+    jac = block.jacobian(ev, None).dxi  # type: ignore[arg-type, union-attr]
+    xi, h = ev.lengths.as_array(), 1e-6
+    fd = np.column_stack(
+        [
+            (block.values(replace_lengths(ev, xi + h * e)) - block.values(replace_lengths(ev, xi - h * e))) / (2 * h)
+            for e in np.eye(6)
+        ]
+    )
+    np.testing.assert_allclose(jac, fd, atol=1e-5)
+
+
+def test_tracking_band_multipliers_predict_a_wider_band(solved: tuple[LinkLengthProblem, np.ndarray]) -> None:
+    """The position-band multipliers predict the re-solved cost change of a 0.01 mm wider band within 5 %."""
+    problem, z = solved
+    study = problem.study
+    sens = sensitivity(problem, z)
+    predicted = sum(m.cost_per_unit_W2s for m in sens.multipliers if m.constraint.startswith("tracking.position."))
+    assert predicted > 0.0
+    delta = 1e-5  # m
+    wider = dataclasses.replace(
+        study, tracking=dataclasses.replace(study.tracking, position=study.tracking.position + delta)
+    )
+    p2 = LinkLengthProblem(wider, cost_scale=problem.cost_scale)
+    z2 = solve(p2, study.initial_lengths, progress=None, z0=z).z
+    actual = (problem.evaluate(z).cost - p2.evaluate(z2).cost) / (delta * 1e3)  # per mm
+    assert actual == pytest.approx(predicted, rel=0.05)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["xs031_spiral", "xs031_spiral_payload", "seed_scale_spiral"])
+def test_shipped_studies_print_a_rounded_design_that_mjcf_accepts(
+    name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Each shipped study prints a mm-rounded design; its export command runs; its fine-grid re-check is <= 1e-6."""
+    out = tmp_path / name
+    assert main(["optimize", f"optimize/{name}.yaml", "--out", str(out), "--no-figures", "--no-video", "--quiet"]) == 0
+    printed = capsys.readouterr().out
+    command = next(line.split("export: hiab-sim ")[1] for line in printed.splitlines() if "export: hiab-sim" in line)
+    result = json.loads((out / "result.json").read_text())["buildable"]
+    xi = np.array([result["lengths"][c][k] for c in ("lift", "tilt") for k in ("L", "Lc0", "Lc")])
+    np.testing.assert_allclose(xi * 1e3, np.round(xi * 1e3), atol=1e-9)
+    assert (
+        result["recheck"]["margin"] <= 1e-6 and result["crane_check"]["passed"] and result["tolerance_check"]["passed"]
+    )
+    assert main([*command.split(), "-o", str(tmp_path / "crane.xml")]) == 0

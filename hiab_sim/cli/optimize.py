@@ -3,7 +3,11 @@
 Runs a study (default ``optimize/xs031_spiral.yaml``) with SQP, prints one line per iteration to
 stderr, and writes ``result.json``, ``trajectory.npz``, the figures and the playback video into
 the output folder. Bad input exits 2 before anything is written; a solver failure exits 1 and
-keeps the partial history (``checkpoint_<k>.json``) for ``--resume``.
+keeps the partial history (``checkpoint_<k>.json``) for ``--resume``. A start that violates
+constraints goes through the feasibility phase (:mod:`hiab_sim.study.feasibility`); when no point
+within the bounds is feasible the run exits 3 and names the binding limit. stdout also prints the
+design rounded to the study's ``build.tolerance`` with its re-checks and export command, and the
+largest KKT multipliers (``result.json`` -> ``buildable``, ``feasibility``, ``sensitivity``).
 """
 
 from __future__ import annotations
@@ -28,6 +32,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "Minimise the seed's cost (eq. costf2: 1/2 Dt sum (sum_i P_i)^2 with EMLA electrical power) over "
             "both chains' link lengths and the B-spline joint trajectory, subject to inverse dynamics, TCP "
             "tracking of a spiral, the EMLA envelope, stroke, triangle and joint limits (SLSQP)."
+        ),
+        epilog=(
+            "exit status: 0 done; 1 the solver failed (partial history kept for --resume); 2 bad input "
+            "(nothing written); 3 no feasible point within the bounds (the binding limit is named)"
         ),
     )
     parser.add_argument(
