@@ -152,7 +152,7 @@ def test_an_impossible_payload_exits_3_naming_the_limit(tmp_path: Path, capsys: 
 
 
 def test_each_length_moved_by_the_tolerance_keeps_every_nlp_row(solved: tuple[LinkLengthProblem, np.ndarray]) -> None:
-    """Each length moved by +-t (optimal trajectory kept): every nominal fine-grid row holds (bounds: the search box)."""
+    """Each length moved by +-t (optimal trajectory kept): every nominal fine-grid row holds (bounds: search box)."""
     problem, z = solved
     study = problem.study
     short = dataclasses.replace(study, crane=buildable_crane(study.crane, study.build.stroke_margin))
