@@ -52,7 +52,8 @@ def test_optimum_is_feasible_better_and_reported(solved: Path) -> None:
     for design in ("initial", "optimal"):
         assert set(raw[design]["lengths"]) == {"lift", "tilt"}
         assert set(raw[design]["lengths"]["lift"]) == {"L", "Lc0", "Lc"}
-    assert len(list(solved.glob("*.png"))) == 8
+    assert len(list(solved.glob("*.png"))) == 9
+    assert (solved / "sensitivity.png").is_file()
 
 
 def test_result_json_keeps_every_key_of_schema_1_and_round_trips(solved: Path) -> None:
