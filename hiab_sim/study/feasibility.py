@@ -6,7 +6,9 @@ Least violation within the bounds: minimise
 
 over z with Xi in its bounds (L-BFGS-B with the problem's exact gradients, grad phi = J^T min(0,
 g - delta) + E^T e), g the solver's scaled rows (tightened bands, clearances, robust rows) and
-delta = :data:`TARGET` a small positive target, so phi = 0 is reached at a point strictly inside.
+delta = :data:`TARGET` a small positive target. From that point SLSQP finds the feasible point
+nearest to the start, min 1/2 |z - z0|^2 subject to every row (the penalty alone approaches the
+feasible set only asymptotically and not along the shortest way).
 If the least violation stays > 0, no feasible point was found: :class:`InfeasibleStudyError`
 names the row that is violated most at the best point, where and by how much in physical units
 (:func:`describe_violation`). A trial point outside the model's domain (a chain that cannot close)
@@ -78,12 +80,14 @@ def _phi(problem: LinkLengthProblem, z: Array) -> tuple[float, Array]:
     return value, grad
 
 
-def _project(problem: LinkLengthProblem, z: Array, bounds: list[tuple[float | None, float | None]]) -> Array:
-    """The nearest point to z satisfying the rows to SLSQP's accuracy (the penalty only approaches them)."""
-    target = np.array(z)
+def _project(
+    problem: LinkLengthProblem, target: Array, start: Array, bounds: list[tuple[float | None, float | None]]
+) -> Array:
+    """The point nearest to ``target`` that satisfies the rows to SLSQP's accuracy, searched from ``start``."""
+    target = np.array(target)
     res = minimize(
         lambda x: (0.5 * float((x - target) @ (x - target)), x - target),
-        target,
+        np.array(start),
         jac=True,
         method="SLSQP",
         bounds=bounds,
@@ -139,8 +143,15 @@ def feasible_start(
     )
     z = np.asarray(res.x, dtype=float)
     g = problem.constraints(z)
-    if g.min() < 0.0 and g.min() > -POLISH:
-        z = _project(problem, z, bounds)
+    if g.min() > -POLISH:  # near or in the feasible set: the nearest feasible point to the start, else to z
+        for target in (z0, z):
+            try:
+                candidate = _project(problem, target, z, bounds)
+                if problem.constraints(candidate).min() >= -START_TOLERANCE:
+                    z = candidate
+                    break
+            except HiabSimError:
+                continue
         g = problem.constraints(z)
     if g.min() < -START_TOLERANCE or np.abs(problem.equalities(z)).max() > 1e-9:
         k = int(np.argmin(g))
@@ -172,8 +183,8 @@ def feasible_starts(
     """
     z, phase = feasible_start(problem, problem.initial_point(problem.study.initial_lengths), 0)
     points, phases = [z], [phase] if phase else []
-    if count > 1 and phase is None:
-        try:  # the solver's own draw of feasible starts (sensible retracted lengths) when the study's start is feasible
+    if count > 1:
+        try:  # the solver's own draw of feasible starts (sensible retracted lengths for the working range)
             points += [problem.initial_point(lengths) for lengths in start_points(problem, count, seed)[1:]]
         except InvalidInputError:
             pass
