@@ -1,6 +1,6 @@
 """Feasibility phase: from a start that violates constraints to the nearest feasible point, or a named limit.
 
-Least violation within the bounds: minimise
+Least violation within the bounds: first minimise
 
     phi(z) = 1/2 sum_i min(0, g_i(z) - delta)^2 + 1/2 sum_j e_j(z)^2
 
@@ -8,7 +8,9 @@ over z with Xi in its bounds (L-BFGS-B with the problem's exact gradients, grad 
 g - delta) + E^T e), g the solver's scaled rows (tightened bands, clearances, robust rows) and
 delta = :data:`TARGET` a small positive target. From that point SLSQP finds the feasible point
 nearest to the start, min 1/2 |z - z0|^2 subject to every row (the penalty alone approaches the
-feasible set only asymptotically and not along the shortest way).
+feasible set only asymptotically and not along the shortest way). Where the penalty stalls far from
+the feasible set (its gradient vanishes with the violation), SLSQP minimises the largest violation
+v directly, g(z) + v >= 0 (:func:`_least_max_violation`), before the projection.
 If the least violation stays > 0, no feasible point was found: :class:`InfeasibleStudyError`
 names the row that is violated most at the best point, where and by how much in physical units
 (:func:`describe_violation`). A trial point outside the model's domain (a chain that cannot close)
@@ -33,6 +35,8 @@ from hiab_sim.study.solve import start_points
 Array = np.ndarray
 #: Scaled margin the phase aims for on every row.
 TARGET = 1e-4
+#: Violation [scaled] reported for every row at a trial point outside the model's domain.
+OUTSIDE = 1e3
 #: Least violation [scaled] below which the penalty's point is projected onto the feasible set by SLSQP.
 POLISH = 1e-2
 #: A start whose nominal rows are all >= -this needs no feasibility phase (round-off only).
@@ -56,16 +60,22 @@ def describe_violation(problem: LinkLengthProblem, index: int, value: float) -> 
         _, actuator, limit = name.split(".")
         m = problem.envelope_margin
         g = value * (1.0 - m) + m
-        ratio = math.sqrt(max(1.0 - g, 0.0))
+        excess = 100.0 * (math.sqrt(max(1.0 - g, 0.0)) - 1.0)
+        if excess <= 0.0:
+            return (
+                f"{actuator} EMLA {limit.replace('_', ' ')} at {100.0 + excess:.1f} % of its limit{where}, inside the "
+                f"envelope margin {m:g} the optimiser keeps: {_REMEDY.get(limit, 'a larger EMLA is needed')}"
+            )
         return (
-            f"{actuator} EMLA {limit.replace('_', ' ')} exceeded by {100.0 * (ratio - 1.0):.0f} %{where} "
-            f"even at the best lengths: {_REMEDY.get(limit, 'a larger EMLA is needed')}"
+            f"{actuator} EMLA {limit.replace('_', ' ')} exceeded by {excess:.{0 if abs(excess) >= 10 else 1}f} %"
+            f"{where}"
+            f": {_REMEDY.get(limit, 'a larger EMLA is needed')}"
         )
     if block in ("stroke", "working_range", "buildable_range"):
-        return f"{name}{where} violated by {-value * STROKE_SCALE * 1e3:.1f} mm even at the best lengths"
+        return f"{name}{where} violated by {-value * STROKE_SCALE * 1e3:.1f} mm"
     if block == "tracking":
         return f"{name}{where}: the TCP leaves its tracking band by {-value * 100:.0f} % of the band"
-    return f"{name}{where} violated by {-value:.3g} (scaled) even at the best lengths"
+    return f"{name}{where} violated by {-value:.3g} (scaled)"
 
 
 def _phi(problem: LinkLengthProblem, z: Array) -> tuple[float, Array]:
@@ -98,6 +108,65 @@ def _project(
         options={"maxiter": 100, "ftol": 1e-14},
     )
     return np.asarray(res.x, dtype=float)
+
+
+def _least_max_violation(
+    problem: LinkLengthProblem, z: Array, bounds: list[tuple[float | None, float | None]], maxiter: int
+) -> Array:
+    """Min v over (z, v) subject to g(z) + v >= 0, e(z) = 0, v >= -TARGET (SLSQP, exact gradients).
+
+    One extra variable: the largest violation v. Unlike the squared penalty its gradient does not
+    vanish as the violation shrinks, so it crosses long flat stretches (a payload that only a much
+    longer lever arm can carry). Returns z at the least largest violation found (z itself if a
+    trial point left the model's domain).
+    """
+    n = len(z)
+    v0 = max(0.0, -float(problem.constraints(z).min())) + TARGET
+    rows = len(problem.layout)
+
+    last = [np.hstack([problem.constraints_jacobian(z), np.ones((rows, 1))])]
+    e0, E = problem.equalities(z), problem.equalities_jacobian(z)  # the rest equalities are affine in z
+
+    def rows_plus_v(x: Array) -> Array:
+        try:
+            return problem.constraints(x[:n]) + x[n]
+        except HiabSimError:  # outside the model's domain: a large violation, so the line search steps back
+            return np.full(rows, -OUTSIDE)
+
+    def rows_jacobian(x: Array) -> Array:
+        try:
+            last[0] = np.hstack([problem.constraints_jacobian(x[:n]), np.ones((rows, 1))])
+        except HiabSimError:  # keep the last Jacobian inside the domain (the point is rejected anyway)
+            pass
+        return last[0]
+
+    unit = np.zeros(n + 1)
+    unit[n] = 1.0
+    try:
+        res = minimize(
+            lambda x: (float(x[n]), unit),
+            np.append(z, v0),
+            jac=True,
+            method="SLSQP",
+            bounds=[*bounds, (-TARGET, None)],
+            constraints=[
+                {
+                    "type": "ineq",
+                    "fun": rows_plus_v,
+                    "jac": rows_jacobian,
+                },
+                {
+                    "type": "eq",
+                    "fun": lambda x: e0 + E @ (x[:n] - z),
+                    "jac": lambda x: np.hstack([E, np.zeros((E.shape[0], 1))]),
+                },
+            ],
+            options={"maxiter": maxiter, "ftol": 1e-12},
+        )
+    except HiabSimError:
+        return z
+    out = np.asarray(res.x[:n], dtype=float)
+    return out if problem.constraints(out).min() > problem.constraints(z).min() else z
 
 
 def changes(before: LinkLengths, after: LinkLengths) -> tuple[str, ...]:
@@ -143,6 +212,9 @@ def feasible_start(
     )
     z = np.asarray(res.x, dtype=float)
     g = problem.constraints(z)
+    if g.min() <= -POLISH:  # the penalty stalled far out: minimise the largest violation directly
+        z = _least_max_violation(problem, z, bounds, maxiter)
+        g = problem.constraints(z)
     if g.min() > -POLISH:  # near or in the feasible set: the nearest feasible point to the start, else to z
         for target in (z0, z):
             try:
@@ -155,9 +227,10 @@ def feasible_start(
         g = problem.constraints(z)
     if g.min() < -START_TOLERANCE or np.abs(problem.equalities(z)).max() > 1e-9:
         k = int(np.argmin(g))
+        xi = ", ".join(f"{v:.4f}" for v in problem.unpack(z)[0].as_array())
         raise InfeasibleStudyError(
-            f"no feasible point within the bounds (least violation found by the feasibility phase from start {start}): "
-            + describe_violation(problem, k, float(g[k]))
+            f"no feasible point within the bounds (feasibility phase from start {start}, least violation at "
+            f"Xi = [{xi}] m): " + describe_violation(problem, k, float(g[k]))
         )
     before, _ = problem.unpack(z0)
     after, _ = problem.unpack(z)
