@@ -235,3 +235,44 @@ def test_shipped_studies_print_a_rounded_design_that_mjcf_accepts(
         result["recheck"]["margin"] <= 1e-6 and result["crane_check"]["passed"] and result["tolerance_check"]["passed"]
     )
     assert main([*command.split(), "-o", str(tmp_path / "crane.xml")]) == 0
+
+
+@pytest.mark.parametrize(
+    ("build", "field"),
+    [({"tolerance": 0.0}, "build.tolerance"), ({"stroke_margin": -1e-3}, "build.stroke_margin"), ({"tol": 1}, "build")],
+)
+def test_bad_build_settings_exit_2_naming_the_field(
+    build: dict[str, float], field: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A tolerance <= 0, a negative stroke margin or an unknown key: exit 2, the field named, nothing written."""
+    path = write_study(tmp_path, small_study(build=build))
+    assert main(["optimize", str(path), "--out", str(tmp_path / "run"), "--no-figures", "--no-video", "--quiet"]) == 2
+    assert field in capsys.readouterr().err
+    assert not (tmp_path / "run").exists()
+
+
+def test_mjcf_stroke_margin_shortens_the_range_the_lengths_must_serve(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The default optimum rounded to 1 mm fails the full tilt range but passes with --stroke-margin 0.004."""
+    lengths = "1.25,0.3,0.735,1.24,0.3,0.637"
+    assert main(["mjcf", "--lengths", lengths, "-o", str(tmp_path / "a.xml")]) == 2
+    assert "tilt.joint_range" in capsys.readouterr().err
+    assert main(["mjcf", "--stroke-margin", "0.004", "--lengths", lengths, "-o", str(tmp_path / "b.xml")]) == 0
+    assert main(["mjcf", "--stroke-margin", "-0.001", "-o", str(tmp_path / "c.xml")]) == 2
+    assert "--stroke-margin" in capsys.readouterr().err
+
+
+def test_result_sections_round_trip_typed(tmp_path: Path) -> None:
+    """buildable, feasibility and sensitivity load back as typed sections from result.json."""
+    from hiab_sim.study.result import read_result
+
+    study = small_study(initial_lengths={"lift": {"L": 1.0071227324212, "Lc0": 0.0865, "Lc": 0.745},
+                                         "tilt": {"L": 1.132185817991, "Lc0": 0.085, "Lc": 0.745}})  # fmt: skip
+    path = write_study(tmp_path, study)
+    assert main(["optimize", str(path), "--out", str(tmp_path / "run"), "--no-figures", "--no-video", "--quiet"]) == 0
+    r = read_result(tmp_path / "run")
+    assert r.buildable is not None and r.buildable.recheck.passed and r.buildable.tolerance_check.passed
+    assert r.feasibility is not None and r.feasibility[0].changes and r.feasibility[0].final_max_violation <= 1e-9
+    assert r.sensitivity is not None and all(m.multiplier > 0.0 for m in r.sensitivity.multipliers)
+    assert r.sensitivity.kkt_residual < 1e-3
