@@ -44,3 +44,7 @@ class BackendUnavailableError(HiabSimError, RuntimeError):
 
 class SolverError(HiabSimError, RuntimeError):
     """The optimiser failed; the partial history is kept on disk."""
+
+
+class InfeasibleStudyError(HiabSimError, RuntimeError):
+    """No point within the bounds satisfies every constraint; the message names the binding limit (exit 3)."""

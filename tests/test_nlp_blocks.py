@@ -83,10 +83,10 @@ def test_every_row_belongs_to_one_named_block() -> None:
 
 
 def test_clearance_belongs_to_the_working_range_block_only() -> None:
-    """The solver's rows plus the clearance are the nominal rows; only working_range rows carry it."""
+    """Solver rows plus the clearance are the nominal rows; only working-range rows (nominal, buildable) carry it."""
     tight = LinkLengthProblem(STUDY, id_path="analytic")
     nominal = {name: values for name, values in tight.layout.split(tight.clearance).items() if np.any(values)}
-    assert list(nominal) == ["working_range"]
+    assert list(nominal) == ["working_range", "buildable_range"]
     z = tight.initial_point(STUDY.initial_lengths)
     loose = LinkLengthProblem(STUDY, id_path="analytic", tightened=False)
     rows = tight.layout.slices["working_range"]

@@ -2,7 +2,8 @@
 
 Every subcommand module in :data:`SUBCOMMANDS` exposes ``add_parser(subparsers)`` and
 ``run(args) -> int``. A :class:`~hiab_sim.errors.HiabSimError` (bad input) is printed on one
-line and the process exits with status 2, without a traceback.
+line and the process exits with status 2, without a traceback; a solver failure exits 1, a study with no
+feasible point within its bounds exits 3 (the message names the binding limit).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from collections.abc import Sequence
 
 from hiab_sim import __version__
 from hiab_sim._gl import check_gl_backend
-from hiab_sim.errors import HiabSimError, SolverError
+from hiab_sim.errors import HiabSimError, InfeasibleStudyError, SolverError
 
 #: Subcommands that import MuJoCo: its OpenGL backend is checked before they run.
 USES_MUJOCO = {"mjcf", "validate", "optimize", "render", "simulate", "sweep", "pareto"}
@@ -60,6 +61,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command in USES_MUJOCO:
             check_gl_backend()
         return int(args.run(args))
+    except InfeasibleStudyError as error:
+        print(f"hiab-sim {args.command}: infeasible: {error}", file=sys.stderr)
+        return 3
     except SolverError as error:
         print(f"hiab-sim {args.command}: solver failed: {error}", file=sys.stderr)
         return 1

@@ -56,6 +56,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         default="optimal",
         help="with --from-result: which design (default: optimal)",
     )
+    parser.add_argument(
+        "--stroke-margin",
+        type=float,
+        default=0.0,
+        metavar="M",
+        help="keep M [m] of stroke free at both ends of each chain's joint range, as a study's build.stroke_margin "
+        "(the rounded designs of hiab-sim optimize serve that range; default: 0, the crane's full range)",
+    )
     parser.add_argument("-o", "--output", default="crane.xml", metavar="FILE.xml", help="default: crane.xml")
     parser.set_defaults(run=run)
 
@@ -106,9 +114,11 @@ def run(args: argparse.Namespace) -> int:
     """Build the model, write it and print a one-line summary."""
     import mujoco
 
+    from hiab_sim.crane.tolerance import buildable_crane
     from hiab_sim.model.mjcf import to_xml
 
     crane, lengths = _crane_and_lengths(args)
+    crane = buildable_crane(crane, args.stroke_margin, field="--stroke-margin")
     from hiab_sim.emla import load_emla_set
     from hiab_sim.model.drives import HomePose, SlideDrives, servo_gains
     from hiab_sim.model.mjcf import build_model

@@ -3,7 +3,11 @@
 Runs a study (default ``optimize/xs031_spiral.yaml``) with SQP, prints one line per iteration to
 stderr, and writes ``result.json``, ``trajectory.npz``, the figures and the playback video into
 the output folder. Bad input exits 2 before anything is written; a solver failure exits 1 and
-keeps the partial history (``checkpoint_<k>.json``) for ``--resume``.
+keeps the partial history (``checkpoint_<k>.json``) for ``--resume``. A start that violates
+constraints goes through the feasibility phase (:mod:`hiab_sim.study.feasibility`); when no point
+within the bounds is feasible the run exits 3 and names the binding limit. stdout also prints the
+design rounded to the study's ``build.tolerance`` with its re-checks and export command, and the
+largest KKT multipliers (``result.json`` -> ``buildable``, ``feasibility``, ``sensitivity``).
 """
 
 from __future__ import annotations
@@ -31,6 +35,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "instead minimise the battery's energy (objective: battery_energy), add the motors' thermal limits "
             "(duty:) and enumerate a transmission catalogue (transmission:); every result reports the battery "
             "energy, costf2, thermal margins and the hydraulic baseline."
+        ),
+        epilog=(
+            "exit status: 0 done; 1 the solver failed (partial history kept for --resume); 2 bad input "
+            "(nothing written); 3 no feasible point within the bounds (the binding limit is named)"
         ),
     )
     parser.add_argument(
@@ -90,6 +98,9 @@ def summary_lines(r: Result) -> list[str]:
         f"re-check ({rc.id_path}, {rc.grid_points} points): max violation {rc.max_violation_scaled:.1e}, "
         f"TCP tracking error {rc.tracking_error.position_m * 1e3:.3f} mm"
     )
+    from hiab_sim.study.report_extra import extra_lines
+
+    lines += extra_lines(r)
     ms = r.multistart
     if len(ms.starts) > 1:
         converged = ms.converged_starts

@@ -30,7 +30,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -185,3 +185,54 @@ def _unit(j: int) -> Array:
     e = np.zeros(6)
     e[j] = 1.0
     return e
+
+
+#: Default stroke margin at both ends of the working range [m] (see :func:`buildable_crane`): the
+#: robust stroke rows use about 3 t of stroke at each end (t = 1 mm), plus 1 mm of room.
+DEFAULT_STROKE_MARGIN = 4e-3
+
+
+def buildable_crane(
+    crane: Crane, stroke_margin: float = DEFAULT_STROKE_MARGIN, field: str = "build.stroke_margin"
+) -> Crane:
+    """The crane with each chain's working joint range shortened by a stroke margin at both ends.
+
+    The new range is the part of the crane's joint range over which its own cylinders (the
+    chain's ``default_lengths``) keep ``stroke_margin`` [m] from both stroke ends,
+    theta in [theta(x = m), theta(x = stroke - m)] (eqs. qus_a, thetas; theta increases with x),
+    intersected with the crane's range. A design served over this range keeps spare stroke
+    at both ends that a manufacturing tolerance can use up: x = s(L, theta) - Lc0 - Lc moves by
+    up to (|dx/dL| + 2) t at each end for a tolerance t on (L, Lc0, Lc), about 3 t. The XS 031's
+    tilt range uses its whole 0.59 m stroke (the ends sit at x = 0 and x = stroke), so without
+    a margin no design within +-t of the nominal one serves it. ``stroke_margin = 0`` returns
+    the crane unchanged.
+    """
+    if not (math.isfinite(stroke_margin) and stroke_margin >= 0.0):
+        raise InvalidInputError(field, stroke_margin, "must be a finite length >= 0", "m")
+    if stroke_margin == 0.0:
+        return crane
+    chains = {}
+    for chain in crane.chains:
+        if not 2.0 * stroke_margin < chain.stroke:
+            raise InvalidInputError(
+                field, stroke_margin, f"must be < half the {chain.name} stroke {chain.stroke:.6g}", "m"
+            )
+        theta = mechanism.stroke_to_joint(
+            chain, chain.default_lengths, np.array([stroke_margin, chain.stroke - stroke_margin])
+        )
+        lo, hi = chain.joint_range
+        new = (max(lo, float(theta[0])), min(hi, float(theta[1])))
+        chains[chain.name] = replace(chain, joint_range=new)
+    return replace(crane, lift=chains["lift"], tilt=chains["tilt"])
+
+
+def range_cost_deg(crane: Crane, stroke_margin: float = DEFAULT_STROKE_MARGIN) -> dict[str, tuple[float, float]]:
+    """Per chain, the joint range [deg] given up at the (low, up) end by :func:`buildable_crane`."""
+    narrow = buildable_crane(crane, stroke_margin)
+    out = {}
+    for full, short in zip(crane.chains, narrow.chains, strict=True):
+        out[full.name] = (
+            math.degrees(short.joint_range[0] - full.joint_range[0]),
+            math.degrees(full.joint_range[1] - short.joint_range[1]),
+        )
+    return out

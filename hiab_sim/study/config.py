@@ -27,9 +27,11 @@ import numpy as np
 from hiab_sim.checks import check_choice, check_range
 from hiab_sim.crane.description import CHAIN_NAMES, ChainLengths, Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
+from hiab_sim.crane.mounting import MountingSpace
 from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import DEFAULT_STUDY, Source, locate
+from hiab_sim.study.build_settings import BuildSettings
 from hiab_sim.study.energy_config import ENERGY_KEYS, EnergySettings, energy_settings
 from hiab_sim.study.references import TaskReference
 from hiab_sim.study.tasks import Task, tasks_from_mapping
@@ -212,6 +214,8 @@ class Study:
     tracking: Tracking
     bounds: Bounds
     solver: SolverSettings
+    build: BuildSettings = field(default_factory=BuildSettings)  # manufacturing tolerance, stroke margin (issue 14)
+    mounting: MountingSpace | None = None  # optional mounting polygons of the base pivots (issue 14)
     crane_file: Source | None = field(default=None, repr=False, compare=False)
     energy: EnergySettings = field(default_factory=EnergySettings)  # objective, duty, transmission (issue 13)
 
@@ -256,6 +260,8 @@ _TOP = {
     "payload",
     *ENERGY_KEYS,
     "tasks",
+    "build",
+    "mounting",
 }
 _REQUIRED_TOP = {"crane", "bounds"}
 
@@ -285,7 +291,6 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
     crane = load_crane(crane_file)
     emla_source = "default" if top.get("emla") is None else str(top["emla"])
     emlas = load_emla_set(locate(emla_source, "emla", relative_to=file))
-    initial = _lengths(top.get("initial_lengths"), crane)
     bounds = _bounds(top["bounds"])
     grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
     name = str(top.get("name", Path(str(file.file)).stem))
@@ -295,6 +300,7 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
     if "tasks" not in top and isinstance(top.get("payload", 0.0), int | float):
         # single-reference form: a plain number is today's payload, its weight only (module docstring)
         tasks = (replace(tasks[0], payload=replace(tasks[0].payload, inertia=False)),)
+    initial = _lengths(top.get("initial_lengths"), crane, bounds)
     return Study(
         name=name,
         path=str(file.file),
@@ -309,14 +315,16 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
         tracking=Tracking(**section(Tracking, top.get("tracking"), "tracking")),
         bounds=bounds,
         solver=SolverSettings(**section(SolverSettings, top.get("solver"), "solver")),
+        build=BuildSettings.from_mapping(top.get("build")),
+        mounting=None if top.get("mounting") is None else MountingSpace.from_mapping(top["mounting"]),
         crane_file=crane_file,
         energy=energy_settings(top),
     )
 
 
-def _lengths(data: Any, crane: Crane) -> LinkLengths:
-    if data is None:
-        return crane.default_lengths
+def _lengths(data: Any, crane: Crane, bounds: Bounds) -> LinkLengths:
+    if data is None:  # the crane's own lengths, clipped into the bounds (the feasibility phase moves on from there)
+        return _clipped_lengths(crane, bounds)
     top = mapping(data, "initial_lengths", set(CHAIN_NAMES), set(CHAIN_NAMES))
     chains = []
     for name in CHAIN_NAMES:
@@ -324,6 +332,28 @@ def _lengths(data: Any, crane: Crane) -> LinkLengths:
         values = [positive(d[k], f"initial_lengths.{name}.{k}", "m") for k in ("L", "Lc0", "Lc")]
         chains.append(ChainLengths(*values))
     return LinkLengths(chains[0], chains[1])
+
+
+def _clipped_lengths(crane: Crane, bounds: Bounds) -> LinkLengths:
+    """The crane's lengths if inside the bounds; else L clipped and x0 = Lc0 + Lc centring the joint range's stroke.
+
+    A clipped L moves the strokes at the ends of the joint range (eq. qus_a); x0 is chosen so the
+    stroke used, s(theta_up) - s(theta_low), sits in the middle of [0, stroke], and Lc takes what
+    Lc0 (clipped) leaves, within its bounds. The feasibility phase starts from this point.
+    """
+    xi = crane.default_lengths.as_array()
+    low, up = np.asarray(bounds.xi_low), np.asarray(bounds.xi_up)
+    if np.all((low <= xi) & (xi <= up)):
+        return crane.default_lengths
+    out = np.clip(xi, low, up)
+    for j, chain in enumerate(crane.chains):
+        if out[3 * j] == xi[3 * j]:
+            continue
+        q = chain.joint_offset - math.pi - np.asarray(chain.joint_range)  # hinge angle (eq. thetas)
+        s = np.sqrt(out[3 * j] ** 2 + chain.L1**2 - 2.0 * out[3 * j] * chain.L1 * np.cos(q))
+        x0 = 0.5 * (float(s.min() + s.max()) - chain.stroke)
+        out[3 * j + 2] = float(np.clip(x0 - out[3 * j + 1], low[3 * j + 2], up[3 * j + 2]))
+    return LinkLengths.from_array(out)
 
 
 def _bounds(data: Any) -> Bounds:

@@ -49,6 +49,7 @@ from hiab_sim.emla import (
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study import blocks as bl
 from hiab_sim.study import trajectory as tr
+from hiab_sim.study.buildable import buildable_blocks
 from hiab_sim.study.config import Study
 from hiab_sim.study.id_partials import id_joint_partials, id_length_partials
 from hiab_sim.study.nlp import (
@@ -233,6 +234,7 @@ class LinkLengthProblem:
             bl.JointVelocityLimits(t, np.asarray(self.study.bounds.joint_velocity)),
             bl.WorkingRange(self.crane.chains, self.working, self.working_clearance),
             *thermal_blocks(self.emlas, self.study.energy.duty, self.task.reference.duration),
+            *buildable_blocks(self.study, self.working, self.tightened),
         ]
 
     # -- variables ---------------------------------------------------------------------------

@@ -24,6 +24,7 @@ from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import ConfigError
 from hiab_sim.study.codec import from_json, optional, to_json
 from hiab_sim.study.energy_result import Codesign, EnergyReport, HydraulicBaseline
+from hiab_sim.study.result_sections import Buildable, FeasibilityPhase, Sensitivity
 
 #: Version of the result.json layout; files without the key are version 1 (the same keys).
 SCHEMA_VERSION = 1
@@ -339,6 +340,9 @@ class Result:
     codesign: Codesign | None = optional()
     tasks: tuple[TaskResult, ...] | None = optional()
     cross_evaluation: CrossEvaluation | None = optional()
+    buildable: Buildable | None = optional()
+    feasibility: tuple[FeasibilityPhase, ...] | None = optional()
+    sensitivity: Sensitivity | None = optional()
     extra: dict[str, Any] = field(default_factory=dict)  # keys of a newer writer, kept verbatim
 
     def __post_init__(self) -> None:

@@ -14,10 +14,14 @@ from hiab_sim.study import run_safety
 from hiab_sim.study.codesign import run_codesign
 from hiab_sim.study.config import Study, load_study
 from hiab_sim.study.cross import cross_evaluation
+from hiab_sim.study.feasibility import feasible_starts, phase_lines
 from hiab_sim.study.mix import MixProblem, make_problem
 from hiab_sim.study.mix_report import build_mix_result
+from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.report import build_result, write_results
+from hiab_sim.study.report_extra import issue14_sections
 from hiab_sim.study.result import Result
+from hiab_sim.study.result_sections import FeasibilityPhase
 from hiab_sim.study.solve import (
     SolveResult,
     check_checkpoint,
@@ -67,8 +71,14 @@ def run_study(
         codesign, emlas = run_codesign(study, progress=progress)
         study = replace(study, emlas=emlas)
     problem = make_problem(study, id_path)
-    check_start(problem, problem.initial_point(study.initial_lengths))
-    initials = start_points(problem, starts)
+    phases: list[FeasibilityPhase] = []
+    if isinstance(problem, MixProblem):  # the feasibility phase serves single-task studies (README)
+        check_start(problem, problem.initial_point(study.initial_lengths))
+        initials = start_points(problem, starts)
+        points = [problem.initial_point(lengths) for lengths in initials]
+    else:
+        points, phases = feasible_starts(problem, starts)
+        initials = [problem.unpack(z)[0] for z in points]
     folder = Path(out)
     run_safety.check_folder(folder, study_digest(problem), resume, force)
     if resume:
@@ -81,15 +91,17 @@ def run_study(
     results: list[SolveResult] = []
     for k, initial in enumerate(initials):
         try:
-            results.append(solve(problem, initial, start=k, out=folder, resume=resume, progress=progress))
+            if progress is not None:
+                for phase in phases:
+                    if phase.start == k:
+                        progress.write("\n".join(phase_lines(phase)) + "\n")
+            results.append(solve(problem, initial, start=k, out=folder, resume=resume, progress=progress, z0=points[k]))
         except SolverError as error:
             if k == 0:
                 raise
             if progress is not None:
                 progress.write(f"[start {k}] {error}\n")
-            failed = SolveResult(
-                start=k, initial_lengths=initial, z0=problem.initial_point(initial), z=problem.initial_point(initial)
-            )
+            failed = SolveResult(start=k, initial_lengths=initial, z0=points[k], z=points[k])
             failed.success = False
             failed.message = str(error)
             results.append(failed)
@@ -110,6 +122,9 @@ def run_study(
     if crane_file is not None and not (crane_file.shipped and crane_file.label == study.crane_source):
         write_atomic(folder / "crane.yaml", crane_file.read_bytes())  # a crane file, not a preset name
         result = replace(result, crane="crane.yaml", crane_source=study.crane_source)
+    crane_label = study.crane_source if result.crane != "crane.yaml" else str(folder / "crane.yaml")
+    if isinstance(problem, LinkLengthProblem):  # buildable design, feasibility, sensitivity: single-task studies
+        result = replace(result, **issue14_sections(problem, results[0].z, result, crane_label, phases))
     write_results(folder, result, arrays)
     paths: list[Path] = []
     if figures:

@@ -223,6 +223,7 @@ def solve(
     maxiter: int | None = None,
     use_gradients: bool = True,
     on_iterate: Callable[[Iterate], None] | None = None,
+    z0: Array | None = None,
 ) -> SolveResult:
     """Solve the NLP from ``initial`` with SLSQP; checkpoint into ``out`` after every iteration.
 
@@ -237,6 +238,8 @@ def solve(
         maxiter: Iteration limit (default: the study's).
         use_gradients: False uses scipy's finite-difference jacobians (the benchmark's baseline).
         on_iterate: Called with each new history row.
+        z0: Start point (default: ``initial`` with the inverse-kinematics coefficients), e.g. the
+            point of the feasibility phase (:mod:`hiab_sim.study.feasibility`).
 
     Raises:
         InvalidInputError: The start violates a constraint (named), or the checkpoint to resume
@@ -244,7 +247,7 @@ def solve(
         SolverError: SLSQP did not report success; the checkpoint keeps the partial history.
 
     """
-    z0 = problem.initial_point(initial)
+    z0 = problem.initial_point(initial) if z0 is None else np.asarray(z0, dtype=float)
     check_start(problem, z0)
     result = SolveResult(start=start, initial_lengths=initial, z0=z0, z=z0.copy())
     identity = checkpoint_identity(problem, initial)

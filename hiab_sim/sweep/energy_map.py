@@ -38,6 +38,7 @@ from hiab_sim.emla import ENVELOPE_LIMIT_NAMES, electrical_power, energy_summary
 from hiab_sim.emla.battery import battery_power, trapezoid_weights
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study import trajectory as tr
+from hiab_sim.study.buildable import RobustXi, replace_lengths
 from hiab_sim.study.problem import ACTUATORS, STROKE_SCALE, LinkLengthProblem
 from hiab_sim.study.result import read_result
 
@@ -187,7 +188,24 @@ def evaluate_designs(problem: LinkLengthProblem, base: BaseDesign, xi: Array) ->
         margins = np.concatenate([env_rows, stroke_rows, work_rows], axis=1)
         parts.append((cost, objective / problem.cost_scale, net, drawn, margins, battery))
     cost, objective, net, drawn, margins, battery = (np.concatenate([p[k] for p in parts]) for k in range(6))
-    return DesignValues(xi, cost, objective, net, drawn, margins, margin_names(), battery)
+    robust, robust_names = _robust_rows(problem, base, xi)
+    margins = np.concatenate([margins, robust], axis=1)
+    return DesignValues(xi, cost, objective, net, drawn, margins, (*margin_names(), *robust_names), battery)
+
+
+def _robust_rows(problem: LinkLengthProblem, base: BaseDesign, xi: Array) -> tuple[Array, list[str]]:
+    """The optimiser's rows of Xi only held within the manufacturing tolerance (issue 14), per design (D, R).
+
+    They depend on the link lengths alone (no samples), so each design is one call of the block
+    (:class:`hiab_sim.study.buildable.RobustXi`: the buildable range, the mounting space).
+    """
+    blocks = [b for b in problem.layout.blocks if isinstance(b, RobustXi)]
+    if not blocks:
+        return np.zeros((len(xi), 0)), []
+    state = problem.evaluate(problem.initial_point(LinkLengths.from_array(base.xi)))
+    # nominal margins as LinkLengthProblem.margins gives them: the rows without the optimiser's clearance
+    rows = np.array([np.concatenate([b.values(replace_lengths(state, x)) + b.clearance() for b in blocks]) for x in xi])
+    return rows, [name for b in blocks for name in b.row_names()]
 
 
 @dataclass(frozen=True)
