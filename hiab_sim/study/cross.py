@@ -24,7 +24,7 @@ from hiab_sim.study.mix import MixProblem
 from hiab_sim.study.nlp import N_XI, Array
 from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.report import design_summary, fine_problem
-from hiab_sim.study.result import CrossEvaluation
+from hiab_sim.study.result_sections import CrossEvaluation
 from hiab_sim.study.solve import solve
 
 #: Largest scaled violation of a design's re-optimised trajectory that counts as serving the task.

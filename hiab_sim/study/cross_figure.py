@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from hiab_sim.study.figures import _figure, _save
-from hiab_sim.study.result import CrossEvaluation
+from hiab_sim.study.result_sections import CrossEvaluation
 
 
 def cross_figure(cross: CrossEvaluation, path: Path) -> None:

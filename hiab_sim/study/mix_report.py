@@ -26,6 +26,7 @@ from hiab_sim.study.report import (
     other_path,
     recheck_section,
 )
+from hiab_sim.study.report_solver import solver_summary
 from hiab_sim.study.result import (
     ENERGY_PARTS,
     ActuatorSummary,
@@ -39,7 +40,6 @@ from hiab_sim.study.result import (
     Recheck,
     Result,
     Settings,
-    SolverSummary,
     TaskResult,
     TrackingBands,
     TrackingError,
@@ -223,24 +223,7 @@ def build_mix_result(
     optimal = weighted_summary([t.optimal for t in task_results], w, names)
     e0, e1 = initial.net_electrical_energy_J, optimal.net_electrical_energy_J
     cost0, cost1 = problem.evaluate(main.z0).cost, problem.evaluate(main.z).cost
-    method = problem.study.solver.method
-    solver = SolverSummary(
-        method=(
-            "IPOPT (CasADi) with sparse exact-structure Jacobians, L-BFGS Hessian"
-            if method == "ipopt"
-            else "SLSQP (scipy.optimize.minimize) with exact-structure gradients"
-        ),
-        id_path=problem.id_path,
-        success=main.success,
-        status=main.status,
-        message=main.message,
-        iterations=main.iterations,
-        wall_time_s=main.wall_time,
-        total_wall_time_s=wall_time,
-        max_violation_scaled=problem.max_violation(main.z),
-        function_evaluations=main.n_evaluations,
-        gradient_evaluations=main.n_gradients,
-    )
+    solver = solver_summary(problem, main, wall_time)
 
     def mix_energy(z: Array) -> float:
         return float(

@@ -31,6 +31,7 @@ from hiab_sim.study.energy_report import energy_report, hydraulic_report
 from hiab_sim.study.mix import Problem
 from hiab_sim.study.objectives import SquaredPowerCost
 from hiab_sim.study.problem import ACTUATORS, Evaluation, LinkLengthProblem
+from hiab_sim.study.report_solver import solver_summary
 from hiab_sim.study.result import (
     ENERGY_PARTS,
     RESULT_FILE,
@@ -47,7 +48,6 @@ from hiab_sim.study.result import (
     Recheck,
     Result,
     Settings,
-    SolverSummary,
     StartRow,
     TrackingBands,
     TrackingError,
@@ -176,19 +176,7 @@ def build_result(
         net_energy_saved_percent=100.0 * (e0 - e1) / e0,
         decomposition=energy_decomposition(problem, fine, main.z0, main.z),
     )
-    solver = SolverSummary(
-        method="SLSQP (scipy.optimize.minimize) with exact-structure gradients",
-        id_path=problem.id_path,
-        success=main.success,
-        status=main.status,
-        message=main.message,
-        iterations=main.iterations,
-        wall_time_s=main.wall_time,
-        total_wall_time_s=wall_time,
-        max_violation_scaled=problem.max_violation(main.z),
-        function_evaluations=main.n_evaluations,
-        gradient_evaluations=main.n_gradients,
-    )
+    solver = solver_summary(problem, main, wall_time)
     recheck_summary = recheck_section(checks, recheck)
     study = problem.study
     settings = Settings(
@@ -331,6 +319,14 @@ def energy_decomposition(
     )
 
 
+def write_results(out: Path, result: Result, arrays: dict[str, Array]) -> None:
+    """Write ``result.json`` and ``trajectory.npz`` atomically."""
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, **arrays)  # type: ignore[arg-type]
+    write_atomic(out / "trajectory.npz", buffer.getvalue())
+    write_atomic(out / RESULT_FILE, json.dumps(result.to_json(), indent=2) + "\n")
+
+
 def multistart_summary(
     problem: Problem, results: list[SolveResult], tolerance: float, energy: Callable[[Array], float] | None = None
 ) -> MultiStart:
@@ -389,11 +385,3 @@ def multistart_summary(
         distinct_optima=distinct,
         failed_starts=tuple(failed),
     )
-
-
-def write_results(out: Path, result: Result, arrays: dict[str, Array]) -> None:
-    """Write ``result.json`` and ``trajectory.npz`` atomically."""
-    buffer = io.BytesIO()
-    np.savez_compressed(buffer, **arrays)  # type: ignore[arg-type]
-    write_atomic(out / "trajectory.npz", buffer.getvalue())
-    write_atomic(out / RESULT_FILE, json.dumps(result.to_json(), indent=2) + "\n")

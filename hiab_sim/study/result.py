@@ -24,7 +24,7 @@ from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import ConfigError
 from hiab_sim.study.codec import from_json, optional, to_json
 from hiab_sim.study.energy_result import Codesign, EnergyReport, HydraulicBaseline
-from hiab_sim.study.result_sections import Buildable, FeasibilityPhase, Sensitivity
+from hiab_sim.study.result_sections import Buildable, CrossEvaluation, FeasibilityPhase, Sensitivity
 
 #: Version of the result.json layout; files without the key are version 1 (the same keys).
 SCHEMA_VERSION = 1
@@ -286,32 +286,6 @@ class TaskResult:
     initial: DesignSummary
     optimal: DesignSummary
     recheck: Recheck
-
-
-@dataclass(frozen=True)
-class CrossEvaluation:
-    """The price of robustness (:mod:`hiab_sim.study.cross`): designs x tasks, trajectories re-optimised at fixed Xi.
-
-    Rows are the designs (each task's optimum alone, then the mix optimum), columns the tasks; the
-    ``mix_*`` entries are the weighted sums over the tasks; None where a design cannot serve a task.
-    Energies [J] on each task's fine grid (nominal bands, the optimisation's ID path), costs of eq.
-    ``costf2`` [W^2 s] on the collocation grid (what the optimiser minimises).
-    """
-
-    note: str
-    tasks: tuple[str, ...]
-    weights: tuple[float, ...]
-    designs: tuple[str, ...]
-    lengths: tuple[LinkLengths, ...]
-    net_energy_J: tuple[tuple[float | None, ...], ...]
-    drawn_energy_J: tuple[tuple[float | None, ...], ...]
-    cost_W2s: tuple[tuple[float | None, ...], ...]
-    max_violation: tuple[tuple[float | None, ...], ...]
-    mix_net_energy_J: tuple[float | None, ...]
-    mix_cost_W2s: tuple[float | None, ...]
-    mix_energy_lost_J: tuple[float | None, ...]
-    mix_energy_lost_percent: tuple[float | None, ...]
-    mix_cost_lost_percent: tuple[float | None, ...]
 
 
 @dataclass(frozen=True)
