@@ -227,6 +227,10 @@ def test_drive_losses_enabled_in_the_emla_file_flow_into_the_objective_and_the_r
     assert e.drive_loss_energy_J is not None
     assert e.drive_loss_energy_J["lift"]["transmission_loss"] > 0 and e.drive_loss_energy_J["lift"]["inverter_loss"] > 0
     assert abs(e.battery_energy_J - e.battery_energy_smooth_J) < 0.01 * e.battery_energy_J
+    # smooth - exact = the battery kinks' smoothing (within its bound) + the drive losses' smoothing (reported)
+    assert e.drive_loss_smoothing_J is not None
+    kinks = e.battery_energy_smooth_J - e.drive_loss_smoothing_J - e.battery_energy_J
+    assert 0.0 <= kinks <= e.smoothing_bound_J
     assert (
         design_energy(
             LinkLengthProblem(study_off, times=study_off.grid.fine_times(), tightened=False, cost_scale=1.0),

@@ -72,7 +72,8 @@ def design_energy(problem: LinkLengthProblem, state: SampleState) -> DesignEnerg
         operating_point(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], exact=True)
         for i, p in enumerate(problem.emlas)
     ]
-    exact = battery_energy(t, np.column_stack([op.electrical_power for op in ops]), battery)
+    exact_power = np.column_stack([op.electrical_power for op in ops])
+    exact = battery_energy(t, exact_power, battery)
     smooth = battery_energy(t, state.power, battery, smooth=True)
     duty, _ = study_duty(problem)
     losses = {
@@ -102,6 +103,9 @@ def design_energy(problem: LinkLengthProblem, state: SampleState) -> DesignEnerg
         net_energy_J=dict(zip(ACTUATOR_NAMES, map(float, exact.net_energy), strict=True)),
         thermal=thermal or None,
         drive_loss_energy_J=losses or None,
+        drive_loss_smoothing_J=(
+            smooth.energy - battery_energy(t, exact_power, battery, smooth=True).energy if losses else None
+        ),
     )
 
 

@@ -38,13 +38,16 @@ class DesignEnergy:
     """One design on the fine grid: battery energy, the paper's cost, per-actuator energies, thermal state."""
 
     battery_energy_J: float
-    battery_energy_smooth_J: float
-    smoothing_bound_J: float
+    battery_energy_smooth_J: float  # the solver's: smooth battery kinks on the solver's (smooth) drive powers
+    smoothing_bound_J: float  # bound of the battery and inverter kinks' smoothing alone (BatteryParams)
     costf2_W2s: float
     drawn_energy_J: dict[str, float]
     net_energy_J: dict[str, float]
     thermal: dict[str, ActuatorThermal] | None = optional()
     drive_loss_energy_J: dict[str, dict[str, float]] | None = optional()  # only with drive_losses enabled
+    # with drive_losses enabled: the part of smooth - exact that the smoothed drive losses (brake, direction-
+    # dependent efficiency, inverter current) add, beyond the battery kinks' smoothing_bound_J
+    drive_loss_smoothing_J: float | None = optional()
 
 
 @dataclass(frozen=True)
