@@ -46,18 +46,23 @@ def summary_figures(frame: pd.DataFrame, parameters: list[str], out: Path, title
     paths = [out / "sweep_summary.png"]
     _save(fig, paths[0])
     if len(numeric) == 2 and ok.any():
-        pivot = frame[ok].pivot_table(index=numeric[1], columns=numeric[0], values="net_energy_saved_percent")
+        xs, ys = np.sort(frame[numeric[0]].unique()), np.sort(frame[numeric[1]].unique())
+        saved = np.full((len(ys), len(xs)), np.nan)  # every point of the grid, failed ones left blank
+        for _, row in frame[ok].iterrows():
+            saved[np.searchsorted(ys, row[numeric[1]]), np.searchsorted(xs, row[numeric[0]])] = row[
+                "net_energy_saved_percent"
+            ]
         fig, ax = plt.subplots(figsize=(6.4, 4.8), constrained_layout=True)
-        mesh = ax.pcolormesh(pivot.columns, pivot.index, pivot.to_numpy(), shading="nearest", cmap="viridis")
+        mesh = ax.pcolormesh(xs, ys, np.ma.masked_invalid(saved), shading="nearest", cmap="viridis")
         fig.colorbar(mesh, ax=ax, label="net energy saved [%]")
-        for (yv, xv), v in np.ndenumerate(pivot.to_numpy()):
+        for (yi, xi), v in np.ndenumerate(saved):
             if np.isfinite(v):
-                ax.text(pivot.columns[xv], pivot.index[yv], f"{v:.1f}", ha="center", va="center", fontsize=8, c="w")
+                ax.text(float(xs[xi]), float(ys[yi]), f"{v:.1f}", ha="center", va="center", fontsize=8, c="w")
         for _, row in frame[~ok].iterrows():
             ax.text(row[numeric[0]], row[numeric[1]], "failed", ha="center", va="center", fontsize=8, c="red")
         ax.set_xlabel(numeric[0])
         ax.set_ylabel(numeric[1])
-        ax.set_title(f"{title}: net energy saved [%] (failed: start outside the EMLA envelope or solver)")
+        ax.set_title(f"{title}\nnet energy saved [%] (failed: no feasible start, or the solver)", fontsize=10)
         paths.append(out / "sweep_saving_map.png")
         _save(fig, paths[1])
     return paths
