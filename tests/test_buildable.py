@@ -131,7 +131,7 @@ def test_an_infeasible_start_goes_through_the_feasibility_phase_and_converges(tm
 
 
 def test_bounds_that_exclude_the_built_crane_start_inside_them_and_converge(tmp_path: Path) -> None:
-    """Tilt L >= 1.2 m excludes the built crane (1.132 m): the start is clipped and re-centred; the run converges."""
+    """Tilt L >= 1.2 m excludes the built crane (1.132 m): the start moves into the bounds, says so, and converges."""
     study = small_study(bounds={"lift": {"low": [0.8, 0.04, 0.6], "up": [1.25, 0.3, 1.0]},
                                 "tilt": {"low": [1.2, 0.04, 0.6], "up": [1.35, 0.3, 1.0]}})  # fmt: skip
     path = write_study(tmp_path, study)
@@ -140,6 +140,10 @@ def test_bounds_that_exclude_the_built_crane_start_inside_them_and_converge(tmp_
     assert result["initial"]["lengths"]["tilt"]["L"] == pytest.approx(1.2)
     assert result["optimal"]["lengths"]["tilt"]["L"] >= 1.2 - 1e-9
     assert result["solver"]["max_violation_scaled"] <= 1e-6
+    phase = result["feasibility"][0]  # the step that moved the start into the bounds, and what it changed
+    assert phase["start"] == 0 and phase["initial_max_violation"] == pytest.approx(1.2 - 1.132185818, abs=1e-6)
+    assert any(line.startswith("tilt.L: 1132.2 -> 1200.0 mm") for line in phase["changes"])
+    assert phase["final_max_violation"] <= 1e-9
 
 
 def test_an_impossible_payload_exits_3_naming_the_limit(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

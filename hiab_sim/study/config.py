@@ -217,6 +217,8 @@ class Study:
     build: BuildSettings = field(default_factory=BuildSettings)  # manufacturing tolerance, stroke margin (issue 14)
     mounting: MountingSpace | None = None  # optional mounting polygons of the base pivots (issue 14)
     crane_file: Source | None = field(default=None, repr=False, compare=False)
+    #: The built crane's lengths when they lie outside the bounds and the loader moved the start into them.
+    start_moved_from: LinkLengths | None = field(default=None, repr=False, compare=False)
     energy: EnergySettings = field(default_factory=EnergySettings)  # objective, duty, transmission (issue 13)
 
     def __post_init__(self) -> None:
@@ -301,6 +303,7 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
         # single-reference form: a plain number is today's payload, its weight only (module docstring)
         tasks = (replace(tasks[0], payload=replace(tasks[0].payload, inertia=False)),)
     initial = _lengths(top.get("initial_lengths"), crane, bounds)
+    moved = "initial_lengths" not in top and initial != crane.default_lengths
     return Study(
         name=name,
         path=str(file.file),
@@ -318,6 +321,7 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
         build=BuildSettings.from_mapping(top.get("build")),
         mounting=None if top.get("mounting") is None else MountingSpace.from_mapping(top["mounting"]),
         crane_file=crane_file,
+        start_moved_from=crane.default_lengths if moved else None,
         energy=energy_settings(top),
     )
 

@@ -286,3 +286,29 @@ def phase_lines(phase: FeasibilityPhase) -> list[str]:
         f"({phase.initial_worst}) -> {phase.final_max_violation:.1e} in {phase.iterations} iterations; changed:",
         *(f"  {c}" for c in phase.changes),
     ]
+
+
+def moved_start_phase(problem: LinkLengthProblem, z: Array) -> FeasibilityPhase | None:
+    """The step that moved the study's start into the bounds, when the built crane's lengths lie outside them.
+
+    The loader projects the built crane's lengths onto the bounds and re-centres each moved chain's
+    retracted length on its stroke (:func:`hiab_sim.study.config._clipped_lengths`): this records what
+    that changed, like a feasibility phase (``iterations`` 0), so the run says it.
+    """
+    before = problem.study.start_moved_from
+    if before is None:
+        return None
+    xi = before.as_array()
+    low, up = problem.lower[: problem.n_xi], problem.upper[: problem.n_xi]
+    excess = np.maximum(low - xi, xi - up)
+    k = int(np.argmax(excess))
+    return FeasibilityPhase(
+        start=0,
+        initial_max_violation=float(excess[k]),
+        initial_worst=f"bounds: the built crane's {XI_NAMES[k]} lies {excess[k] * 1e3:.1f} mm outside its bounds",
+        final_max_violation=problem.max_violation(z),
+        lengths_before=before,
+        lengths_after=problem.study.initial_lengths,
+        changes=changes(before, problem.study.initial_lengths),
+        iterations=0,
+    )

@@ -14,7 +14,7 @@ from hiab_sim.study import run_safety
 from hiab_sim.study.codesign import run_codesign
 from hiab_sim.study.config import Study, load_study
 from hiab_sim.study.cross import cross_evaluation
-from hiab_sim.study.feasibility import feasible_starts, phase_lines
+from hiab_sim.study.feasibility import feasible_starts, moved_start_phase, phase_lines
 from hiab_sim.study.mix import MixProblem, make_problem
 from hiab_sim.study.mix_report import build_mix_result
 from hiab_sim.study.problem import LinkLengthProblem
@@ -79,6 +79,8 @@ def run_study(
     else:
         points, phases = feasible_starts(problem, starts)
         initials = [problem.unpack(z)[0] for z in points]
+        moved = moved_start_phase(problem, problem.initial_point(study.initial_lengths))
+        phases = [moved, *phases] if moved is not None else phases
     folder = Path(out)
     run_safety.check_folder(folder, study_digest(problem), resume, force)
     if resume:
