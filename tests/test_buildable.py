@@ -114,6 +114,31 @@ def test_multipliers_predict_the_cost_change_of_a_bound_move(solved: tuple[LinkL
         assert actual == pytest.approx(m.cost_per_unit_W2s, rel=0.05), m.constraint
 
 
+@pytest.mark.parametrize("chain", ["lift", "tilt"])
+def test_stroke_row_multipliers_predict_a_longer_stroke(
+    solved: tuple[LinkLengthProblem, np.ndarray], chain: str
+) -> None:
+    """A 1 mm longer stroke moves each active 'x <= stroke' row by 1 mm: the multipliers predict the re-solve in 5 %.
+
+    The rows are the working range's and the buildable range's at the up end (the lift's buildable
+    range ends at its toggle margin, not at its stroke, so its row moves with the stroke too).
+    """
+    problem, z = solved
+    study = problem.study
+    rows = [
+        m for m in sensitivity(problem, z).multipliers if m.constraint.endswith(f"{chain}.x <= stroke at the up end")
+    ]
+    assert rows, f"an {chain} stroke row is active at the small study's optimum"
+    predicted = sum(m.cost_per_unit_W2s for m in rows)
+    old = getattr(study.crane, chain)
+    crane = dataclasses.replace(study.crane, **{chain: dataclasses.replace(old, stroke=old.stroke + 1e-3)})
+    longer = dataclasses.replace(study, crane=crane)
+    p2 = LinkLengthProblem(longer, cost_scale=problem.cost_scale)
+    z2 = solve(p2, study.initial_lengths, progress=None, z0=z).z
+    actual = problem.evaluate(z).cost - p2.evaluate(z2).cost
+    assert actual == pytest.approx(predicted, rel=0.05), [m.constraint for m in rows]
+
+
 def test_an_infeasible_start_goes_through_the_feasibility_phase_and_converges(tmp_path: Path) -> None:
     """Lift Lc0 + 1.5 mm leaves x < 0 at the low end of the range: the phase repairs it, the run converges."""
     study = small_study(initial_lengths={"lift": {"L": 1.0071227324212, "Lc0": 0.0865, "Lc": 0.745},
