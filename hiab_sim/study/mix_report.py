@@ -25,6 +25,7 @@ from hiab_sim.study.report import (
     multistart_summary,
     other_path,
     recheck_section,
+    tracking_bands,
 )
 from hiab_sim.study.report_solver import solver_summary
 from hiab_sim.study.result import (
@@ -41,7 +42,6 @@ from hiab_sim.study.result import (
     Result,
     Settings,
     TaskResult,
-    TrackingBands,
     TrackingError,
     WorstConstraint,
 )
@@ -256,12 +256,7 @@ def build_mix_result(
             collocation_step_s=problem.problems[0].dt,
             fine_grid_points=sum(len(f.times) for f in fines),
             redundancy=f"xt2 {TELESCOPE} in every task; counts summed over the tasks",
-            tracking_bands=TrackingBands(
-                position_m=study.tracking.position,
-                velocity_m_per_s=study.tracking.velocity,
-                acceleration_m_per_s2=study.tracking.acceleration,
-                collocation_fraction=study.tracking.collocation_fraction,
-            ),
+            tracking_bands=tracking_bands(study),
             xi_low=tuple(study.bounds.xi_low),
             xi_up=tuple(study.bounds.xi_up),
             envelope_margin=study.bounds.envelope_margin,

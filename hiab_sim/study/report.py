@@ -27,6 +27,7 @@ from hiab_sim.atomic_io import write_atomic
 from hiab_sim.emla import energy_summary, operating_point
 from hiab_sim.errors import HiabSimError
 from hiab_sim.quadrature import trapezoid
+from hiab_sim.study.config import Study
 from hiab_sim.study.energy_report import energy_report, hydraulic_report
 from hiab_sim.study.mix import Problem
 from hiab_sim.study.objectives import SquaredPowerCost
@@ -186,12 +187,7 @@ def build_result(
         collocation_step_s=problem.dt,
         fine_grid_points=len(fine.times),
         redundancy="xt2 prescribed by the study (third reference coordinate)",
-        tracking_bands=TrackingBands(
-            position_m=study.tracking.position,
-            velocity_m_per_s=study.tracking.velocity,
-            acceleration_m_per_s2=study.tracking.acceleration,
-            collocation_fraction=study.tracking.collocation_fraction,
-        ),
+        tracking_bands=tracking_bands(study),
         xi_low=tuple(study.bounds.xi_low),
         xi_up=tuple(study.bounds.xi_up),
         envelope_margin=study.bounds.envelope_margin,
@@ -384,4 +380,14 @@ def multistart_summary(
         same_optimum=len(distinct) == 1,
         distinct_optima=distinct,
         failed_starts=tuple(failed),
+    )
+
+
+def tracking_bands(study: Study) -> TrackingBands:
+    """The study's tracking tolerance bands as result.json's ``settings.tracking_bands``."""
+    return TrackingBands(
+        position_m=study.tracking.position,
+        velocity_m_per_s=study.tracking.velocity,
+        acceleration_m_per_s2=study.tracking.acceleration,
+        collocation_fraction=study.tracking.collocation_fraction,
     )
