@@ -9,14 +9,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from test_study_small import small_study, write_study
 
 from hiab_sim.cli import main
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.mechanism import check_lengths, joint_to_stroke
 from hiab_sim.crane.tolerance import buildable_crane
+from hiab_sim.resources import shipped
 from hiab_sim.study.buildable import RobustXi, rounded_design
-from hiab_sim.study.config import study_from_dict
+from hiab_sim.study.config import Study, study_from_dict
 from hiab_sim.study.feasibility import feasible_start
 from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.sensitivity import sensitivity
@@ -137,6 +139,38 @@ def test_stroke_row_multipliers_predict_a_longer_stroke(
     z2 = solve(p2, study.initial_lengths, progress=None, z0=z).z
     actual = problem.evaluate(z).cost - p2.evaluate(z2).cost
     assert actual == pytest.approx(predicted, rel=0.05), [m.constraint for m in rows]
+
+
+def test_envelope_multiplier_predicts_a_slightly_stronger_motor(tmp_path: Path) -> None:
+    """With the lift's peak-torque row binding, its per-% multiplier predicts a re-solve with 1e-5 more peak torque.
+
+    460 kg on the small study with the envelope margin raised to 0.1 makes the row bind at the
+    optimum (the start goes through the feasibility phase). The unconstrained optimum lies close,
+    so the prediction is first order only for small moves (0.01 % already saturates by 9 %).
+    """
+
+    def study_with(peak_scale: float) -> Study:
+        document = yaml.safe_load(shipped("emla", "default").read_text())
+        peak = document["pmsm"]["peak_torque"]
+        value = float(peak["value"] if isinstance(peak, dict) else peak)
+        document["actuators"]["lift"].setdefault("pmsm", {})["peak_torque"] = value * peak_scale
+        emla = tmp_path / f"emla_{peak_scale}.yaml"
+        emla.write_text(yaml.safe_dump(document))
+        mapping = small_study(payload=460.0, emla=str(emla))
+        mapping["bounds"]["envelope_margin"] = 0.1
+        return study_from_dict(mapping, "small.yaml")
+
+    problem = LinkLengthProblem(study_with(1.0))
+    z0, phase = feasible_start(problem, problem.initial_point(problem.study.initial_lengths))
+    assert phase is not None  # the raised margin makes the built crane's start infeasible
+    z = solve(problem, problem.unpack(z0)[0], progress=None, z0=z0).z
+    rows = [m for m in sensitivity(problem, z).multipliers if m.constraint.startswith("envelope.lift.peak_torque")]
+    assert len(rows) == 1 and rows[0].unit == "%"
+    step = 1e-5  # relative: 0.001 %
+    stronger_problem = LinkLengthProblem(study_with(1.0 + step), cost_scale=problem.cost_scale)
+    z2 = solve(stronger_problem, problem.unpack(z)[0], progress=None, z0=z).z
+    actual = problem.evaluate(z).cost - stronger_problem.evaluate(z2).cost
+    assert actual == pytest.approx(rows[0].cost_per_unit_W2s * step * 100.0, rel=0.05)
 
 
 def test_an_infeasible_start_goes_through_the_feasibility_phase_and_converges(tmp_path: Path) -> None:
