@@ -8,33 +8,19 @@
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
-from hiab_sim.atomic_io import write_atomic
 from hiab_sim.emla.config import ACTUATOR_NAMES
 from hiab_sim.env.rollout import ClosedLoopRun
+from hiab_sim.figure_io import new_figure, save_png
+from hiab_sim.style import COLOURS
 
-COLOURS = {"initial": "tab:blue", "optimal": "tab:red"}
+#: Resolution of the closed-loop figures [dots per inch].
+DPI = 110
 DRIVE_COLOURS = ("tab:green", "tab:purple", "tab:orange")
-
-
-def _figure(size: tuple[float, float]) -> Figure:
-    fig = Figure(figsize=size, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def _save(fig: Figure, path: Path) -> Path:
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=110)
-    write_atomic(path, buffer.getvalue())
-    return path
 
 
 def _label(run: ClosedLoopRun) -> str:
@@ -46,8 +32,16 @@ def _cumulative(power: np.ndarray, time: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(time))])
 
 
+def _colour(run: ClosedLoopRun) -> str:
+    """The design's colour of the one visual language (hiab_sim.style); black for another design."""
+    return COLOURS.get(run.design, COLOURS["reference"])
+
+
 def _style(run: ClosedLoopRun) -> dict[str, Any]:
-    return {"color": COLOURS.get(run.design, "k"), "linestyle": "-" if run.payload_error == 0 else "-."}
+    return {
+        "color": _colour(run),
+        "linestyle": "-" if run.payload_error == 0 else "-.",
+    }
 
 
 def write_figures(folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedLoopRun] | None = None) -> list[Path]:
@@ -57,12 +51,12 @@ def write_figures(folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedL
     """
     paths = []
     every = [*(nominal or []), *runs]
-    fig = _figure((8.0, 3.6))
+    fig = new_figure((8.0, 3.6))
     ax = fig.add_subplot()
     for run in every:
         ax.plot(run.time, 1000.0 * run.tcp_error, label=f"{_label(run)}: to the reference", **_style(run))
     for run in runs:
-        colour = COLOURS.get(run.design, "k")
+        colour = _colour(run)
         ax.plot(
             run.time,
             1000.0 * run.plan_error,
@@ -74,9 +68,9 @@ def write_figures(folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedL
     ax.set(xlabel="time [s]", ylabel="TCP error [mm]", title="Closed-loop TCP tracking error")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    paths.append(_save(fig, folder / "closed_loop_tcp_error.png"))
+    paths.append(save_png(fig, folder / "closed_loop_tcp_error.png", DPI))
 
-    fig = _figure((4.2 * len(runs), 5.6))
+    fig = new_figure((4.2 * len(runs), 5.6))
     axes = fig.subplots(2, len(runs), squeeze=False, sharex=True)
     for column, run in enumerate(runs):
         top, bottom = axes[0, column], axes[1, column]
@@ -94,32 +88,32 @@ def write_figures(folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedL
         for ax in (top, bottom):
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7)
-    paths.append(_save(fig, folder / "closed_loop_drives.png"))
+    paths.append(save_png(fig, folder / "closed_loop_drives.png", DPI))
 
-    fig = _figure((8.0, 3.6))
+    fig = new_figure((8.0, 3.6))
     ax = fig.add_subplot()
     for run in every:
         ax.plot(run.time, run.electrical_power.sum(axis=1) / 1e3, label=f"{_label(run)}: closed loop", **_style(run))
     for run in runs:
-        colour = COLOURS.get(run.design, "k")
+        colour = _colour(run)
         predicted = run.predicted_power.sum(axis=1) / 1e3
         ax.plot(run.plan_time, predicted, color=colour, linestyle="--", label=f"{run.design}: predicted")
     ax.set(xlabel="time [s]", ylabel="DC bus power [kW]", title="Electrical power, closed loop vs predicted")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    paths.append(_save(fig, folder / "closed_loop_power.png"))
+    paths.append(save_png(fig, folder / "closed_loop_power.png", DPI))
 
-    fig = _figure((8.0, 3.6))
+    fig = new_figure((8.0, 3.6))
     ax = fig.add_subplot()
     for run in every:
         energy = run.cumulative_energy.sum(axis=1) / 1e3
         ax.plot(run.time, energy, label=f"{_label(run)}: closed loop", **_style(run))
     for run in runs:
         predicted = _cumulative(run.predicted_power.sum(axis=1), run.plan_time)
-        colour = COLOURS.get(run.design, "k")
+        colour = _colour(run)
         ax.plot(run.plan_time, predicted / 1e3, color=colour, linestyle="--", label=f"{run.design}: predicted")
     ax.set(xlabel="time [s]", ylabel="net electrical energy [kJ]", title="Cumulative net electrical energy")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    paths.append(_save(fig, folder / "closed_loop_energy.png"))
+    paths.append(save_png(fig, folder / "closed_loop_energy.png", DPI))
     return paths

@@ -6,13 +6,13 @@ from pathlib import Path
 
 import numpy as np
 
-from hiab_sim.study.figures import _figure, _save
+from hiab_sim.figure_io import new_figure, save_png
 from hiab_sim.study.result_sections import CrossEvaluation
 
 
 def cross_figure(cross: CrossEvaluation, path: Path) -> None:
     """Bars: each design's mix net energy over the mix optimum's [J]; matrix: net energy per task over the best [%]."""
-    fig = _figure((10.0, 4.0))
+    fig = new_figure((10.0, 4.0))
     ax1, ax2 = fig.subplots(1, 2)
     lost = [np.nan if v is None else v for v in cross.mix_energy_lost_J]
     bars = ax1.bar(range(len(lost)), lost, color=["tab:gray"] * (len(lost) - 1) + ["tab:red"])
@@ -30,4 +30,4 @@ def cross_figure(cross: CrossEvaluation, path: Path) -> None:
     ax2.set_yticks(range(len(cross.designs)), cross.designs)
     ax2.set_title("net energy per task over the best design [%]")
     fig.colorbar(image, ax=ax2)
-    _save(fig, path)
+    save_png(fig, path)

@@ -9,16 +9,13 @@ breakdown, initial vs optimal.
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
-from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.emla import EmlaSet
+from hiab_sim.figure_io import new_figure, save_png
 from hiab_sim.study.energy_figure import hydraulic_figure
 from hiab_sim.study.figures_design import (
     cumulative_energy,
@@ -37,21 +34,9 @@ from hiab_sim.style import colour
 __all__ = ["draw_crane", "write_figures"]
 
 
-def _figure(size: tuple[float, float]) -> Figure:
-    fig = Figure(figsize=size, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def _save(fig: Figure, path: Path) -> None:
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=120)
-    write_atomic(path, buffer.getvalue())
-
-
 def objective_figure(history: tuple[HistoryRow, ...], path: Path) -> None:
     """Scaled cost and max violation per SQP iteration (seed Fig. Objective_function)."""
-    fig = _figure((6.5, 4.0))
+    fig = new_figure((6.5, 4.0))
     ax = fig.add_subplot()
     it = [h.iteration for h in history]
     ax.plot(it, [h.scaled_cost for h in history], "o-", color=colour("optimal"), markersize=3)
@@ -61,33 +46,33 @@ def objective_figure(history: tuple[HistoryRow, ...], path: Path) -> None:
     ax2.semilogy(it, [max(h.max_violation, 1e-16) for h in history], ".--", color="tab:gray", markersize=3)
     ax2.set_ylabel("max constraint violation (scaled)")
     ax.set_title("Objective per iteration")
-    _save(fig, path)
+    save_png(fig, path)
 
 
 def decision_figure(
     history: tuple[HistoryRow, ...], chain: int, name: str, path: Path, low: np.ndarray, up: np.ndarray
 ) -> None:
     """L, Lc0, Lc of one chain per iteration with the bounds shaded (seed Figs. Decision_variables_1/2)."""
-    fig = _figure((6.5, 6.0))
+    fig = new_figure((6.5, 6.0))
     axes = fig.subplots(3, 1, sharex=True)
     decision_panels(axes, history, chain, low, up)
     axes[0].legend(fontsize=8)
     fig.suptitle(f"Decision variables of the {name} chain (grey: outside the bounds)")
-    _save(fig, path)
+    save_png(fig, path)
 
 
 def structure_figure(crane: Crane, designs: dict[str, LinkLengths], pose: np.ndarray, path: Path, label: str) -> None:
     """Both structures overlaid in one pose, pivot shifts dimensioned (seed Fig. Initial_Structure_Modified)."""
-    fig = _figure((8.0, 6.4))
+    fig = new_figure((8.0, 6.4))
     structure_overlay(fig.add_subplot(), crane, designs, pose, label)
-    _save(fig, path)
+    save_png(fig, path)
 
 
 def spiral_figure(
     crane: Crane, lengths: LinkLengths, joints: np.ndarray, ref: np.ndarray, tcp: np.ndarray, path: Path
 ) -> None:
     """The crane at a few poses along the motion, with the reference spiral (seed Fig. hiab)."""
-    fig = _figure((7.0, 5.0))
+    fig = new_figure((7.0, 5.0))
     ax = fig.add_subplot()
     for i, idx in enumerate(np.linspace(0, len(joints) - 1, 5).astype(int)):
         draw_crane(ax, crane, lengths, joints[idx], colour("optimal"), alpha=0.2 + 0.15 * i)
@@ -99,12 +84,12 @@ def spiral_figure(
     ax.set_ylabel("y [m] (up)")
     ax.legend(loc="lower left", fontsize=8)
     ax.set_title("Crane following the spiral (vertical plane of {W})")
-    _save(fig, path)
+    save_png(fig, path)
 
 
 def actuator_figure(time: np.ndarray, checks: dict[str, DesignCheck], path: Path) -> None:
     """Force, velocity and electrical power per actuator over time, initial vs optimal."""
-    fig = _figure((12.0, 8.0))
+    fig = new_figure((12.0, 8.0))
     axes = fig.subplots(3, 3, sharex=True)
     for name in ("initial", "optimal"):
         ev = checks[name].evaluation
@@ -121,14 +106,14 @@ def actuator_figure(time: np.ndarray, checks: dict[str, DesignCheck], path: Path
     axes[0, 0].legend()
     for ax in axes.ravel():
         ax.grid(alpha=0.3)
-    _save(fig, path)
+    save_png(fig, path)
 
 
 def efficiency_figure(emlas: EmlaSet, checks: dict[str, DesignCheck], path: Path) -> None:
     """Operating points (initial, optimal) over each actuator's efficiency map."""
     from hiab_sim.emla.maps import efficiency_map, plot_efficiency_map
 
-    fig = _figure((19.0, 6.0))
+    fig = new_figure((19.0, 6.0))
     axes = fig.subplots(1, 3)
     for i, (ax, params) in enumerate(zip(axes, emlas, strict=True)):
         emap = efficiency_map(params, n_force=81, n_velocity=81)
@@ -136,26 +121,26 @@ def efficiency_figure(emlas: EmlaSet, checks: dict[str, DesignCheck], path: Path
         opt = checks["optimal"].evaluation.actuators
         designs = {"initial": (ini.force[:, i], ini.velocity[:, i]), "optimal": (opt.force[:, i], opt.velocity[:, i])}
         plot_efficiency_map(emap, ax=ax, designs=designs)
-    _save(fig, path)
+    save_png(fig, path)
 
 
 def energy_figure(time: np.ndarray, checks: dict[str, DesignCheck], path: Path) -> None:
     """Energy breakdown with values on the bars, and the cumulative net electrical energy, initial vs optimal."""
-    fig = _figure((12.0, 4.4))
+    fig = new_figure((12.0, 4.4))
     left, right = fig.subplots(1, 2, width_ratios=(1.3, 1.0))
     names = ("initial", "optimal")
     energy_bars(left, {n: checks[n].summary.energy_breakdown_J.as_tuple() for n in names})
     left.set_title("Energy breakdown (all actuators, fine grid)")
     cumulative_energy(right, time, {n: checks[n].evaluation.power for n in names})
     right.set_title("Cumulative net electrical energy")
-    _save(fig, path)
+    save_png(fig, path)
 
 
 def sensitivity_figure(sensitivity: Sensitivity, path: Path) -> None:
     """The active constraints' multipliers in physical units (result.json -> sensitivity)."""
-    fig = _figure((10.0, 5.0))
+    fig = new_figure((10.0, 5.0))
     sensitivity_bars(fig.add_subplot(), sensitivity)
-    _save(fig, path)
+    save_png(fig, path)
 
 
 def write_figures(
