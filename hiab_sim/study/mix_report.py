@@ -16,7 +16,6 @@ from dataclasses import replace
 
 from hiab_sim.study.mix import MixProblem
 from hiab_sim.study.nlp import Array
-from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.report import (
     DesignCheck,
     design_summary,
@@ -26,6 +25,7 @@ from hiab_sim.study.report import (
     other_path,
     recheck_section,
     tracking_bands,
+    trajectory_arrays,
 )
 from hiab_sim.study.report_solver import solver_summary
 from hiab_sim.study.result import (
@@ -215,9 +215,9 @@ def build_mix_result(
         decompositions.append(energy_decomposition(p, fine, z0, z1))
         if k == 0:
             first_checks = checks
-        _task_arrays(arrays, fine, checks, f"task{k}_")
+        arrays.update(trajectory_arrays(fine, checks, f"task{k}_"))
         if k == 0:
-            _task_arrays(arrays, fine, checks, "")
+            arrays.update(trajectory_arrays(fine, checks))
     w = problem.weights
     initial = weighted_summary([t.initial for t in task_results], w, names)
     optimal = weighted_summary([t.optimal for t in task_results], w, names)
@@ -270,20 +270,3 @@ def build_mix_result(
         cross_evaluation=cross,
     )
     return result, arrays, first_checks
-
-
-def _task_arrays(
-    arrays: dict[str, Array], fine: LinkLengthProblem, checks: dict[str, DesignCheck], prefix: str
-) -> None:
-    arrays[f"{prefix}time"] = fine.times
-    arrays[f"{prefix}reference_tcp"] = fine.reference.tcp()
-    for name in ("initial", "optimal"):
-        ev = checks[name].evaluation
-        arrays[f"{prefix}{name}_position"] = ev.joints.position
-        arrays[f"{prefix}{name}_velocity"] = ev.joints.velocity
-        arrays[f"{prefix}{name}_acceleration"] = ev.joints.acceleration
-        arrays[f"{prefix}{name}_tcp"] = fine.kin.position(ev.joints.position)
-        arrays[f"{prefix}{name}_actuator_force"] = ev.actuators.force
-        arrays[f"{prefix}{name}_actuator_velocity"] = ev.actuators.velocity
-        arrays[f"{prefix}{name}_actuator_stroke"] = ev.actuators.stroke
-        arrays[f"{prefix}{name}_electrical_power"] = ev.power

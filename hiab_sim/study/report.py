@@ -212,18 +212,23 @@ def build_result(
         energy=energy,
         hydraulic_baseline=hydraulic_report(fine, checks["initial"].evaluation, checks["optimal"].evaluation, energy),
     )
-    arrays: dict[str, Array] = {"time": fine.times, "reference_tcp": fine.reference.tcp()}
+    return result, trajectory_arrays(fine, checks), checks
+
+
+def trajectory_arrays(fine: LinkLengthProblem, checks: dict[str, DesignCheck], prefix: str = "") -> dict[str, Array]:
+    """``trajectory.npz``'s arrays of one task on its fine grid (SI units; keys prefixed by ``prefix``)."""
+    arrays: dict[str, Array] = {f"{prefix}time": fine.times, f"{prefix}reference_tcp": fine.reference.tcp()}
     for name in ("initial", "optimal"):
         ev = checks[name].evaluation
-        arrays[f"{name}_position"] = ev.joints.position
-        arrays[f"{name}_velocity"] = ev.joints.velocity
-        arrays[f"{name}_acceleration"] = ev.joints.acceleration
-        arrays[f"{name}_tcp"] = fine.kin.position(ev.joints.position)
-        arrays[f"{name}_actuator_force"] = ev.actuators.force
-        arrays[f"{name}_actuator_velocity"] = ev.actuators.velocity
-        arrays[f"{name}_actuator_stroke"] = ev.actuators.stroke
-        arrays[f"{name}_electrical_power"] = ev.power
-    return result, arrays, checks
+        arrays[f"{prefix}{name}_position"] = ev.joints.position
+        arrays[f"{prefix}{name}_velocity"] = ev.joints.velocity
+        arrays[f"{prefix}{name}_acceleration"] = ev.joints.acceleration
+        arrays[f"{prefix}{name}_tcp"] = fine.kin.position(ev.joints.position)
+        arrays[f"{prefix}{name}_actuator_force"] = ev.actuators.force
+        arrays[f"{prefix}{name}_actuator_velocity"] = ev.actuators.velocity
+        arrays[f"{prefix}{name}_actuator_stroke"] = ev.actuators.stroke
+        arrays[f"{prefix}{name}_electrical_power"] = ev.power
+    return arrays
 
 
 def recheck_section(checks: dict[str, DesignCheck], recheck: LinkLengthProblem) -> Recheck:
