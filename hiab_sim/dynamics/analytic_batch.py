@@ -78,7 +78,8 @@ def batched_inverse_dynamics(
             (D, T, 3), one trajectory per design.
         velocity: Their rates, same shape.
         acceleration: Their second derivatives, same shape.
-        tcp_force: Force of the environment on the TCP in {W} [N], (3,) or None.
+        tcp_force: Force of the environment on the TCP in {W} [N], (3,), (T, 3) (one per joint
+            sample, the same for every design) or None.
 
     Returns:
         Four arrays (D, T, 3): force, velocity, acceleration and stroke of lift, tilt and telescope.
@@ -90,8 +91,9 @@ def batched_inverse_dynamics(
     ddq = np.asarray(acceleration, dtype=float)
     D, T = xi.shape[0], q.shape[-2]
     force = np.zeros(3) if tcp_force is None else np.asarray(tcp_force, dtype=float)
-    if force.shape != (3,):
-        raise InvalidInputError("tcp_force", f"shape {force.shape}", "must have shape (3,)", "N")
+    if force.shape not in ((3,), (T, 3)):
+        raise InvalidInputError("tcp_force", f"shape {force.shape}", f"must have shape (3,) or ({T}, 3)", "N")
+    external = np.broadcast_to(force, (D * T, 3)) if force.ndim == 1 else np.tile(force, (D, 1))
     model = stacked_model(crane, xi, T)
     if q.ndim == 3:
         if q.shape != (D, T, 3) or dq.shape != q.shape or ddq.shape != q.shape:
@@ -99,5 +101,5 @@ def batched_inverse_dynamics(
         q, dq, ddq = (x.reshape(D * T, 3) for x in (q, dq, ddq))
     else:
         q, dq, ddq = (np.tile(x, (D, 1)) for x in (q, dq, ddq))
-    out = planar_solve(crane, model, q, dq, ddq, np.broadcast_to(force, (D * T, 3)))
+    out = planar_solve(crane, model, q, dq, ddq, external)
     return tuple(a.reshape(D, T, 3) for a in out)  # type: ignore[return-value]

@@ -49,6 +49,9 @@ STROKE_SCALE = 0.1
 TRACKED = ("x_tcp", "y_tcp", "xt2")
 #: Rows of one chain's stroke limits (const_j), scaled by 1 / STROKE_SCALE.
 STROKE_ROWS = ("x >= 0", "x <= Lc", "x <= stroke")
+#: Per-sample row pairs (i, i + 3) of a block whose first three rows bound three quantities from one
+#: side and last three from the other (:attr:`hiab_sim.study.nlp.PerSampleBlock.pairs`).
+OPPOSITE_ROWS = ((0, 3), (1, 4), (2, 5))
 
 
 class TrackingBand(PerSampleBlock):
@@ -69,6 +72,7 @@ class TrackingBand(PerSampleBlock):
         self.target = target
         self.width = band * fraction
         self.sample_rows = (*(f"{c} <= band" for c in TRACKED), *(f"{c} >= -band" for c in TRACKED))
+        self.pairs = OPPOSITE_ROWS  # (1 - e) + (1 + e) = 2
 
     def values(self, state: SampleState) -> Array:
         """1 - e and 1 + e per sample, e = (r - r_ref) / width."""
@@ -154,6 +158,8 @@ class StrokeLimits(PerSampleBlock):
         self.times = times
         self.chains = tuple(chains)
         self.sample_rows = tuple(f"{c.name}.{w}" for c in self.chains for w in STROKE_ROWS)
+        # x + (stroke - x) = stroke; x + (Lc - x) = Lc depends on Xi and is not a pair
+        self.pairs = tuple((3 * j, 3 * j + 2) for j in range(len(self.chains)))
 
     def values(self, state: SampleState) -> Array:
         """Scaled stroke margins per sample, (K * 6,)."""
@@ -173,6 +179,7 @@ class JointLimits(PerSampleBlock):
         self.low = low
         self.up = up
         self.sample_rows = (*(f"{j} >= low" for j in JOINT_NAMES), *(f"{j} <= up" for j in JOINT_NAMES))
+        self.pairs = OPPOSITE_ROWS  # (theta - low) + (up - theta) = up - low
 
     def values(self, state: SampleState) -> Array:
         """Distances to the joint bounds [rad, rad, m], (K * 6,)."""
@@ -195,6 +202,7 @@ class JointVelocityLimits(PerSampleBlock):
         self.times = times
         self.limit = np.asarray(limit, dtype=float)
         self.sample_rows = (*(f"{j} <= limit" for j in JOINT_NAMES), *(f"{j} >= -limit" for j in JOINT_NAMES))
+        self.pairs = OPPOSITE_ROWS  # (1 - dtheta / limit) + (1 + dtheta / limit) = 2
 
     def values(self, state: SampleState) -> Array:
         """1 - dtheta / limit and 1 + dtheta / limit, (K * 6,)."""

@@ -166,7 +166,11 @@ def _least_max_violation(
     except HiabSimError:
         return z
     out = np.asarray(res.x[:n], dtype=float)
-    return out if problem.constraints(out).min() > problem.constraints(z).min() else z
+    try:
+        better = problem.constraints(out).min() > problem.constraints(z).min()
+    except HiabSimError:  # SLSQP may end on a trial point outside the model's domain
+        return z
+    return out if better else z
 
 
 def changes(before: LinkLengths, after: LinkLengths) -> tuple[str, ...]:

@@ -149,6 +149,10 @@ class PerSampleBlock(ConstraintBlock):
 
     times: Array
     sample_rows: tuple[str, ...]
+    #: Pairs (a, b) of this block's per-sample rows whose values add up to a constant (the lower
+    #: and upper limit of one quantity): g_a + g_b does not depend on z. A sparse solver may hold
+    #: such a pair as one two-sided row 0 <= g_a <= g_a + g_b (half the rows, same feasible set).
+    pairs: tuple[tuple[int, int], ...] = ()
 
     def row_names(self) -> list[str]:
         """Sample-major names: every row of sample 0, then of sample 1, ..."""

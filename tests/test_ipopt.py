@@ -1,0 +1,111 @@
+"""The IPOPT backend's own NLP: two-sided range rows, the sparse Jacobian assembly, and a solve against SLSQP."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_mix import LOCAL_SPREAD, two_tasks
+
+from hiab_sim.dynamics.samples import JointSamples
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.study.config import study_from_dict
+from hiab_sim.study.id_partials import id_length_partials
+from hiab_sim.study.ipopt import SparseJacobian, range_pairs, task_rows, task_z
+from hiab_sim.study.mix import MixProblem
+from hiab_sim.study.problem import XI_SCALE
+from hiab_sim.study.solve import solve
+
+
+@pytest.fixture(scope="module")
+def mix() -> MixProblem:
+    return MixProblem(study_from_dict(two_tasks(), "two.yaml"))
+
+
+def _points(mix: MixProblem, count: int) -> list[np.ndarray]:
+    """Admissible points around the start: Xi moved by up to +-5 mm, every coefficient perturbed.
+
+    The built crane's tilt chain uses its whole stroke, so some moves of Xi leave no working range:
+    those draws are skipped (fixed seed, so the points are the same on every run).
+    """
+    rng = np.random.default_rng(7)
+    z0 = mix.initial_point(mix.study.initial_lengths)
+    out: list[np.ndarray] = []
+    while len(out) < count:
+        z = z0.copy()
+        z[:6] += rng.uniform(-5e-3, 5e-3, 6) / XI_SCALE
+        z[6:] += rng.normal(0.0, 5e-3, len(z) - 6)
+        try:
+            mix.evaluate(z)
+        except InvalidInputError:
+            continue
+        out.append(z)
+    return out
+
+
+def test_range_pairs_add_up_to_a_constant_and_have_opposite_jacobians(mix: MixProblem) -> None:
+    """Every declared pair (a, b): g_a + g_b is the same at points with other Xi and coefficients; D g_a = -D g_b."""
+    points = _points(mix, 3)
+    for k, p in enumerate(mix.problems):
+        first, second = range_pairs(p)
+        assert len(first) == 17 * len(p.times)  # tracking 9, joint 3, joint velocity 3, stroke 2 per sample
+        sums = [p.constraints(task_z(mix, z, k))[first] + p.constraints(task_z(mix, z, k))[second] for z in points]
+        spread = np.abs(sums[0] - sums[1]).max(), np.abs(sums[0] - sums[2]).max()
+        assert max(spread) <= 1e-12 * np.abs(sums[0]).max()
+        assert np.ptp([p.constraints(task_z(mix, z, k))[first] for z in points], axis=0).max() > 1e-3  # rows move
+        jac = p.constraints_jacobian(task_z(mix, points[0], k))
+        np.testing.assert_array_equal(jac[first], -jac[second])
+
+
+def test_sparse_jacobian_holds_the_dense_jacobians_rows_and_each_pair_once(mix: MixProblem) -> None:
+    """Values, rows and bounds of the IPOPT NLP against the mix's dense assembly, row for row."""
+    z0, z = _points(mix, 2)
+    jac = SparseJacobian(mix, z0)
+    dense, g = mix.constraints_jacobian(z), mix.constraints(z)
+    held = []
+    start = 0
+    for t, kept in zip(task_rows(mix), mix.rows, strict=True):
+        position = {row: i for i, row in enumerate(kept)}
+        held += [start + position[row] for row in t.rows]
+        start += len(kept)
+    held_rows = np.array(held)
+    np.testing.assert_array_equal(jac.dense(z), np.vstack([mix.equalities_jacobian(z), dense[held_rows]]))
+    np.testing.assert_array_equal(jac.rows(z), np.concatenate([mix.equalities(z), g[held_rows]]))
+    pairs = sum(len(range_pairs(p)[0]) for p in mix.problems)
+    assert jac.shape[0] == len(mix.equality_names) + len(g) - pairs
+    upper = jac.upper(z0)[jac.m_eq :]
+    assert np.isinf(upper).sum() == len(g) - 2 * pairs and np.all(upper[np.isfinite(upper)] > 0.0)
+    # a two-sided row's upper bound less its value is its dropped partner's row, at any point
+    partners = np.concatenate(
+        [
+            p.constraints(task_z(mix, z, k))[t.partner[t.partner >= 0]]
+            for k, (p, t) in enumerate(zip(mix.problems, task_rows(mix), strict=True))
+        ]
+    )
+    paired = np.isfinite(upper)
+    np.testing.assert_allclose(upper[paired] - jac.rows(z)[jac.m_eq :][paired], partners, atol=1e-12)
+
+
+def test_length_partials_on_the_stacked_analytic_path_equal_mujocos_per_design_models(mix: MixProblem) -> None:
+    """dY/dXi with a per-sample payload force: 12 stacked analytic designs against 12 MuJoCo models (1e-6 relative)."""
+    p = mix.problems[1]  # the task with the payload schedule
+    ev = p.evaluate(task_z(mix, _points(mix, 1)[0], 1))
+    samples = JointSamples(ev.joints.position, ev.joints.velocity, ev.joints.acceleration)
+    assert np.ndim(p.tcp_force) == 2
+    analytic = id_length_partials(p.crane, ev.lengths, samples, "analytic", 1e-6, p.tcp_force)
+    mujoco = id_length_partials(p.crane, ev.lengths, samples, "mujoco", 1e-6, p.tcp_force)
+    assert np.abs(mujoco).max() > 1e3
+    np.testing.assert_allclose(analytic, mujoco, atol=1e-6 * np.abs(mujoco).max())
+
+
+def test_ipopt_and_dense_slsqp_reach_the_same_design_of_the_two_task_mix() -> None:
+    """Two solvers, two Jacobian assemblies (sparse two-sided rows vs dense one-sided): same Xi, feasible, same cost."""
+    pytest.importorskip("casadi")
+    out = {}
+    for method in ("slsqp", "ipopt"):
+        study = study_from_dict(two_tasks(method=method), "two.yaml")
+        problem = MixProblem(study)
+        result = solve(problem, study.initial_lengths, progress=None)
+        assert problem.max_violation(result.z) <= 1e-6
+        out[method] = (problem.cost(result.z), problem.unpack(result.z)[0].as_array())
+    assert out["ipopt"][0] == pytest.approx(out["slsqp"][0], rel=LOCAL_SPREAD)
+    np.testing.assert_allclose(out["ipopt"][1], out["slsqp"][1], atol=1e-3)
