@@ -198,3 +198,44 @@ def test_study_file_with_tasks_loads_them_and_one_without_either_form_is_refused
     del data["reference"]
     with pytest.raises(ConfigError, match="'tasks:'"):
         study_from_dict(data, "none.yaml")
+
+
+def test_an_infeasible_mix_start_goes_through_the_feasibility_phase_and_converges(tmp_path: Path) -> None:
+    """Lift Lc0 + 1.5 mm leaves x < 0 at the low end of the range on both tasks: repaired (IPOPT projection), solved."""
+    from hiab_sim.study.feasibility import feasible_start
+    from hiab_sim.study.result import read_result
+
+    pytest.importorskip("casadi")
+    data = two_tasks()
+    data["initial_lengths"] = {"lift": {"L": 1.0071227324212, "Lc0": 0.0865, "Lc": 0.745},
+                               "tilt": {"L": 1.132185817991, "Lc0": 0.085, "Lc": 0.745}}  # fmt: skip
+    study = study_from_dict(data, tmp_path / "two.yaml")
+    problem = MixProblem(study)
+    z0 = problem.initial_point(study.initial_lengths)
+    assert problem.max_violation(z0) > 1e-3
+    z, phase = feasible_start(problem, z0)
+    assert phase is not None and problem.max_violation(z) <= 1e-9
+    assert phase.initial_worst.split(": ")[0] in ("spiral", "second")  # the row is named with its task
+    run_study(study, tmp_path / "out", progress=None, figures=False, cross=False)
+    r = read_result(tmp_path / "out")
+    assert r.feasibility is not None and r.feasibility[0].initial_max_violation > 1e-3
+    assert r.solver.success and r.solver.max_violation_scaled <= 1e-6
+
+
+def test_an_impossible_payload_on_one_task_exits_3_naming_the_limit_and_the_task(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A 2 t schedule on the second task exceeds the lift EMLA at every length: exit 3, the limit and task named."""
+    import yaml
+
+    from hiab_sim.cli import main
+
+    pytest.importorskip("casadi")
+    data = two_tasks()
+    data["tasks"][1]["payload"] = {**SCHEDULE, "mass": 2000.0}
+    path = tmp_path / "two.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["optimize", str(path), "--out", str(tmp_path / "run"), "--no-figures", "--no-video", "--quiet"]) == 3
+    err = capsys.readouterr().err
+    assert "EMLA" in err and "exceeded by" in err and "of task second" in err
+    assert not (tmp_path / "run" / "result.json").exists()

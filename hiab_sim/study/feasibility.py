@@ -15,6 +15,12 @@ If the least violation stays > 0, no feasible point was found: :class:`Infeasibl
 names the row that is violated most at the best point, where and by how much in physical units
 (:func:`describe_violation`). A trial point outside the model's domain (a chain that cannot close)
 counts as a large phi, so the line search steps back.
+
+A duty mix (:class:`~hiab_sim.study.mix.MixProblem`: thousands of rows) runs the same phase with
+the projection on IPOPT (sparse Jacobians, :func:`hiab_sim.study.ipopt.solve_ipopt` with the
+distance as its objective): dense SLSQP costs seconds per iteration there. The direct
+least-largest-violation step is dense SLSQP and serves single tasks only; where the penalty
+stalls on a mix, the least violation it found is reported.
 """
 
 from __future__ import annotations
@@ -27,6 +33,8 @@ from scipy.optimize import minimize
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import HiabSimError, InfeasibleStudyError, InvalidInputError
 from hiab_sim.study.blocks import STROKE_SCALE
+from hiab_sim.study.ipopt import solve_ipopt
+from hiab_sim.study.mix import MixProblem, Problem
 from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.result_sections import FeasibilityPhase
 from hiab_sim.study.sensitivity import XI_NAMES
@@ -41,6 +49,8 @@ OUTSIDE = 1e3
 POLISH = 1e-2
 #: A start whose nominal rows are all >= -this needs no feasibility phase (round-off only).
 START_TOLERANCE = 1e-9
+#: Iteration limit of a mix's projection on IPOPT.
+PROJECTION_ITERATIONS = 300
 _REMEDY = {
     "peak_torque": "a larger motor or gear ratio is needed",
     "rated_speed": "a faster motor or a longer screw lead is needed",
@@ -48,13 +58,18 @@ _REMEDY = {
 }
 
 
-def describe_violation(problem: LinkLengthProblem, index: int, value: float) -> str:
-    """A row's violation in words and physical units ("lift EMLA peak torque exceeded by 28 % at t = 2.5 s")."""
-    name = problem.constraint_names[index]
+def describe_violation(problem: Problem, index: int, value: float) -> str:
+    """A row's violation in words and physical units ("lift EMLA peak torque exceeded by 28 % at t = 2.5 s").
+
+    A mix's rows are named ``<task>: <row>``; the task is said after the time.
+    """
+    task, _, name = problem.constraint_names[index].rpartition(": ")
     where = ""
     if " at t=" in name:
         name, t = name.split(" at t=")
         where = f" at t = {t}"
+    if task:
+        where += f" of task {task}"
     block = name.split(".")[0]
     if block == "envelope":
         _, actuator, limit = name.split(".")
@@ -78,7 +93,7 @@ def describe_violation(problem: LinkLengthProblem, index: int, value: float) -> 
     return f"{name}{where} violated by {-value:.3g} (scaled)"
 
 
-def _phi(problem: LinkLengthProblem, z: Array) -> tuple[float, Array]:
+def _phi(problem: Problem, z: Array) -> tuple[float, Array]:
     try:
         g = problem.constraints(z)
         e = problem.equalities(z)
@@ -90,11 +105,21 @@ def _phi(problem: LinkLengthProblem, z: Array) -> tuple[float, Array]:
     return value, grad
 
 
-def _project(
-    problem: LinkLengthProblem, target: Array, start: Array, bounds: list[tuple[float | None, float | None]]
-) -> Array:
-    """The point nearest to ``target`` that satisfies the rows to SLSQP's accuracy, searched from ``start``."""
+def _project(problem: Problem, target: Array, start: Array, bounds: list[tuple[float | None, float | None]]) -> Array:
+    """The point nearest to ``target`` that satisfies the rows to SLSQP's accuracy, searched from ``start``.
+
+    On a mix the same problem goes to IPOPT (sparse Jacobians).
+    """
     target = np.array(target)
+    if isinstance(problem, MixProblem):
+        outcome = solve_ipopt(
+            problem,
+            np.array(start),
+            PROJECTION_ITERATIONS,
+            1e-12,
+            objective=(lambda x: 0.5 * float((x - target) @ (x - target)), lambda x: x - target),
+        )
+        return outcome.z
     res = minimize(
         lambda x: (0.5 * float((x - target) @ (x - target)), x - target),
         np.array(start),
@@ -184,7 +209,7 @@ def changes(before: LinkLengths, after: LinkLengths) -> tuple[str, ...]:
 
 
 def feasible_start(
-    problem: LinkLengthProblem, z0: Array, start: int = 0, maxiter: int = 500
+    problem: Problem, z0: Array, start: int = 0, maxiter: int = 500
 ) -> tuple[Array, FeasibilityPhase | None]:
     """The start itself if it is feasible, else the feasibility phase's point and what it changed.
 
@@ -216,8 +241,8 @@ def feasible_start(
     )
     z = np.asarray(res.x, dtype=float)
     g = problem.constraints(z)
-    if g.min() <= -POLISH:  # the penalty stalled far out: minimise the largest violation directly
-        z = _least_max_violation(problem, z, bounds, maxiter)
+    if g.min() <= -POLISH and isinstance(problem, LinkLengthProblem):  # the penalty stalled far out
+        z = _least_max_violation(problem, z, bounds, maxiter)  # minimise the largest violation directly
         g = problem.constraints(z)
     if g.min() > -POLISH:  # near or in the feasible set: the nearest feasible point to the start, else to z
         for target in (z0, z):
@@ -250,9 +275,7 @@ def feasible_start(
     )
 
 
-def feasible_starts(
-    problem: LinkLengthProblem, count: int, seed: int = 6
-) -> tuple[list[Array], list[FeasibilityPhase]]:
+def feasible_starts(problem: Problem, count: int, seed: int = 6) -> tuple[list[Array], list[FeasibilityPhase]]:
     """The study's start and ``count - 1`` starts drawn uniformly in the Xi bounds, each made feasible.
 
     A draw the feasibility phase cannot repair is skipped (at most 20 ``count`` draws); the
@@ -292,7 +315,7 @@ def phase_lines(phase: FeasibilityPhase) -> list[str]:
     ]
 
 
-def moved_start_phase(problem: LinkLengthProblem, z: Array) -> FeasibilityPhase | None:
+def moved_start_phase(problem: Problem, z: Array) -> FeasibilityPhase | None:
     """The step that moved the study's start into the bounds, when the built crane's lengths lie outside them.
 
     The loader projects the built crane's lengths onto the bounds and re-centres each moved chain's

@@ -274,7 +274,12 @@ def _callback_class(ca: Any) -> Any:
 
 
 def solve_ipopt(
-    problem: Problem, z0: Array, maxiter: int, tol: float, on_iterate: Callable[[Array], None] | None = None
+    problem: Problem,
+    z0: Array,
+    maxiter: int,
+    tol: float,
+    on_iterate: Callable[[Array], None] | None = None,
+    objective: tuple[Callable[[Array], float], Callable[[Array], Array]] | None = None,
 ) -> IpoptOutcome:
     """Minimise the problem's scaled cost from z0 with IPOPT (L-BFGS Hessian, sparse Jacobians).
 
@@ -285,8 +290,11 @@ def solve_ipopt(
         tol: Relative cost change that ends the solve (as SLSQP's ``ftol``) once the point is
             feasible to 1e-8 (scaled); IPOPT's own ``tol`` on the scaled NLP error is 1e-8.
         on_iterate: Called with every iterate's z.
+        objective: (value, gradient) of another objective over the problem's rows and bounds
+            (the feasibility phase's distance to a point); default the problem's scaled cost.
 
     """
+    cost, cost_gradient = (problem.cost, problem.cost_gradient) if objective is None else objective
     ca = _casadi()
     Callback = _callback_class(ca)
     n = problem.n
@@ -306,9 +314,9 @@ def solve_ipopt(
     scalar = ca.Sparsity.dense(1, 1)
 
     def grad_f() -> Any:
-        return made(Callback("grad_f", [dense_z, scalar], ca.Sparsity.dense(1, n), problem.cost_gradient))
+        return made(Callback("grad_f", [dense_z, scalar], ca.Sparsity.dense(1, n), cost_gradient))
 
-    f_cb = made(Callback("f", [dense_z], scalar, problem.cost, jacobian=grad_f))
+    f_cb = made(Callback("f", [dense_z], scalar, cost, jacobian=grad_f))
     g_cb = made(Callback("g", [dense_z], ca.Sparsity.dense(m, 1), jac.rows, jacobian=jac_g, jac_sparsity=jac_sparsity))
 
     iterates: list[Array] = []

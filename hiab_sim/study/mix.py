@@ -93,6 +93,7 @@ class MixProblem:
         self.emlas = first.emlas
         self.id_path = first.id_path
         self.crane = first.crane
+        self.envelope_margin = first.envelope_margin  # the study's, the same for every task
         self.weights = np.array([task.weight for task in study.tasks])
         # the working range the starts must serve: the widest of the tasks' (the crane's for ``crane``)
         self.working = tuple(

@@ -21,13 +21,10 @@ from hiab_sim.study.problem import LinkLengthProblem
 from hiab_sim.study.report import build_result, write_results
 from hiab_sim.study.report_extra import issue14_sections
 from hiab_sim.study.result import Result
-from hiab_sim.study.result_sections import FeasibilityPhase
 from hiab_sim.study.solve import (
     SolveResult,
     check_checkpoint,
-    check_start,
     solve,
-    start_points,
     study_digest,
 )
 
@@ -71,16 +68,10 @@ def run_study(
         codesign, emlas = run_codesign(study, progress=progress)
         study = replace(study, emlas=emlas)
     problem = make_problem(study, id_path)
-    phases: list[FeasibilityPhase] = []
-    if isinstance(problem, MixProblem):  # the feasibility phase serves single-task studies (README)
-        check_start(problem, problem.initial_point(study.initial_lengths))
-        initials = start_points(problem, starts)
-        points = [problem.initial_point(lengths) for lengths in initials]
-    else:
-        points, phases = feasible_starts(problem, starts)
-        initials = [problem.unpack(z)[0] for z in points]
-        moved = moved_start_phase(problem, problem.initial_point(study.initial_lengths))
-        phases = [moved, *phases] if moved is not None else phases
+    points, phases = feasible_starts(problem, starts)
+    initials = [problem.unpack(z)[0] for z in points]
+    moved = moved_start_phase(problem, problem.initial_point(study.initial_lengths))
+    phases = [moved, *phases] if moved is not None else phases
     folder = Path(out)
     run_safety.check_folder(folder, study_digest(problem), resume, force)
     if resume:
@@ -116,6 +107,7 @@ def run_study(
                 if progress is not None:
                     progress.write(f"no cross-evaluation: {error}\n")
         result, arrays, checks = build_mix_result(problem, results, time.perf_counter() - t0, evaluation)
+        result = replace(result, feasibility=tuple(phases) if phases else None)
     else:
         result, arrays, checks = build_result(problem, results, time.perf_counter() - t0)
     if codesign is not None:
