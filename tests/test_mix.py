@@ -239,3 +239,37 @@ def test_an_impossible_payload_on_one_task_exits_3_naming_the_limit_and_the_task
     err = capsys.readouterr().err
     assert "EMLA" in err and "exceeded by" in err and "of task second" in err
     assert not (tmp_path / "run" / "result.json").exists()
+
+
+def test_each_task_reports_its_thermal_state_over_its_own_cycle_and_the_hourly_rms_is_duty_independent() -> None:
+    """A 7.5 s task in a study of 6.25 s grids: its duty is 7.5 s + rest; int tau^2 dt = rms^2 P for any duty.
+
+    The mix's hourly RMS torque (weights as cycles per hour) sums w_k rms_k^2 P_k, so it must not
+    depend on the duty the tasks' own RMS values were taken over.
+    """
+    from hiab_sim.study.energy_report import energy_report, study_duty, weighted_energy_report
+    from hiab_sim.study.report import design_summary, fine_problem
+
+    rms, hourly = {}, {}
+    for per_hour in (60.0, 120.0):
+        data = two_tasks()
+        data["tasks"][1]["reference"]["duration"] = 7.5
+        data["duty"] = {"cycles_per_hour": per_hour}
+        mix = MixProblem(study_from_dict(data, "two.yaml"))
+        z = mix.initial_point(mix.study.initial_lengths)
+        reports, periods = [], []
+        for k, p in enumerate(mix.problems):
+            fine = fine_problem(p)
+            state = design_summary(fine, mix.task_z(z, k)).evaluation
+            reports.append(energy_report(fine, state, state))
+            periods.append(study_duty(fine)[0].period)
+        assert "7.5 s cycle" in reports[1].duty and reports[1].optimal.thermal is not None
+        rms[per_hour] = {k: th.rms_torque_Nm for k, th in reports[1].optimal.thermal.items()}
+        cycles = [task.reference.duration for task in mix.tasks]
+        hourly[per_hour] = weighted_energy_report(reports, mix.weights.tolist(), cycles, periods).hourly_rms_torque_Nm
+    for name, value in rms[60.0].items():  # periods 60 s and 30 s: the same int tau^2 dt over the 7.5 s cycle
+        assert value**2 * 60.0 == pytest.approx(rms[120.0][name] ** 2 * 30.0, rel=1e-12)
+        assert value > 0.0
+    assert hourly[60.0] is not None and hourly[120.0] is not None
+    for name, value in hourly[60.0].items():
+        assert value == pytest.approx(hourly[120.0][name], rel=1e-12) and value > 0.0

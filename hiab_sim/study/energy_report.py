@@ -21,6 +21,10 @@ Every result reports both objectives, whichever the solver minimised:
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
+from dataclasses import replace
+
 import numpy as np
 
 from hiab_sim.crane.names import ACTUATOR_NAMES
@@ -53,8 +57,8 @@ BATTERY_NOTE = (
 
 
 def study_duty(problem: LinkLengthProblem) -> tuple[Duty, str]:
-    """The study's duty, or back-to-back cycles (no rest) when it gives none; with a description."""
-    settings, cycle = problem.study.energy.duty, problem.study.grid.duration
+    """The study's duty for the problem's task (its own cycle time), or back-to-back cycles when none is given."""
+    settings, cycle = problem.study.energy.duty, problem.task.reference.duration
     if settings is None:
         return Duty(cycle, 0.0), f"none given: back-to-back cycles ({cycle:g} s, no rest)"
     return settings.duty(cycle), settings.describe(cycle)
@@ -128,6 +132,64 @@ def energy_report(fine: LinkLengthProblem, initial: SampleState, optimal: Sample
         optimal=e1,
         battery_energy_saved_J=e0.battery_energy_J - e1.battery_energy_J,
         battery_energy_saved_percent=100.0 * (e0.battery_energy_J - e1.battery_energy_J) / e0.battery_energy_J,
+    )
+
+
+def weighted_energy_report(
+    reports: list[EnergyReport], weights: Sequence[float], cycles: Sequence[float], periods: Sequence[float]
+) -> EnergyReport:
+    """A duty mix's ``energy``: each task's battery energy, costf2 and per-actuator energies weighted.
+
+    The thermal state stays per task (each task's ``energy``, its cycle at the study's duty): the
+    tasks' weights do not say in which order the crane runs them, which the winding temperature
+    depends on. When the weights read as cycles per hour fit in an hour (sum_k w_k T_k <= 3600 s,
+    ``cycles`` the tasks' cycle times T_k [s]), the hour's RMS torque of each motor is given too:
+    tau_rms,h^2 = sum_k w_k tau_rms,k^2 P_k / 3600 s (``periods`` P_k [s], the duty periods over
+    which each task's tau_rms,k was taken), independent of the order: the continuous-torque limit
+    of a crane doing that mix for hours.
+    """
+    w = [float(v) for v in weights]
+    work = float(sum(wk * t for wk, t in zip(w, cycles, strict=True)))
+    hourly = None
+    if work <= 3600.0 and all(r.optimal.thermal for r in reports):
+        names = list(reports[0].optimal.thermal or {})
+        hourly = {
+            name: math.sqrt(
+                sum(
+                    wk * (r.optimal.thermal or {})[name].rms_torque_Nm ** 2 * period
+                    for wk, r, period in zip(w, reports, periods, strict=True)
+                )
+                / 3600.0
+            )
+            for name in names
+        }
+
+    def total(values: Sequence[float]) -> float:
+        return float(sum(wk * v for wk, v in zip(w, values, strict=True)))
+
+    def design(name: str) -> DesignEnergy:
+        each = [getattr(r, name) for r in reports]
+        return DesignEnergy(
+            battery_energy_J=total([d.battery_energy_J for d in each]),
+            battery_energy_smooth_J=total([d.battery_energy_smooth_J for d in each]),
+            smoothing_bound_J=total([d.smoothing_bound_J for d in each]),
+            costf2_W2s=total([d.costf2_W2s for d in each]),
+            drawn_energy_J={k: total([d.drawn_energy_J[k] for d in each]) for k in each[0].drawn_energy_J},
+            net_energy_J={k: total([d.net_energy_J[k] for d in each]) for k in each[0].net_energy_J},
+        )
+
+    initial, optimal = design("initial"), design("optimal")
+    saved = initial.battery_energy_J - optimal.battery_energy_J
+    return replace(
+        reports[0],
+        note=reports[0].note + "; a duty mix: every energy weighted by the tasks' weights, thermal state per task",
+        duty="per task (see tasks[k].energy)",
+        initial=initial,
+        optimal=optimal,
+        battery_energy_saved_J=saved,
+        battery_energy_saved_percent=100.0 * saved / initial.battery_energy_J,
+        hourly_rms_torque_Nm=hourly,
+        hourly_work_s=work if hourly is not None else None,
     )
 
 
@@ -207,6 +269,22 @@ def energy_lines(r: Result) -> list[str]:
             for k, th in e.optimal.thermal.items()
         ]
         lines.append(f"thermal at the optimum, duty {e.duty}: " + "; ".join(parts))
+    first = r.tasks[0].energy if r.tasks else None
+    if e.hourly_rms_torque_Nm is not None and first is not None:
+        limits = {k: th.continuous_torque_Nm for k, th in (first.optimal.thermal or {}).items()}
+        lines.append(
+            f"thermal over the mix's hour (weights as cycles per hour, {e.hourly_work_s:.0f} s of work): RMS "
+            + ", ".join(f"{k} {v:.2f}/{limits.get(k, float('nan')):.1f} N m" for k, v in e.hourly_rms_torque_Nm.items())
+        )
+    for task in r.tasks or ():
+        if task.energy is not None and task.energy.optimal.thermal:
+            worst = min(task.energy.optimal.thermal.items(), key=lambda item: item[1].torque_margin)
+            th = worst[1]
+            lines.append(
+                f"thermal at the optimum, task {task.name} ({task.energy.duty}): tightest {worst[0]} RMS "
+                f"{th.rms_torque_Nm:.2f}/{th.continuous_torque_Nm:.1f} N m, winding "
+                f"{th.peak_winding_temperature_C:.1f}/{th.max_winding_temperature_C:.0f} deg C"
+            )
     h = r.hydraulic_baseline
     if h is not None:
         o = h.optimal

@@ -63,6 +63,10 @@ class EnergyReport:
     optimal: DesignEnergy
     battery_energy_saved_J: float
     battery_energy_saved_percent: float
+    # a duty mix whose weights are cycles per hour: each motor's RMS torque over the hour at the optimum
+    # (sqrt(sum_k w_k int_k tau^2 dt / 3600 s), order-independent) and the hour's seconds of work
+    hourly_rms_torque_Nm: dict[str, float] | None = optional()
+    hourly_work_s: float | None = optional()
 
 
 @dataclass(frozen=True)

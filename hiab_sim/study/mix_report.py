@@ -2,18 +2,20 @@
 
 Each task is reported as a single-task study would be (:func:`hiab_sim.study.report.design_summary`
 on its fine grid with nominal bands, re-checked with the other ID path): initial and optimal
-energies (net and drawn), peaks, tracking error. The top-level ``initial``/``optimal``/``recheck``
-of ``result.json`` hold the mix: energies and costs weighted by the tasks' weights (per unit of
-the weights, e.g. per hour for cycles per hour), peaks and violations the worst over the tasks,
-worst constraints named ``<task>: <row>``. ``trajectory.npz`` holds the first task under the
-renderer's keys (``time``, ``reference_tcp``, ``initial_*``, ``optimal_*``) and every task k under
-``task<k>_<key>``.
+energies (net and drawn), peaks, tracking error, and its ``energy`` section (battery energy,
+costf2, thermal state over its own cycle at the study's duty). The top-level
+``initial``/``optimal``/``recheck``/``energy`` of ``result.json`` hold the mix: energies and costs
+weighted by the tasks' weights (per unit of the weights, e.g. per hour for cycles per hour), peaks
+and violations the worst over the tasks, worst constraints named ``<task>: <row>``.
+``trajectory.npz`` holds the first task under the renderer's keys (``time``, ``reference_tcp``,
+``initial_*``, ``optimal_*``) and every task k under ``task<k>_<key>``.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
 
+from hiab_sim.study.energy_report import energy_report, study_duty, weighted_energy_report
 from hiab_sim.study.mix import MixProblem
 from hiab_sim.study.nlp import Array
 from hiab_sim.study.report import (
@@ -210,6 +212,7 @@ def build_mix_result(
                 initial=designs["initial"],
                 optimal=designs["optimal"],
                 recheck=recheck_section(checks, recheck),
+                energy=energy_report(fine, checks["initial"].evaluation, checks["optimal"].evaluation),
             )
         )
         decompositions.append(energy_decomposition(p, fine, z0, z1))
@@ -268,5 +271,11 @@ def build_mix_result(
         ),
         tasks=tuple(task_results),
         cross_evaluation=cross,
+        energy=weighted_energy_report(
+            [t.energy for t in task_results if t.energy is not None],
+            w.tolist(),
+            [task.reference.duration for task in problem.tasks],
+            [study_duty(f)[0].period for f in fines],
+        ),
     )
     return result, arrays, first_checks

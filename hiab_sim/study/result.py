@@ -286,6 +286,7 @@ class TaskResult:
     initial: DesignSummary
     optimal: DesignSummary
     recheck: Recheck
+    energy: EnergyReport | None = optional()  # battery energy, costf2, thermal at the study's duty
 
 
 @dataclass(frozen=True)
