@@ -6,7 +6,7 @@ for a duty mix (a few hundred variables, thousands of rows) that is seconds per 
 Jacobian is sparse by structure: a per-sample row (:class:`~hiab_sim.study.nlp.PerSampleBlock`)
 depends on Xi and on the k + 1 B-spline coefficients per joint whose support covers its sample,
 another row (an integral, the working range) on Xi and its task's coefficients; rows of another
-task never depend on a task's coefficients. :func:`jacobian_sparsity` builds that pattern from the
+task never depend on a task's coefficients. :func:`task_sparsity` builds that pattern from the
 blocks; the values are the problem's exact-structure Jacobian at the pattern. The Hessian is the
 limited-memory quasi-Newton approximation (L-BFGS), as SLSQP's BFGS.
 
@@ -70,18 +70,6 @@ def task_sparsity(problem: LinkLengthProblem) -> sparse.csr_matrix:
         else:
             rows.append(np.ones((count, N_XI + 3 * n_c), bool))
     return sparse.csr_matrix(np.vstack(rows).astype(float))
-
-
-def jacobian_sparsity(problem: Problem) -> sparse.csr_matrix:
-    """Structural nonzeros of D g/dz of a task's or a mix's NLP (module docstring)."""
-    if isinstance(problem, LinkLengthProblem):
-        return task_sparsity(problem)
-    parts = []
-    for k, (p, rows) in enumerate(zip(problem.problems, problem.rows, strict=True)):
-        local = task_sparsity(p)[rows].tocoo()
-        cols = np.where(local.col < N_XI, local.col, local.col - N_XI + problem.offsets[k])
-        parts.append(sparse.csr_matrix((local.data, (local.row, cols)), shape=(len(rows), problem.n)))
-    return sparse.csr_matrix(sparse.vstack(parts))
 
 
 def range_pairs(problem: LinkLengthProblem) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
