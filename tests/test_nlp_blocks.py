@@ -10,7 +10,7 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.nlp.blocks import ObjectiveBound
 from hiab_sim.study.nlp.interface import ConstraintBlock, DenseRows, SamplePartials, SampleState
 from hiab_sim.study.nlp.objectives import SquaredPowerCost, make_objective
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.solvers.slsqp import start_points
 from hiab_sim.study.spec.study_file import study_from_dict
 
@@ -43,14 +43,14 @@ class RmsForceLimit(ConstraintBlock):
         return DenseRows(dq=dq[None], dxi=dxi[None])
 
 
-class WithRmsBlock(LinkLengthProblem):
+class WithRmsBlock(TaskProblem):
     """The small study's NLP with one more block: the only edit is the block list."""
 
     def _build_blocks(self) -> list[ConstraintBlock]:
         return [*super()._build_blocks(), RmsForceLimit(limit=60e3)]
 
 
-class WithCostBound(LinkLengthProblem):
+class WithCostBound(TaskProblem):
     """The small study's NLP with its own cost held below a bound (an epsilon constraint)."""
 
     def _build_blocks(self) -> list[ConstraintBlock]:
@@ -58,16 +58,16 @@ class WithCostBound(LinkLengthProblem):
         return [*super()._build_blocks(), ObjectiveBound(cost, bound=5e5, scale=1e5)]
 
 
-def _point(problem: LinkLengthProblem) -> np.ndarray:
+def _point(problem: TaskProblem) -> np.ndarray:
     """A feasible start other than the built crane's (drawn on the plain NLP), with perturbed coefficients."""
     rng = np.random.default_rng(5)
-    z = problem.initial_point(start_points(LinkLengthProblem(STUDY, id_path="analytic"), 2)[1])
+    z = problem.initial_point(start_points(TaskProblem(STUDY, id_path="analytic"), 2)[1])
     return z + np.concatenate([np.zeros(6), rng.normal(0.0, 0.02, problem.n_c)])
 
 
 def test_every_row_belongs_to_one_named_block() -> None:
     """Block slices tile the rows in order, each row is named after its block, and values match names."""
-    problem = LinkLengthProblem(STUDY, id_path="analytic")
+    problem = TaskProblem(STUDY, id_path="analytic")
     ev = problem.evaluate(problem.initial_point(STUDY.initial_lengths))
     layout = problem.layout
     stop = 0
@@ -84,11 +84,11 @@ def test_every_row_belongs_to_one_named_block() -> None:
 
 def test_clearance_belongs_to_the_working_range_block_only() -> None:
     """Solver rows plus the clearance are the nominal rows; only working-range rows (nominal, buildable) carry it."""
-    tight = LinkLengthProblem(STUDY, id_path="analytic")
+    tight = TaskProblem(STUDY, id_path="analytic")
     nominal = {name: values for name, values in tight.layout.split(tight.clearance).items() if np.any(values)}
     assert list(nominal) == ["working_range", "buildable_range"]
     z = tight.initial_point(STUDY.initial_lengths)
-    loose = LinkLengthProblem(STUDY, id_path="analytic", tightened=False)
+    loose = TaskProblem(STUDY, id_path="analytic", tightened=False)
     rows = tight.layout.slices["working_range"]
     np.testing.assert_allclose(tight.margins(z)[rows], loose.constraints(z)[rows], rtol=0, atol=1e-15)
 
@@ -98,7 +98,7 @@ def test_clearance_belongs_to_the_working_range_block_only() -> None:
     [(WithRmsBlock, "rms_force.lift <= limit"), (WithCostBound, "bound.costf2 <= 500000 W^2 s")],
     ids=["rms_force", "cost_bound"],
 )
-def test_an_added_integral_block_gets_an_exact_jacobian(kind: type[LinkLengthProblem], last_row: str) -> None:
+def test_an_added_integral_block_gets_an_exact_jacobian(kind: type[TaskProblem], last_row: str) -> None:
     """A row that depends on every sample (RMS force, a cost bound) enters D g / dz and matches central differences."""
     problem = kind(STUDY, id_path="analytic")
     assert problem.constraint_names[-1] == last_row
@@ -113,7 +113,7 @@ def test_an_added_integral_block_gets_an_exact_jacobian(kind: type[LinkLengthPro
         fd[i] = (problem.constraints(up)[-1] - problem.constraints(down)[-1]) / (2 * h)
     np.testing.assert_allclose(row, fd, atol=1e-6 * np.max(np.abs(fd)), rtol=1e-4)
     # the other rows are those of the plain problem
-    plain = LinkLengthProblem(STUDY, id_path="analytic")
+    plain = TaskProblem(STUDY, id_path="analytic")
     np.testing.assert_array_equal(problem.constraints(z)[:-1], plain.constraints(z))
 
 
@@ -126,6 +126,6 @@ def test_cost_bound_row_is_the_bound_less_the_problem_cost() -> None:
 
 def test_unknown_objective_names_the_field() -> None:
     """An objective name outside the registry is rejected with the field ``objective``."""
-    problem = LinkLengthProblem(STUDY, id_path="analytic")
+    problem = TaskProblem(STUDY, id_path="analytic")
     with pytest.raises(InvalidInputError, match="objective"):
         make_objective("fastest", problem.emlas, problem.dt)

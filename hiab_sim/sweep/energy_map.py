@@ -40,7 +40,7 @@ from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.results.schema import read_result
 from hiab_sim.study.analysis.buildable import RobustXi, replace_lengths
 from hiab_sim.study.motion import trajectory as tr
-from hiab_sim.study.nlp.problem import ACTUATORS, STROKE_SCALE, LinkLengthProblem
+from hiab_sim.study.nlp.task_problem import ACTUATORS, STROKE_SCALE, TaskProblem
 
 Array = NDArray[np.float64]
 
@@ -64,7 +64,7 @@ class BaseDesign:
     source: str  # "optimum of <folder>" or "start of the study"
 
 
-def start_design(problem: LinkLengthProblem) -> BaseDesign:
+def start_design(problem: TaskProblem) -> BaseDesign:
     """The study's start: its initial lengths and the inverse-kinematics spline fit."""
     times = problem.study.grid.fine_times()
     joints = tr.evaluate(problem.basis, problem.c_ref, times)
@@ -147,7 +147,7 @@ def _stroke_rows(xi: Array, x: Array, strokes: Array) -> Array:
     return np.stack(cols, axis=-1) / STROKE_SCALE
 
 
-def evaluate_designs(problem: LinkLengthProblem, base: BaseDesign, xi: Array) -> DesignValues:
+def evaluate_designs(problem: TaskProblem, base: BaseDesign, xi: Array) -> DesignValues:
     """Objective, energies and Xi-dependent margins of designs xi (D, 6) on the base trajectory."""
     xi = np.atleast_2d(np.asarray(xi, dtype=float))
     ff = problem.study.grid.fine_factor
@@ -193,7 +193,7 @@ def evaluate_designs(problem: LinkLengthProblem, base: BaseDesign, xi: Array) ->
     return DesignValues(xi, cost, objective, net, drawn, margins, (*margin_names(), *robust_names), battery)
 
 
-def _robust_rows(problem: LinkLengthProblem, base: BaseDesign, xi: Array) -> tuple[Array, list[str]]:
+def _robust_rows(problem: TaskProblem, base: BaseDesign, xi: Array) -> tuple[Array, list[str]]:
     """The optimiser's rows of Xi only held within the manufacturing tolerance, per design (D, R).
 
     They depend on the link lengths alone (no samples), so each design is one call of the block
@@ -203,7 +203,7 @@ def _robust_rows(problem: LinkLengthProblem, base: BaseDesign, xi: Array) -> tup
     if not blocks:
         return np.zeros((len(xi), 0)), []
     state = problem.evaluate(problem.initial_point(LinkLengths.from_array(base.xi)))
-    # nominal margins as LinkLengthProblem.margins gives them: the rows without the optimiser's clearance
+    # nominal margins as TaskProblem.margins gives them: the rows without the optimiser's clearance
     rows = np.array([np.concatenate([b.values(replace_lengths(state, x)) + b.clearance() for b in blocks]) for x in xi])
     return rows, [name for b in blocks for name in b.row_names()]
 
@@ -235,7 +235,7 @@ def parse_variables(text: str) -> tuple[int, int]:
     return VARIABLES.index(names[0]), VARIABLES.index(names[1])
 
 
-def energy_map(problem: LinkLengthProblem, base: BaseDesign, variables: tuple[int, int], n: int) -> EnergyMap:
+def energy_map(problem: TaskProblem, base: BaseDesign, variables: tuple[int, int], n: int) -> EnergyMap:
     """Evaluate the n x n grid of two link lengths over their study bounds, the rest at the base design."""
     if n < 2:
         raise InvalidInputError("--grid", n, "must be >= 2")

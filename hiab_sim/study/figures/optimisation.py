@@ -27,7 +27,7 @@ from hiab_sim.study.figures.design import (
     structure_overlay,
 )
 from hiab_sim.study.figures.energy import hydraulic_figure
-from hiab_sim.study.nlp.problem import ACTUATORS
+from hiab_sim.study.nlp.task_problem import ACTUATORS
 from hiab_sim.study.report.result_folder import DesignCheck
 from hiab_sim.style import colour
 
