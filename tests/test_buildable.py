@@ -113,7 +113,7 @@ def test_multipliers_predict_the_cost_change_of_a_bound_move(solved: tuple[TaskP
         p2 = TaskProblem(moved, cost_scale=problem.cost_scale)
         z2 = solve(p2, study.initial_lengths, progress=None, z0=z).z
         actual = f0 - p2.evaluate(z2).cost
-        assert actual == pytest.approx(m.cost_per_unit_W2s, rel=0.05), m.constraint
+        assert actual == pytest.approx(m.objective_decrease_per_unit, rel=0.05), m.constraint
 
 
 @pytest.mark.parametrize("chain", ["lift", "tilt"])
@@ -131,7 +131,7 @@ def test_stroke_row_multipliers_predict_a_longer_stroke(
         m for m in sensitivity(problem, z).multipliers if m.constraint.endswith(f"{chain}.x <= stroke at the up end")
     ]
     assert rows, f"an {chain} stroke row is active at the small study's optimum"
-    predicted = sum(m.cost_per_unit_W2s for m in rows)
+    predicted = sum(m.objective_decrease_per_unit for m in rows)
     old = getattr(study.crane, chain)
     crane = dataclasses.replace(study.crane, **{chain: dataclasses.replace(old, stroke=old.stroke + 1e-3)})
     longer = dataclasses.replace(study, crane=crane)
@@ -170,7 +170,7 @@ def test_envelope_multiplier_predicts_a_slightly_stronger_motor(tmp_path: Path) 
     stronger_problem = TaskProblem(study_with(1.0 + step), cost_scale=problem.cost_scale)
     z2 = solve(stronger_problem, problem.unpack(z)[0], progress=None, z0=z).z
     actual = problem.evaluate(z).cost - stronger_problem.evaluate(z2).cost
-    assert actual == pytest.approx(rows[0].cost_per_unit_W2s * step * 100.0, rel=0.05)
+    assert actual == pytest.approx(rows[0].objective_decrease_per_unit * step * 100.0, rel=0.05)
 
 
 def test_an_infeasible_start_goes_through_the_feasibility_phase_and_converges(tmp_path: Path) -> None:
@@ -269,7 +269,7 @@ def test_tracking_band_multipliers_predict_a_wider_band(solved: tuple[TaskProble
     problem, z = solved
     study = problem.study
     sens = sensitivity(problem, z)
-    predicted = sum(m.cost_per_unit_W2s for m in sens.multipliers if m.constraint.startswith("tracking.position."))
+    predicted = sum(m.objective_decrease_per_unit for m in sens.multipliers if m.constraint.startswith("tracking.position."))
     assert predicted > 0.0
     delta = 1e-5  # m
     wider = dataclasses.replace(

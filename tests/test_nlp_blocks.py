@@ -8,7 +8,7 @@ from test_study_small import small_study
 
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.nlp.blocks import ObjectiveBound
-from hiab_sim.study.nlp.interface import ConstraintBlock, DenseRows, SamplePartials, SampleState
+from hiab_sim.study.nlp.interface import ConstraintBlock, DenseRows, Relaxation, SamplePartials, SampleState
 from hiab_sim.study.nlp.objectives import SquaredPowerCost, make_objective
 from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.solvers.slsqp import start_points
@@ -41,6 +41,10 @@ class RmsForceLimit(ConstraintBlock):
         dq = d_f[:, None] * partials.id_q[:, 0, :]  # (K, 9)
         dxi = d_f @ partials.id_xi[:, 0, :]  # (6,)
         return DenseRows(dq=dq[None], dxi=dxi[None])
+
+    def relaxation(self, values: np.ndarray) -> Relaxation:
+        """Per N of the limit: the row moves by RMS / limit^2 = (1 - g) / limit."""
+        return Relaxation(("N",), (1.0 - np.asarray(values)) / self.limit)
 
 
 class WithRmsBlock(TaskProblem):
@@ -82,15 +86,21 @@ def test_every_row_belongs_to_one_named_block() -> None:
     assert sum(len(rows) for rows in named.values()) == len(ev.constraints)
 
 
-def test_clearance_belongs_to_the_working_range_block_only() -> None:
-    """Solver rows plus the clearance are the nominal rows; only working-range rows (nominal, buildable) carry it."""
+def test_clearance_only_tightens_rows_of_xi_alone_and_adds_back_to_the_nominal_rows() -> None:
+    """The optimiser's clearance is >= 0, sits only on rows independent of the trajectory, and solver rows
+    plus it are the nominal problem's rows (for every block the nominal problem has too)."""
     tight = TaskProblem(STUDY, id_path="analytic")
-    nominal = {name: values for name, values in tight.layout.split(tight.clearance).items() if np.any(values)}
-    assert list(nominal) == ["working_range", "buildable_range"]
     z = tight.initial_point(STUDY.initial_lengths)
+    assert np.all(tight.clearance >= 0.0) and np.any(tight.clearance > 0.0)
+    jac = tight.constraints_jacobian(z)
+    cleared = tight.clearance > 0.0
+    assert np.all(jac[cleared][:, tight.n_xi :] == 0.0)  # the cleared rows do not move with the trajectory
     loose = TaskProblem(STUDY, id_path="analytic", tightened=False)
-    rows = tight.layout.slices["working_range"]
-    np.testing.assert_allclose(tight.margins(z)[rows], loose.constraints(z)[rows], rtol=0, atol=1e-15)
+    for block in tight.layout.blocks:
+        if block.name not in loose.layout.slices or not np.any(tight.layout.split(tight.clearance)[block.name]):
+            continue
+        rows, nominal = tight.layout.slices[block.name], loose.layout.slices[block.name]
+        np.testing.assert_allclose(tight.margins(z)[rows], loose.constraints(z)[nominal], rtol=0, atol=1e-15)
 
 
 @pytest.mark.parametrize(
