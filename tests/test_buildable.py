@@ -117,9 +117,7 @@ def test_multipliers_predict_the_cost_change_of_a_bound_move(solved: tuple[TaskP
 
 
 @pytest.mark.parametrize("chain", ["lift", "tilt"])
-def test_stroke_row_multipliers_predict_a_longer_stroke(
-    solved: tuple[TaskProblem, np.ndarray], chain: str
-) -> None:
+def test_stroke_row_multipliers_predict_a_longer_stroke(solved: tuple[TaskProblem, np.ndarray], chain: str) -> None:
     """A 1 mm longer stroke moves each active 'x <= stroke' row by 1 mm: the multipliers predict the re-solve in 5 %.
 
     The rows are the working range's and the buildable range's at the up end (the lift's buildable
@@ -269,7 +267,9 @@ def test_tracking_band_multipliers_predict_a_wider_band(solved: tuple[TaskProble
     problem, z = solved
     study = problem.study
     sens = sensitivity(problem, z)
-    predicted = sum(m.objective_decrease_per_unit for m in sens.multipliers if m.constraint.startswith("tracking.position."))
+    predicted = sum(
+        m.objective_decrease_per_unit for m in sens.multipliers if m.constraint.startswith("tracking.position.")
+    )
     assert predicted > 0.0
     delta = 1e-5  # m
     wider = dataclasses.replace(

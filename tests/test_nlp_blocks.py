@@ -87,8 +87,10 @@ def test_every_row_belongs_to_one_named_block() -> None:
 
 
 def test_clearance_only_tightens_rows_of_xi_alone_and_adds_back_to_the_nominal_rows() -> None:
-    """The optimiser's clearance is >= 0, sits only on rows independent of the trajectory, and solver rows
-    plus it are the nominal problem's rows (for every block the nominal problem has too)."""
+    """The clearance is >= 0, only on rows independent of the trajectory, and adds back to the nominal rows.
+
+    Solver rows plus the clearance are the nominal problem's rows, for every block the nominal problem has too.
+    """
     tight = TaskProblem(STUDY, id_path="analytic")
     z = tight.initial_point(STUDY.initial_lengths)
     assert np.all(tight.clearance >= 0.0) and np.any(tight.clearance > 0.0)

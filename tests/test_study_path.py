@@ -39,8 +39,11 @@ def test_single_task_study_problem_is_its_task_bit_for_bit() -> None:
 
 @pytest.mark.slow
 def test_battery_objective_gives_sensitivities_cross_evaluation_and_costf2_in_their_units(tmp_path: Path) -> None:
-    """Two tasks, objective battery_energy: sensitivities in J and % of the battery energy, the
-    cross-evaluation's objective in J and its costs in W^2 s (costf2), the designs' costs costf2."""
+    """Two tasks, objective battery_energy: sensitivities, cross-evaluation and costs each in their own unit.
+
+    Sensitivities in J and % of the battery energy, the cross-evaluation's objective in J and its costs
+    in W^2 s (costf2), the designs' costs costf2.
+    """
     study = study_from_dict({**two_tasks(), "objective": "battery_energy"}, "two.yaml")
     r = run_study(study, tmp_path / "run", progress=None, figures=False, cross=True).result
     s = r.sensitivity

@@ -158,7 +158,7 @@ def buildable_working_range(study: Study, working: Sequence[tuple[float, float]]
 
 
 def buildable_blocks(study: Study, working: Sequence[tuple[float, float]], tightened: bool) -> list[ConstraintBlock]:
-    """The buildable-design blocks in row order (registered as ``buildable`` in :mod:`hiab_sim.study.nlp.block_registry`).
+    """The buildable-design blocks in row order (the ``buildable`` entry of the block registry).
 
     On the optimiser's grid (``tightened``): the stroke rows at the ends of the buildable working
     range and the mounting rows (if the study has ``mounting``), both robust to +-``build.tolerance``.

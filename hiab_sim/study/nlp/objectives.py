@@ -75,7 +75,7 @@ class BatteryEnergyCost:
         return battery_energy(state.joints.time, state.power, self.emlas.battery, smooth=True).energy
 
     def exact(self, state: SampleState) -> float:
-        """Exact battery energy [J]: the drives' exact electrical power, the kinks unsmoothed (as the reports give it)."""
+        """Exact battery energy [J]: the drives' exact electrical power, the kinks unsmoothed (as reports give it)."""
         act = state.actuators
         power = np.column_stack(
             [
