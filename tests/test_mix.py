@@ -254,7 +254,7 @@ def test_each_task_reports_its_thermal_state_over_its_own_cycle_and_the_hourly_r
     depend on the duty the tasks' own RMS values were taken over.
     """
     from hiab_sim.study.report.energy_section import energy_report, study_duty, weighted_energy_report
-    from hiab_sim.study.report.result_folder import design_summary, fine_problem
+    from hiab_sim.study.report.design_check import design_summary, fine_problem
 
     rms, hourly = {}, {}
     for per_hour in (60.0, 120.0):

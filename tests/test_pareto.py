@@ -50,7 +50,7 @@ def test_front_is_monotone_from_the_plain_optimum(plain: tuple[TaskProblem, Solv
     problem, result = plain
     front = pareto_front(problem, result.z, "peak_force", 3)
     assert all(p.accepted for p in front), [p.message for p in front]
-    assert front[0].cost == problem.evaluate(result.z).cost
+    assert front[0].objective_value == problem.evaluate(result.z).cost
     for previous, point in itertools.pairwise(front):
         assert point.epsilon < previous.epsilon
         assert point.criterion <= point.epsilon * (1.0 + 1e-6)

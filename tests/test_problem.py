@@ -12,7 +12,7 @@ from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla import electrical_power, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study.nlp import problem as problem_module
+from hiab_sim.study.nlp import task_problem as problem_module
 from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.solvers.slsqp import START_TOLERANCE, check_start, start_points
 from hiab_sim.study.spec.study_file import load_study, study_from_dict

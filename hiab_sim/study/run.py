@@ -54,9 +54,9 @@ def run_study(
     ``resume``) deletes every output of earlier runs; a folder of another study is refused unless
     ``force`` (:mod:`hiab_sim.study.run_safety`). Every study, of one task or several, is one
     :class:`~hiab_sim.study.nlp.problem.StudyProblem`, reported by
-    :func:`~hiab_sim.study.report.result_folder.build_result` with its buildable design, feasibility phases and sensitivities; a study of several tasks adds
-    the cross-evaluation of :mod:`hiab_sim.study.analysis.cross_evaluation` unless ``cross`` is False.
-    A failure of SLSQP on the
+    :func:`~hiab_sim.study.report.result_folder.build_result` with its buildable design, feasibility
+    phases and sensitivities; a study of several tasks adds the cross-evaluation of
+    :mod:`hiab_sim.study.analysis.cross_evaluation` unless ``cross`` is False. A failure of SLSQP on the
     study's own start raises :class:`SolverError` after its checkpoint (the partial history) is
     on disk; failures of extra starts are reported (``multistart.failed_starts``).
     """

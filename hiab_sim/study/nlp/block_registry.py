@@ -13,16 +13,14 @@ velocity, working range, thermal limits, buildable range and mounting space) are
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
+from typing import Any
 
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.nlp.interface import ConstraintBlock
 
-if TYPE_CHECKING:
-    from hiab_sim.study.nlp.task_problem import TaskProblem
-
-#: Builds a task's blocks of one kind (none where the study does not ask for them).
-BlockFactory = Callable[["TaskProblem"], Sequence[ConstraintBlock]]
+#: Builds a task's blocks of one kind from its :class:`~hiab_sim.study.nlp.task_problem.TaskProblem`
+#: (typed ``Any`` here: the problem module imports this one), none where the study does not ask for them.
+BlockFactory = Callable[[Any], Sequence[ConstraintBlock]]
 
 #: Block factories by name, in row order.
 BLOCKS: dict[str, BlockFactory] = {}
@@ -42,6 +40,6 @@ def unregister_block(name: str) -> None:
     del BLOCKS[name]
 
 
-def build_blocks(problem: TaskProblem) -> list[ConstraintBlock]:
+def build_blocks(problem: Any) -> list[ConstraintBlock]:
     """Every registered factory's blocks for ``problem``, in registration order."""
     return [block for factory in BLOCKS.values() for block in factory(problem)]

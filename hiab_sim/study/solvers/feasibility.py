@@ -120,6 +120,7 @@ def _project(
             PROJECTION_ITERATIONS,
             1e-12,
             objective=(lambda x: 0.5 * float((x - target) @ (x - target)), lambda x: x - target),
+            constraint_tolerance=0.1 * START_TOLERANCE,  # the phase's point must pass check_start
         )
         return outcome.z
     res = minimize(

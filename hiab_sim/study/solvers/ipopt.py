@@ -265,11 +265,12 @@ def solve_ipopt(
     tol: float,
     on_iterate: Callable[[Array], None] | None = None,
     objective: tuple[Callable[[Array], float], Callable[[Array], Array]] | None = None,
+    constraint_tolerance: float = 1e-8,
 ) -> IpoptOutcome:
     """Minimise the problem's scaled cost from z0 with IPOPT (L-BFGS Hessian, sparse Jacobians).
 
     Args:
-        problem: A task's or a mix's NLP.
+        problem: The study's NLP (one task or several).
         z0: Start point (scaled).
         maxiter: Iteration limit.
         tol: Relative cost change that ends the solve (as SLSQP's ``ftol``) once the point is
@@ -277,6 +278,7 @@ def solve_ipopt(
         on_iterate: Called with every iterate's z.
         objective: (value, gradient) of another objective over the problem's rows and bounds
             (the feasibility phase's distance to a point); default the problem's scaled cost.
+        constraint_tolerance: Largest scaled row violation IPOPT may end with (its ``constr_viol_tol``).
 
     """
     cost, cost_gradient = (problem.cost, problem.cost_gradient) if objective is None else objective
@@ -329,14 +331,14 @@ def solve_ipopt(
         "ipopt.limited_memory_aug_solver": "extended",
         "ipopt.max_iter": int(maxiter),
         "ipopt.tol": 1e-8,
-        "ipopt.constr_viol_tol": 1e-8,
+        "ipopt.constr_viol_tol": constraint_tolerance,
         # SLSQP's criterion: stop once the cost changes by less than ``tol`` (relative) for
         # ACCEPTABLE_ITERATIONS iterations at a point feasible to 1e-8; the L-BFGS Hessian otherwise
         # spends tens of iterations driving the dual infeasibility down at a flat cost
         "ipopt.acceptable_obj_change_tol": float(tol),
         "ipopt.acceptable_iter": ACCEPTABLE_ITERATIONS,
         "ipopt.acceptable_tol": 1e-2,
-        "ipopt.acceptable_constr_viol_tol": 1e-8,
+        "ipopt.acceptable_constr_viol_tol": constraint_tolerance,
         "ipopt.acceptable_compl_inf_tol": 1e-6,
         "ipopt.print_level": int(os.environ.get("HIAB_IPOPT_PRINT", "0")),
         "ipopt.print_timing_statistics": "yes" if os.environ.get("HIAB_IPOPT_PRINT") else "no",
