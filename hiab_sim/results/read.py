@@ -97,7 +97,6 @@ def read_result(run_dir: str | Path) -> Result:
     return read_json_as(Result, path / RESULT_FILE)
 
 
-
 def result_crane(run_dir: str | Path, crane: str) -> Crane:
     """The crane a result was computed for (its ``crane`` entry): a preset name, or a YAML file in the result folder."""
     path = Path(run_dir) / RESULT_FILE
