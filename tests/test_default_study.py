@@ -78,4 +78,3 @@ def test_saving_decomposes_into_lengths_and_trajectory(run: RunOutput, result: R
     assert d.from_lengths_J is not None and d.from_lengths_J > 0.0
     assert d.from_lengths_J == pytest.approx(e00 - e10, abs=1e-6)
     assert d.from_trajectory_J == pytest.approx(e00 - e01, abs=1e-6)
-    assert d.interaction_J == pytest.approx(e10 + e01 - e00 - e11, abs=1e-6)
