@@ -24,6 +24,9 @@ from hiab_sim.study.solvers.feasibility import feasible_start
 from hiab_sim.study.solvers.slsqp import solve
 from hiab_sim.study.spec.study_file import Study, study_from_dict
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 
 @pytest.fixture(scope="module")
 def solved() -> tuple[LinkLengthProblem, np.ndarray]:

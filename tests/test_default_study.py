@@ -14,6 +14,9 @@ from hiab_sim.results.schema import Result
 from hiab_sim.study.run import RunOutput, run_study
 from hiab_sim.study.spec.study_file import load_study
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> RunOutput:

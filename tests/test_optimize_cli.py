@@ -15,6 +15,9 @@ from hiab_sim.emla import load_emla_set
 from hiab_sim.results.read import read_result
 from hiab_sim.study.spec.study_file import study_from_dict
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 FLAGS = ["--no-video", "--quiet", "--no-figures"]
 
 

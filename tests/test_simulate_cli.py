@@ -11,6 +11,9 @@ from test_study_small import small_study, write_study
 from hiab_sim.cli import main
 from hiab_sim.study.run import run_study
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 
 @pytest.fixture(scope="module")
 def small_result(tmp_path_factory: pytest.TempPathFactory) -> Path:
