@@ -270,7 +270,9 @@ class HistoryRow:
 
 @dataclass(frozen=True)
 class TaskResult:
-    """One task of a duty mix (:mod:`hiab_sim.study.report.mix`): share, load, grid, designs on its fine grid, re-check.
+    """One task of a study of several tasks: share, load, grid, designs on its fine grid, re-check.
+
+    Written by :func:`hiab_sim.study.report.result_folder.build_result`.
 
     ``telescope`` says how the crane's redundancy is set for the task (prescribed by the reference).
     """
@@ -373,9 +375,3 @@ def read_json_as(cls: type[T], path: Path) -> T:
         return from_json(cls, data)
     except ConfigError as error:
         raise ConfigError(f"{path}: {error}") from None
-
-
-def read_result(folder: str | Path) -> Result:
-    """The :class:`Result` in ``folder/result.json`` (or the file itself); ConfigError names what is wrong."""
-    path = Path(folder)
-    return read_json_as(Result, path / RESULT_FILE if path.is_dir() else path)

@@ -28,7 +28,7 @@ from scipy.optimize import minimize
 
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.emla.drive import drive_state
-from hiab_sim.errors import HiabSimError, InvalidInputError, SolverError
+from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.task_problem import C_SCALE, XI_SCALE, TaskProblem
 
@@ -134,7 +134,7 @@ class EpsilonProblem:
                 ],
                 options={"maxiter": maxiter, "ftol": p.study.solver.ftol},
             )
-        except HiabSimError as error:  # a trial point left the model's domain
+        except InvalidInputError as error:  # a trial point left the model's domain
             return np.asarray(z0, dtype=float), False, f"a trial point left the model's domain: {error}", 0
         z = np.asarray(res.x, dtype=float)
         accepted = bool(res.success) and self.max_violation(z) <= FEASIBLE

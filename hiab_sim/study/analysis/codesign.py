@@ -29,7 +29,7 @@ from typing import TextIO
 import numpy as np
 
 from hiab_sim.emla import EmlaSet
-from hiab_sim.errors import HiabSimError, InvalidInputError, SolverError
+from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.results.energy_sections import Codesign, CodesignRow, DesignEnergy, TransmissionChoice
 from hiab_sim.study.nlp.interface import Array
 from hiab_sim.study.nlp.objectives import exact_value
@@ -106,7 +106,7 @@ def solve_combination(study: Study, combo: Combination) -> CodesignRow:
         problem = StudyProblem(study, emlas=emlas)
         z0 = problem.initial_point(study.initial_lengths)
         check_start(problem, z0)
-    except HiabSimError as error:
+    except InvalidInputError as error:
         return CodesignRow(combo, "infeasible start", str(error))
     fine = StudyProblem(
         study, emlas=emlas, tightened=False, fine=True, cost_scales=[p.cost_scale for p in problem.problems]
@@ -114,7 +114,7 @@ def solve_combination(study: Study, combo: Combination) -> CodesignRow:
     e0 = study_energy(fine, z0)
     try:
         result = solve(problem, study.initial_lengths, progress=None)
-    except (SolverError, HiabSimError) as error:
+    except (SolverError, InvalidInputError) as error:
         return CodesignRow(combo, "solver failed", str(error), initial_battery_energy_J=e0.battery_energy_J)
     e1 = study_energy(fine, result.z)
     return CodesignRow(

@@ -17,7 +17,6 @@ in ``energy`` (battery energy [J]), ``sensitivity.objective_value`` and the hist
 
 from __future__ import annotations
 
-import io
 import json
 from collections.abc import Callable
 from dataclasses import replace
@@ -40,6 +39,7 @@ from hiab_sim.results.schema import (
     StartRow,
     TaskResult,
 )
+from hiab_sim.results.trajectory_file import write_trajectory
 from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.report.design_check import (
@@ -206,10 +206,8 @@ def build_result(
 
 
 def write_results(out: Path, result: Result, arrays: dict[str, Array]) -> None:
-    """Write ``result.json`` and ``trajectory.npz`` atomically."""
-    buffer = io.BytesIO()
-    np.savez_compressed(buffer, **arrays)  # type: ignore[arg-type]
-    write_atomic(out / "trajectory.npz", buffer.getvalue())
+    """Write ``result.json`` and ``trajectory.npz`` (its declared schema) atomically."""
+    write_trajectory(out, arrays)
     write_atomic(out / RESULT_FILE, json.dumps(result.to_json(), indent=2) + "\n")
 
 

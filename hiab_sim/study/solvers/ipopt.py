@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import sparse
 
-from hiab_sim.errors import ConfigError
+from hiab_sim.errors import BackendUnavailableError
 from hiab_sim.study.nlp.interface import N_XI, Array, PerSampleBlock
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import TaskProblem
@@ -187,7 +187,9 @@ def _casadi() -> Any:
     try:
         import casadi
     except ImportError:  # an optional dependency
-        raise ConfigError("solver.method: ipopt needs CasADi (pip install casadi)") from None
+        raise BackendUnavailableError(
+            "IPOPT (solver.method: ipopt, duty-mix cross-evaluation) needs CasADi: pip install 'hiab-sim[ipopt]'"
+        ) from None
     return casadi
 
 
