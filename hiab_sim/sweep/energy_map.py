@@ -9,8 +9,10 @@ design's (the optimum's spline, or the start's inverse-kinematics fit), so every
 Per design, on the analytic path with all designs stacked into the sample axis
 (:mod:`hiab_sim.dynamics.analytic_batch`):
 
-* the objective of eq. ``costf2``, f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 [W^2 s] on the collocation
-  grid, and f / f_start (the optimiser's scaled objective, ``objective``);
+* the cost of eq. ``costf2``, f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 [W^2 s] on the collocation
+  grid (``cost``), and the study's objective (any registered one,
+  :data:`hiab_sim.study.nlp.objectives.OBJECTIVES`: the optimiser's own value on the collocation
+  grid, e.g. the smoothed battery energy) divided by its value at the study's start (``objective``);
 * the net electrical energy and the energy drawn without regeneration [J], trapezoid on the fine
   grid (as in ``result.json``); ``battery_energy`` is the energy the battery delivers
   (:func:`hiab_sim.emla.battery.battery_power`, exact kinks, fine grid);
@@ -34,6 +36,7 @@ from numpy.typing import NDArray
 
 from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
+from hiab_sim.dynamics.samples import ActuatorSamples
 from hiab_sim.emla import ENVELOPE_LIMIT_NAMES, electrical_power, energy_summary, envelope_margins
 from hiab_sim.emla.battery import battery_power, trapezoid_weights
 from hiab_sim.errors import InvalidInputError
@@ -41,6 +44,7 @@ from hiab_sim.results.read import open_run, read_result
 from hiab_sim.results.schema import Result
 from hiab_sim.study.analysis.buildable import RobustXi, replace_lengths
 from hiab_sim.study.motion import trajectory as tr
+from hiab_sim.study.nlp.interface import SampleState
 from hiab_sim.study.nlp.task_problem import ACTUATORS, STROKE_SCALE, TaskProblem
 
 Array = NDArray[np.float64]
@@ -106,7 +110,7 @@ class DesignValues:
 
     xi: Array  # (D, 6) [m]
     cost: Array  # (D,) [W^2 s], collocation grid
-    objective: Array  # (D,) the study's objective (costf2 or battery energy) / its value at the study's start
+    objective: Array  # (D,) the study's objective (any registered one) / its value at the study's start
     net_energy: Array  # (D,) [J], fine grid
     drawn_energy: Array  # (D,) [J], fine grid, without regeneration
     margins: Array  # (D, R) scaled, min over time per row
@@ -155,7 +159,10 @@ def evaluate_designs(problem: TaskProblem, base: BaseDesign, xi: Array) -> Desig
     strokes = np.array([chain.stroke for chain in crane.chains])
     working = np.array([[w[0] for w in problem.working] + [0.0], [w[1] for w in problem.working] + [0.0]])
     weights = trapezoid_weights(base.time)
-    colloc_weights = trapezoid_weights(base.time[::ff])
+    joints = tr.JointTrajectory(
+        base.time[::ff], base.position[::ff], base.velocity[::ff], base.acceleration[::ff]
+    )  # the fixed trajectory on the collocation grid, what the optimiser's objective sees
+    tcp_samples = problem.kin.samples(joints.position, joints.velocity, joints.acceleration)
     parts: list[tuple[Array, ...]] = []
     for lo in range(0, len(xi), CHUNK):
         block = xi[lo : lo + CHUNK]
@@ -163,12 +170,13 @@ def evaluate_designs(problem: TaskProblem, base: BaseDesign, xi: Array) -> Desig
         power = np.stack([electrical_power(p, f[..., i], v[..., i], a[..., i]) for i, p in enumerate(problem.emlas)])
         total = power.sum(axis=0)  # (D, K)
         colloc = total[:, ::ff]
+        objective = np.array(
+            [
+                problem.objective.value(collocation_state(joints, tcp_samples, block[d], f, v, a, x, power, ff, d))
+                for d in range(len(block))
+            ]
+        )
         cost = 0.5 * problem.dt * np.sum(colloc**2, axis=1)
-        if problem.objective.name == "battery_energy":  # the optimiser's value: smooth, collocation grid
-            drives = np.moveaxis(power[..., ::ff], 0, -1)
-            objective = battery_power(drives, problem.emlas.battery, smooth=True)[1] @ colloc_weights
-        else:
-            objective = cost
         net, drawn = energy_summary(base.time, total)
         battery = battery_power(np.moveaxis(power, 0, -1), problem.emlas.battery)[1] @ weights  # (D,) exact [J]
         fc, vc, ac = f[:, ::ff], v[:, ::ff], a[:, ::ff]
@@ -186,6 +194,23 @@ def evaluate_designs(problem: TaskProblem, base: BaseDesign, xi: Array) -> Desig
     robust, robust_names = _robust_rows(problem, base, xi)
     margins = np.concatenate([margins, robust], axis=1)
     return DesignValues(xi, cost, objective, net, drawn, margins, (*margin_names(), *robust_names), battery)
+
+
+def collocation_state(
+    joints: tr.JointTrajectory,
+    tcp: tr.TcpSamples,
+    xi: Array,
+    f: Array,
+    v: Array,
+    a: Array,
+    x: Array,
+    power: Array,
+    ff: int,
+    d: int,
+) -> SampleState:
+    """Design d of a batch as the NLP's objectives see it: its samples on the collocation grid (every ``ff``-th)."""
+    actuators = ActuatorSamples(f[d, ::ff], v[d, ::ff], a[d, ::ff], x[d, ::ff])
+    return SampleState(LinkLengths.from_array(xi), joints, tcp, actuators, power[:, d, ::ff].T)
 
 
 def _robust_rows(problem: TaskProblem, base: BaseDesign, xi: Array) -> tuple[Array, list[str]]:
@@ -215,7 +240,7 @@ class EnergyMap:
     start_xi: Array
     low: Array  # study bounds of Xi [m]
     up: Array
-    objective: str  # the study's objective (costf2 or battery_energy)
+    objective: str  # the study's objective (a name of the objective registry)
 
     def grid(self, array: NDArray[Any]) -> NDArray[Any]:
         """Reshape a per-design array (D,) to the grid (n0, n1)."""
