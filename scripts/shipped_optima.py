@@ -3,11 +3,13 @@
 A refactoring of the study code must leave every shipped optimum where it was: the optimal link
 lengths Xi within 1e-8 m, the energies within 1e-9 relative and the same number of SLSQP iterations.
 
-    python scripts/shipped_optima.py record DIR...   # write the summaries of result folders DIR (named *_<study>)
-    python scripts/shipped_optima.py check DIR...    # compare result folders with the recorded summaries
+    python scripts/shipped_optima.py check DIR...           # compare with the recorded optima (deliberate changes included)
+    python scripts/shipped_optima.py check-baseline DIR...  # compare with main's optima before the change
 
 Each DIR is a result folder written by ``hiab-sim optimize optimize/<study>.yaml --out DIR``; the
-study is the folder's ``name`` field in result.json.
+study is the folder's ``name`` field in result.json. The file holds main's optima (recorded on
+8440d36 by running every shipped study there) and, under ``changed``, each deliberate change since
+with its reason.
 """
 
 from __future__ import annotations
@@ -62,22 +64,26 @@ def differences(got: dict[str, Any], expected: dict[str, Any]) -> list[str]:
     return out
 
 
+def expected(name: str, baseline: bool = False) -> dict[str, Any]:
+    """The recorded optimum of a study: its deliberate change (``changed``, with its reason) or main's."""
+    data = json.loads(EXPECTED.read_text())
+    if not baseline and name in data["changed"]:
+        return dict(data["changed"][name])
+    return dict(data["main_8440d36"][name])
+
+
 def main(argv: list[str]) -> int:
-    """Record or check (module docstring); exit 1 when a check finds a difference."""
+    """Check result folders (module docstring); ``check-baseline`` compares with main's optima only."""
     mode, folders = argv[0], [Path(a) for a in argv[1:]]
     results = {}
     for folder in folders:
         result = json.loads((folder / "result.json").read_text())
         results[result["name"]] = summary(result)
-    if mode == "record":
-        recorded = json.loads(EXPECTED.read_text()) if EXPECTED.exists() else {}
-        recorded.update(results)
-        EXPECTED.write_text(json.dumps(dict(sorted(recorded.items())), indent=1) + "\n")
-        return 0
-    expected = json.loads(EXPECTED.read_text())
+    if mode not in ("check", "check-baseline"):
+        raise SystemExit(f"mode must be check or check-baseline, not {mode!r}")
     failed = 0
     for name, got in results.items():
-        diffs = differences(got, expected[name])
+        diffs = differences(got, expected(name, baseline=mode == "check-baseline"))
         print(f"{name}: {'same optimum' if not diffs else '; '.join(diffs)}")
         failed += bool(diffs)
     return 1 if failed else 0

@@ -115,7 +115,7 @@ def test_registered_objective_and_block_enter_the_nlp_with_exact_derivatives(reg
         np.testing.assert_allclose(jac[rows, j], fd_rows, rtol=1e-5, atol=1e-8)
 
 
-@pytest.mark.slow
+@pytest.mark.e2e
 @pytest.mark.parametrize("tasks", [1, 2])
 def test_registered_objective_and_block_run_a_study_with_sensitivities_and_report(
     registered: None, tmp_path: Path, tasks: int

@@ -38,6 +38,7 @@ def test_single_task_study_problem_is_its_task_bit_for_bit() -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.e2e
 def test_battery_objective_gives_sensitivities_cross_evaluation_and_costf2_in_their_units(tmp_path: Path) -> None:
     """Two tasks, objective battery_energy: sensitivities, cross-evaluation and costs each in their own unit.
 
