@@ -63,3 +63,23 @@ def test_battery_objective_gives_sensitivities_cross_evaluation_and_costf2_in_th
     assert mix_objective is not None and mix_objective == pytest.approx(s.objective_value, rel=1e-3)
     mix_cost = cross.mix_cost_W2s[-1]
     assert mix_cost is not None and mix_cost == pytest.approx(r.optimal.collocation_cost_W2s, rel=1e-2)
+
+
+@pytest.mark.e2e
+def test_codesign_of_two_tasks_scores_each_combination_by_the_weighted_objective() -> None:
+    """A two-task study's co-design row: the objective [J] is the tasks' weighted exact battery energy."""
+    from hiab_sim.study.analysis.codesign import combinations, solve_combination
+
+    data = {
+        **two_tasks(),
+        "objective": "battery_energy",
+        "transmission": {"lift": [{"gear_ratio": 4.5, "screw_lead": 0.01}]},
+    }
+    study = study_from_dict(data, "two.yaml")
+    combo = combinations(study)[1]
+    row = solve_combination(study, combo)
+    assert row.status == "converged", row.message
+    assert row.objective_unit == "J" and row.objective_value == row.battery_energy_J
+    assert row.costf2_W2s is not None and row.costf2_W2s > 1e5  # W^2 s, not joules
+    assert row.battery_energy_J is not None and row.initial_battery_energy_J is not None
+    assert row.battery_energy_J < row.initial_battery_energy_J
