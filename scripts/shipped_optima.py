@@ -3,8 +3,8 @@
 A refactoring of the study code must leave every shipped optimum where it was: the optimal link
 lengths Xi within 1e-8 m, the energies within 1e-9 relative and the same number of SLSQP iterations.
 
-    python scripts/shipped_optima.py check DIR...           # compare with the recorded optima (deliberate changes included)
-    python scripts/shipped_optima.py check-baseline DIR...  # compare with main's optima before the change
+    python scripts/shipped_optima.py check DIR...           # the recorded optima, deliberate changes included
+    python scripts/shipped_optima.py check-baseline DIR...  # main's optima before the change
 
 Each DIR is a result folder written by ``hiab-sim optimize optimize/<study>.yaml --out DIR``; the
 study is the folder's ``name`` field in result.json. The file holds main's optima (recorded on

@@ -150,3 +150,14 @@ def test_unknown_objective_is_one_line_naming_the_field_and_the_registered_names
     assert "\n" not in message and "objective" in message
     for name in ("costf2", "battery_energy", "squared_force"):
         assert name in message
+
+
+def test_a_violated_registered_row_is_described_in_its_own_unit(registered: None) -> None:
+    """The feasibility phase's message names a registered block's row and its violation in the block's unit."""
+    from hiab_sim.study.solvers.feasibility import describe_violation
+
+    problem = StudyProblem(study_from_dict(small_study(), "x.yaml"))
+    index = next(i for i, n in enumerate(problem.constraint_names) if n.startswith("tcp_floor."))
+    # scaled row -0.01 = 1 mm below the floor (FLOOR_SCALE 0.1 m per unit)
+    text = describe_violation(problem, index, -0.01)
+    assert text.startswith("tcp_floor.y_tcp >= floor") and text.endswith("violated by 1 mm")

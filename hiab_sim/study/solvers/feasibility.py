@@ -90,6 +90,13 @@ def describe_violation(problem: StudyProblem, index: int, value: float) -> str:
         return f"{name}{where} violated by {-value * STROKE_SCALE * 1e3:.1f} mm"
     if block == "tracking":
         return f"{name}{where}: the TCP leaves its tracking band by {-value * 100:.0f} % of the band"
+    # any other block (e.g. a registered one) states its rows' unit (ConstraintBlock.relaxation)
+    stacked = next(b for b in problem.blocks if b.rows.start <= index < b.rows.stop)
+    i = index - stacked.rows.start
+    relax = stacked.block.relaxation(np.full(stacked.rows.stop - stacked.rows.start, value))
+    unit, per_unit = relax.units[i], float(relax.per_unit[i])
+    if per_unit > 0.0:
+        return f"{name}{where} violated by {-value / per_unit:.3g} {unit}"
     return f"{name}{where} violated by {-value:.3g} (scaled)"
 
 
