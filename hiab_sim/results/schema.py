@@ -18,7 +18,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, TypeVar, cast
 
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import ConfigError
@@ -26,8 +26,13 @@ from hiab_sim.results.analysis_sections import Buildable, CrossEvaluation, Feasi
 from hiab_sim.results.codec import from_json, optional, to_json
 from hiab_sim.results.energy_sections import Codesign, EnergyReport, HydraulicBaseline
 
-#: Version of the result.json layout; files without the key are version 1 (the same keys).
-SCHEMA_VERSION = 1
+#: Version of the result.json layout; files without the key are version 1 (the same keys). Version 2
+#: renames the ``sensitivity`` keys that held the objective's value whatever its unit (``cost_W2s``
+#: -> ``objective_value`` with ``objective`` and ``objective_unit``, ``multipliers[].cost_per_unit_W2s``
+#: -> ``objective_decrease_per_unit``); :func:`upgrade` reads version-1 files.
+SCHEMA_VERSION = 2
+#: The unit of each objective a version-1 file can name (the objectives that existed then).
+_SCHEMA1_UNITS = {"costf2": "W^2 s", "battery_energy": "J"}
 RESULT_FILE = "result.json"
 #: Keys of :class:`EnergyBreakdown`, in the order the figures and tables show them.
 T = TypeVar("T")
@@ -335,8 +340,40 @@ class Result:
 
     @classmethod
     def from_json(cls, data: Any) -> Result:
-        """Build from a parsed result.json (ConfigError names a missing or mistyped key)."""
-        return from_json(cls, data)
+        """Build from a parsed result.json of any version up to :data:`SCHEMA_VERSION` (:func:`upgrade`).
+
+        ConfigError names a missing or mistyped key.
+        """
+        return from_json(cls, upgrade(data))
+
+
+def upgrade(data: Any) -> Any:
+    """A parsed result.json of version 1 with its renamed keys under their version-2 names (else unchanged).
+
+    Version 1 stored the objective's value as ``sensitivity.cost_W2s`` and the decreases as
+    ``cost_per_unit_W2s`` whatever the objective (joules under ``battery_energy``); the objective
+    is the file's ``energy.objective`` (``costf2`` without an energy section).
+    """
+    if not isinstance(data, dict):
+        return data
+    data = {"schema_version": data.get("schema_version", 1), **data}  # a file without the key is version 1
+    old = data.get("sensitivity")
+    if not isinstance(old, dict) or "cost_W2s" not in old:
+        return data
+    energy = data.get("energy")
+    objective = energy.get("objective", "costf2") if isinstance(energy, dict) else "costf2"
+    sensitivity = {k: v for k, v in old.items() if k != "cost_W2s"}
+    sensitivity = {
+        "objective": objective,
+        "objective_unit": _SCHEMA1_UNITS.get(objective, "unknown"),
+        "objective_value": old["cost_W2s"],
+        **sensitivity,
+    }
+    sensitivity["multipliers"] = [
+        {("objective_decrease_per_unit" if k == "cost_per_unit_W2s" else k): v for k, v in m.items()}
+        for m in old.get("multipliers", [])
+    ]
+    return {**data, "schema_version": max(2, int(data.get("schema_version", 1))), "sensitivity": sensitivity}
 
 
 @dataclass(frozen=True)
@@ -372,6 +409,8 @@ def read_json_as(cls: type[T], path: Path) -> T:
     """``cls`` built from the JSON file ``path``; ConfigError names the file and the bad key."""
     data = parse_json(path)
     try:
+        if cls is Result:  # every version it reads (upgrade)
+            return cast(T, Result.from_json(data))
         return from_json(cls, data)
     except ConfigError as error:
         raise ConfigError(f"{path}: {error}") from None
