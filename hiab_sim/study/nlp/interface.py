@@ -1,6 +1,6 @@
 """The building blocks of the NLP: what a constraint block or an objective sees, returns and owns.
 
-A point z of the NLP is turned by :class:`hiab_sim.study.nlp.task_problem.TaskProblem` into a
+A point z of a task's NLP is turned by :class:`hiab_sim.study.nlp.task_problem.TaskProblem` into a
 :class:`SampleState` (link lengths Xi, joint samples q9 = (theta, dtheta, ddtheta) per sample,
 TCP samples, actuator samples [f_x, v_x, a_x] from the inverse dynamics, EMLA electrical power).
 Blocks and objectives read only that state and, for gradients, :class:`SamplePartials` (the
@@ -19,19 +19,19 @@ the Jacobian of one list of blocks, and splits any row vector (margins, multipli
 An objective (:class:`Objective`) returns its value [its unit] and gradient w.r.t. q9 (K, 9)
 and Xi (6,); the problem divides both by its ``cost_scale``.
 
-Extending (one edit each):
+Extending (one module and its registration each, docs/extending.md):
 
 - a block: subclass :class:`PerSampleBlock` (same rows at every sample, return :class:`SampleRows`)
-  or :class:`ConstraintBlock` (return :class:`DenseRows`), and add an instance to
-  ``TaskProblem._build_blocks``. An integral row (RMS torque over the duty, a thermal
+  or :class:`ConstraintBlock` (return :class:`DenseRows`), give its rows' unit
+  (:meth:`ConstraintBlock.relaxation`) and register a factory with
+  :func:`hiab_sim.study.nlp.block_registry.register_block`. An integral row (RMS torque over the duty, a thermal
   steady state) returns ``DenseRows(dq=(m, K, 9), dxi=(m, 6))``; a row of Xi only (working
   range, mounting-space polygons) ``DenseRows(dxi=...)``; an epsilon constraint on any objective
   is :class:`hiab_sim.study.nlp.blocks.ObjectiveBound`.
-- an objective: a class with ``name``, ``unit``, ``value`` and ``gradient`` and one entry in
-  :data:`hiab_sim.study.nlp.objectives.OBJECTIVES`.
-- several tasks: each task's blocks read that task's state; the problem's ``to_z(block, jacobian,
-  rows)`` (passed to :meth:`BlockLayout.jacobian`) receives the block, so it can map q9 partials
-  to the block's task's spline matrices and coefficient columns.
+- an objective: a class with ``name``, ``unit``, ``value`` and ``gradient`` registered with
+  :func:`hiab_sim.study.nlp.objectives.register_objective` (:data:`~hiab_sim.study.nlp.objectives.OBJECTIVES`).
+- several tasks: each task's blocks read that task's state; :class:`hiab_sim.study.nlp.problem.StudyProblem`
+  stacks them, holding a block of Xi only once per :meth:`ConstraintBlock.shared_key`.
 - multipliers or margins by name: :meth:`BlockLayout.split` and :meth:`BlockLayout.named` cut any
   row vector into blocks and rows.
 """

@@ -1,4 +1,7 @@
-"""The NLP of seed eq. ``costf2`` subject to ``const_a``..``const_m``: cost, constraints, exact gradients.
+"""One task's rows and cost of the seed's NLP (eq. ``costf2`` subject to ``const_a``..``const_m``), exact gradients.
+
+The solvers, reports and analyses take :class:`hiab_sim.study.nlp.problem.StudyProblem`, which stacks
+one :class:`TaskProblem` per task over the shared Xi (a single task is its own study, bit for bit).
 
 Decision variables z = [z_xi (6), z_c (3 N)] (scaled): Xi = ``XI_SCALE`` z_xi [m] (lift L, Lc0,
 Lc, then tilt) and c = c_ref + ``C_SCALE`` z_c, the B-spline coefficients of theta1, theta2, xt2
@@ -22,8 +25,9 @@ Constraints, all scaled to O(1) and written g(z) >= 0 (rows named in :attr:`cons
 * ``const_l``, ``const_m`` hold by construction: the chain is solved from its triangle.
 
 Each inequality group is a constraint block (:mod:`hiab_sim.study.nlp.blocks`) and the cost an objective
-(:mod:`hiab_sim.study.nlp.objectives`); :meth:`TaskProblem._build_blocks` lists the blocks once, and
-row names, row layout, clearances and the Jacobian follow from that list (:class:`~.nlp.BlockLayout`).
+(:mod:`hiab_sim.study.nlp.objectives`); the block registry
+(:data:`hiab_sim.study.nlp.block_registry.BLOCKS`) lists the blocks once, and row names, row layout,
+clearances and the Jacobian follow from that list (:class:`~hiab_sim.study.nlp.interface.BlockLayout`).
 
 Gradients: per-sample ID partials by batched central differences (all samples and all 9
 perturbations in one ID call), chained through the B-spline matrices (exact); Xi partials by
@@ -105,14 +109,14 @@ def working_range(crane: Crane, joints: Array, margin: float) -> tuple[tuple[flo
 
 
 class TaskProblem:
-    """The scaled NLP of one task of a study on a time grid (its collocation grid by default).
+    """The scaled rows and cost of one task of a study on a time grid (its collocation grid by default).
 
     Args:
         study: The study.
         emlas: EMLA set (default: the study's own).
         id_path: ``mujoco`` or ``analytic`` (default: the study's).
         times: Sample times [s] (default: the collocation grid); Dt of the cost is their step.
-        cost_scale: Divisor of the cost [W^2 s] (default: its value at the study's start).
+        cost_scale: Divisor of the cost [the objective's unit] (default: its value at the study's start).
         tightened: Hold the tracking bands times ``collocation_fraction`` and the envelope margins
             >= ``envelope_margin`` (the optimiser's grid); False for the nominal re-check.
         objective: Name of the objective (:data:`hiab_sim.study.nlp.objectives.OBJECTIVES`; default: the study's).
