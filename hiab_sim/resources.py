@@ -8,6 +8,7 @@ kind          folder in the source tree   shipped names
 ============  ==========================  ===================================================
 ``crane``     ``hiab_sim/presets/``       ``xs031``
 ``emla``      ``hiab_sim/presets/``       ``default``, ``xs031``
+``plant``     ``hiab_sim/presets/``       ``realistic`` (the closed loop's plant effects)
 ``study``     ``optimize/``               every ``*.yaml`` by its path without the suffix,
                                           e.g. ``xs031_spiral``, ``sweeps/<name>``
 ``cases``     ``validate/``               ``cases``
@@ -30,12 +31,13 @@ from typing import Literal
 
 from hiab_sim.errors import ConfigError
 
-Kind = Literal["crane", "emla", "study", "cases", "mjcf"]
+Kind = Literal["crane", "emla", "study", "cases", "mjcf", "plant"]
 
 #: Package (anchor) and sub-folder of each kind's shipped files.
 _FOLDERS: dict[str, tuple[str, str]] = {
     "crane": ("hiab_sim", "presets"),
     "emla": ("hiab_sim", "presets"),
+    "plant": ("hiab_sim", "presets"),
     "study": ("hiab_sim._data.studies", ""),
     "cases": ("hiab_sim._data.validate", ""),
     "mjcf": ("hiab_sim._data.mjcf", ""),
@@ -44,11 +46,12 @@ _FOLDERS: dict[str, tuple[str, str]] = {
 _NAMED: dict[str, dict[str, str]] = {
     "crane": {"xs031": "hiab_xs031.yaml"},
     "emla": {"default": "emla_xs031.yaml", "xs031": "emla_xs031.yaml"},
+    "plant": {"realistic": "plant_realistic.yaml"},
 }
 _SUFFIX = {"mjcf": ".xml"}
 
 #: What each kind is called in messages.
-_WHAT = {"crane": "crane", "emla": "EMLA set", "study": "study", "cases": "case file", "mjcf": "MJCF file"}
+_WHAT = {"crane": "crane", "emla": "EMLA set", "study": "study", "cases": "case file", "mjcf": "MJCF file", "plant": "plant"}
 
 DEFAULT_STUDY = "xs031_spiral"
 DEFAULT_CASES = "cases"
