@@ -51,7 +51,14 @@ _NAMED: dict[str, dict[str, str]] = {
 _SUFFIX = {"mjcf": ".xml"}
 
 #: What each kind is called in messages.
-_WHAT = {"crane": "crane", "emla": "EMLA set", "study": "study", "cases": "case file", "mjcf": "MJCF file", "plant": "plant"}
+_WHAT = {
+    "crane": "crane",
+    "emla": "EMLA set",
+    "study": "study",
+    "cases": "case file",
+    "mjcf": "MJCF file",
+    "plant": "plant",
+}
 
 DEFAULT_STUDY = "xs031_spiral"
 DEFAULT_CASES = "cases"

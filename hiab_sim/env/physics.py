@@ -218,7 +218,8 @@ def crane_physics(
     if active is not None:
         crane = true_crane(crane, active.mismatch)
         arrays, slides = true_drives(arrays, slides, active.mismatch)
-    compliant = active is not None and active.drive_train.enabled
+    train_data = active.drive_train if active is not None and active.drive_train.enabled else None
+    compliant = train_data is not None
     if compliant:  # the rotor and the screw friction move to the motor side of the spring
         slides = replace(slides, armature=(0.0, 0.0, 0.0), damping=(0.0, 0.0, 0.0))
     spec = build_spec(crane, plan.lengths, slides)
@@ -248,8 +249,12 @@ def crane_physics(
     physics.attach_drives(
         drives,
         plant,
-        drive_train=TwoMassDriveTrain(active.drive_train, arrays.reflected_inertia, arrays.viscous) if compliant else None,
-        thermal=WindingTemperature(active.thermal, plan.emlas.as_tuple()) if active and active.thermal.enabled else None,
+        drive_train=None
+        if train_data is None
+        else TwoMassDriveTrain(train_data, arrays.reflected_inertia, arrays.viscous),
+        thermal=WindingTemperature(active.thermal, plan.emlas.as_tuple())
+        if active and active.thermal.enabled
+        else None,
         friction=FrictionMeter(physics.model.ptr, joints, tendons) if joints else None,
     )
     return physics

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import time as _time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from dm_control.rl import control
@@ -91,7 +91,7 @@ class ClosedLoopRun:
     friction_loss: float = 0.0
     winding_temperature: Array | None = None
     cycles: tuple[dict[str, object], ...] = ()
-    gains: CascadeGains = CascadeGains()
+    gains: CascadeGains = field(default_factory=CascadeGains)
     lowest_resonance_hz: float | None = None
 
     @property
@@ -169,7 +169,7 @@ def run_closed_loop(
     plant: Plant | None = None,
     cycles: int = 1,
 ) -> tuple[ClosedLoopRun, CranePhysics]:
-    """Simulate ``cycles`` cycles of a design's plan under the cascade controller; return the last one's log and the Physics.
+    """Simulate ``cycles`` cycles of a design's plan under the cascade controller; return the last log and the Physics.
 
     The Physics is returned at the end of the cycle (for rendering the logged ``qpos``); call its
     ``free()`` when done with it. ``gains`` None: the design rules for the plant (module docstring).

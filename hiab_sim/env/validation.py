@@ -16,6 +16,7 @@ from hiab_sim.control.cascade import CascadeGains
 from hiab_sim.env import CURRENT_BANDWIDTH_HZ, PHYSICS_TIMESTEP
 from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.plan import read_plan
+from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.rollout import ClosedLoopRun, run_closed_loop
 
 #: Video frame rate [1/s] and the size of one design's viewport (width, height) [px].
@@ -24,9 +25,14 @@ VIEWPORT = (480, 480)
 
 
 def simulate_designs(
-    result_dir: str | Path, designs: Sequence[str], payload_error: float, quiet: bool = False
+    result_dir: str | Path,
+    designs: Sequence[str],
+    payload_error: float,
+    quiet: bool = False,
+    plant: Plant | None = None,
+    cycles: int = 1,
 ) -> tuple[list[ClosedLoopRun], list[ClosedLoopRun], list[CranePhysics]]:
-    """Run every design at ``payload_error`` (and, when it is not 0, nominally too).
+    """Run every design at ``payload_error`` (and, when it is not 0, nominally too) on ``plant`` for ``cycles``.
 
     Returns:
         The runs at ``payload_error``, the nominal runs (empty when payload_error is 0) and the
@@ -48,7 +54,7 @@ def simulate_designs(
                         bar.n = done
                         bar.refresh()
 
-                run, item = run_closed_loop(plan, error, progress=progress)
+                run, item = run_closed_loop(plan, error, progress=progress, plant=plant, cycles=cycles)
             if error == payload_error:
                 runs.append(run)
                 physics.append(item)
@@ -71,7 +77,7 @@ def simulation_report(
             entry["extra_energy_J"] = run.net_energy - match.net_energy
             entry["extra_energy_vs_predicted_J"] = run.net_energy - run.predicted_net_energy
         designs[run.design] = entry
-    gains = CascadeGains()
+    gains = runs[0].gains if runs else CascadeGains()
     report: dict[str, object] = {
         "result_dir": str(Path(result_dir).resolve()),
         "designs": designs,
@@ -86,6 +92,7 @@ def simulation_report(
             },
             "energy": "closed loop: int 3/2 (v_d i_d + v_q i_q) dt over the cycle, summed over the drives",
             "tcp_error": "distance of the simulated TCP to the study's TCP reference at the same time",
+            "plant": runs[0].plant if runs else "ideal",
         },
     }
     by_design = {run.design: run for run in runs}

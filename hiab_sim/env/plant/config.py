@@ -113,7 +113,11 @@ class Sensors:
         _check(
             self,
             "sensors",
-            {"current_noise_rms_A": (0.0, None, "A"), "current_offset_A": (-100.0, 100.0, "A"), "delay_s": (0, 0.05, "s")},
+            {
+                "current_noise_rms_A": (0.0, None, "A"),
+                "current_offset_A": (-100.0, 100.0, "A"),
+                "delay_s": (0, 0.05, "s"),
+            },
         )
         check_range("sensors.encoder_counts_per_rev", self.encoder_counts_per_rev, 4, None, integral=True)
         check_range("sensors.seed", self.seed, 0, None, integral=True)
@@ -275,7 +279,7 @@ class Plant:
         return tuple(name for name in EFFECTS if getattr(self, name).enabled)
 
     def with_effects(self, names: tuple[str, ...], label: str | None = None) -> Plant:
-        """This plant's data with exactly the effects ``names`` on."""
+        """The plant's data with exactly the effects ``names`` on."""
         unknown = sorted(set(names) - set(EFFECTS))
         if unknown:
             raise InvalidInputError("effects", ", ".join(unknown), f"must be among {', '.join(EFFECTS)}")

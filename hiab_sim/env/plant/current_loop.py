@@ -81,7 +81,9 @@ class DiscreteCurrentLoop(DriveSimulator):
         super().__init__(drives, bandwidth_hz=loop.bandwidth_Hz)
         periods = loop.rate_Hz * h
         if abs(periods - round(periods)) > 1e-6 or round(periods) < 1:
-            raise InvalidInputError("current_loop.rate_Hz", loop.rate_Hz, f"must be a multiple of 1/h = {1 / h:g} Hz", "Hz")
+            raise InvalidInputError(
+                "current_loop.rate_Hz", loop.rate_Hz, f"must be a multiple of 1/h = {1 / h:g} Hz", "Hz"
+            )
         self.loop = loop
         self.sensor = sensor
         self.periods = round(periods)
@@ -119,7 +121,13 @@ class DiscreteCurrentLoop(DriveSimulator):
         v_dead = loop.dead_time_voltage_V
         eps2 = DEAD_TIME_CURRENT_A**2
         for j in range(n):
-            r, ld, lq, p, flux = float(d.resistance[j]), float(d.Ld[j]), float(d.Lq[j]), float(d.pole_pairs[j]), float(d.flux[j])
+            r, ld, lq, p, flux = (
+                float(d.resistance[j]),
+                float(d.Ld[j]),
+                float(d.Lq[j]),
+                float(d.pole_pairs[j]),
+                float(d.flux[j]),
+            )
             w_e = p * float(omega[j])
             a11, a12, a21, a22 = -r / ld, w_e * lq / ld, -w_e * ld / lq, -r / lq
             e1, f1, g1 = _exp_maps(a11, a12, a21, a22, T)
@@ -165,12 +173,19 @@ class DiscreteCurrentLoop(DriveSimulator):
                 products = T * (i_d * i_q + 4.0 * mid_d * mid_q + end_d * end_q) / 6.0
                 torque += 1.5 * p * (flux * int_q + (ld - lq) * products)
                 magnitude = T * (math.sqrt(s0) + 4.0 * math.sqrt(sm) + math.sqrt(s1)) / 6.0
-                inverter += loop.constant_loss_W * T + self.linear_loss * magnitude + 1.5 * loop.on_resistance_ohm * squares
+                inverter += (
+                    loop.constant_loss_W * T + self.linear_loss * magnitude + 1.5 * loop.on_resistance_ohm * squares
+                )
                 i_d, i_q = end_d, end_q
             self.x_d[j], self.x_q[j] = x_d, x_q
             self.pending_d[j], self.pending_q[j] = pend_d, pend_q
             out["id"][j], out["iq"][j], out["vd"][j], out["vq"][j] = i_d, i_q, va_d, va_q
-            out["energy"][j], out["copper"][j], out["torque"][j], out["inverter"][j] = energy, copper, torque / h, inverter
+            out["energy"][j], out["copper"][j], out["torque"][j], out["inverter"][j] = (
+                energy,
+                copper,
+                torque / h,
+                inverter,
+            )
             saturated[j] = sat
         self.i_d, self.i_q = out["id"], out["iq"]
         friction = d.coulomb * np.tanh(omega / d.smoothing)

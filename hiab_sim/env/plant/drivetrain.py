@@ -83,7 +83,7 @@ class TwoMassDriveTrain:
         return np.where(e > 0.0, np.maximum(force, 0.0), np.where(e < 0.0, np.minimum(force, 0.0), 0.0))
 
     def rod_actuator(self, rod_position: Array, h: float) -> tuple[Array, Array, Array]:
-        """(ctrl [N], k_c [N/m], c_c [N s/m]) of the rod's affine actuator f = ctrl - k_c x - c_c v (module docstring)."""
+        """(ctrl [N], k_c [N/m], c_c [N s/m]) of the rod's actuator f = ctrl - k_c x - c_c v (module docstring)."""
         d = self.position - rod_position
         above, below = d > self.half_play, d < -self.half_play
         contact = above | below
@@ -113,7 +113,9 @@ class TwoMassDriveTrain:
         slip = self.velocity - rod_velocity
         spring = np.where(contact, h * (self.damping * slip * slip + self.stiffness * h * rod_velocity**2), 0.0)
         # Screw friction implicit (-b_f v_m at the new rate): its work over the step is -b_f v_m^2 h exactly.
-        self.velocity = (self.velocity + h * (drive_force - rod_force) / self.mass) / (1.0 + h * self.viscous / self.mass)
+        self.velocity = (self.velocity + h * (drive_force - rod_force) / self.mass) / (
+            1.0 + h * self.viscous / self.mass
+        )
         self.position = self.position + h * self.velocity
         dissipated: Array = h * self.viscous * self.velocity**2 + spring
         return dissipated

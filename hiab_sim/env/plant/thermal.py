@@ -28,7 +28,9 @@ class WindingTemperature:
     def __init__(self, thermal: Thermal, emlas: tuple[EmlaParams, ...]) -> None:
         missing = [p.name for p in emlas if p.thermal is None]
         if missing:
-            raise InvalidInputError("thermal", ", ".join(missing), "needs the EMLA file's thermal section for every drive")
+            raise InvalidInputError(
+                "thermal", ", ".join(missing), "needs the EMLA file's thermal section for every drive"
+            )
         self.settings = thermal
         self.resistance_ref = np.array([p.motor.stator_resistance for p in emlas])
         self.r_th = np.array([p.thermal.thermal_resistance for p in emlas if p.thermal is not None])
@@ -39,7 +41,9 @@ class WindingTemperature:
     def resistance(self) -> Array:
         """R_s(T) per drive [ohm]."""
         s = self.settings
-        return self.resistance_ref * (1.0 + s.temperature_coefficient_per_K * (self.temperature - s.reference_temperature_C))
+        return self.resistance_ref * (
+            1.0 + s.temperature_coefficient_per_K * (self.temperature - s.reference_temperature_C)
+        )
 
     def advance(self, copper_energy: Array, h: float) -> None:
         """Advance by h [s] with the copper loss E_cu [J] of the step."""
