@@ -105,8 +105,8 @@ def effect_study(
         table[variant.name]["lowest_drive_train_resonance_Hz"] = run.lowest_resonance_hz
     for entry in table.values():
         if all(d in entry for d in ("initial", "optimal")):
-            energy = {d: entry[d]["dc_bus_energy_J"] for d in ("initial", "optimal")}
-            entry["optimal_below_initial"] = energy["optimal"] < energy["initial"]  # type: ignore[operator]
+            energy = {d: float(entry[d]["dc_bus_energy_J"]) for d in ("initial", "optimal")}  # type: ignore[index]
+            entry["optimal_below_initial"] = energy["optimal"] < energy["initial"]
     report: dict[str, object] = {
         "plant": plant.name,
         "cycles": cycles,

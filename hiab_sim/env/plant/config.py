@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields, replace
+from typing import Any
 
 from hiab_sim.checks import check_range
 from hiab_sim.errors import InvalidInputError
@@ -18,7 +19,7 @@ from hiab_sim.errors import InvalidInputError
 Vector3 = tuple[float, float, float]
 
 
-def _check(section: object, where: str, ranges: dict[str, tuple[float | None, float | None, str]]) -> None:
+def _check(section: Any, where: str, ranges: dict[str, tuple[float | None, float | None, str]]) -> None:
     """Check each named field against (low, high, unit); ``enabled`` must be a bool."""
     enabled = section.enabled
     if not isinstance(enabled, bool):
