@@ -220,8 +220,10 @@ def crane_physics(
         arrays, slides = true_drives(arrays, slides, active.mismatch)
     train_data = active.drive_train if active is not None and active.drive_train.enabled else None
     compliant = train_data is not None
-    if compliant:  # the rotor and the screw friction move to the motor side of the spring
-        slides = replace(slides, armature=(0.0, 0.0, 0.0), damping=(0.0, 0.0, 0.0))
+    if train_data is not None:  # the rotor and the screw friction move to the motor side of the spring
+        train_data.check_step(timestep)
+        rod_side = train_data.rod_side_mass_kg
+        slides = replace(slides, armature=(rod_side, rod_side, rod_side), damping=(0.0, 0.0, 0.0))
     spec = build_spec(crane, plan.lengths, slides)
     names = [spec.joints[i].name for i in range(len(spec.joints))]
     home = HomePose(

@@ -37,6 +37,9 @@ class DriveTrain:
         axial_stiffness_N_per_m: k_s of screw, nut, bearings and pins in series, at the rod [N/m] > 0.
         damping_ratio: zeta of the locked-rod mode, c_s = 2 zeta sqrt(k_s m_m) [-], in [0, 1].
         backlash_m: Total free play 2 b between the motor side and the rod [m], >= 0.
+        rod_side_mass_kg: Mass moving with the rod on the load side of the spring (nut, push tube, rod
+            eye) [kg] >= 0, added to the slide; at least k_s h^2 / 2 for the physics step h
+            (:mod:`hiab_sim.env.plant.drivetrain`).
 
     """
 
@@ -44,6 +47,7 @@ class DriveTrain:
     axial_stiffness_N_per_m: float
     damping_ratio: float
     backlash_m: float
+    rod_side_mass_kg: float
 
     def __post_init__(self) -> None:
         _check(
@@ -53,8 +57,15 @@ class DriveTrain:
                 "axial_stiffness_N_per_m": (1e3, None, "N/m"),
                 "damping_ratio": (0.0, 1.0, ""),
                 "backlash_m": (0.0, 0.01, "m"),
+                "rod_side_mass_kg": (0.0, 1e4, "kg"),
             },
         )
+
+    def check_step(self, h: float) -> None:
+        """Raise unless the rod-side mass keeps the spring's local modes stable at the physics step h [s]."""
+        if self.enabled:
+            low = 0.5 * self.axial_stiffness_N_per_m * h * h
+            check_range("drive_train.rod_side_mass_kg", self.rod_side_mass_kg, low, None, "kg (k_s h^2 / 2)")
 
 
 @dataclass(frozen=True)

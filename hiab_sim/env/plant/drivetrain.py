@@ -89,8 +89,8 @@ class TwoMassDriveTrain:
         contact = above | below
         anchor = self.position - np.where(above, self.half_play, np.where(below, -self.half_play, 0.0))
         k_c = np.where(contact, self.stiffness, 0.0)
-        c_c = np.where(contact, self.damping + self.stiffness * h, 0.0)
-        return k_c * anchor + np.where(contact, self.damping, 0.0) * self.velocity, k_c, c_c
+        c_c = np.where(contact, self.damping, 0.0)
+        return k_c * anchor + c_c * self.velocity, k_c, c_c
 
     def spring_energy(self, rod_position: Array) -> Array:
         """1/2 k_s e^2 [J] per drive."""
@@ -111,7 +111,7 @@ class TwoMassDriveTrain:
         """
         contact = rod_force != 0.0
         slip = self.velocity - rod_velocity
-        spring = np.where(contact, h * (self.damping * slip * slip + self.stiffness * h * rod_velocity**2), 0.0)
+        spring = np.where(contact, h * self.damping * slip * slip, 0.0)
         # Screw friction implicit (-b_f v_m at the new rate): its work over the step is -b_f v_m^2 h exactly.
         self.velocity = (self.velocity + h * (drive_force - rod_force) / self.mass) / (
             1.0 + h * self.viscous / self.mass
