@@ -32,7 +32,7 @@ from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator, DriveStep
 from hiab_sim.env.plan import DesignPlan
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.plant.current_loop import DiscreteCurrentLoop
-from hiab_sim.env.plant.drivetrain import TwoMassDriveTrain
+from hiab_sim.env.plant.drivetrain import TwoMassDriveTrain, coupled_step
 from hiab_sim.env.plant.friction import FrictionMeter, add_joint_friction
 from hiab_sim.env.plant.mismatch import true_crane, true_drives
 from hiab_sim.env.plant.sensors import CurrentSensorError, MotionSensor
@@ -167,23 +167,16 @@ class CranePhysics(dm_mujoco.Physics):
         discrete = isinstance(self.drives, DiscreteCurrentLoop)
         with self.check_invalid_state():
             for _ in range(nstep):
-                x, v = data.qpos[self.slide_dofs], data.qvel[self.slide_dofs]
+                v = data.qvel[self.slide_dofs]
                 omega = ratio * (v if train is None else train.velocity)
                 reference = self.current_reference if discrete else self.current_reference - self.current_error.sample()
                 result = self.drives.step(reference, omega, h)
                 if train is None:
                     data.ctrl[:] = result.rod_force
+                    mujoco.mj_step(model, data)
                 else:
-                    x_rod = x.copy()
-                    ctrl, k_c, c_c = train.rod_actuator(x_rod, h)
-                    data.ctrl[:] = ctrl
-                    model.actuator_biasprm[self.actuator_ids, 1] = -k_c
-                    model.actuator_biasprm[self.actuator_ids, 2] = -c_c
-                mujoco.mj_step(model, data)
-                if train is not None:
-                    v_new = data.qvel[self.slide_dofs]
-                    force = ctrl - k_c * x_rod - c_c * v_new  # what the rod received over the step
-                    self.drive_train_loss += train.step(result.rod_force, force, v_new, h)
+                    loss = coupled_step(train, model, data, self.actuator_ids, self.slide_dofs, result.rod_force, h)
+                    self.drive_train_loss += loss
                 if friction is not None:
                     self.friction_loss += h * friction.power(model, data)
                 if thermal is not None:

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 
+import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
@@ -119,3 +120,28 @@ class TwoMassDriveTrain:
         self.position = self.position + h * self.velocity
         dissipated: Array = h * self.viscous * self.velocity**2 + spring
         return dissipated
+
+
+def coupled_step(
+    train: TwoMassDriveTrain,
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    actuators: NDArray[np.int64],
+    dofs: NDArray[np.int64],
+    drive_force: Array,
+    h: float,
+) -> Array:
+    """One physics step of the rods (``mj_step``) and the motor sides on their springs; return the dissipated energy [J].
+
+    ``actuators`` are the slides' affine actuators (gain 1, bias (0, -k_c, -c_c)), ``dofs`` the slides'
+    degrees of freedom; see the module docstring.
+    """
+    x = data.qpos[dofs].copy()
+    ctrl, k_c, c_c = train.rod_actuator(x, h)
+    data.ctrl[actuators] = ctrl
+    model.actuator_biasprm[actuators, 1] = -k_c
+    model.actuator_biasprm[actuators, 2] = -c_c
+    mujoco.mj_step(model, data)
+    v_new = data.qvel[dofs]
+    force = ctrl - k_c * x - c_c * v_new  # what the rod received over the step
+    return train.step(drive_force, force, v_new, h)

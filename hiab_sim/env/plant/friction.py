@@ -12,7 +12,9 @@ boom hinge). Friction is placed on the three rotations of the chain:
 MuJoCo treats ``frictionloss`` as a constraint (static friction included, no regularisation) and
 the damping implicitly, so the model stays stable at the physics step. The power they dissipate is
 :func:`friction_power`: sum over friction rows of f_i (J qvel)_i, minus sum c_j qdot_j^2 over the
-damped joints and tendons (<= 0).
+damped joints and tendons (<= 0), with the rates after the step: the ``implicitfast`` step applies
+damping and constraint forces at the new rate v', so h f v' is the work they do over the step (the
+rate at the step's start would miscount a light body's step-to-step reversals).
 """
 
 from __future__ import annotations
@@ -73,8 +75,13 @@ class FrictionMeter:
     def __init__(self, model: mujoco.MjModel, joints: tuple[str, ...] = (), tendons: tuple[str, ...] = ()) -> None:
         self.dofs = np.array([model.jnt_dofadr[model.joint(name).id] for name in joints], dtype=int)
         self.joint_damping = np.array([model.dof_damping[d] for d in self.dofs])
-        self.tendons = np.array([model.tendon(name).id for name in tendons], dtype=int)
-        self.tendon_damping = np.array([model.tendon_damping[t] for t in self.tendons])
+        ids = [model.tendon(name).id for name in tendons]
+        self.tendon_damping = np.array([model.tendon_damping[t] for t in ids])
+        # Fixed tendons: rate = sum coef_j qdot_j over their joints' dofs (wrap_objid names the joint).
+        self.tendon_rows = np.zeros((len(ids), model.nv))
+        for row, t in enumerate(ids):
+            for w in range(model.tendon_adr[t], model.tendon_adr[t] + model.tendon_num[t]):
+                self.tendon_rows[row, model.jnt_dofadr[model.wrap_objid[w]]] = model.wrap_prm[w]
 
     def power(self, model: mujoco.MjModel, data: mujoco.MjData) -> float:
         """Dissipated power [W] (>= 0) at the state in ``data``, with its last solver's friction forces."""
@@ -87,6 +94,6 @@ class FrictionMeter:
             mujoco.mj_mulJacVec(model, data, velocity, data.qvel)
             coulomb = float(-(data.efc_force[friction] @ velocity[friction]))
         viscous = float(self.joint_damping @ data.qvel[self.dofs] ** 2)
-        if self.tendons.size:
-            viscous += float(self.tendon_damping @ data.ten_velocity[self.tendons] ** 2)
+        if self.tendon_damping.size:
+            viscous += float(self.tendon_damping @ (self.tendon_rows @ data.qvel) ** 2)
         return coulomb + viscous
