@@ -37,7 +37,7 @@ def test_ideal_plant_reproduces_todays_closed_loop_exactly(crane: Crane) -> None
 
 @pytest.mark.parametrize("effect", EFFECTS)
 def test_each_effect_alone_completes_the_cycle_and_tracks(crane: Crane, effect: str) -> None:
-    """With one effect on, the cycle completes within 5 mm of the reference and costs within [-2 %, +80 %] of today's."""
+    """With one effect on, the cycle completes within 5 mm of the reference, costing -2 % to +80 % of today's energy."""
     today = _run(crane, None)
     run = _run(crane, REALISTIC.only(effect))
     assert run.time[-1] == pytest.approx(today.time[-1])

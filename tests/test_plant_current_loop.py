@@ -23,7 +23,7 @@ def _loop(rate: float, dead_time: float = 0.0) -> CurrentLoop:
 
 
 def _run(sim: DriveSimulator, steps: int = 40) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """References 20/-10/5 A then 5/3/-2 A at held speeds; (i_q log, electrical, copper, torque x omega x h, inverter)."""
+    """References 20/-10/5 A, then 5/3/-2 A, at held speeds: (i_q, electrical, copper, torque omega h, inverter)."""
     sim.reset(0.0, 0.0)
     currents, electrical, copper, mechanical, inverter = [], np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
     for k in range(steps):
@@ -56,7 +56,7 @@ def test_drive_energy_balance_closes_with_the_discrete_loop() -> None:
     Dead time on: the applied voltage differs from the command, and the balance uses the applied one.
     """
     sim = DiscreteCurrentLoop(DRIVES, _loop(8e3, dead_time=2e-6), CurrentSensorError(None, 3, 1.0), H)
-    currents, electrical, copper, mechanical, _ = _run(sim)
+    _, electrical, copper, mechanical, _ = _run(sim)
     stored = DRIVES.magnetic_energy(sim.i_d, sim.i_q)  # from zero current
     np.testing.assert_allclose(electrical, copper + mechanical + stored, rtol=1e-6, atol=1e-6)
 
@@ -99,7 +99,7 @@ def test_a_rate_that_does_not_divide_the_physics_step_is_rejected() -> None:
     """f_s h must be an integer: 7.5 kHz at 1 ms names current_loop.rate_Hz."""
     from hiab_sim.errors import InvalidInputError
 
-    with pytest.raises(InvalidInputError, match="current_loop.rate_Hz"):
+    with pytest.raises(InvalidInputError, match=r"current_loop\.rate_Hz"):
         DiscreteCurrentLoop(
             DRIVES, dataclasses.replace(_loop(8e3), rate_Hz=7500.0), CurrentSensorError(None, 3, 1.0), H
         )

@@ -1,4 +1,4 @@
-"""The two-mass drive train on its own: resonance frequency, free play, energy balance (MuJoCo rod, Python motor side)."""
+"""The two-mass drive train alone: resonance, free play, energy balance (a MuJoCo rod, the Python motor side)."""
 
 from __future__ import annotations
 
@@ -91,7 +91,7 @@ def test_backlash_lets_the_motor_side_travel_freely_across_the_gap() -> None:
     k, play, m_m, force, h = 1.0e7, 2.0e-4, 10.0, 5.0, 1e-4
     train = _train(k, 0.0, play, m_m)
     train.position = np.array([-play / 2])  # at the far edge of the gap
-    log, _, _, _, data = _simulate(train, 50.0, force, h, 200)
+    log, _, _, _, _ = _simulate(train, 50.0, force, h, 200)
     # The motor side crosses 2 b in t = sqrt(2 * 2b * m / F) = 0.04 s; before that the rod stays put.
     crossing = math.sqrt(2 * play * m_m / force)
     before = log[:, 0] < 0.9 * crossing
@@ -110,7 +110,7 @@ def test_drive_train_energy_balance_closes() -> None:
     """
     h = 1e-4
     train = _train(1.0e6, 0.1, 1e-4, 100.0, viscous=200.0)
-    log, dissipated, work, model, data = _simulate(train, 50.0, 2000.0, h, 10000)
+    _, dissipated, work, _, data = _simulate(train, 50.0, 2000.0, h, 10000)
     kinetic = float(train.kinetic_energy()[0]) + 0.5 * 50.0 * float(data.qvel[0]) ** 2
     spring = float(train.spring_energy(data.qpos[:1])[0])
     assert dissipated > 0.05 * work

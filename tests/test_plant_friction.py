@@ -1,4 +1,4 @@
-"""Hinge and pin friction on the crane: where it sits, and that the energy it dissipates is the energy the crane loses."""
+"""Hinge and pin friction on the crane: where it sits, and that what it dissipates is what the crane loses."""
 
 from __future__ import annotations
 

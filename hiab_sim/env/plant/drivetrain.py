@@ -131,7 +131,7 @@ def coupled_step(
     drive_force: Array,
     h: float,
 ) -> Array:
-    """One physics step of the rods (``mj_step``) and the motor sides on their springs; return the dissipated energy [J].
+    """One physics step of the rods (``mj_step``) and the motor sides on their springs; return the loss [J].
 
     ``actuators`` are the slides' affine actuators (gain 1, bias (0, -k_c, -c_c)), ``dofs`` the slides'
     degrees of freedom; see the module docstring.
