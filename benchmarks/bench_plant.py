@@ -1,4 +1,4 @@
-"""Time one closed-loop cycle of the default study (optimal design) on the realistic plant: real-time factor, share per part.
+"""Time a closed-loop cycle of the default study (optimal design) on the realistic plant: real-time factor, parts.
 
 Usage: ``python benchmarks/bench_plant.py [RESULT_DIR] [--plant realistic|FILE] [--repeat N]`` (without
 RESULT_DIR the default study is optimised first, outside the timing). The cycle is exactly what
@@ -6,7 +6,8 @@ RESULT_DIR the default study is optimised first, outside the timing). The cycle 
 process on the same Physics, as many calls as the cycle made: MuJoCo's ``mj_step`` (with the drive
 train's springs), the discrete current loops, the friction meter, the winding temperature (update and
 R_s hand-over), the encoder and delay line; the rest (controller, observations, dm-control, the
-drive train's Python side) is the remainder; the environment's build is timed on its own. Best of ``--repeat``, wall clock and process CPU time.
+drive train's Python side) is the remainder; the environment's build is timed on its own. Best of
+``--repeat``, wall clock and process CPU time.
 """
 
 from __future__ import annotations
