@@ -11,9 +11,9 @@ from test_study_small import small_study, write_study
 from test_sweep import TINY
 
 from hiab_sim.cli import main
-from hiab_sim.study.config import study_from_dict
-from hiab_sim.study.problem import LinkLengthProblem
-from hiab_sim.study.solve import SolveResult, solve
+from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.solvers.slsqp import SolveResult, solve
+from hiab_sim.study.spec.study_file import study_from_dict
 from hiab_sim.sweep.pareto import EpsilonProblem, criterion, pareto_front, samples_of_points
 
 
@@ -45,6 +45,7 @@ def test_inactive_epsilon_reproduces_the_plain_optimum(plain: tuple[LinkLengthPr
     np.testing.assert_allclose(z[: problem.n_xi], result.z[: problem.n_xi], atol=1e-8)
 
 
+@pytest.mark.e2e
 def test_front_is_monotone_from_the_plain_optimum(plain: tuple[LinkLengthProblem, SolveResult]) -> None:
     """A lower peak force never comes with a lower objective; each point holds its epsilon; it starts at the optimum."""
     problem, result = plain

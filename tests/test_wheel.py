@@ -13,6 +13,10 @@ from pathlib import Path
 
 import mujoco
 import numpy
+import pytest
+
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
 
 REPO = Path(__file__).resolve().parents[1]
 #: What the wheel is built from (the tracked sources; no .venv, runs/ or build/ from this checkout).
@@ -79,7 +83,7 @@ def test_wheel_installed_in_a_fresh_environment_optimizes_and_writes_mjcf(tmp_pa
         [
             str(python),
             "-c",
-            "from hiab_sim.study.config import load_study; print(load_study('seed_scale_spiral').path)",
+            "from hiab_sim.study.spec.study_file import load_study; print(load_study('seed_scale_spiral').path)",
         ],
         cwd=work,
         env=environment,
