@@ -117,3 +117,30 @@ def test_true_mass_prediction_without_errors_is_the_plans_prediction(crane: Cran
     )
     heavier = true_mass_prediction(plan, REALISTIC)
     assert heavier > plan.predicted_net_energy
+
+
+@pytest.mark.slow
+def test_true_mass_prediction_agrees_with_the_optimiser_on_the_true_crane(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """The same-motion prediction at the true masses equals the optimiser's own energy of that design on the true crane.
+
+    The default study is solved again with the mismatch's crane (:func:`replanned_prediction`'s
+    path): its initial design is the nominal study's initial design, so its reported energy is an
+    independent computation (the optimiser's objective) of what ``true_mass_prediction`` computes
+    (1e-6); the re-planned optimum is no worse than the nominal optimum at the true masses.
+    """
+    import json
+
+    from hiab_sim.env.plan import read_plan
+    from hiab_sim.env.plant.mismatch import true_crane
+    from hiab_sim.study.run import run_study
+    from hiab_sim.study.spec.study_file import load_study
+
+    nominal = run_study(None, tmp_path / "nominal", progress=None, figures=False).folder
+    study = load_study(None)
+    true_study = dataclasses.replace(study, crane=true_crane(study.crane, REALISTIC.mismatch))
+    replanned = run_study(true_study, tmp_path / "true", progress=None, figures=False, force=True, cross=False).folder
+    result = json.loads((replanned / "result.json").read_text())
+    initial = true_mass_prediction(read_plan(nominal, "initial"), REALISTIC)
+    assert initial == pytest.approx(result["initial"]["net_electrical_energy_J"], rel=1e-6)
+    optimal = true_mass_prediction(read_plan(nominal, "optimal"), REALISTIC)
+    assert result["optimal"]["net_electrical_energy_J"] <= optimal * (1 + 1e-6)

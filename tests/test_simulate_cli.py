@@ -110,6 +110,8 @@ def test_simulate_on_the_realistic_plant_reports_every_effect(small_result: Path
     assert ideal["dc_bus_energy_J"] == pytest.approx(ideal["predicted_net_electrical_energy_J"], rel=0.02)
     split = effects["mismatch_split"]["optimal"]
     assert split["predicted_at_true_masses_J"] > split["predicted_J"]
+    # No worse than the nominal optimum at the true masses, within the small study's solver and ID tolerances.
+    assert split["replanned_optimum_predicted_J"] <= split["predicted_at_true_masses_J"] * (1 + 1e-3)
     assert (out / "closed_loop_plant_effects.png").is_file()
 
 

@@ -12,13 +12,17 @@ With a mass mismatch the report also gives the prediction of the same planned mo
 masses (MuJoCo inverse dynamics of the true crane, the planner's steady-state EMLA model,
 eq. ``costf2``'s P_elec integrated by the trapezoid rule), which splits the mismatch's extra energy
 into the cost of the heavier load (true-mass prediction - prediction) and the cost of tracking
-without knowing it (closed loop - true-mass prediction). A plan re-optimised for the true masses is
-not computed.
+without knowing it (closed loop - true-mass prediction). Beside them stands the plan re-optimised
+for the true masses (:func:`replanned_prediction`: the study solved again with the true crane), the
+energy a planner that knew the load would have predicted for its own optimum.
 """
 
 from __future__ import annotations
 
+import json
 import sys
+import tempfile
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -56,6 +60,27 @@ def true_mass_prediction(plan: DesignPlan, plant: Plant) -> float:
     )
     total = np.asarray(power, dtype=float)
     return float(0.5 * np.sum((total[1:] + total[:-1]) * np.diff(plan.time)))
+
+
+def replanned_prediction(result_dir: str | Path, plant: Plant) -> dict[str, object]:
+    """The result's study optimised again with the mismatch's true crane: its optimum's predicted energy [J].
+
+    Returns a mapping with ``predicted_J`` and ``lengths`` of the re-optimised design, or with
+    ``skipped`` saying why (the study file is gone, or the study is a mix of tasks).
+    """
+    from hiab_sim.results.read import read_result
+    from hiab_sim.study.run import run_study
+    from hiab_sim.study.spec.study_file import load_study
+
+    study = load_study(read_result(result_dir).study)
+    if len(study.tasks) != 1:
+        return {"skipped": f"the study has {len(study.tasks)} tasks; re-planning is done for single-task studies"}
+    true_study = replace(study, crane=true_crane(study.crane, plant.mismatch))
+    with tempfile.TemporaryDirectory(prefix="hiab_sim_replan_") as folder:
+        out = run_study(true_study, Path(folder) / "replan", progress=None, figures=False, force=True, cross=False)
+        result = json.loads((out.folder / "result.json").read_text(encoding="utf-8"))
+    optimal = result["optimal"]
+    return {"predicted_J": float(optimal["net_electrical_energy_J"]), "lengths": optimal.get("lengths")}
 
 
 def _entry(summary: dict[str, object]) -> dict[str, object]:
@@ -139,6 +164,11 @@ def effect_study(
                 "cost_of_heavier_load_J": true - plan.predicted_net_energy,
                 "cost_of_mismatch_J": closed - true,
             }
+        replanned = replanned_prediction(result_dir, plant)
+        report["mismatch_replanned"] = replanned
+        if "predicted_J" in replanned:
+            for row in split.values():
+                row["replanned_optimum_predicted_J"] = float(replanned["predicted_J"])  # type: ignore[arg-type]
         report["mismatch_split"] = split
     return report
 
