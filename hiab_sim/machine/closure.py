@@ -91,7 +91,7 @@ class Closure:
     angles: dict[str, Array]
     angles_dq: dict[str, Array]
     angles_dq2: dict[str, Array]
-    closes: Array
+    closes: NDArray[np.bool_]
 
 
 def _cross(a: Array, b: Array) -> Array:
@@ -160,7 +160,7 @@ def _triangle(geo: ChainGeometry, q: Array) -> Closure:
     return Closure(s, ds, dds, {"cylinder": a}, {"cylinder": da}, {"cylinder": dda}, closes)
 
 
-def pin_position(geo: ChainGeometry, q: Array) -> tuple[Array, Array, Array, Array]:
+def pin_position(geo: ChainGeometry, q: Array) -> tuple[Array, Array, Array, NDArray[np.bool_]]:
     """Pin H of a linkage at q: (H, C, u, closes) with C the coupler pivot and u = C - r."""
     r = geo.fixed["rocker"]
     C, _, _ = _moving_point(geo, geo.moving["coupler"], q)
@@ -228,7 +228,7 @@ def joint_to_actuator(
 def actuator_to_joint(
     machine: Machine, chain: Chain, x: ArrayLike, dx: ArrayLike, ddx: ArrayLike
 ) -> tuple[Array, Array, Array]:
-    """Joint coordinate, velocity, acceleration (q, dq, ddq) from the actuator's (inverse of :func:`joint_to_actuator`)."""
+    """Joint coordinate, velocity, acceleration (q, dq, ddq) from the actuator's (inverts :func:`joint_to_actuator`)."""
     q = stroke_to_joint(machine, chain, x)
     c = closure(machine, chain, q)
     dq = np.asarray(dx, dtype=float) / c.length_dq

@@ -115,7 +115,7 @@ def _add_chain_bodies(machine: Machine, name: str, q: Array, frames: Frames) -> 
     if chain.kind == "direct":
         return
     parent = str(machine.joint_link(chain.joint).parent)
-    rp, pp = frames.rotation[parent], frames.position[parent]
+    rp = frames.rotation[parent]
     base = chain.pivot("base")
     base_p = frames.point(base.link, base.position)
     cyl_r = rp @ rotation_z(c.angles["cylinder"])
