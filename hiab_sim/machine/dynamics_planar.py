@@ -211,7 +211,9 @@ def _wrap(angle: Array) -> Array:
     return np.angle(np.exp(1j * angle))
 
 
-def loop_points(tree: MachineTree, planar: tuple[PlanarBody, ...], fk: Frames) -> list[tuple[Complex, Complex, Complex]]:
+def loop_points(
+    tree: MachineTree, planar: tuple[PlanarBody, ...], fk: Frames
+) -> list[tuple[Complex, Complex, Complex]]:
     """Per loop pin: relative position, velocity and acceleration p_a - p_b (complex, (T,))."""
     out = []
     for loop in tree.loops:

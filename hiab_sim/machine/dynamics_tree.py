@@ -160,14 +160,18 @@ def machine_tree(machine: Machine) -> MachineTree:
     driven = {c.joint for c in machine.chains}
     for link in machine.links[1:]:
         if link.joint not in driven:
-            raise InvalidInputError(f"links.{link.name}.joint", link.joint, "every moving joint needs a chain driving it")
+            raise InvalidInputError(
+                f"links.{link.name}.joint", link.joint, "every moving joint needs a chain driving it"
+            )
     z = _world_z(machine)
 
     def pivot_z(link: str, point: Array) -> float:
         origin, rotation = z[link]
         return origin + float((rotation @ point)[2])
 
-    def add(name: str, parent: int, kind: str, joint: str, position: Array, inertia: RigidBody | None, chain: str) -> int:
+    def add(
+        name: str, parent: int, kind: str, joint: str, position: Array, inertia: RigidBody | None, chain: str
+    ) -> int:
         bodies.append(TreeBody(name, parent, kind, joint, np.asarray(position, float), np.eye(3), inertia, chain))
         return len(bodies) - 1
 
@@ -311,7 +315,9 @@ def joint_arrays(tree: MachineTree, q: object, dq: object, ddq: object) -> tuple
         column = out[0][:, k]
         outside = (column < low) | (column > high)
         if np.any(outside):
-            raise InvalidInputError(name, float(column[np.argmax(outside)]), f"must lie in [{low:.6g}, {high:.6g}]", link.unit)
+            raise InvalidInputError(
+                name, float(column[np.argmax(outside)]), f"must lie in [{low:.6g}, {high:.6g}]", link.unit
+            )
     return out[0], out[1], out[2]
 
 
