@@ -49,7 +49,7 @@ Complex = NDArray[np.complex128]
 
 
 def _cross(a: Complex, b: Complex) -> Array:
-    """z component of the cross product of in-plane vectors (complex)."""
+    """The z component of the cross product of in-plane vectors (complex)."""
     return (np.conj(a) * b).imag
 
 
@@ -174,7 +174,7 @@ class NewtonEulerInverseDynamics:
             rhs[:, r + 2] -= _cross(tcp, external)
         return A, rhs
 
-    def _pin_forces(self, fk: Frames, u: Array) -> PinForces:
+    def _pin_forces(self, fk: Frames, u: NDArray[np.floating[Any]]) -> PinForces:
         """World and body-frame forces of every pin from the solved unknowns."""
         tree = self.tree
         world = []
@@ -187,7 +187,7 @@ class NewtonEulerInverseDynamics:
             world.append(u[:, c : c + 2])
             on_body.append(loop.body_a)
         world_array = np.stack(world, axis=1)
-        local = np.empty(world_array.shape[:2] + (3,))
+        local = np.empty((*world_array.shape[:2], 3))
         for k, b in enumerate(on_body):
             local[:, k] = _to_body_frame(self.planar[b].fixed, fk.theta[b], world_array[:, k])
         names, on, by = self._pins

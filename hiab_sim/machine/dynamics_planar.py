@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.machine.dynamics_tree import MachineTree
+from hiab_sim.machine.dynamics_tree import MachineTree, actuator_lengths
 
 Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
@@ -104,7 +104,7 @@ class Frames:
     omega: list[Array]
     alpha: list[Array]
 
-    def point(self, b: int, r: complex) -> tuple[Complex, Complex, Complex]:
+    def point(self, b: int, r: complex | Complex) -> tuple[Complex, Complex, Complex]:
         """Position, velocity and acceleration of planar point r of body b."""
         arm = np.exp(1j * self.theta[b]) * r
         w, a = self.omega[b], self.alpha[b]
@@ -135,7 +135,7 @@ def frames(tree: MachineTree, planar: tuple[PlanarBody, ...], q: Array, dq: Arra
                 out.alpha[parent] + ddq[:, b],
             )
         else:
-            z, dz, ddz = out.point(parent, p.origin + p.axis * q[:, b])
+            z, dz, ddz = out.point(parent, np.asarray(p.origin + p.axis * q[:, b], dtype=np.complex128))
             u = np.exp(1j * out.theta[parent]) * p.axis
             dz = dz + u * dq[:, b]
             ddz = ddz + 2j * out.omega[parent] * u * dq[:, b] + u * ddq[:, b]
@@ -203,7 +203,7 @@ def close_loops(tree: MachineTree, planar: tuple[PlanarBody, ...], q: Array) -> 
             full[:, rocker + 1] = _wrap(np.angle(k - end) - psi_rocker)
         d = end - base
         full[:, cyl] = _wrap(np.angle(d) - _angle(fk, planar, tree.bodies[cyl].parent))
-        full[:, rod] = np.abs(d) - (float(chain.actuator.piston_offset) + float(chain.actuator.rod_length))
+        full[:, rod] = np.abs(d) - sum(actuator_lengths(chain))
     return full
 
 
@@ -224,7 +224,7 @@ def loop_points(
 
 
 def point_jacobian(tree: MachineTree, planar: tuple[PlanarBody, ...], fk: Frames, b: int, r: complex) -> Complex:
-    """d p / d q (T, nbody) of planar point r of body b (complex): i (p - z_j) for a revolute ancestor j, u_j for a slide."""
+    """Jacobian dp/dq (T, nbody) of point r of body b (complex): i (p - z_j) per revolute ancestor j, u_j per slide."""
     T = fk.z[0].shape[0]
     p = fk.point(b, r)[0]
     jac = np.zeros((T, len(tree.bodies)), dtype=complex)

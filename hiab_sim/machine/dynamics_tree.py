@@ -45,7 +45,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.machine.description import Machine
+from hiab_sim.machine.description import Chain, Machine
 from hiab_sim.machine.parts import Pose, RigidBody
 
 Array = NDArray[np.float64]
@@ -101,7 +101,7 @@ class MachineTree:
 
     @property
     def gravity(self) -> float:
-        """g [m/s^2] along -y of the world."""
+        """Gravity g [m/s^2], along -y of the world."""
         return self.machine.gravity
 
     @property
@@ -120,6 +120,14 @@ class MachineTree:
             if body.name == name:
                 return k
         raise InvalidInputError("body", name, f"unknown body; bodies: {[b.name for b in self.bodies]}")
+
+
+def actuator_lengths(chain: Chain) -> tuple[float, float]:
+    """Piston offset Lc0 and rod length Lc [m] of a triangle's or linkage's actuator."""
+    piston, rod = chain.actuator.piston_offset, chain.actuator.rod_length
+    if piston is None or rod is None:
+        raise AssertionError(f"a {chain.kind} chain has both actuator lengths (validated by the description)")
+    return float(piston), float(rod)
 
 
 def _world_z(machine: Machine) -> dict[str, tuple[float, Array]]:
@@ -182,6 +190,7 @@ def machine_tree(machine: Machine) -> MachineTree:
             actuated.append(index[machine.joint_link(chain.joint).name])
             continue
         act = chain.actuator
+        piston, rod_length = actuator_lengths(chain)
         base = chain.pivot("base")
         base_xyz = np.asarray(base.position, dtype=float)
         cylinder = add(
@@ -190,14 +199,14 @@ def machine_tree(machine: Machine) -> MachineTree:
         )  # fmt: skip
         rod = add(
             f"{chain.name}.rod", cylinder, "prismatic", f"{chain.name}.stroke",
-            np.array([float(act.piston_offset), 0.0, 0.0]), act.rod_body, chain.name,
+            np.array([piston, 0.0, 0.0]), act.rod_body, chain.name,
         )  # fmt: skip
         actuated.append(rod)
         z_base = pivot_z(base.link, base_xyz)
         if chain.kind == "triangle":
             end = chain.pivot("end")
             end_xyz = np.asarray(end.position, dtype=float)
-            rod_end = np.array([float(act.rod_length), 0.0, pivot_z(end.link, end_xyz) - z_base])
+            rod_end = np.array([rod_length, 0.0, pivot_z(end.link, end_xyz) - z_base])
             loops.append(LoopPin(f"{chain.name}.end_pin", rod, rod_end, index[end.link], end_xyz))
             continue
         linkage = chain.linkage
@@ -214,7 +223,7 @@ def machine_tree(machine: Machine) -> MachineTree:
             np.array([linkage.rocker_length, 0.0, 0.0]), linkage.coupler_body, chain.name,
         )  # fmt: skip
         z_rocker = pivot_z(rocker_pivot.link, rocker_xyz)
-        rod_end = np.array([float(act.rod_length), 0.0, z_rocker - z_base])
+        rod_end = np.array([rod_length, 0.0, z_rocker - z_base])
         loops.append(LoopPin(f"{chain.name}.rod_pin", rod, rod_end, rocker, np.array([linkage.rocker_length, 0, 0.0])))
         far = chain.pivot("coupler")
         far_xyz = np.asarray(far.position, dtype=float)

@@ -35,7 +35,7 @@ import numpy as np
 from hiab_sim.checks import check_non_negative
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.dynamics_tree import MachineTree, machine_tree
+from hiab_sim.machine.dynamics_tree import MachineTree, actuator_lengths, machine_tree
 from hiab_sim.machine.parts import RigidBody
 from hiab_sim.model.mjcf import EQUALITY_SOLIMP, EQUALITY_SOLREF, SOURCE_TO_WORLD
 from hiab_sim.resources import mjcf_template
@@ -169,9 +169,9 @@ def _add_visuals(spec: mujoco.MjSpec, tree: MachineTree, made: list[mujoco.MjsBo
         if chain.kind == "direct":
             continue
         cylinder = tree.index(f"{chain.name}.cylinder")
-        act = chain.actuator
-        _capsule(made[cylinder], np.zeros(3), [float(act.retracted_length), 0.0, 0.0], barrel)
-        _capsule(made[cylinder + 1], np.zeros(3), [float(act.rod_length), 0.0, 0.0], rod)
+        piston, rod_length = actuator_lengths(chain)
+        _capsule(made[cylinder], np.zeros(3), [piston + rod_length, 0.0, 0.0], barrel)
+        _capsule(made[cylinder + 1], np.zeros(3), [rod_length, 0.0, 0.0], rod)
         if chain.kind == "linkage" and chain.linkage is not None:
             _capsule(made[cylinder + 2], np.zeros(3), [chain.linkage.rocker_length, 0.0, 0.0], boom)
             _capsule(made[cylinder + 3], np.zeros(3), [chain.linkage.coupler_length, 0.0, 0.0], boom)
