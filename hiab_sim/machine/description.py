@@ -180,6 +180,8 @@ class Machine:
         tcp_link: The link carrying the TCP.
         tcp: TCP frame in that link's frame.
         hydraulic: The hydraulic baseline, or None.
+        workspace: ((x_min, x_max), (y_min, y_max)) the TCP must stay in over the working
+            ranges [m] (a cell, a floor), or None.
 
     """
 
@@ -191,9 +193,13 @@ class Machine:
     tcp_link: str
     tcp: Pose
     hydraulic: HydraulicSystem | None = field(default=None, repr=False)
+    workspace: tuple[tuple[float, float], tuple[float, float]] | None = None
 
     def __post_init__(self) -> None:
         check_positive("gravity", self.gravity, "m/s^2")
+        if self.workspace is not None:
+            check_interval("workspace.x", self.workspace[0], "m")
+            check_interval("workspace.y", self.workspace[1], "m")
         self._check_tree()
         self._check_chains()
 
