@@ -130,7 +130,7 @@ def _chain_failures(machine: Machine, chain: Chain) -> list[Failure]:
         return [Failure(where, f"{chain.joint} = {bad:.6g} {unit}", "loop does not close there (a side too short)")]
     out = []
     sign = np.sign(c.length_dq)
-    toggled = np.any(sign != sign[CHECK_SAMPLES // 2]) or np.any(c.length_dq == 0.0)
+    toggled = bool(np.any(sign != sign[CHECK_SAMPLES // 2]) or np.any(c.length_dq == 0.0))
     if geo.kind == "linkage":
         t = np.sign(_transmission(geo, q))
         toggled = toggled or bool(np.any(t != t[CHECK_SAMPLES // 2]))
