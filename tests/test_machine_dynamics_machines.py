@@ -99,6 +99,7 @@ def hand_machine() -> Machine:
         rod_body=RigidBody("rod", HAND_MR, (0.2, 0.0, 0.0), ((0.005, 0, 0), (0, 0.06, 0), (0, 0, 0.06))),
     )
     boom = RigidBody("boom", HAND_M, (HAND_C, HAND_D, 0.0), ((2.0, 0, 0), (0, 20.0, 0), (0, 0, 21.0)))
+    pivots = (Pivot("base", "ground", (HAND_A, -HAND_H, 0.0)), Pivot("end", "beam", (HAND_A, 0.0, 0.0)))
     return Machine(
         name="hand",
         source="test",
@@ -107,10 +108,7 @@ def hand_machine() -> Machine:
             Link("ground", None, "mount", "fixed", Pose((0.0, 0.0, 0.0)), None, ()),
             Link("beam", "ground", "hinge", "revolute", Pose((0.0, 0.0, 0.0)), (-0.3, 0.3), (boom,)),
         ),
-        chains=(
-            Chain("act", "triangle", "hinge", actuator,
-                  (Pivot("base", "ground", (HAND_A, -HAND_H, 0.0)), Pivot("end", "beam", (HAND_A, 0.0, 0.0)))),
-        ),  # fmt: skip
+        chains=(Chain("act", "triangle", "hinge", actuator, pivots),),
         tcp_link="beam",
         tcp=Pose((2.0, 0.0, 0.0)),
     )

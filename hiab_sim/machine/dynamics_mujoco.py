@@ -183,18 +183,18 @@ class MujocoMachineDynamics:
             lam = solution[n_act:].reshape(-1, 2)
             velocity[i], acceleration[i], stroke[i] = qvel[self._act], qacc[self._act], d.qpos[self._act]
             world[i], local[i] = self._pin_forces(lam, f_ext)
-        names, on, by = self._pins
+        names, kinds, on, by = self._pins
         return MachineActuatorSamples(
             names=tuple(self.tree.machine.actuator_names),
             force=force,
             velocity=velocity,
             acceleration=acceleration,
             stroke=stroke,
-            pins=PinForces(names=names, on=on, by=by, world=world, local=local),
+            pins=PinForces(names=names, kinds=kinds, on=on, by=by, world=world, local=local),
         )
 
     def _pin_forces(self, lam: Array, f_ext: Array) -> tuple[Array, Array]:
-        """World (P, 2) and body-frame (P, 3) pin forces: hinges from ``cfrc_int``, loop pins = lambda."""
+        """World (P, 2) and body-frame (P, 3) forces: joints from ``cfrc_int``, loop pins = lambda."""
         m, d = self.model, self.data
         d.xfrc_applied[:] = 0.0
         for (a, b), force in zip(self._sites, lam, strict=True):
@@ -210,7 +210,7 @@ class MujocoMachineDynamics:
         d.xfrc_applied[:] = 0.0
         world = []
         on = []
-        for b in self.tree.hinges:
+        for b in range(1, len(self.tree.bodies)):
             world.append(d.cfrc_int[self._body[b], 3:][_PLANE])
             on.append(b)
         for loop, force in zip(self.tree.loops, lam, strict=True):

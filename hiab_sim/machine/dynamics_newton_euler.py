@@ -179,9 +179,14 @@ class NewtonEulerInverseDynamics:
         tree = self.tree
         world = []
         on_body = []
-        for b in tree.hinges:
+        for b in self._moving:
             c = self._joint_column[b]
-            world.append(u[:, c : c + 2])
+            if tree.bodies[b].kind == "revolute":
+                world.append(u[:, c : c + 2])
+            else:  # axial (actuator) and normal force along u and i u
+                axis = np.exp(1j * fk.theta[tree.bodies[b].parent]) * self.planar[b].axis
+                total = axis * (u[:, c] + 1j * u[:, c + 1])
+                world.append(np.stack([total.real, total.imag], axis=1))
             on_body.append(b)
         for loop, c in zip(tree.loops, self._loop_column, strict=True):
             world.append(u[:, c : c + 2])
@@ -190,8 +195,8 @@ class NewtonEulerInverseDynamics:
         local = np.empty((*world_array.shape[:2], 3))
         for k, b in enumerate(on_body):
             local[:, k] = _to_body_frame(self.planar[b].fixed, fk.theta[b], world_array[:, k])
-        names, on, by = self._pins
-        return PinForces(names=names, on=on, by=by, world=world_array, local=local)
+        names, kinds, on, by = self._pins
+        return PinForces(names=names, kinds=kinds, on=on, by=by, world=world_array, local=local)
 
     # ------------------------------------------------------------------------------------------
 

@@ -109,11 +109,6 @@ class MachineTree:
         """Bodies whose joint coordinate follows from the loops (every non-root body not independent)."""
         return tuple(b for b in range(1, len(self.bodies)) if b not in self.independent)
 
-    @property
-    def hinges(self) -> tuple[int, ...]:
-        """Bodies carried by a revolute joint (each joint is a pin between the body and its parent)."""
-        return tuple(b for b, body in enumerate(self.bodies) if body.kind == "revolute")
-
     def index(self, name: str) -> int:
         """Index of the body of this name."""
         for k, body in enumerate(self.bodies):
@@ -243,14 +238,18 @@ def machine_tree(machine: Machine) -> MachineTree:
 
 @dataclass(frozen=True)
 class PinForces:
-    """Forces on every pin over T samples: each revolute joint of the tree and each loop pin.
+    """Forces through every joint and pin over T samples, in the order of :func:`pin_layout`.
 
-    Pin p acts on body ``on[p]`` from body ``by[p]`` (the reaction on ``by[p]`` is its negative):
-    ``world`` (T, P, 2) [N] in the world plane (x, y); ``local`` (T, P, 3) [N] in the frame of
-    ``on[p]`` (its z component is non-zero only for a frame tilted out of the plane).
+    Entry p is the force body ``by[p]`` applies to body ``on[p]`` (the reaction on ``by[p]`` is its
+    negative): ``world`` (T, P, 2) [N] in the world plane (x, y); ``local`` (T, P, 3) [N] in the
+    frame of ``on[p]`` (its z component is non-zero only for a frame tilted out of the plane).
+    ``kinds[p]``: ``hinge`` (a revolute joint of the tree: a pin, no moment about the plane
+    normal), ``slide`` (a prismatic joint: its whole in-plane force, actuator force included; its
+    moment is not reported, so it is no pin) or ``loop`` (a loop pin).
     """
 
     names: tuple[str, ...]
+    kinds: tuple[str, ...]
     on: tuple[str, ...]
     by: tuple[str, ...]
     world: Array
@@ -284,19 +283,23 @@ class MachineActuatorSamples:
         return self.force * self.velocity
 
 
-def pin_layout(tree: MachineTree) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
-    """Names, acted-on bodies and acting bodies of every pin: the tree's hinges, then the loop pins."""
-    names, on, by = [], [], []
-    for b in tree.hinges:
-        body = tree.bodies[b]
+PinLayout = tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], tuple[str, ...]]
+
+
+def pin_layout(tree: MachineTree) -> PinLayout:
+    """Names, kinds, acted-on and acting bodies: every joint of the tree in body order, then the loop pins."""
+    names, kinds, on, by = [], [], [], []
+    for body in tree.bodies[1:]:
         names.append(body.joint)
+        kinds.append("hinge" if body.kind == "revolute" else "slide")
         on.append(body.name)
         by.append(tree.bodies[body.parent].name)
     for loop in tree.loops:
         names.append(loop.name)
+        kinds.append("loop")
         on.append(tree.bodies[loop.body_a].name)
         by.append(tree.bodies[loop.body_b].name)
-    return tuple(names), tuple(on), tuple(by)
+    return tuple(names), tuple(kinds), tuple(on), tuple(by)
 
 
 def joint_arrays(tree: MachineTree, q: object, dq: object, ddq: object) -> tuple[Array, Array, Array]:
