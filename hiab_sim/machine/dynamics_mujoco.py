@@ -83,6 +83,11 @@ class MujocoMachineDynamics:
         self._tcp = m.site("tcp").id
         self._body = np.array([m.body(body.name).id for body in tree.bodies])
         self._pins = pin_layout(tree)
+        #: sites where forces act in the pin pass (each pin's two sites, then the TCP), their bodies,
+        #: and the body each reported force acts on
+        self._force_sites = np.array([*(s for pair in self._sites for s in pair), self._tcp])
+        self._force_bodies = m.site_bodyid[self._force_sites]
+        self._on = self._body[[*range(1, len(tree.bodies)), *(p.body_a for p in tree.loops)]]
         if m.nq != m.nv:
             raise AssertionError("a planar machine has only hinges and slides")
         # the balance matrix [S^T J^T]: S^T's columns are fixed
@@ -196,32 +201,21 @@ class MujocoMachineDynamics:
     def _pin_forces(self, lam: Array, f_ext: Array) -> tuple[Array, Array]:
         """World (P, 2) and body-frame (P, 3) forces: joints from ``cfrc_int``, loop pins = lambda."""
         m, d = self.model, self.data
-        d.xfrc_applied[:] = 0.0
-        for (a, b), force in zip(self._sites, lam, strict=True):
-            f = np.array([force[0], 0.0, force[1]])
-            for site, sign in ((a, 1.0), (b, -1.0)):
-                body = m.site_bodyid[site]
-                d.xfrc_applied[body, :3] += sign * f
-                d.xfrc_applied[body, 3:] += sign * np.cross(d.site_xpos[site] - d.xipos[body], f)
-        body = m.site_bodyid[self._tcp]
-        d.xfrc_applied[body, :3] += f_ext
-        d.xfrc_applied[body, 3:] += np.cross(d.site_xpos[self._tcp] - d.xipos[body], f_ext)
+        n = len(self._sites)
+        forces = np.zeros((2 * n + 1, 3))
+        forces[0 : 2 * n : 2, 0::2] = lam  # on body a at its site
+        forces[1 : 2 * n : 2, 0::2] = -lam  # on body b at its site
+        forces[-1] = f_ext
+        arm = d.site_xpos[self._force_sites] - d.xipos[self._force_bodies]
+        d.xfrc_applied[:] = 0.0  # (force, torque about the body's com) per body
+        np.add.at(d.xfrc_applied, self._force_bodies, np.hstack([forces, np.cross(arm, forces)]))
         mujoco.mj_rnePostConstraint(m, d)
         d.xfrc_applied[:] = 0.0
-        world = []
-        on = []
-        for b in range(1, len(self.tree.bodies)):
-            world.append(d.cfrc_int[self._body[b], 3:][_PLANE])
-            on.append(b)
-        for loop, force in zip(self.tree.loops, lam, strict=True):
-            world.append(force)
-            on.append(loop.body_a)
-        world_array = np.array(world)
-        local = np.empty((len(on), 3))
-        for k, b in enumerate(on):
-            f = np.array([world_array[k, 0], 0.0, world_array[k, 1]])
-            local[k] = d.xmat[self._body[b]].reshape(3, 3).T @ f  # body frames keep the description's axes
-        return world_array, local
+        world = np.vstack([d.cfrc_int[self._body[1:], 3:][:, _PLANE], lam])
+        planar = np.zeros((len(world), 3))
+        planar[:, 0::2] = world
+        rotation = d.xmat[self._on].reshape(-1, 3, 3)  # body frames keep the description's axes
+        return world, np.einsum("pji,pj->pi", rotation, planar)
 
     # ------------------------------------------------------------------------------------------
 
