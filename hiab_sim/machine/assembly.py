@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.machine.closure import ChainGeometry, chain_geometry, geometry_closure, pin_position
+from hiab_sim.machine.closure import ChainGeometry, chain_geometry, geometry_closure, pin_position, stroke_to_joint
 from hiab_sim.machine.description import Chain, Machine
 from hiab_sim.machine.kinematics import forward_kinematics
 
@@ -87,7 +87,8 @@ def reachable_joint_range(machine: Machine, chain: Chain) -> tuple[float, float]
     """Largest joint interval around the working range's middle that the chain serves, or None.
 
     Found by stepping outwards from the middle (revolute: up to pi each way in 4000 steps;
-    direct: the usable stroke) and bisecting each end to round-off.
+    direct: the usable stroke) and bisecting each end to round-off; an end set by a stroke limit
+    is then recomputed by the closed-form inverse closure.
     """
     geo = chain_geometry(machine, chain)
     if chain.kind == "direct":
@@ -114,8 +115,17 @@ def reachable_joint_range(machine: Machine, chain: Chain) -> tuple[float, float]
                 good = mid
             else:
                 bad = mid
-        ends.append(good)
+        ends.append(_snap_to_stroke_end(machine, chain, geo, good))
     return (ends[0], ends[1])
+
+
+def _snap_to_stroke_end(machine: Machine, chain: Chain, geo: ChainGeometry, q: float) -> float:
+    """An end bisected to a stroke limit, recomputed exactly by the inverse closure (no tolerance slack)."""
+    x = float(geometry_closure(geo, np.array(q)).length) - geo.x0
+    for limit in usable_stroke(chain):
+        if abs(x - limit) < 1e-9:
+            return float(stroke_to_joint(machine, chain, np.array(limit)))
+    return q
 
 
 def _chain_failures(machine: Machine, chain: Chain) -> list[Failure]:

@@ -69,6 +69,7 @@ from hiab_sim.machine.chains import (
     Linkage,
     Pivot,
 )
+from hiab_sim.machine.design import variable_value, with_design
 from hiab_sim.machine.parts import (
     IDENTITY,
     Matrix3,
@@ -367,8 +368,6 @@ class Machine:
 
     def design_values(self) -> np.ndarray:
         """Values of :attr:`decision_variables` in this machine [m]."""
-        from hiab_sim.machine.design import variable_value
-
         return np.array([variable_value(self, v) for v in self.decision_variables])
 
     def design_bounds(self) -> tuple[np.ndarray, np.ndarray]:
@@ -378,6 +377,4 @@ class Machine:
 
     def with_design(self, values: Any, *, check_bounds: bool = True) -> Machine:
         """The machine with its decision variables set to ``values`` (:func:`hiab_sim.machine.design.with_design`)."""
-        from hiab_sim.machine.design import with_design
-
         return with_design(self, values, check_bounds=check_bounds)

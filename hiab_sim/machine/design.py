@@ -9,18 +9,42 @@ Lc, the rod length takes x0 - Lc0). Values in m.
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
+from typing import Any, Protocol, TypeVar
 
 import numpy as np
 
 from hiab_sim.checks import check_range
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.chains import Chain, DecisionVariable
-from hiab_sim.machine.description import Machine
 from hiab_sim.machine.parts import vec3
 
 
-def variable_value(machine: Machine, variable: DecisionVariable) -> float:
+class Designable(Protocol):
+    """What this module needs of a :class:`~hiab_sim.machine.description.Machine` (no import circle)."""
+
+    @property
+    def chains(self) -> tuple[Chain, ...]:
+        """The chains."""
+
+    @property
+    def decision_variables(self) -> tuple[DecisionVariable, ...]:
+        """The declared decision variables."""
+
+    @property
+    def variable_keys(self) -> list[str]:
+        """Their ``chain.name`` keys."""
+
+    def chain(self, name: str) -> Chain:
+        """The chain of this name."""
+
+    def hinge_xy(self, chain: Chain, link: str) -> np.ndarray:
+        """The chain's hinge in a link frame."""
+
+
+MachineT = TypeVar("MachineT", bound=Designable)
+
+
+def variable_value(machine: Designable, variable: DecisionVariable) -> float:
     """Current value of a decision variable [m]."""
     chain = machine.chain(variable.chain)
     act = chain.actuator
@@ -37,7 +61,7 @@ def variable_value(machine: Machine, variable: DecisionVariable) -> float:
     return float(np.linalg.norm(pivot.xy - machine.hinge_xy(chain, pivot.link)))
 
 
-def with_design(machine: Machine, values: Any, *, check_bounds: bool = True) -> Machine:
+def with_design(machine: MachineT, values: Any, *, check_bounds: bool = True) -> MachineT:
     """The machine with its decision variables set to ``values`` (in ``machine.decision_variables`` order).
 
     Values outside the declared bounds raise :class:`InvalidInputError` unless ``check_bounds`` is
@@ -55,10 +79,10 @@ def with_design(machine: Machine, values: Any, *, check_bounds: bool = True) -> 
     for chain in machine.chains:
         mine = [(v, float(x)) for v, x in zip(variables, values, strict=True) if v.chain == chain.name]
         chains.append(_chain_with(machine, chain, mine) if mine else chain)
-    return replace(machine, chains=tuple(chains))
+    return replace(machine, chains=tuple(chains))  # type: ignore[type-var]
 
 
-def _chain_with(machine: Machine, chain: Chain, assigned: list[tuple[DecisionVariable, float]]) -> Chain:
+def _chain_with(machine: Designable, chain: Chain, assigned: list[tuple[DecisionVariable, float]]) -> Chain:
     act = chain.actuator
     piston, rod = act.piston_offset, act.rod_length
     pivots = {p.role: p for p in chain.pivots}

@@ -1,0 +1,190 @@
+"""Loop closure of any chain: closed form against the generic Newton closure and finite differences."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from hiab_sim.machine import closure
+from hiab_sim.machine.closure_numeric import numeric_closure
+from hiab_sim.machine.description import Machine
+from hiab_sim.machine.kinematics import forward_kinematics, pin_positions
+from hiab_sim.machine.loader import load_machine, machine_from_dict
+
+MACHINES = ("xs031", "exact")
+
+
+@pytest.fixture(scope="module", params=MACHINES)
+def machine(request: pytest.FixtureRequest) -> Machine:
+    """Each shipped machine."""
+    return load_machine(request.param)
+
+
+def _wrap(a: np.ndarray) -> np.ndarray:
+    return np.angle(np.exp(1j * a))
+
+
+def _joint_samples(machine: Machine, joint: str, n: int, seed: int) -> np.ndarray:
+    low, high = machine.joint_link(joint).joint_range  # type: ignore[misc]
+    return np.random.default_rng(seed).uniform(low, high, n)
+
+
+def test_closed_form_and_newton_closure_agree(machine: Machine) -> None:
+    """s, s', s'' and every body angle with its derivatives agree between the two closures to 1e-12."""
+    for k, chain in enumerate(machine.chains):
+        q = _joint_samples(machine, chain.joint, 500, k)
+        a, b = closure.closure(machine, chain, q), numeric_closure(machine, chain, q)
+        assert np.all(a.closes) and np.all(b.closes)
+        for field in ("length", "length_dq", "length_dq2"):
+            np.testing.assert_allclose(getattr(b, field), getattr(a, field), rtol=0, atol=1e-12)
+        assert set(a.angles) == set(b.angles)
+        for name in a.angles:
+            np.testing.assert_allclose(_wrap(b.angles[name] - a.angles[name]), 0.0, atol=1e-12)
+            np.testing.assert_allclose(b.angles_dq[name], a.angles_dq[name], rtol=0, atol=1e-11)
+            np.testing.assert_allclose(b.angles_dq2[name], a.angles_dq2[name], rtol=0, atol=1e-10)
+
+
+def test_closure_derivatives_match_central_differences(machine: Machine) -> None:
+    """ds/dq and d2s/dq2 (and the body angles') equal central differences of the closure itself."""
+    h = 1e-5
+    for k, chain in enumerate(machine.chains):
+        q = _joint_samples(machine, chain.joint, 50, 10 + k) * 0.98
+        c = closure.closure(machine, chain, q)
+        plus, minus = closure.closure(machine, chain, q + h), closure.closure(machine, chain, q - h)
+        np.testing.assert_allclose(c.length_dq, (plus.length - minus.length) / (2 * h), rtol=1e-7, atol=1e-9)
+        np.testing.assert_allclose(c.length_dq2, (plus.length_dq - minus.length_dq) / (2 * h), rtol=1e-6, atol=1e-8)
+        second = (plus.length - 2 * c.length + minus.length) / h**2
+        np.testing.assert_allclose(c.length_dq2, second, rtol=1e-3, atol=1e-4)
+        for name in c.angles:
+            fd = _wrap(plus.angles[name] - minus.angles[name]) / (2 * h)
+            np.testing.assert_allclose(c.angles_dq[name], fd, rtol=1e-7, atol=1e-9)
+            fd2 = (plus.angles_dq[name] - minus.angles_dq[name]) / (2 * h)
+            np.testing.assert_allclose(c.angles_dq2[name], fd2, rtol=1e-6, atol=1e-8)
+
+
+def test_stroke_to_joint_inverts_joint_to_stroke(machine: Machine) -> None:
+    """The map joint -> stroke -> joint is the identity over the working range, and the time maps invert each other."""
+    rng = np.random.default_rng(3)
+    for chain in machine.chains:
+        q = _joint_samples(machine, chain.joint, 300, 5)
+        x = closure.joint_to_stroke(machine, chain, q)
+        np.testing.assert_allclose(closure.stroke_to_joint(machine, chain, x), q, rtol=0, atol=1e-11)
+        dq, ddq = rng.normal(size=300), rng.normal(size=300)
+        back = closure.actuator_to_joint(machine, chain, *closure.joint_to_actuator(machine, chain, q, dq, ddq))
+        for want, got in zip((q, dq, ddq), back, strict=True):
+            np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-10)
+
+
+def test_actuator_length_is_the_distance_between_its_pins(machine: Machine) -> None:
+    """Independently of the closure: the actuator's pins are x0 + x apart; rocker and coupler keep their lengths."""
+    rng = np.random.default_rng(4)
+    ranges = [machine.joint_link(j).joint_range for j in machine.joint_names]
+    q = np.stack([rng.uniform(lo, hi, 200) for lo, hi in ranges], -1)  # type: ignore[misc]
+    frames = forward_kinematics(machine, q)
+    for chain in machine.chains:
+        if chain.kind == "direct":
+            continue
+        pins = pin_positions(machine, frames, chain.name)
+        end = pins["pin"] if chain.kind == "linkage" else pins["end"]
+        x0 = chain.actuator.retracted_length
+        assert x0 is not None
+        np.testing.assert_allclose(
+            np.linalg.norm(end - pins["base"], axis=-1), x0 + frames.stroke[chain.name], atol=1e-12
+        )
+        _, rod_origin = frames.bodies[(chain.name, "rod")]
+        rod_end = np.linalg.norm(rod_origin - pins["base"], axis=-1) + chain.actuator.rod_length  # type: ignore[operator]
+        np.testing.assert_allclose(rod_end, x0 + frames.stroke[chain.name], atol=1e-12)
+        if chain.kind == "linkage" and chain.linkage is not None:
+            np.testing.assert_allclose(
+                np.linalg.norm(pins["pin"] - pins["rocker"], axis=-1), chain.linkage.rocker_length
+            )
+            np.testing.assert_allclose(
+                np.linalg.norm(pins["pin"] - pins["coupler"], axis=-1), chain.linkage.coupler_length
+            )
+
+
+def _four_bar(
+    rocker: tuple[float, float], coupler: tuple[float, float], lengths: tuple[float, float], side: int
+) -> Machine:
+    """A two-link machine whose second joint is driven through a four-bar of the given geometry."""
+    return machine_from_dict(
+        {
+            "name": "four-bar",
+            "source": "test",
+            "gravity": 9.81,
+            "links": {
+                "ground": {},
+                "stick": {
+                    "parent": "ground",
+                    "joint": "j1",
+                    "kind": "revolute",
+                    "joint_range": [-0.5, 0.5],
+                    "bodies": {"s": {"mass": 10.0, "com": [0.5, 0.0], "inertia_zz": 1.0}},
+                },
+                "tool": {
+                    "parent": "stick",
+                    "joint": "j2",
+                    "kind": "revolute",
+                    "joint_frame": {"r": [1.0, 0.0]},
+                    "joint_range": [-0.2, 0.2],
+                    "bodies": {"t": {"mass": 5.0, "com": [0.2, 0.0], "inertia_zz": 0.1}},
+                },
+            },
+            "chains": {
+                "c1": {
+                    "kind": "triangle",
+                    "joint": "j1",
+                    "pivots": {
+                        "base": {"link": "ground", "position": [0.3, -0.3]},
+                        "end": {"link": "stick", "position": [0.5, 0.1]},
+                    },
+                    "actuator": {"stroke": 1.0, "piston_offset": 0.05, "rod_length": 0.3, "emla": "e"},
+                },
+                "c2": {
+                    "kind": "linkage",
+                    "joint": "j2",
+                    "pivots": {
+                        "base": {"link": "stick", "position": [0.2, 0.25]},
+                        "rocker": {"link": "stick", "position": list(rocker)},
+                        "coupler": {"link": "tool", "position": list(coupler)},
+                    },
+                    "linkage": {"rocker_length": lengths[0], "coupler_length": lengths[1], "pin_side": side},
+                    "actuator": {"stroke": 2.0, "piston_offset": 0.05, "rod_length": 0.2, "emla": "e"},
+                },
+            },
+            "tcp": {"link": "tool", "r": [0.4, 0.0]},
+        },
+        check_assembly=False,
+    )
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    rx=st.floats(0.7, 0.9),
+    ry=st.floats(-0.05, 0.05),
+    cx=st.floats(-0.05, 0.05),
+    cy=st.floats(0.1, 0.2),
+    lr=st.floats(0.2, 0.3),
+    lc=st.floats(0.2, 0.3),
+    side=st.sampled_from([1, -1]),
+    q=st.floats(-0.2, 0.2),
+)
+def test_four_bar_closures_agree_for_any_geometry(
+    rx: float, ry: float, cx: float, cy: float, lr: float, lc: float, side: int, q: float
+) -> None:
+    """For random four-bars that assemble, the closed form and Newton agree and H lies on pin_side."""
+    machine = _four_bar((rx, ry), (cx, cy), (lr, lc), side)
+    chain = machine.chain("c2")
+    a = closure.closure(machine, chain, np.array([q]))
+    if not a.closes[0] or abs(a.length_dq[0]) < 1e-3:
+        return
+    geo = closure.chain_geometry(machine, chain)
+    H, _, u, _ = closure.pin_position(geo, np.array([q]))
+    r = geo.fixed["rocker"]
+    assert np.sign(u[0, 0] * (H[0, 1] - r[1]) - u[0, 1] * (H[0, 0] - r[0])) == side
+    b = numeric_closure(machine, chain, np.array([q]))
+    assert b.closes[0]
+    np.testing.assert_allclose([b.length[0], b.length_dq[0]], [a.length[0], a.length_dq[0]], rtol=1e-9, atol=1e-11)
+    np.testing.assert_allclose(b.length_dq2[0], a.length_dq2[0], rtol=1e-7, atol=1e-9)
