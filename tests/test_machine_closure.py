@@ -94,7 +94,7 @@ def test_actuator_length_is_the_distance_between_its_pins(machine: Machine) -> N
             np.linalg.norm(end - pins["base"], axis=-1), x0 + frames.stroke[chain.name], atol=1e-12
         )
         _, rod_origin = frames.bodies[(chain.name, "rod")]
-        rod_end = np.linalg.norm(rod_origin - pins["base"], axis=-1) + chain.actuator.rod_length  # type: ignore[operator]
+        rod_end = np.linalg.norm(rod_origin - pins["base"], axis=-1) + chain.actuator.rod_length
         np.testing.assert_allclose(rod_end, x0 + frames.stroke[chain.name], atol=1e-12)
         if chain.kind == "linkage" and chain.linkage is not None:
             np.testing.assert_allclose(
