@@ -57,9 +57,10 @@ def usable_stroke(chain: Chain) -> tuple[float, float]:
 
 def _transmission(geo: ChainGeometry, q: Array) -> Array:
     """Sign-carrying transmission of a linkage: cross(H - r, H - C) (zero at the four-bar's toggle)."""
-    H, C, _, _ = pin_position(geo, q)
-    a, b = H - geo.fixed["rocker"], H - C
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    with np.errstate(invalid="ignore"):  # NaN where the loop does not close
+        H, C, _, _ = pin_position(geo, q)
+        a, b = H - geo.fixed["rocker"], H - C
+        return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
 def _serves(geo: ChainGeometry, chain: Chain, q: Array, reference: float) -> NDArray[np.bool_]:

@@ -82,7 +82,8 @@ class Closure:
     ``length``, ``length_dq``, ``length_dq2``: s [m], ds/dq, d2s/dq2 (per rad or per m).
     ``angles`` (and ``_dq``, ``_dq2``): in-plane angle in the frame P of the x axis of each
     dependent body: ``cylinder`` (base pivot -> end), and for a linkage ``rocker`` (r -> H) and
-    ``coupler`` (H -> coupler pivot) [rad]. ``closes``: False where the loop cannot be assembled.
+    ``coupler`` (H -> coupler pivot) [rad]. ``closes``: False where the loop cannot be assembled
+    (the other fields are NaN there).
     """
 
     length: Array
@@ -141,7 +142,8 @@ def geometry_closure(geo: ChainGeometry, q: ArrayLike) -> Closure:
         return Closure(geo.x0 + q, np.ones_like(q), zero, {}, {}, {}, np.ones(q.shape, dtype=bool))
     if geo.kind == "triangle":
         return _triangle(geo, q)
-    return _linkage(geo, q)
+    with np.errstate(divide="ignore", invalid="ignore"):  # NaN where the loop does not close (closes False)
+        return _linkage(geo, q)
 
 
 def _point(geo: ChainGeometry, role: str, q: Array) -> tuple[Array, Array, Array]:

@@ -16,6 +16,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+import yaml
+
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.hydraulics.cylinders import Cylinder
 from hiab_sim.machine.assembly import check_machine
@@ -23,7 +25,7 @@ from hiab_sim.machine.chains import Actuator, Chain, DecisionVariable, Hydraulic
 from hiab_sim.machine.description import Link, Machine
 from hiab_sim.machine.parts import IDENTITY, Matrix3, Pose, RigidBody, Vector3, rot_z
 from hiab_sim.resources import Source
-from hiab_sim.yaml_fields import integer, mapping, number, read_yaml, text, vector
+from hiab_sim.yaml_fields import integer, mapping, number, text, vector
 
 #: Shipped machines: name -> file in hiab_sim/presets/.
 PRESETS = {"xs031": "xs031_machine.yaml", "exact": "exact_excavator.yaml"}
@@ -37,6 +39,31 @@ _ACTUATOR_OPTIONAL = {"body_scaling"}
 _LINKAGE = {"rocker_length", "coupler_length", "pin_side", "rocker_body", "coupler_body"}
 _BODY = {"mass", "com", "inertia", "inertia_zz"}
 _VARIABLE = {"kind", "pivot", "bounds"}
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """YAML safe loader that refuses a key given twice in one mapping (two links of one name)."""
+
+
+def _unique_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+    seen: set[Any] = set()
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=deep)
+        if key in seen:
+            raise ConfigError(f"line {key_node.start_mark.line + 1}: duplicate name {key!r} in one mapping")
+        seen.add(key)
+    return loader.construct_mapping(node, deep=deep)
+
+
+_UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _unique_mapping)
+
+
+def read_machine_yaml(source: Source) -> Any:
+    """Parse a machine file; malformed YAML or a duplicate key raises :class:`ConfigError`."""
+    try:
+        return yaml.load(source.read_text(), Loader=_UniqueKeyLoader)  # a SafeLoader subclass
+    except yaml.YAMLError as error:
+        raise ConfigError(f"{source.label}: not valid YAML: {' '.join(str(error).split())}") from None
 
 
 def locate_machine(source: str | Path | Source) -> Source:
@@ -62,7 +89,7 @@ def load_machine(source: str | Path | Source = "xs031", *, check_assembly: bool 
 
     """
     found = locate_machine(source)
-    return machine_from_dict(read_yaml(found), origin=found.label, check_assembly=check_assembly)
+    return machine_from_dict(read_machine_yaml(found), origin=found.label, check_assembly=check_assembly)
 
 
 def machine_from_dict(data: Any, origin: str = "machine", *, check_assembly: bool = True) -> Machine:
