@@ -19,6 +19,7 @@ from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.machine import closure
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics_mujoco import MujocoMachineDynamics
 from hiab_sim.machine.dynamics_newton_euler import NewtonEulerInverseDynamics
@@ -28,7 +29,9 @@ from hiab_sim.machine.mjcf_build import SimulationExtras
 
 CRANE = load_crane("xs031")
 XS031 = load_machine("xs031")
-EXCAVATOR = excavator()
+EXACT = load_machine("exact")  # the shipped excavator preset
+EXCAVATOR = excavator()  # the same arm written in the test from the reference sheet, other actuator bodies
+MACHINES = pytest.mark.parametrize("machine", [XS031, EXACT, EXCAVATOR], ids=["xs031", "exact", "test-excavator"])
 
 
 def relative(a: np.ndarray, b: np.ndarray) -> float:
@@ -85,7 +88,7 @@ def _both(machine: Machine, samples: int, seed: int) -> tuple[MachineActuatorSam
     )
 
 
-@pytest.mark.parametrize("machine", [XS031, EXCAVATOR], ids=["xs031", "excavator"])
+@MACHINES
 def test_both_paths_agree_on_random_states(machine: Machine) -> None:
     """Newton-Euler and MuJoCo give the same actuator forces and pin forces (1e-10 relative; measured ~1e-14)."""
     ne, mj = _both(machine, 80, seed=5)
@@ -100,9 +103,19 @@ def test_both_paths_agree_on_random_states(machine: Machine) -> None:
     assert np.max(np.abs(mj.pins.local - ne.pins.local)) < 1e-10 * peak
 
 
+@MACHINES
+def test_strokes_equal_the_machine_closure(machine: Machine) -> None:
+    """The dynamics' own closed-form closure gives the strokes of :mod:`hiab_sim.machine.closure` (1e-12 m)."""
+    q, dq, ddq = random_states(machine, 50, seed=9)
+    out = NewtonEulerInverseDynamics(machine)(q, dq, ddq)
+    for k, chain in enumerate(machine.chains):
+        x = closure.joint_to_stroke(machine, chain, q[:, machine.joint_names.index(chain.joint)])
+        np.testing.assert_allclose(out.stroke[:, k], x, atol=1e-12, err_msg=chain.name)
+
+
 def test_excavator_pins_include_every_four_bar_pin() -> None:
     """The bucket linkage reports its rocker hinge, the rocker-link pin, the rod pin and the link-bucket pin."""
-    ne, _ = _both(EXCAVATOR, 3, seed=6)
+    ne, _ = _both(EXACT, 3, seed=6)
     for pin in ("bucket.base_pin", "bucket.rocker_pin", "bucket.link_pin", "bucket.rod_pin", "bucket.coupler_pin"):
         assert pin in ne.pins.names
         assert np.all(np.linalg.norm(ne.pins.force(pin), axis=1) > 1.0)  # every pin carries load
@@ -118,12 +131,23 @@ def test_both_paths_agree_for_any_feasible_xs031_design(u: np.ndarray) -> None:
     assert relative(mj.pins.world, ne.pins.world) < 1e-10
 
 
+@settings(max_examples=10, deadline=None)
+@given(st.lists(st.floats(0.0, 1.0), min_size=9, max_size=9).map(np.array))
+def test_both_paths_agree_for_any_excavator_design_in_its_bounds(u: np.ndarray) -> None:
+    """For any design of the excavator preset inside its declared bounds the two paths agree (1e-10 relative)."""
+    low, high = EXACT.design_bounds()
+    machine = EXACT.with_design(low + u * (high - low))
+    ne, mj = _both(machine, 8, seed=int(1000 * u[0]))
+    assert relative(mj.force, ne.force) < 1e-10
+    assert relative(mj.pins.world, ne.pins.world) < 1e-10
+
+
 def test_simulation_extras_add_armature_and_damping_on_the_motor_side() -> None:
     """With extras the MuJoCo force is f_x + J a_x + b v_x (eqs. torque_torque, torque_force); pins unchanged."""
-    q, dq, ddq = random_states(EXCAVATOR, 20, seed=7)
+    q, dq, ddq = random_states(EXACT, 20, seed=7)
     armature, damping = (310.0, 420.0, 530.0), (1.5e3, 2.5e3, 3.5e3)
-    bare = MujocoMachineDynamics(EXCAVATOR)(q, dq, ddq)
-    drive = MujocoMachineDynamics(EXCAVATOR, extras=SimulationExtras(armature, damping))(q, dq, ddq)
+    bare = MujocoMachineDynamics(EXACT)(q, dq, ddq)
+    drive = MujocoMachineDynamics(EXACT, extras=SimulationExtras(armature, damping))(q, dq, ddq)
     expected = bare.force + np.array(armature) * bare.acceleration + np.array(damping) * bare.velocity
     assert relative(drive.force, expected) < 1e-12
     assert relative(drive.pins.world, bare.pins.world) < 1e-12

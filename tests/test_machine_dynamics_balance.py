@@ -28,8 +28,9 @@ from hiab_sim.machine.loader import load_machine
 from hiab_sim.machine.mjcf_build import build_machine_model
 
 XS031 = load_machine("xs031")
+EXACT = load_machine("exact")
 EXCAVATOR = excavator()
-MACHINES = pytest.mark.parametrize("machine", [XS031, EXCAVATOR], ids=["xs031", "excavator"])
+MACHINES = pytest.mark.parametrize("machine", [XS031, EXACT, EXCAVATOR], ids=["xs031", "exact", "test-excavator"])
 PATHS = pytest.mark.parametrize("path", [NewtonEulerInverseDynamics, MujocoMachineDynamics], ids=["ne", "mujoco"])
 
 
@@ -123,13 +124,13 @@ def test_constrained_forward_dynamics_reproduces_the_accelerations() -> None:
     The loops are soft ``connect`` equalities there; their compliance (solref/solimp) is the remaining
     difference, bounded at 1 % of the largest acceleration.
     """
-    q, dq, ddq = random_states(EXCAVATOR, 6, seed=15)
-    forces = NewtonEulerInverseDynamics(EXCAVATOR)(q, dq, ddq).force
-    mj = MujocoMachineDynamics(EXCAVATOR)
+    q, dq, ddq = random_states(EXACT, 6, seed=15)
+    forces = NewtonEulerInverseDynamics(EXACT)(q, dq, ddq).force
+    mj = MujocoMachineDynamics(EXACT)
     qpos, qvel, _ = mj.state(q, dq, ddq)
-    model = build_machine_model(EXCAVATOR)
+    model = build_machine_model(EXACT)
     data = mujoco.MjData(model)
-    joints = [int(model.joint(name).dofadr[0]) for name in EXCAVATOR.joint_names]
+    joints = [int(model.joint(name).dofadr[0]) for name in EXACT.joint_names]
     for i in range(len(q)):
         data.qpos[:], data.qvel[:], data.ctrl[:] = qpos[i], qvel[i], forces[i]
         mujoco.mj_forward(model, data)

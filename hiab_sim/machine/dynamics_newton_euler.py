@@ -27,6 +27,7 @@ This yields the actuator forces and every pin force in one solve, with no Jacobi
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -57,14 +58,17 @@ class NewtonEulerInverseDynamics:
     """Inverse dynamics of one machine design by per-body Newton-Euler (see the module docstring).
 
     Args:
-        machine: The machine, already set to its design (``hiab_sim.machine.design.with_design``).
+        machine: The machine description.
+        design: Decision variable values (default: the file's), as :meth:`Machine.with_design`.
 
     Raises:
-        InvalidInputError: a moving joint that no chain drives.
+        InvalidInputError: a moving joint that no chain drives, a design outside its bounds.
 
     """
 
-    def __init__(self, machine: Machine) -> None:
+    def __init__(self, machine: Machine, design: Sequence[float] | None = None) -> None:
+        if design is not None:
+            machine = machine.with_design(design)
         self.tree: MachineTree = machine_tree(machine)
         self.planar: tuple[PlanarBody, ...] = planar_bodies(self.tree)
         self._pins = pin_layout(self.tree)
