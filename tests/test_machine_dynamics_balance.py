@@ -58,7 +58,7 @@ def test_power_balance_on_random_states(machine: Machine, path: type) -> None:
     rate = (energy[0] - 8.0 * energy[1] + 8.0 * energy[2] - energy[3]) / (12.0 * h)
     peak = float(np.max(np.abs(out.power)))
     assert peak > 100.0
-    assert float(np.max(np.abs(power - rate))) < 1e-7 * peak
+    assert float(np.max(np.abs(power - rate))) < 1e-9 * peak  # measured 2e-12 (XS 031), 9e-13 (excavator)
 
 
 @MACHINES
