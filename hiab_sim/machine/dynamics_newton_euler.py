@@ -1,28 +1,31 @@
-"""Analytic inverse dynamics of any planar parallel-serial machine: Newton-Euler of every body, numpy only.
+"""Analytic inverse dynamics of any planar parallel-serial machine: Newton-Euler on the link tree, numpy only.
 
 Written independently of MuJoCo. For each sample the loop-consistent motion of every body comes
-from :mod:`hiab_sim.machine.dynamics_planar`; then each moving body b of the tree
-(:mod:`hiab_sim.machine.dynamics_tree`) is cut free and its planar Newton-Euler equations are
-written in the world, moments about the world origin (Lynch & Park eq. 8.41 restricted to se(2)):
+from :mod:`hiab_sim.machine.dynamics_planar`; each moving body b of the tree
+(:mod:`hiab_sim.machine.dynamics_tree`) is then cut free at its joint and at its loop pins. Its
+planar Newton-Euler equations, in the world with moments about the world origin (Lynch & Park
+eq. 8.41 restricted to se(2)), fix what the forces on it must add up to:
 
-    sum F   = m_b (a_c - g),                 g = (0, -g) [m/s^2]
-    sum M_O = I_zz,b alpha_b + c_b x m_b (a_c - g),
+    (F, M_O)_b = ( m_b (a_c - g),  I_zz,b alpha_b + c_b x m_b (a_c - g) ),   g = (0, -g).
 
-where the forces on the body are its unknown joint and pin forces and the known external force
-at the TCP. The unknowns, per sample:
+The force (and moment) that body b's joint transmits from its parent follows tip to base, the
+backward pass of recursive Newton-Euler:
 
-* each revolute joint: the pin force R (2) the parent applies to the child at the joint origin
-  (the parent gets -R); an unactuated hinge carries no moment about the plane normal;
-* each prismatic joint: the actuator force f along the slide axis u (the seed's f_x: > 0
-  extends), and the constraint force N along i u and moment M, all applied at the child's frame
-  origin (the parent gets the opposite);
-* each loop pin: the force lambda (2) body b applies to body a at the pin (body b gets -lambda).
+    T_b = (F, M_O)_b - (TCP force on b) - sum (loop pin forces on b) + sum_children T_c,
 
-With every moving joint driven by one chain the unknowns are exactly three per moving body, so
-the system A(q) u = b (3 n x 3 n per sample) is square and is solved for all samples at once
-(``numpy.linalg.solve``); it is regular away from a flat triangle or a four-bar at its toggle.
-This yields the actuator forces and every pin force in one solve, with no Jacobian projection
-(the MuJoCo path, :mod:`hiab_sim.machine.dynamics_mujoco`, projects instead).
+with the force lambda (2 per loop pin) that body b of a pin applies to its body a (and -lambda
+on b) still unknown: every T_b is affine in lambda. The unknowns follow from the joints that
+carry no moment: each unactuated revolute joint's moment about its pin vanishes,
+
+    M_O(T_b) - o_b x F(T_b) = 0   for every revolute joint b,
+
+one equation each. With every moving joint driven by one chain (all prismatic joints are the
+actuators) there are exactly as many hinges as loop-pin force components, so this system
+(2 n_pins square, per sample) gives lambda; then every T_b is known: a hinge's T_b is its pin
+force, a slide's axial component u . F(T_b) is the actuator force f_x (> 0 extends). It is
+regular away from a flat triangle or a four-bar at its toggle. The MuJoCo path
+(:mod:`hiab_sim.machine.dynamics_mujoco`) instead projects MuJoCo's generalised forces on the
+loops' admissible motions.
 """
 
 from __future__ import annotations
@@ -49,7 +52,7 @@ Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
 
 
-def _cross(a: Complex, b: Complex) -> Array:
+def _cross(a: Complex | complex, b: Complex | complex) -> Array:
     """The z component of the cross product of in-plane vectors (complex)."""
     return (np.conj(a) * b).imag
 
@@ -72,19 +75,9 @@ class NewtonEulerInverseDynamics:
         self.tree: MachineTree = machine_tree(machine)
         self.planar: tuple[PlanarBody, ...] = planar_bodies(self.tree)
         self._pins = pin_layout(self.tree)
-        bodies = self.tree.bodies
-        self._moving = list(range(1, len(bodies)))
-        self._row = {b: 3 * k for k, b in enumerate(self._moving)}
-        columns: dict[int, int] = {}
-        size = 0
-        for b in self._moving:
-            columns[b] = size
-            size += 2 if bodies[b].kind == "revolute" else 3
-        self._joint_column = columns
-        self._loop_column = [size + 2 * k for k in range(len(self.tree.loops))]
-        self._size = size + 2 * len(self.tree.loops)
-        if self._size != 3 * len(self._moving):
-            raise AssertionError("a fully driven tree has three unknowns per moving body")
+        self._hinges = [b for b, body in enumerate(self.tree.bodies) if body.kind == "revolute"]
+        if len(self._hinges) != 2 * len(self.tree.loops):
+            raise AssertionError("a fully driven tree has one hinge per loop-pin force component")
 
     def state(self, q: Any, dq: Any, ddq: Any) -> tuple[Array, Array, Array]:
         """Loop-consistent full coordinates, rates, accelerations (T, nbody); inputs checked."""
@@ -109,92 +102,70 @@ class NewtonEulerInverseDynamics:
         T = qf.shape[0]
         external = tcp_force_array(tcp_force, T)
         fk = frames(self.tree, self.planar, qf, dqf, ddqf)
-        A, rhs = self._system(fk, external[:, 0] + 1j * external[:, 1])
-        u = np.linalg.solve(A, rhs[..., None])[..., 0]
+        transmitted, lam = self._joint_forces(fk, external[:, 0] + 1j * external[:, 1])
         act = list(self.tree.actuated)
-        force = np.stack([u[:, self._joint_column[b]] for b in act], axis=1)
+        force = np.stack([(np.conj(self._axis(fk, b)) * transmitted[b]).real for b in act], axis=1)
         return MachineActuatorSamples(
             names=tuple(self.tree.machine.actuator_names),
             force=force,
             velocity=dqf[:, act],
             acceleration=ddqf[:, act],
             stroke=qf[:, act],
-            pins=self._pin_forces(fk, u),
+            pins=self._pin_forces(fk, transmitted, lam),
         )
 
     # ------------------------------------------------------------------------------------------
 
-    def _system(self, fk: Frames, external: Complex) -> tuple[Array, Array]:
-        """The stacked Newton-Euler equations A u = b, (T, 3n, 3n) and (T, 3n)."""
+    def _axis(self, fk: Frames, b: int) -> Complex:
+        """World direction of body b's slide (T,)."""
+        return fk.rot[self.tree.bodies[b].parent] * self.planar[b].axis
+
+    def _joint_forces(self, fk: Frames, external: Complex) -> tuple[list[Complex], Array]:
+        """Force each joint transmits from parent to body (complex (T,), index = body) and lambda (T, 2 n_pins)."""
         tree, planar = self.tree, self.planar
-        T = fk.z[0].shape[0]
-        A = np.zeros((T, self._size, self._size))
-        rhs = np.zeros((T, self._size))
-
-        def put(body: int, column: int, force: Complex | complex, point: Complex, moment: float = 0.0) -> None:
-            """Add unit unknown ``column``'s force on ``body`` at ``point`` (and a pure moment)."""
-            if body == 0:
-                return  # the root is held by the world: its equations are not written
-            r = self._row[body]
-            f = np.broadcast_to(np.asarray(force, dtype=complex), (T,))
-            A[:, r, column] += f.real
-            A[:, r + 1, column] += f.imag
-            A[:, r + 2, column] += _cross(point, f) + moment
-
-        for b in self._moving:
-            body, c = tree.bodies[b], self._joint_column[b]
-            origin = fk.z[b]
-            if body.kind == "revolute":
-                for k, direction in enumerate((1.0 + 0j, 1j)):
-                    put(b, c + k, direction, origin)
-                    put(body.parent, c + k, -direction, origin)
-            else:
-                u = np.exp(1j * fk.theta[body.parent]) * planar[b].axis
-                for k, direction in enumerate((u, 1j * u)):
-                    put(b, c + k, direction, origin)
-                    put(body.parent, c + k, -direction, origin)
-                put(b, c + 2, 0j, origin, 1.0)
-                put(body.parent, c + 2, 0j, origin, -1.0)
-            # Newton-Euler: what the forces on the body must add up to
+        T, n, pins = fk.z[0].shape[0], len(tree.bodies), 2 * len(tree.loops)
+        # T_b = base + coefficient @ lambda, force (complex) and moment about O, per body
+        force = [np.zeros(T, dtype=complex) for _ in range(n)]
+        moment = [np.zeros(T) for _ in range(n)]
+        force_per = [np.zeros((T, pins), dtype=complex) for _ in range(n)]
+        moment_per = [np.zeros((T, pins)) for _ in range(n)]
+        for b in range(1, n):
             p = planar[b]
             if p.mass > 0.0 or p.inertia_zz > 0.0:
                 com, _, acc = fk.point(b, p.com)
                 net = p.mass * (acc + 1j * tree.gravity)
-                r = self._row[b]
-                rhs[:, r] += net.real
-                rhs[:, r + 1] += net.imag
-                rhs[:, r + 2] += p.inertia_zz * fk.alpha[b] + _cross(com, net)
-        for loop, c in zip(tree.loops, self._loop_column, strict=True):
-            pa = fk.point(loop.body_a, planar[loop.body_a].point(loop.point_a))[0]
-            pb = fk.point(loop.body_b, planar[loop.body_b].point(loop.point_b))[0]
-            for k, direction in enumerate((1.0 + 0j, 1j)):
-                put(loop.body_a, c + k, direction, pa)
-                put(loop.body_b, c + k, -direction, pb)
+                force[b] += net
+                moment[b] += p.inertia_zz * fk.alpha[b] + _cross(com, net)
         tcp = fk.point(tree.tcp_body, planar[tree.tcp_body].point(np.asarray(tree.tcp.position)))[0]
-        if tree.tcp_body != 0:
-            r = self._row[tree.tcp_body]
-            rhs[:, r] -= external.real
-            rhs[:, r + 1] -= external.imag
-            rhs[:, r + 2] -= _cross(tcp, external)
-        return A, rhs
+        force[tree.tcp_body] -= external
+        moment[tree.tcp_body] -= _cross(tcp, external)
+        for k, loop in enumerate(tree.loops):
+            on_a = fk.point(loop.body_a, planar[loop.body_a].point(loop.point_a))[0]
+            on_b = fk.point(loop.body_b, planar[loop.body_b].point(loop.point_b))[0]
+            for j, unit in enumerate((1.0 + 0j, 1j)):  # lambda_x, lambda_y
+                force_per[loop.body_a][:, 2 * k + j] -= unit
+                moment_per[loop.body_a][:, 2 * k + j] -= _cross(on_a, unit)
+                force_per[loop.body_b][:, 2 * k + j] += unit
+                moment_per[loop.body_b][:, 2 * k + j] += _cross(on_b, unit)
+        for b in range(n - 1, 0, -1):  # parents precede children: add each body's joint into its parent's
+            parent = tree.bodies[b].parent
+            if parent > 0:
+                force[parent] += force[b]
+                moment[parent] += moment[b]
+                force_per[parent] += force_per[b]
+                moment_per[parent] += moment_per[b]
+        rows = np.stack([moment_per[b] - _cross(fk.z[b][:, None], force_per[b]) for b in self._hinges], axis=1)
+        rhs = np.stack([_cross(fk.z[b], force[b]) - moment[b] for b in self._hinges], axis=1)
+        lam = np.asarray(np.linalg.solve(rows, rhs[..., None])[..., 0], dtype=float)
+        transmitted = [force[b] + np.einsum("tl,tl->t", force_per[b], lam) for b in range(n)]
+        return transmitted, lam
 
-    def _pin_forces(self, fk: Frames, u: NDArray[np.floating[Any]]) -> PinForces:
-        """World and body-frame forces of every pin from the solved unknowns."""
+    def _pin_forces(self, fk: Frames, transmitted: list[Complex], lam: Array) -> PinForces:
+        """World and body-frame forces of every joint and loop pin."""
         tree = self.tree
-        world = []
-        on_body = []
-        for b in self._moving:
-            c = self._joint_column[b]
-            if tree.bodies[b].kind == "revolute":
-                world.append(u[:, c : c + 2])
-            else:  # axial (actuator) and normal force along u and i u
-                axis = np.exp(1j * fk.theta[tree.bodies[b].parent]) * self.planar[b].axis
-                total = axis * (u[:, c] + 1j * u[:, c + 1])
-                world.append(np.stack([total.real, total.imag], axis=1))
-            on_body.append(b)
-        for loop, c in zip(tree.loops, self._loop_column, strict=True):
-            world.append(u[:, c : c + 2])
-            on_body.append(loop.body_a)
+        world = [np.stack([transmitted[b].real, transmitted[b].imag], axis=1) for b in range(1, len(tree.bodies))]
+        world.extend(lam[:, 2 * k : 2 * k + 2] for k in range(len(tree.loops)))
+        on_body = [*range(1, len(tree.bodies)), *(loop.body_a for loop in tree.loops)]
         world_array = np.stack(world, axis=1)
         local = np.empty((*world_array.shape[:2], 3))
         for k, b in enumerate(on_body):

@@ -94,7 +94,8 @@ class Frames:
     """Motion of every body frame over T samples (lists indexed by body, each (T,)).
 
     ``z``, ``dz``, ``ddz``: origin position, velocity, acceleration (complex) [m, m/s, m/s^2];
-    ``theta``, ``omega``, ``alpha``: planar angle [rad], rate, acceleration of the frame.
+    ``theta``, ``omega``, ``alpha``: planar angle [rad], rate, acceleration of the frame;
+    ``rot``: e^{i theta}.
     """
 
     z: list[Complex]
@@ -103,10 +104,11 @@ class Frames:
     theta: list[Array]
     omega: list[Array]
     alpha: list[Array]
+    rot: list[Complex]
 
     def point(self, b: int, r: complex | Complex) -> tuple[Complex, Complex, Complex]:
         """Position, velocity and acceleration of planar point r of body b."""
-        arm = np.exp(1j * self.theta[b]) * r
+        arm = self.rot[b] * r
         w, a = self.omega[b], self.alpha[b]
         return self.z[b] + arm, self.dz[b] + 1j * w * arm, self.ddz[b] + (1j * a - w**2) * arm
 
@@ -114,7 +116,7 @@ class Frames:
 def frames(tree: MachineTree, planar: tuple[PlanarBody, ...], q: Array, dq: Array, ddq: Array) -> Frames:
     """Forward kinematics of all bodies for full coordinates q, dq, ddq (T, nbody); column b is body b's joint."""
     T = q.shape[0]
-    out = Frames([], [], [], [], [], [])
+    out = Frames([], [], [], [], [], [], [])
     for b, body in enumerate(tree.bodies):
         p = planar[b]
         if body.parent < 0:
@@ -125,6 +127,7 @@ def frames(tree: MachineTree, planar: tuple[PlanarBody, ...], q: Array, dq: Arra
             out.theta.append(zero)
             out.omega.append(zero)
             out.alpha.append(zero)
+            out.rot.append(np.ones(T, dtype=complex))
             continue
         parent = body.parent
         if body.kind == "revolute":
@@ -134,18 +137,21 @@ def frames(tree: MachineTree, planar: tuple[PlanarBody, ...], q: Array, dq: Arra
                 out.omega[parent] + dq[:, b],
                 out.alpha[parent] + ddq[:, b],
             )
+            rot = out.rot[parent] * np.exp(1j * q[:, b])
         else:
             z, dz, ddz = out.point(parent, np.asarray(p.origin + p.axis * q[:, b], dtype=np.complex128))
-            u = np.exp(1j * out.theta[parent]) * p.axis
+            u = out.rot[parent] * p.axis
             dz = dz + u * dq[:, b]
             ddz = ddz + 2j * out.omega[parent] * u * dq[:, b] + u * ddq[:, b]
             theta, omega, alpha = out.theta[parent], out.omega[parent], out.alpha[parent]
+            rot = out.rot[parent]
         out.z.append(z)
         out.dz.append(dz)
         out.ddz.append(ddz)
         out.theta.append(theta)
         out.omega.append(omega)
         out.alpha.append(alpha)
+        out.rot.append(rot)
     return out
 
 
@@ -234,7 +240,7 @@ def point_jacobian(tree: MachineTree, planar: tuple[PlanarBody, ...], fk: Frames
         if body.kind == "revolute":
             jac[:, j] = 1j * (p - fk.z[j])
         else:
-            jac[:, j] = np.exp(1j * fk.theta[body.parent]) * planar[j].axis
+            jac[:, j] = fk.rot[body.parent] * planar[j].axis
         j = body.parent
     return jac
 
