@@ -6,7 +6,8 @@ where a number belongs raise :class:`ConfigError`); ranges and names are checked
 dataclasses when they are built, and the assembly over the working ranges (a loop that cannot
 close, a chain passing its toggle, a stroke shorter than the working range needs) by
 :func:`hiab_sim.machine.assembly.check_machine`; each raises a one-line
-:class:`InvalidInputError` naming the field.
+:class:`InvalidInputError` naming the field. The file's own values of its decision variables must
+lie within their declared bounds.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from typing import Any
 
 import yaml
 
+from hiab_sim.checks import check_range
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.hydraulics.cylinders import Cylinder
 from hiab_sim.machine.assembly import check_machine
@@ -98,7 +100,7 @@ def machine_from_dict(data: Any, origin: str = "machine", *, check_assembly: boo
     if "notes" in top and not isinstance(top["notes"], Mapping | list | str):
         raise ConfigError("notes: expected text, a list or a mapping")
     links_node = mapping(top["links"], "links", None)
-    links = tuple(_link(str(name), node) for name, node in links_node.items())
+    links = _parents_first(tuple(_link(str(name), node) for name, node in links_node.items()))
     chains_node = mapping(top["chains"], "chains", None)
     chains = tuple(_chain(str(name), node) for name, node in chains_node.items())
     tcp = mapping(top["tcp"], "tcp", {"link", "r", "R", "angle"}, {"link", "r"})
@@ -113,11 +115,36 @@ def machine_from_dict(data: Any, origin: str = "machine", *, check_assembly: boo
         hydraulic=_hydraulic(top["hydraulic"]) if "hydraulic" in top else None,
         workspace=_workspace(top["workspace"]) if "workspace" in top else None,
     )
+    for variable, value in zip(machine.decision_variables, machine.design_values(), strict=True):
+        check_range(f"chains.{variable.chain}.variables.{variable.name}", value, variable.low, variable.high, "m")
     if check_assembly:
         failures = check_machine(machine)
         if failures:
             raise failures[0].error()
     return machine
+
+
+def _parents_first(links: tuple[Link, ...]) -> tuple[Link, ...]:
+    """The links reordered so every parent precedes its children (file order otherwise kept).
+
+    Links whose parent is unknown or that form a cycle keep their place at the end, where
+    :class:`Machine` names the offending ``parent``.
+    """
+    placed: list[Link] = []
+    names: set[str] = set()
+    pending = list(links)
+    while pending:
+        left = []
+        for link in pending:  # one pass in file order: a file listed parents-first keeps its order
+            if link.parent is None or link.parent in names:
+                placed.append(link)
+                names.add(link.name)
+            else:
+                left.append(link)
+        if len(left) == len(pending):
+            return (*placed, *left)
+        pending = left
+    return tuple(placed)
 
 
 def _vec3(value: Any, where: str) -> Vector3:
