@@ -19,7 +19,7 @@ def test_upright_smooth_blade_in_sand_meets_the_rankine_passive_force() -> None:
     Rankine's passive earth pressure on a smooth vertical wall (the Coulomb wedge at beta* = 45 deg - phi/2).
     """
     phi = np.radians(33.0)
-    soil = SoilProperties(1700.0, phi, 0.0, 0.0, source="test values")
+    soil = SoilProperties(1700.0, phi, 0.0, 0.0, 0.0, 0.0, "test values")
     depth = np.array([0.1, 0.25, 0.4])
     along, up = blade_force(soil, G, np.pi / 2, depth, width_m=0.6)
     rankine = 0.5 * 1700.0 * G * depth**2 * np.tan(np.pi / 4 + phi / 2) ** 2 * 0.6
@@ -60,7 +60,7 @@ def test_blade_force_equals_the_wedge_equilibrium(
     alpha: float, depth: float, phi: float, cohesion: float, delta_ratio: float, adhesion: float, surcharge: float
 ) -> None:
     """For any soil and rake angle, the closed-form N factors give the wedge's own force balance at beta*."""
-    soil = SoilProperties(1800.0, phi, cohesion, delta_ratio * phi, adhesion, surcharge)
+    soil = SoilProperties(1800.0, phi, cohesion, delta_ratio * phi, adhesion, surcharge, "test values")
     beta = float(failure_plane_angle(soil, G, alpha, depth)[0])
     along, up = blade_force(soil, G, alpha, depth, width_m=1.0)
     expected = _wedge_equilibrium(soil, alpha, depth, beta)
@@ -72,7 +72,7 @@ def test_blade_force_equals_the_wedge_equilibrium(
 
 def test_world_force_opposes_the_travel_and_vanishes_above_ground() -> None:
     """The tool travelling along -x is pushed towards +x; depth 0 gives no force; bad inputs name their field."""
-    soil = SoilProperties(1600.0, np.radians(30.0), 5e3, np.radians(20.0), source="test values")
+    soil = SoilProperties(1600.0, np.radians(30.0), 5e3, np.radians(20.0), 0.0, 0.0, "test values")
     force = tool_force_world(soil, G, [1.2, 1.2], [0.2, 0.0], 0.5, [-1.0, -1.0])
     assert force[0, 0] > 0.0
     np.testing.assert_array_equal(force[1], [0.0, 0.0])
@@ -83,4 +83,6 @@ def test_world_force_opposes_the_travel_and_vanishes_above_ground() -> None:
     with pytest.raises(InvalidInputError, match="travel_sign"):
         tool_force_world(soil, G, 1.0, 0.1, 0.5, 0.5)
     with pytest.raises(InvalidInputError, match=r"soil\.friction_angle_rad"):
-        SoilProperties(1600.0, 2.0, 0.0, 0.0)
+        SoilProperties(1600.0, 2.0, 0.0, 0.0, 0.0, 0.0, "test values")
+    with pytest.raises(InvalidInputError, match=r"soil\.source"):
+        SoilProperties(1600.0, 0.5, 0.0, 0.0, 0.0, 0.0, " ")

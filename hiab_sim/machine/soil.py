@@ -59,7 +59,7 @@ class SoilProperties:
         tool_friction_angle_rad: Soil-tool friction angle delta [rad] in [0, pi/2).
         adhesion_Pa: Soil-tool adhesion c_a [Pa] >= 0.
         surcharge_Pa: Pressure q on the soil surface above the wedge [Pa] >= 0.
-        source: Where these numbers come from.
+        source: Where these numbers come from (required: soil data vary by an order of magnitude).
 
     """
 
@@ -67,11 +67,13 @@ class SoilProperties:
     friction_angle_rad: float
     cohesion_Pa: float
     tool_friction_angle_rad: float
-    adhesion_Pa: float = 0.0
-    surcharge_Pa: float = 0.0
-    source: str = ""
+    adhesion_Pa: float
+    surcharge_Pa: float
+    source: str
 
     def __post_init__(self) -> None:
+        if not self.source.strip():
+            raise InvalidInputError("soil.source", self.source, "must name where the soil data come from")
         check_positive("soil.density_kg_m3", self.density_kg_m3, "kg/m^3")
         check_range("soil.friction_angle_rad", self.friction_angle_rad, 0.0, np.pi / 2, "rad", high_open=True)
         check_non_negative("soil.cohesion_Pa", self.cohesion_Pa, "Pa")
