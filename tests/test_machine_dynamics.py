@@ -7,6 +7,7 @@ loop projection) are independent; on the XS 031 both must also reproduce the cra
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -25,7 +26,9 @@ from hiab_sim.machine.dynamics_mujoco import MujocoMachineDynamics
 from hiab_sim.machine.dynamics_newton_euler import NewtonEulerInverseDynamics
 from hiab_sim.machine.dynamics_tree import MachineActuatorSamples
 from hiab_sim.machine.loader import load_machine
-from hiab_sim.machine.mjcf_build import SimulationExtras
+from hiab_sim.machine.mjcf_build import SimulationExtras, build_machine_model
+from hiab_sim.model.drives import SlideDrives
+from hiab_sim.model.mjcf import build_model
 
 CRANE = load_crane("xs031")
 XS031 = load_machine("xs031")
@@ -172,3 +175,36 @@ def test_bad_samples_and_forces_name_their_field() -> None:
         NewtonEulerInverseDynamics(undriven)
     with pytest.raises(InvalidInputError, match="extras"):
         MujocoMachineDynamics(EXCAVATOR, extras=SimulationExtras((1.0,), (1.0,)))
+
+
+def test_xs031_simulation_model_equals_the_crane_simulation_model() -> None:
+    """The machine MJCF with extras has the crane simulation MJCF's mass matrix, bias and passive forces.
+
+    Compared at the same loop-consistent states, joints matched by name (1e-12 relative).
+    """
+    armature, damping = (310.0, 420.0, 53.0), (1500.0, 2500.0, 350.0)
+    crane_model = build_model(CRANE, drives=SlideDrives(armature, damping, (1e5, 1e5, 1e5)))
+    machine_model = build_machine_model(XS031, extras=SimulationExtras(armature, damping))
+    same = {"lift_q1": "lift.base_pin", "x1": "lift.stroke", "tilt_q1": "tilt.base_pin", "x2": "tilt.stroke"}
+    order = [
+        int(machine_model.joint(same.get(name, name)).dofadr[0])
+        for name in (crane_model.joint(j).name for j in range(crane_model.njnt))
+    ]
+    q, dq, ddq = random_states(XS031, 5, seed=10)
+    crane_state = MujocoInverseDynamics(CRANE).state(JointSamples(q, dq, ddq))
+    machine_state = MujocoMachineDynamics(XS031).state(q, dq, ddq)
+    crane_data, machine_data = mujoco.MjData(crane_model), mujoco.MjData(machine_model)
+    nv = crane_model.nv
+    for i in range(len(q)):
+        crane_data.qpos[:], crane_data.qvel[:] = crane_state[0][i], crane_state[1][i]
+        machine_data.qpos[:], machine_data.qvel[:] = machine_state[0][i], machine_state[1][i]
+        np.testing.assert_allclose(machine_data.qvel[order], crane_data.qvel, atol=1e-12)
+        mujoco.mj_forward(crane_model, crane_data)
+        mujoco.mj_forward(machine_model, machine_data)
+        crane_mass, machine_mass = np.zeros((nv, nv)), np.zeros((nv, nv))
+        mujoco.mj_fullM(crane_model, crane_data, crane_mass)
+        mujoco.mj_fullM(machine_model, machine_data, machine_mass)
+        assert relative(machine_mass[np.ix_(order, order)], crane_mass) < 1e-12
+        bias_scale = np.max(np.abs(crane_data.qfrc_bias))
+        assert np.max(np.abs(machine_data.qfrc_bias[order] - crane_data.qfrc_bias)) < 1e-12 * bias_scale
+        np.testing.assert_allclose(machine_data.qfrc_passive[order], crane_data.qfrc_passive, atol=1e-9)
