@@ -24,6 +24,7 @@ from hiab_sim.machine import closure
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics_mujoco import MujocoMachineDynamics
 from hiab_sim.machine.dynamics_newton_euler import NewtonEulerInverseDynamics
+from hiab_sim.machine.dynamics_paths import MACHINE_ID_PATHS, make_machine_dynamics
 from hiab_sim.machine.dynamics_tree import MachineActuatorSamples
 from hiab_sim.machine.loader import load_machine
 from hiab_sim.machine.mjcf_build import SimulationExtras, build_machine_model
@@ -146,14 +147,33 @@ def test_both_paths_agree_for_any_excavator_design_in_its_bounds(u: np.ndarray) 
 
 
 def test_simulation_extras_add_armature_and_damping_on_the_motor_side() -> None:
-    """With extras the MuJoCo force is f_x + J a_x + b v_x (eqs. torque_torque, torque_force); pins unchanged."""
+    """With extras the MuJoCo force is f_x + J a_x + b v_x (eqs. torque_torque, torque_force); pins unchanged.
+
+    MuJoCo carries the armature in its mass matrix and the damping as a passive force; the
+    Newton-Euler path adds both to the load-side force: the two agree.
+    """
     q, dq, ddq = random_states(EXACT, 20, seed=7)
-    armature, damping = (310.0, 420.0, 530.0), (1.5e3, 2.5e3, 3.5e3)
+    extras = SimulationExtras((310.0, 420.0, 530.0), (1.5e3, 2.5e3, 3.5e3))
     bare = MujocoMachineDynamics(EXACT)(q, dq, ddq)
-    drive = MujocoMachineDynamics(EXACT, extras=SimulationExtras(armature, damping))(q, dq, ddq)
-    expected = bare.force + np.array(armature) * bare.acceleration + np.array(damping) * bare.velocity
+    drive = MujocoMachineDynamics(EXACT, extras=extras)(q, dq, ddq)
+    expected = bare.force + np.array(extras.armature_kg) * bare.acceleration
+    expected += np.array(extras.damping_Ns_per_m) * bare.velocity
     assert relative(drive.force, expected) < 1e-12
     assert relative(drive.pins.world, bare.pins.world) < 1e-12
+    analytic = NewtonEulerInverseDynamics(EXACT, extras=extras)(q, dq, ddq)
+    assert relative(analytic.force, drive.force) < 1e-10
+
+
+@pytest.mark.parametrize("path", MACHINE_ID_PATHS)
+def test_paths_by_name_give_the_same_forces(path: str) -> None:
+    """make_machine_dynamics builds either path for a design; an unknown path names the field id_path."""
+    design = EXACT.design_values()
+    q, dq, ddq = random_states(EXACT, 10, seed=16)
+    out = make_machine_dynamics(EXACT, design, path)(q, dq, ddq, [500.0, -300.0])
+    reference = NewtonEulerInverseDynamics(EXACT)(q, dq, ddq, [500.0, -300.0])
+    assert relative(out.force, reference.force) < 1e-10
+    with pytest.raises(InvalidInputError, match="id_path"):
+        make_machine_dynamics(EXACT, path="trigonometric")
 
 
 def test_bad_samples_and_forces_name_their_field() -> None:
@@ -173,8 +193,9 @@ def test_bad_samples_and_forces_name_their_field() -> None:
     undriven = EXCAVATOR.__class__(**{**EXCAVATOR.__dict__, "chains": EXCAVATOR.chains[:2]})
     with pytest.raises(InvalidInputError, match="gamma"):
         NewtonEulerInverseDynamics(undriven)
-    with pytest.raises(InvalidInputError, match="extras"):
-        MujocoMachineDynamics(EXCAVATOR, extras=SimulationExtras((1.0,), (1.0,)))
+    for path in (MujocoMachineDynamics, NewtonEulerInverseDynamics):
+        with pytest.raises(InvalidInputError, match="extras"):
+            path(EXCAVATOR, extras=SimulationExtras((1.0,), (1.0,)))
 
 
 def test_xs031_simulation_model_equals_the_crane_simulation_model() -> None:

@@ -36,12 +36,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics_planar import Frames, PlanarBody, frames, loop_state, planar_bodies
 from hiab_sim.machine.dynamics_tree import (
     MachineActuatorSamples,
     MachineTree,
     PinForces,
+    SimulationExtras,
     joint_arrays,
     machine_tree,
     pin_layout,
@@ -63,15 +65,25 @@ class NewtonEulerInverseDynamics:
     Args:
         machine: The machine description.
         design: Decision variable values (default: the file's), as :meth:`Machine.with_design`.
+        extras: Armature and damping per actuator: the forces become the motor side,
+            f_x + (J_m k^2 + M_sm) a_x + b_f v_x (eqs. ``torque_torque``, ``torque_force``); pin
+            forces stay those of the mechanism. Default: the bare mechanism (load side).
 
     Raises:
-        InvalidInputError: a moving joint that no chain drives, a design outside its bounds.
+        InvalidInputError: a moving joint that no chain drives, a design outside its bounds,
+            extras of the wrong length.
 
     """
 
-    def __init__(self, machine: Machine, design: Sequence[float] | None = None) -> None:
+    def __init__(
+        self, machine: Machine, design: Sequence[float] | None = None, extras: SimulationExtras | None = None
+    ) -> None:
         if design is not None:
             machine = machine.with_design(design)
+        if extras is not None and len(extras.armature_kg) != len(machine.chains):
+            need = f"need one per actuator: {machine.actuator_names}"
+            raise InvalidInputError("extras.armature_kg", f"{len(extras.armature_kg)} values", need)
+        self.extras = extras
         self.tree: MachineTree = machine_tree(machine)
         self.planar: tuple[PlanarBody, ...] = planar_bodies(self.tree)
         self._pins = pin_layout(self.tree)
@@ -105,6 +117,9 @@ class NewtonEulerInverseDynamics:
         transmitted, lam = self._joint_forces(fk, external[:, 0] + 1j * external[:, 1])
         act = list(self.tree.actuated)
         force = np.stack([(np.conj(self._axis(fk, b)) * transmitted[b]).real for b in act], axis=1)
+        if self.extras is not None:
+            force = force + np.asarray(self.extras.armature_kg) * ddqf[:, act]
+            force = force + np.asarray(self.extras.damping_Ns_per_m) * dqf[:, act]
         return MachineActuatorSamples(
             names=tuple(self.tree.machine.actuator_names),
             force=force,

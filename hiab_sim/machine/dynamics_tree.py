@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.checks import check_non_negative
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Chain, Machine
 from hiab_sim.machine.parts import Pose, RigidBody
@@ -234,6 +235,29 @@ def machine_tree(machine: Machine) -> MachineTree:
         tcp_body=index[machine.tcp_link],
         tcp=machine.tcp,
     )
+
+
+@dataclass(frozen=True)
+class SimulationExtras:
+    """Per actuator (chain order): armature [kg] and viscous damping [N s/m] on its actuated joint.
+
+    The armature is the rotor and screw inertia reflected to the rod, J_m k^2 + M_sm (eq.
+    ``torque_torque`` with k = 2 pi G / rho); the damping the screw's viscous friction b_f (eq.
+    ``torque_force``). With them the actuator force is the motor side, f_x + (J_m k^2 + M_sm) a_x + b_f v_x.
+    """
+
+    armature_kg: tuple[float, ...]
+    damping_Ns_per_m: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        if len(self.armature_kg) != len(self.damping_Ns_per_m):
+            raise InvalidInputError(
+                "extras", f"{len(self.armature_kg)} armatures, {len(self.damping_Ns_per_m)} dampings", "one each"
+            )
+        for k, value in enumerate(self.armature_kg):
+            check_non_negative(f"extras.armature_kg[{k}]", value, "kg")
+        for k, value in enumerate(self.damping_Ns_per_m):
+            check_non_negative(f"extras.damping_Ns_per_m[{k}]", value, "N s/m")
 
 
 @dataclass(frozen=True)

@@ -26,37 +26,19 @@ gives the motor-side forces f_x + (J_m k^2 + M_sm) a_x + b_f v_x.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import mujoco
 import numpy as np
 
-from hiab_sim.checks import check_non_negative
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.dynamics_tree import MachineTree, actuator_lengths, machine_tree
+from hiab_sim.machine.dynamics_tree import MachineTree, SimulationExtras, actuator_lengths, machine_tree
 from hiab_sim.machine.parts import RigidBody
 from hiab_sim.model.mjcf import EQUALITY_SOLIMP, EQUALITY_SOLREF, SOURCE_TO_WORLD
 from hiab_sim.resources import mjcf_template
 
-
-@dataclass(frozen=True)
-class SimulationExtras:
-    """Per actuator (chain order): armature [kg] and viscous damping [N s/m] on its actuated joint."""
-
-    armature_kg: tuple[float, ...]
-    damping_Ns_per_m: tuple[float, ...]
-
-    def __post_init__(self) -> None:
-        if len(self.armature_kg) != len(self.damping_Ns_per_m):
-            raise InvalidInputError(
-                "extras", f"{len(self.armature_kg)} armatures, {len(self.damping_Ns_per_m)} dampings", "one each"
-            )
-        for k, value in enumerate(self.armature_kg):
-            check_non_negative(f"extras.armature_kg[{k}]", value, "kg")
-        for k, value in enumerate(self.damping_Ns_per_m):
-            check_non_negative(f"extras.damping_Ns_per_m[{k}]", value, "N s/m")
+__all__ = ["SimulationExtras", "build_machine_model", "build_machine_spec", "spec_of_tree"]
 
 
 def _quat(rotation: np.ndarray) -> list[float]:
