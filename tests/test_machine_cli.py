@@ -75,7 +75,7 @@ def test_machine_check_lists_each_failure_and_exits_2(tmp_path: Path, capsys: py
 def test_bad_machine_file_exits_2_with_one_line_and_writes_nothing(
     path: str, value: Any, field: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """Show on a bad file: exit 2, one stderr line naming the field, no traceback, no PNG."""
+    """Show and check on a bad file: exit 2, one stderr line naming the field, no traceback, no PNG."""
     data = copy.deepcopy(_excavator())
     *parents, last = path.split(".")
     node = data
@@ -89,3 +89,7 @@ def test_bad_machine_file_exits_2_with_one_line_and_writes_nothing(
     assert captured.err.count("\n") == 1 and field in captured.err and "Traceback" not in captured.err
     assert not figure.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["machine.yaml"]
+    assert main(["machine", "check", str(source)]) == 2  # check: one line, an error or a FAIL report
+    captured = capsys.readouterr()
+    report = captured.out + captured.err
+    assert report.count("\n") == 1 and field in report

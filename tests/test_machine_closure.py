@@ -188,3 +188,33 @@ def test_four_bar_closures_agree_for_any_geometry(
     assert b.closes[0]
     np.testing.assert_allclose([b.length[0], b.length_dq[0]], [a.length[0], a.length_dq[0]], rtol=1e-9, atol=1e-11)
     np.testing.assert_allclose(b.length_dq2[0], a.length_dq2[0], rtol=1e-7, atol=1e-9)
+
+
+def test_reversed_triangle_mounting_gives_the_same_lengths(machine: Machine) -> None:
+    """Swapping an actuator's ends (cylinder on the driven link) leaves s(q), its ratios and the inverse unchanged.
+
+    The cylinder then points the other way: its angle turns by pi. Checked for every triangle of each
+    machine, on both closures.
+    """
+    import dataclasses
+
+    for chain in machine.chains:
+        if chain.kind != "triangle":
+            continue
+        base, end = chain.pivot("base"), chain.pivot("end")
+        flipped = dataclasses.replace(
+            chain,
+            pivots=(dataclasses.replace(end, role="base"), dataclasses.replace(base, role="end")),
+            variables=(),
+        )
+        other = dataclasses.replace(machine, chains=tuple(flipped if c is chain else c for c in machine.chains))
+        q = _joint_samples(machine, chain.joint, 200, 21)
+        a, b = closure.closure(machine, chain, q), closure.closure(other, flipped, q)
+        np.testing.assert_allclose(b.length, a.length, atol=1e-13)
+        np.testing.assert_allclose(b.length_dq, a.length_dq, atol=1e-13)
+        np.testing.assert_allclose(b.length_dq2, a.length_dq2, atol=1e-12)
+        np.testing.assert_allclose(_wrap(b.angles["cylinder"] - a.angles["cylinder"] - np.pi), 0.0, atol=1e-12)
+        n = numeric_closure(other, flipped, q)
+        np.testing.assert_allclose(n.length_dq2, b.length_dq2, atol=1e-12)
+        x = closure.joint_to_stroke(other, flipped, q)
+        np.testing.assert_allclose(closure.stroke_to_joint(other, flipped, x), q, atol=1e-11)
