@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from lengths_helper import feasible_lengths
-from test_machine_dynamics_machines import excavator, random_states
+from test_machine_dynamics_machines import excavator, hand_machine, random_states
 
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
@@ -35,7 +35,11 @@ CRANE = load_crane("xs031")
 XS031 = load_machine("xs031")
 EXACT = load_machine("exact")  # the shipped excavator preset
 EXCAVATOR = excavator()  # the same arm written in the test from the reference sheet, other actuator bodies
-MACHINES = pytest.mark.parametrize("machine", [XS031, EXACT, EXCAVATOR], ids=["xs031", "exact", "test-excavator"])
+MACHINES = pytest.mark.parametrize(
+    "machine",
+    [XS031, EXACT, EXCAVATOR, hand_machine(reversed_actuator=True)],
+    ids=["xs031", "exact", "test-excavator", "cylinder-on-driven-link"],
+)
 
 
 def relative(a: np.ndarray, b: np.ndarray) -> float:

@@ -30,7 +30,11 @@ from hiab_sim.machine.mjcf_build import build_machine_model
 XS031 = load_machine("xs031")
 EXACT = load_machine("exact")
 EXCAVATOR = excavator()
-MACHINES = pytest.mark.parametrize("machine", [XS031, EXACT, EXCAVATOR], ids=["xs031", "exact", "test-excavator"])
+MACHINES = pytest.mark.parametrize(
+    "machine",
+    [XS031, EXACT, EXCAVATOR, hand_machine(reversed_actuator=True)],
+    ids=["xs031", "exact", "test-excavator", "cylinder-on-driven-link"],
+)
 PATHS = pytest.mark.parametrize("path", [NewtonEulerInverseDynamics, MujocoMachineDynamics], ids=["ne", "mujoco"])
 
 
@@ -96,26 +100,31 @@ def test_forces_at_rest_balance_the_weight_of_every_body(machine: Machine, path:
 
 
 @PATHS
-def test_pin_forces_of_a_static_boom_match_a_free_body_calculation(path: type) -> None:
+@pytest.mark.parametrize("reversed_actuator", [False, True], ids=["cylinder-below", "cylinder-on-boom"])
+def test_pin_forces_of_a_static_boom_match_a_free_body_calculation(path: type, reversed_actuator: bool) -> None:
     """Horizontal boom of mass M (com at x = C), vertical actuator at x = A, load W at x = 2 m, at rest.
 
     By hand: the actuator is a two-force member but for its own weight along its axis, so the
-    boom's moment about its hinge gives the end pin's force N = (M g C + 2 W) / A (up on the boom);
-    the hinge carries M g + W - N, the base pin N + (Mc + Mr) g, and the rod's axial balance gives
-    the actuator force f = N + Mr g.
+    boom's moment about its hinge gives the upward force N = (M g C + 2 W) / A the actuator's top pin
+    applies to the boom; the hinge carries M g + W - N, the bottom (ground) pin N + (Mc + Mr) g. The
+    actuator force is N plus the weight of its upper part: f = N + Mr g with the rod on top, N + Mc g
+    with the cylinder on top.
     """
     g, W = 9.81, 500.0
-    machine = hand_machine()
+    machine = hand_machine(reversed_actuator)
     out = path(machine)(np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((1, 1)), np.array([0.0, -W]))
     N = (HAND_M * g * HAND_C + 2.0 * W) / HAND_A
-    np.testing.assert_allclose(out.force[0, 0], N + HAND_MR * g, rtol=1e-12)
+    np.testing.assert_allclose(out.force[0, 0], N + (HAND_MC if reversed_actuator else HAND_MR) * g, rtol=1e-12)
     np.testing.assert_allclose(out.stroke[0, 0], 0.1, atol=1e-12)
     pins = out.pins
-    np.testing.assert_allclose(pins.force("act.end_pin")[0], [0.0, -N], atol=1e-9)
     np.testing.assert_allclose(pins.force("hinge")[0], [0.0, HAND_M * g + W - N], atol=1e-9)
-    np.testing.assert_allclose(pins.force("act.base_pin")[0], [0.0, N + (HAND_MC + HAND_MR) * g], atol=1e-9)
-    # in the rod's frame (x along the actuator, pointing up) the end pin pushes along -x
-    np.testing.assert_allclose(pins.local[0, pins.names.index("act.end_pin")], [-N, 0.0, 0.0], atol=1e-9)
+    top, bottom = ("act.base_pin", "act.end_pin") if reversed_actuator else ("act.end_pin", "act.base_pin")
+    # base_pin: on the cylinder by its link; end_pin: on the rod by its link
+    np.testing.assert_allclose(pins.force(top)[0], [0.0, -N], atol=1e-9)
+    np.testing.assert_allclose(pins.force(bottom)[0], [0.0, N + (HAND_MC + HAND_MR) * g], atol=1e-9)
+    # in the actuator's frame (x from its base pivot to its end pivot) the top pin pushes towards the base
+    sign = 1.0 if reversed_actuator else -1.0
+    np.testing.assert_allclose(pins.local[0, pins.names.index(top)], [sign * N, 0.0, 0.0], atol=1e-9)
 
 
 def test_constrained_forward_dynamics_reproduces_the_accelerations() -> None:

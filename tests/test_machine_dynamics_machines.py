@@ -88,8 +88,12 @@ HAND_M, HAND_C, HAND_D = 120.0, 1.1, 0.15
 HAND_MC, HAND_MR = 9.0, 4.0
 
 
-def hand_machine() -> Machine:
-    """A boom along +x at q = 0, hinged at the origin, held by a vertical actuator from (A, -H) to (A, 0)."""
+def hand_machine(reversed_actuator: bool = False) -> Machine:
+    """A boom along +x at q = 0, hinged at the origin, held by a vertical actuator from (A, -H) to (A, 0).
+
+    ``reversed_actuator``: the cylinder hangs on the boom at (A, 0) and the rod is pinned to the ground
+    at (A, -H) (a triangle whose base pivot is on the driven link).
+    """
     actuator = Actuator(
         stroke=0.3,
         piston_offset=0.1,
@@ -100,6 +104,8 @@ def hand_machine() -> Machine:
     )
     boom = RigidBody("boom", HAND_M, (HAND_C, HAND_D, 0.0), ((2.0, 0, 0), (0, 20.0, 0), (0, 0, 21.0)))
     pivots = (Pivot("base", "ground", (HAND_A, -HAND_H, 0.0)), Pivot("end", "beam", (HAND_A, 0.0, 0.0)))
+    if reversed_actuator:
+        pivots = (Pivot("base", "beam", (HAND_A, 0.0, 0.0)), Pivot("end", "ground", (HAND_A, -HAND_H, 0.0)))
     return Machine(
         name="hand",
         source="test",
