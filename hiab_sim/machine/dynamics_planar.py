@@ -106,6 +106,10 @@ class Frames:
     alpha: list[Array]
     rot: list[Complex]
 
+    def position(self, b: int, r: complex | Complex) -> Complex:
+        """Position of planar point r of body b."""
+        return self.z[b] + self.rot[b] * r
+
     def point(self, b: int, r: complex | Complex) -> tuple[Complex, Complex, Complex]:
         """Position, velocity and acceleration of planar point r of body b."""
         arm = self.rot[b] * r
@@ -113,10 +117,17 @@ class Frames:
         return self.z[b] + arm, self.dz[b] + 1j * w * arm, self.ddz[b] + (1j * a - w**2) * arm
 
 
-def frames(tree: MachineTree, planar: tuple[PlanarBody, ...], q: Array, dq: Array, ddq: Array) -> Frames:
-    """Forward kinematics of all bodies for full coordinates q, dq, ddq (T, nbody); column b is body b's joint."""
+def frames(
+    tree: MachineTree, planar: tuple[PlanarBody, ...], q: Array, dq: Array | None = None, ddq: Array | None = None
+) -> Frames:
+    """Forward kinematics of all bodies for full coordinates q, dq, ddq (T, nbody); column b is body b's joint.
+
+    Without ``dq`` and ``ddq`` only positions are computed (rates and accelerations are left zero).
+    """
     T = q.shape[0]
     out = Frames([], [], [], [], [], [], [])
+    if dq is None or ddq is None:
+        return _positions(tree, planar, q, out)
     for b, body in enumerate(tree.bodies):
         p = planar[b]
         if body.parent < 0:
@@ -155,6 +166,29 @@ def frames(tree: MachineTree, planar: tuple[PlanarBody, ...], q: Array, dq: Arra
     return out
 
 
+def _positions(tree: MachineTree, planar: tuple[PlanarBody, ...], q: Array, out: Frames) -> Frames:
+    """Body frame positions and rotations only (see :func:`frames`)."""
+    zero, zero_c = np.zeros(q.shape[0]), np.zeros(q.shape[0], dtype=complex)
+    for b, body in enumerate(tree.bodies):
+        p = planar[b]
+        if body.parent < 0:
+            z, theta, rot = np.full(q.shape[0], p.origin, dtype=complex), zero, np.ones(q.shape[0], dtype=complex)
+        elif body.kind == "revolute":
+            z = out.position(body.parent, p.origin)
+            theta, rot = out.theta[body.parent] + q[:, b], out.rot[body.parent] * np.exp(1j * q[:, b])
+        else:
+            z = out.position(body.parent, np.asarray(p.origin + p.axis * q[:, b], dtype=np.complex128))
+            theta, rot = out.theta[body.parent], out.rot[body.parent]
+        out.z.append(z)
+        out.theta.append(theta)
+        out.rot.append(rot)
+        for series in (out.dz, out.ddz):
+            series.append(zero_c)
+        out.omega.append(zero)
+        out.alpha.append(zero)
+    return out
+
+
 def _angle(frames_: Frames, planar: tuple[PlanarBody, ...], b: int) -> Array:
     """World angle of body b's x axis [rad] (for a planar frame)."""
     return frames_.theta[b] + planar[b].offset
@@ -170,11 +204,10 @@ def close_loops(tree: MachineTree, planar: tuple[PlanarBody, ...], q: Array) -> 
     T = q.shape[0]
     full = np.zeros((T, len(tree.bodies)))
     full[:, list(tree.independent)] = q
-    zero = np.zeros_like(full)
-    fk = frames(tree, planar, full, zero, zero)  # chain bodies (still at 0) do not move the machine links
+    fk = frames(tree, planar, full)  # chain bodies (still at 0) do not move the machine links
 
     def at(link: int, r: np.ndarray) -> Complex:
-        return fk.point(link, planar[link].point(r))[0]
+        return fk.position(link, planar[link].point(r))
 
     for chain in tree.machine.chains:
         if chain.kind == "direct":
@@ -232,7 +265,7 @@ def loop_points(
 def point_jacobian(tree: MachineTree, planar: tuple[PlanarBody, ...], fk: Frames, b: int, r: complex) -> Complex:
     """Jacobian dp/dq (T, nbody) of point r of body b (complex): i (p - z_j) per revolute ancestor j, u_j per slide."""
     T = fk.z[0].shape[0]
-    p = fk.point(b, r)[0]
+    p = fk.position(b, r)
     jac = np.zeros((T, len(tree.bodies)), dtype=complex)
     j = b
     while tree.bodies[j].parent >= 0:
@@ -268,7 +301,7 @@ def loop_state(
     ddqf[:, ind] = ddq
     if not dep:
         return qf, dqf, ddqf
-    jac = loop_jacobian(tree, planar, frames(tree, planar, qf, dqf, ddqf))
+    jac = loop_jacobian(tree, planar, frames(tree, planar, qf))
     jd = jac[:, :, dep]
     dqf[:, dep] = np.linalg.solve(jd, -np.einsum("tri,ti->tr", jac[:, :, ind], dq)[..., None])[..., 0]
     bias = loop_points(tree, planar, frames(tree, planar, qf, dqf, ddqf))  # ddq_d = 0 here
