@@ -7,6 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from hiab_sim.crane.description import Crane
 from hiab_sim.machine import closure
 from hiab_sim.machine.closure_numeric import numeric_closure
 from hiab_sim.machine.description import Machine
@@ -218,3 +219,72 @@ def test_reversed_triangle_mounting_gives_the_same_lengths(machine: Machine) -> 
         np.testing.assert_allclose(n.length_dq2, b.length_dq2, atol=1e-12)
         x = closure.joint_to_stroke(other, flipped, q)
         np.testing.assert_allclose(closure.stroke_to_joint(other, flipped, x), q, atol=1e-11)
+
+
+def test_design_partials_match_the_crane_and_finite_differences(machine: Machine, crane: Crane) -> None:
+    """The stroke's design partials at fixed q equal the crane's and central differences of with_design.
+
+    On the XS 031: crane/mechanism.py's dx/d(L, Lc0, Lc) to 1e-12; on every chain with variables
+    (the excavator's pivot x/y and retracted length included): central differences.
+    """
+    from hiab_sim.crane import mechanism
+    from hiab_sim.machine.design_partials import stroke_design_partials
+
+    values = machine.design_values()
+    keys = machine.variable_keys
+    for chain in machine.chains:
+        q = _joint_samples(machine, chain.joint, 40, 31)
+        dx_dq, dx_dv = stroke_design_partials(machine, chain, q)
+        np.testing.assert_allclose(dx_dq, closure.closure(machine, chain, q).length_dq, rtol=0, atol=0)
+        if machine.name == crane.name and chain.kind == "triangle":
+            old = getattr(crane, chain.name)
+            want_q, want_xi = mechanism.joint_to_stroke_partials(old, old.default_lengths, q)
+            np.testing.assert_allclose(dx_dq, want_q, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(dx_dv, want_xi, rtol=0, atol=1e-12)
+        for k, variable in enumerate(chain.variables):
+            j = keys.index(variable.key)
+            h = 1e-6
+            plus, minus = values.copy(), values.copy()
+            plus[j] += h
+            minus[j] -= h
+            up_machine = machine.with_design(plus, check_bounds=False)
+            down_machine = machine.with_design(minus, check_bounds=False)
+            up = closure.joint_to_stroke(up_machine, up_machine.chain(chain.name), q)
+            down = closure.joint_to_stroke(down_machine, down_machine.chain(chain.name), q)
+            np.testing.assert_allclose(dx_dv[:, k], (up - down) / (2 * h), rtol=1e-7, atol=1e-9)
+
+
+def test_four_bar_pivot_partials_match_finite_differences() -> None:
+    """Moving the bucket four-bar's rocker or coupler pivot: the analytic dx/dv equals central differences."""
+    import dataclasses
+
+    from hiab_sim.machine.description import DecisionVariable
+    from hiab_sim.machine.design_partials import stroke_design_partials
+
+    base = load_machine("exact")
+    bucket = base.chain("bucket")
+    sets = (
+        (
+            DecisionVariable("bucket", "Jx", "pivot_x", "rocker", 0.7, 1.0),
+            DecisionVariable("bucket", "Jy", "pivot_y", "rocker", -0.1, 0.1),
+            DecisionVariable("bucket", "Kx", "pivot_x", "coupler", -0.1, 0.1),
+        ),
+        (DecisionVariable("bucket", "Kd", "hinge_distance", "coupler", 0.1, 0.2),),
+    )
+    h = 1e-6
+    for extra in sets:
+        chain = dataclasses.replace(bucket, variables=extra)
+        machine = dataclasses.replace(base, chains=tuple(chain if c is bucket else c for c in base.chains))
+        q = _joint_samples(machine, chain.joint, 40, 41) * 0.95
+        _, dx_dv = stroke_design_partials(machine, chain, q)
+        values = machine.design_values()
+        offset = machine.variable_keys.index(extra[0].key)
+        for k in range(len(extra)):
+            plus, minus = values.copy(), values.copy()
+            plus[offset + k] += h
+            minus[offset + k] -= h
+            up, down = machine.with_design(plus), machine.with_design(minus)
+            x_up = closure.joint_to_stroke(up, up.chain("bucket"), q)
+            x_down = closure.joint_to_stroke(down, down.chain("bucket"), q)
+            np.testing.assert_allclose(dx_dv[:, k], (x_up - x_down) / (2 * h), rtol=1e-6, atol=1e-9)
+            assert np.max(np.abs(dx_dv[:, k])) > 1e-3  # the pivot matters
