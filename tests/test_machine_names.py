@@ -25,6 +25,7 @@ GENERIC = [
         "assembly",
         "loader",
         "drawing",
+        "design_partials",
     )
 ] + [PACKAGE / "cli" / "machine.py"]
 #: Words of the file format itself (pivot roles, chain body names); a machine may reuse one as a name.
