@@ -55,11 +55,21 @@ def _set_inertial(body: mujoco.MjsBody, inertia: RigidBody) -> None:
     body.fullinertia = [full[0, 0], full[1, 1], full[2, 2], full[0, 1], full[0, 2], full[1, 2]]
 
 
-def _capsule(body: mujoco.MjsBody, start: Any, end: Any, cls: mujoco.MjsDefault) -> None:
+#: Visual capsules (no mass, no contact): radius [m] and template material, per kind of body.
+_LOOK = {"link": (0.05, "hiab_red"), "cylinder": (0.045, "cylinder"), "rod": (0.025, "rod")}
+
+
+def _capsule(body: mujoco.MjsBody, start: Any, end: Any, look: str) -> None:
     if float(np.linalg.norm(np.asarray(end, float) - np.asarray(start, float))) < 1e-6:
         return
-    geom = body.add_geom(default=cls)
+    radius, material = _LOOK[look]
+    geom = body.add_geom()
     geom.type = mujoco.mjtGeom.mjGEOM_CAPSULE
+    geom.size = [radius, 0.0, 0.0]
+    geom.material = material
+    geom.contype = 0
+    geom.conaffinity = 0
+    geom.group = 1
     geom.fromto = [*map(float, start), *map(float, end)]
 
 
@@ -137,26 +147,25 @@ def spec_of_tree(tree: MachineTree, extras: SimulationExtras | None = None) -> m
 
 def _add_visuals(spec: mujoco.MjSpec, tree: MachineTree, made: list[mujoco.MjsBody]) -> None:
     """Capsules (no mass, no contact): each link to its children's joints and pivots, cylinders and rods."""
-    boom, barrel, rod = (spec.find_default(c) for c in ("boom", "barrel", "rod"))
     for b, body in enumerate(tree.bodies):
         if body.chain is not None:
             continue
         for child in tree.bodies:
             if child.parent == b:
-                _capsule(made[b], np.zeros(3), child.position, boom)
+                _capsule(made[b], np.zeros(3), child.position, "link")
         for loop in tree.loops:
             if loop.body_b == b:
-                _capsule(made[b], np.zeros(3), loop.point_b, boom)
+                _capsule(made[b], np.zeros(3), loop.point_b, "link")
     for chain in tree.machine.chains:
         if chain.kind == "direct":
             continue
         cylinder = tree.index(f"{chain.name}.cylinder")
         piston, rod_length = actuator_lengths(chain)
-        _capsule(made[cylinder], np.zeros(3), [piston + rod_length, 0.0, 0.0], barrel)
-        _capsule(made[cylinder + 1], np.zeros(3), [rod_length, 0.0, 0.0], rod)
+        _capsule(made[cylinder], np.zeros(3), [piston + rod_length, 0.0, 0.0], "cylinder")
+        _capsule(made[cylinder + 1], np.zeros(3), [rod_length, 0.0, 0.0], "rod")
         if chain.kind == "linkage" and chain.linkage is not None:
-            _capsule(made[cylinder + 2], np.zeros(3), [chain.linkage.rocker_length, 0.0, 0.0], boom)
-            _capsule(made[cylinder + 3], np.zeros(3), [chain.linkage.coupler_length, 0.0, 0.0], boom)
+            _capsule(made[cylinder + 2], np.zeros(3), [chain.linkage.rocker_length, 0.0, 0.0], "link")
+            _capsule(made[cylinder + 3], np.zeros(3), [chain.linkage.coupler_length, 0.0, 0.0], "link")
 
 
 def build_machine_model(

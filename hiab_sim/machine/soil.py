@@ -27,7 +27,7 @@ Sources: A. R. Reece, "The fundamental equation of earth-moving mechanics", Proc
 M. Lipsett, "Review of resistive force models for earthmoving processes", J. Aerospace Eng. 14(3)
 (2001) 102-111. The model is quasi-static (no soil inertia) and assumes a planar failure surface and
 a horizontal soil surface; it is the cutting resistance for a tool moving along its travel
-direction, not a penetration or bucket-filling model. Soil properties are the caller's data (no
+direction, not a penetration or tool-filling model. Soil properties are the caller's data (no
 default is given here: they vary by an order of magnitude between soils; state their source).
 """
 
@@ -178,7 +178,7 @@ def tool_force_world(
     """The soil's force on the tool in the world plane (T, 2) [N], for a horizontal soil surface.
 
     ``travel_sign`` +1 or -1 per sample: the tool travels along +x or -x of the world (an excavator
-    drags its bucket towards the machine, -x when the machine faces +x); ``rake_angle_rad`` is
+    drags its tool towards the machine, -x when the machine faces +x); ``rake_angle_rad`` is
     measured from the surface on the side the tool travels to. A depth of 0 (tool above ground)
     gives no force.
     """
