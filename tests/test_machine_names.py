@@ -10,24 +10,8 @@ from hiab_sim.machine.chains import PIVOT_ROLES
 from hiab_sim.machine.loader import PRESETS, load_machine
 
 PACKAGE = Path(hiab_sim.__file__).resolve().parent
-#: The description, closure, assembly, loader, drawing and CLI modules (the dynamics modules have their own tests).
-GENERIC = [
-    PACKAGE / "machine" / f"{name}.py"
-    for name in (
-        "__init__",
-        "parts",
-        "chains",
-        "design",
-        "description",
-        "closure",
-        "closure_numeric",
-        "kinematics",
-        "assembly",
-        "loader",
-        "drawing",
-        "design_partials",
-    )
-] + [PACKAGE / "cli" / "machine.py"]
+#: Every module of the machine package (description, closure, dynamics, MJCF) and the machine CLI.
+GENERIC = sorted((PACKAGE / "machine").glob("*.py")) + [PACKAGE / "cli" / "machine.py"]
 #: Words of the file format itself (pivot roles, chain body names); a machine may reuse one as a name.
 FORMAT_WORDS = {role for roles in PIVOT_ROLES.values() for role in roles} | {"cylinder", "rod", "pin", "hinge"}
 
