@@ -11,7 +11,7 @@ from hiab_sim.machine.loader import PRESETS, load_machine
 
 PACKAGE = Path(hiab_sim.__file__).resolve().parent
 #: Every module of the machine package (description, closure, dynamics, MJCF) and the machine CLI.
-GENERIC = sorted((PACKAGE / "machine").glob("*.py")) + [PACKAGE / "cli" / "machine.py"]
+GENERIC = [*sorted((PACKAGE / "machine").glob("*.py")), PACKAGE / "cli" / "machine.py"]
 #: Words of the file format itself (pivot roles, chain body names); a machine may reuse one as a name.
 FORMAT_WORDS = {role for roles in PIVOT_ROLES.values() for role in roles} | {"cylinder", "rod", "pin", "hinge"}
 
