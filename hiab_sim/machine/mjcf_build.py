@@ -153,9 +153,15 @@ def _add_visuals(spec: mujoco.MjSpec, tree: MachineTree, made: list[mujoco.MjsBo
         for child in tree.bodies:
             if child.parent == b:
                 _capsule(made[b], np.zeros(3), child.position, "link")
+                link = tree.machine.link(child.name) if child.chain is None else None
+                if link is not None and link.joint_kind == "prismatic" and link.joint_range is not None:
+                    end = child.position + child.rotation[:, 0] * link.joint_range[1]  # the slide's guide
+                    _capsule(made[b], child.position, end, "cylinder")
         for loop in tree.loops:
             if loop.body_b == b:
                 _capsule(made[b], np.zeros(3), loop.point_b, "link")
+        if b == tree.tcp_body:
+            _capsule(made[b], np.zeros(3), tree.tcp.position, "link")
     for chain in tree.machine.chains:
         if chain.kind == "direct":
             continue
