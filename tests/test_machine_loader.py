@@ -11,6 +11,8 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from hiab_sim.errors import ConfigError, HiabSimError, InvalidInputError
 from hiab_sim.machine.loader import load_machine, machine_from_dict
@@ -188,3 +190,16 @@ def test_design_moves_pivots_as_declared() -> None:
     assert act.retracted_length == pytest.approx(0.8)
     assert act.piston_offset == machine.chain("bucket").actuator.piston_offset
     np.testing.assert_allclose(designed.design_values(), values, atol=1e-15)
+
+
+@settings(max_examples=30, deadline=None)
+@given(fractions=st.lists(st.floats(0.0, 1.0), min_size=9, max_size=9), preset=st.sampled_from(["xs031", "exact"]))
+def test_design_values_round_trip_through_with_design(fractions: list[float], preset: str) -> None:
+    """Any values inside the declared bounds come back from with_design(values).design_values() to 1e-12."""
+    machine = _MACHINES[preset]
+    low, high = machine.design_bounds()
+    values = low + np.asarray(fractions[: low.size]) * (high - low)
+    np.testing.assert_allclose(machine.with_design(values).design_values(), values, rtol=0, atol=1e-12)
+
+
+_MACHINES = {name: load_machine(name) for name in ("xs031", "exact")}
