@@ -28,6 +28,7 @@ from hiab_sim.machine.dynamics_paths import MACHINE_ID_PATHS, make_machine_dynam
 from hiab_sim.machine.dynamics_tree import MachineActuatorSamples
 from hiab_sim.machine.loader import load_machine
 from hiab_sim.machine.mjcf_build import SimulationExtras, build_machine_model
+from hiab_sim.machine.parts import Pose, rot_z
 from hiab_sim.model.drives import SlideDrives
 from hiab_sim.model.mjcf import build_model
 
@@ -35,10 +36,12 @@ CRANE = load_crane("xs031")
 XS031 = load_machine("xs031")
 EXACT = load_machine("exact")  # the shipped excavator preset
 EXCAVATOR = excavator()  # the same arm written in the test from the reference sheet, other actuator bodies
+#: The test excavator standing on a 12 deg slope, its chassis frame moved off the world origin.
+SLOPE = Pose((0.4, -0.2, 0.05), rot_z(np.radians(12.0)))
 MACHINES = pytest.mark.parametrize(
     "machine",
-    [XS031, EXACT, EXCAVATOR, hand_machine(reversed_actuator=True)],
-    ids=["xs031", "exact", "test-excavator", "cylinder-on-driven-link"],
+    [XS031, EXACT, EXCAVATOR, hand_machine(reversed_actuator=True), excavator(SLOPE)],
+    ids=["xs031", "exact", "test-excavator", "cylinder-on-driven-link", "on-a-slope"],
 )
 
 

@@ -26,14 +26,17 @@ from hiab_sim.machine.dynamics_mujoco import MujocoMachineDynamics
 from hiab_sim.machine.dynamics_newton_euler import NewtonEulerInverseDynamics
 from hiab_sim.machine.loader import load_machine
 from hiab_sim.machine.mjcf_build import build_machine_model
+from hiab_sim.machine.parts import Pose, rot_z
 
 XS031 = load_machine("xs031")
 EXACT = load_machine("exact")
 EXCAVATOR = excavator()
+#: The test excavator standing on a 12 deg slope, its chassis frame moved off the world origin.
+SLOPE = Pose((0.4, -0.2, 0.05), rot_z(np.radians(12.0)))
 MACHINES = pytest.mark.parametrize(
     "machine",
-    [XS031, EXACT, EXCAVATOR, hand_machine(reversed_actuator=True)],
-    ids=["xs031", "exact", "test-excavator", "cylinder-on-driven-link"],
+    [XS031, EXACT, EXCAVATOR, hand_machine(reversed_actuator=True), excavator(SLOPE)],
+    ids=["xs031", "exact", "test-excavator", "cylinder-on-driven-link", "on-a-slope"],
 )
 PATHS = pytest.mark.parametrize("path", [NewtonEulerInverseDynamics, MujocoMachineDynamics], ids=["ne", "mujoco"])
 

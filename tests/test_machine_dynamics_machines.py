@@ -48,10 +48,13 @@ def _actuator(name: str, x0: float, stroke: float) -> Actuator:
     )
 
 
-def excavator() -> Machine:
-    """The eXact arm from the reference sheet's points, lengths and bodies (see the module docstring)."""
+def excavator(mount: Pose | None = None) -> Machine:
+    """The eXact arm from the reference sheet's points, lengths and bodies (see the module docstring).
+
+    ``mount``: the chassis frame in the world (default: the world itself), e.g. a machine on a slope.
+    """
     links = (
-        Link("chassis", None, "mount", "fixed", Pose((0.0, 0.0, 0.0)), None, ()),
+        Link("chassis", None, "mount", "fixed", mount or Pose((0.0, 0.0, 0.0)), None, ()),
         Link("boom", "chassis", "alpha", "revolute", Pose((0.0, 0.0, 0.0)), (-0.4737, 1.0923),
              (_planar_body("boom", 227.343, (1.025, 0.384), 67.768),)),
         Link("arm", "boom", "beta", "revolute", Pose((2.050, 0.0, 0.0)), (-2.5848, -0.5103),
