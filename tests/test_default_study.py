@@ -78,3 +78,11 @@ def test_saving_decomposes_into_lengths_and_trajectory(run: RunOutput, result: R
     assert d.from_lengths_J == pytest.approx(e00 - e10, abs=1e-6)
     assert d.from_trajectory_J == pytest.approx(e00 - e01, abs=1e-6)
     assert d.interaction_J == pytest.approx(e10 + e01 - e00 - e11, abs=1e-6)
+
+
+def test_default_study_results_page_is_current(result: Result) -> None:
+    """docs/results/default-study.md's generated table matches this fresh run within the stated tolerance."""
+    from hiab_sim.docs_site.results_page import current_block, differences, results_block
+
+    page = (Path(__file__).resolve().parents[1] / "docs" / "results" / "default-study.md").read_text()
+    assert differences(current_block(page), results_block(result)) == []
