@@ -38,7 +38,9 @@ class _Session:
 
     def call(self, method: str, **params: Any) -> dict[str, Any]:
         self.next_id += 1
-        self.socket.send(json.dumps({"id": self.next_id, "method": method, "params": params, "sessionId": self.session}))
+        self.socket.send(
+            json.dumps({"id": self.next_id, "method": method, "params": params, "sessionId": self.session})
+        )
         while True:
             message = json.loads(self.socket.recv(timeout=60))
             if message.get("id") == self.next_id:
@@ -67,8 +69,16 @@ def load_page(url: str, width: int = 1100, height: int = 1400) -> PageLoad:
     assert exe is not None, "chromium is not installed (apt-get install chromium)"
     with tempfile.TemporaryDirectory() as profile:
         process = subprocess.Popen(
-            [exe, "--headless", "--no-sandbox", "--disable-gpu", "--remote-debugging-port=0",
-             f"--user-data-dir={profile}", f"--window-size={width},{height}", "about:blank"],
+            [
+                exe,
+                "--headless",
+                "--no-sandbox",
+                "--disable-gpu",
+                "--remote-debugging-port=0",
+                f"--user-data-dir={profile}",
+                f"--window-size={width},{height}",
+                "about:blank",
+            ],
             stderr=subprocess.PIPE,
             text=True,
         )
@@ -93,7 +103,9 @@ def load_page(url: str, width: int = 1100, height: int = 1400) -> PageLoad:
                     "JSON.stringify({text: document.body.innerText, images: Array.from(document.images).map("
                     "i => ({src: i.src.slice(0, 40), complete: i.complete, width: i.naturalWidth}))})"
                 )
-                value = json.loads(page.call("Runtime.evaluate", expression=script, returnByValue=True)["result"]["value"])
+                value = json.loads(
+                    page.call("Runtime.evaluate", expression=script, returnByValue=True)["result"]["value"]
+                )
                 shot = page.call("Page.captureScreenshot", format="png", captureBeyondViewport=True)["data"]
                 load = PageLoad(value["text"], value["images"], screenshot=base64.b64decode(shot))
                 for event in page.events:

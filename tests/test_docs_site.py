@@ -1,4 +1,4 @@
-"""The documentation site: the nav takes the model pages that exist, the CLI reference covers every parser, the README stays short."""
+"""The documentation site: the nav takes the model pages that exist, the CLI reference is complete, the README short."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""validate/update_readme.py --check: a stale validation table (docs/validation.md) fails, round-off-level changes do not."""
+"""validate/update_readme.py --check: a stale table of docs/validation.md fails, round-off-level changes do not."""
 
 from __future__ import annotations
 
@@ -70,7 +70,7 @@ def test_a_stale_table_fails(tmp_path: Path, capsys: pytest.CaptureFixture[str],
 
 
 def test_the_validation_page_has_one_validation_table() -> None:
-    """docs/validation.md holds the markers once, in order, around the table: its header and at least 8 passing cases."""
+    """docs/validation.md holds the markers once, in order, around the table: its header and 8 passing cases."""
     module = _module()
     readme = (ROOT / "docs" / "validation.md").read_text()
     assert readme.count(module.START) == readme.count(module.END) == 1

@@ -37,4 +37,6 @@ def test_tutorial_runs_as_written(page: str, tmp_path: Path) -> None:
         elif lang in ("bash", "python"):
             command = ["bash", "-euo", "pipefail", "-c", body] if lang == "bash" else [sys.executable, "-c", body]
             done = subprocess.run(command, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
-            assert done.returncode == 0, f"{page}: {lang} block failed:\n{body}\n{done.stdout[-2000:]}{done.stderr[-3000:]}"
+            assert done.returncode == 0, (
+                f"{page}: {lang} block failed:\n{body}\n{done.stdout[-2000:]}{done.stderr[-3000:]}"
+            )

@@ -71,7 +71,12 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--table", type=Path, default=Path("runs/validate/table.md"))
     parser.add_argument(
-        "--readme", "--page", dest="readme", type=Path, default=Path("docs/validation.md"), help="the page with the table"
+        "--readme",
+        "--page",
+        dest="readme",
+        type=Path,
+        default=Path("docs/validation.md"),
+        help="the page with the table",
     )
     parser.add_argument("--check", action="store_true", help="only check that the page is up to date")
     parser.add_argument(

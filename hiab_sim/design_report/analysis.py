@@ -26,9 +26,14 @@ def constraints(result: Result) -> str:
     ]
     b = result.buildable
     if b is not None:
-        for label, check in (("machine check", b.crane_check), ("tolerance box", b.tolerance_check),
-                             ("rounded design re-check", b.recheck)):
-            rows.append((label, f"{'passed' if check.passed else 'FAILED'}: {check.worst} ({check.margin:.3g} {check.unit})"))
+        for label, check in (
+            ("machine check", b.crane_check),
+            ("tolerance box", b.tolerance_check),
+            ("rounded design re-check", b.recheck),
+        ):
+            rows.append(
+                (label, f"{'passed' if check.passed else 'FAILED'}: {check.worst} ({check.margin:.3g} {check.unit})")
+            )
     ms = result.multistart
     if len(ms.starts) > 1:
         rows.append(("starts", f"{ms.converged_starts} converged; same optimum: {ms.same_optimum}"))
@@ -55,8 +60,10 @@ def thermal(result: Result) -> str:
     ]
     return section(
         "Thermal state",
-        paragraph(f"Duty: {e.duty}. RMS motor torque against the continuous torque, periodic steady-state winding "
-                  "temperature against its maximum."),
+        paragraph(
+            f"Duty: {e.duty}. RMS motor torque against the continuous torque, periodic steady-state winding "
+            "temperature against its maximum."
+        ),
         table(("motor", "RMS torque / continuous", "winding peak / maximum", "torque margin"), rows, numeric=(1, 2, 3)),
     )
 
@@ -72,8 +79,11 @@ def sensitivities(result: Result, folder: Path) -> str:
     ]
     return section(
         "Sensitivities",
-        paragraph(f"Cost decrease per unit each active limit is relaxed (KKT residual {s.kkt_residual:.1e}); a slope, "
-                  "not a promise for large moves.", "note"),
+        paragraph(
+            f"Cost decrease per unit each active limit is relaxed (KKT residual {s.kkt_residual:.1e}); a slope, "
+            "not a promise for large moves.",
+            "note",
+        ),
         table(("active constraint", "per", "% of the optimal cost", "cost units"), rows, numeric=(2, 3)),
         figure(folder / "sensitivity.png", "KKT multipliers of the active constraints"),
     )
@@ -98,8 +108,13 @@ def hydraulics(result: Result, folder: Path) -> str:
         "Hydraulic comparison",
         paragraph(h.note, "note"),
         table(
-            ("design", "EMLA at the battery", "hydraulic, load sensing (system eff.)", "hydraulic, constant pressure",
-             "EMLA saving vs LS / CP"),
+            (
+                "design",
+                "EMLA at the battery",
+                "hydraulic, load sensing (system eff.)",
+                "hydraulic, constant pressure",
+                "EMLA saving vs LS / CP",
+            ),
             rows,
             numeric=(1, 2, 3, 4),
         ),
@@ -115,7 +130,7 @@ def closed_loop(folder: Path) -> str:
     report: dict[str, Any] = json.loads(path.read_text())
     rows = []
     for design, entry in report["designs"].items():
-        for row in ([entry["nominal"], entry] if "nominal" in entry else [entry]):
+        for row in [entry["nominal"], entry] if "nominal" in entry else [entry]:
             mass = "planned" if row["payload_error"] == 0 else f"+{100 * row['payload_error']:g} %"
             rows.append(
                 (
@@ -129,10 +144,15 @@ def closed_loop(folder: Path) -> str:
             )
     return section(
         "Closed-loop validation",
-        paragraph("Each design driven by simulated EMLA drives (dq current dynamics, voltage and current limits) under "
-                  "a tracking controller through the study's cycle; energy integrated at the motor terminals."),
-        table(("design", "end mass", "predicted", "closed loop", "difference", "TCP error rms / max"), rows,
-              numeric=(2, 3, 4, 5)),
+        paragraph(
+            "Each design driven by simulated EMLA drives (dq current dynamics, voltage and current limits) under "
+            "a tracking controller through the study's cycle; energy integrated at the motor terminals."
+        ),
+        table(
+            ("design", "end mass", "predicted", "closed loop", "difference", "TCP error rms / max"),
+            rows,
+            numeric=(2, 3, 4, 5),
+        ),
         figure(folder / "closed_loop_energy.png", "Cumulative energy, closed loop against prediction"),
     )
 
@@ -142,23 +162,36 @@ def duty_mix(result: Result, folder: Path) -> str:
     if not result.tasks:
         return ""
     rows = [
-        (t.name, f"{t.weight:g}", f"{t.payload_kg:g} kg",
-         f"{t.initial.net_electrical_energy_J:.1f} → {t.optimal.net_electrical_energy_J:.1f} J")
+        (
+            t.name,
+            f"{t.weight:g}",
+            f"{t.payload_kg:g} kg",
+            f"{t.initial.net_electrical_energy_J:.1f} → {t.optimal.net_electrical_energy_J:.1f} J",
+        )
         for t in result.tasks
     ]
     parts = [table(("task", "weight", "payload", "net energy initial → optimal"), rows, numeric=(1, 2, 3))]
     c = result.cross_evaluation
     if c is not None:
         cross = [
-            (design, *[num(v, ".1f") for v in c.net_energy_J[i]], num(c.mix_net_energy_J[i], ".1f"),
-             num(c.mix_energy_lost_percent[i], "+.3f", "%"))
+            (
+                design,
+                *[num(v, ".1f") for v in c.net_energy_J[i]],
+                num(c.mix_net_energy_J[i], ".1f"),
+                num(c.mix_energy_lost_percent[i], "+.3f", "%"),
+            )
             for i, design in enumerate(c.designs)
         ]
         parts += [
-            paragraph("Cross-evaluation: each design on every task, trajectories re-optimised at fixed lengths "
-                      "(net energy [J])."),
-            table(("design", *c.tasks, "mix (weighted)", "mix energy lost"), cross,
-                  numeric=tuple(range(1, len(c.tasks) + 3))),
+            paragraph(
+                "Cross-evaluation: each design on every task, trajectories re-optimised at fixed lengths "
+                "(net energy [J])."
+            ),
+            table(
+                ("design", *c.tasks, "mix (weighted)", "mix energy lost"),
+                cross,
+                numeric=tuple(range(1, len(c.tasks) + 3)),
+            ),
             figure(folder / "cross_evaluation.png", "Cross-evaluation"),
         ]
     return section("Duty mix", *parts)

@@ -62,7 +62,8 @@ def design(result: Result, crane: Crane, folder: Path) -> str:
             (
                 chain.name,
                 f"{before.L:.3f} → {after.L:.3f}",
-                f"{1e3 * (after.L - before.L):+.0f} mm along the cylinder axis (Δx {move[0]:+.0f}, Δy {move[1]:+.0f} mm "
+                f"{1e3 * (after.L - before.L):+.0f} mm along the cylinder axis "
+                f"(Δx {move[0]:+.0f}, Δy {move[1]:+.0f} mm "
                 f"in {chain.parent})",
                 f"{before.Lc0 + before.Lc:.3f} → {after.Lc0 + after.Lc:.3f}",
                 f"{before.Lc0:.3f} / {before.Lc:.3f} → {after.Lc0:.3f} / {after.Lc:.3f}",
@@ -126,8 +127,13 @@ def energies(result: Result, folder: Path) -> str:
             num(o.energy_breakdown_J.copper, ".1f", "J"),
             "",
         ),
-        ("costf2 (the seed's cost)", "squared summed power, not an energy", num(i.cost_W2s, ".4g", "W² s"),
-         num(o.cost_W2s, ".4g", "W² s"), ""),
+        (
+            "costf2 (the seed's cost)",
+            "squared summed power, not an energy",
+            num(i.cost_W2s, ".4g", "W² s"),
+            num(o.cost_W2s, ".4g", "W² s"),
+            "",
+        ),
     ]
     d = result.improvement.decomposition
     note = ""

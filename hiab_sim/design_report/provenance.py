@@ -26,7 +26,7 @@ def package_version(name: str) -> str:
 
 
 def git_commit(folder: Path) -> str:
-    """The commit of the checkout ``folder`` lies in (with ``+ changes`` when the tree is dirty), or why there is none."""
+    """The commit of the checkout ``folder`` lies in (noting uncommitted changes), or why there is none."""
     git = shutil.which("git")
     if git is None:
         return "unknown (git is not installed)"

@@ -89,7 +89,9 @@ def checked_ranges(cls: type) -> dict[str, str]:
             out[target.attr] = ">= 0"
         elif name == "check_choice" and args:
             choices = args[0]
-            out[target.attr] = "one of " + ", ".join(f"`{c}`" for c in choices) if isinstance(choices, tuple) else str(choices)
+            out[target.attr] = (
+                "one of " + ", ".join(f"`{c}`" for c in choices) if isinstance(choices, tuple) else str(choices)
+            )
     return out
 
 
@@ -97,9 +99,10 @@ def _type_name(annotation: Any) -> str:
     text = annotation if isinstance(annotation, str) else getattr(annotation, "__name__", str(annotation))
     text = text.replace(" | None", "")
     return {"float": "number", "int": "integer", "str": "text", "bool": "true/false"}.get(
-        text, text.replace("tuple[float, float, float]", "[number, number, number]").replace(
+        text,
+        text.replace("tuple[float, float, float]", "[number, number, number]").replace(
             "tuple[float, float]", "[number, number]"
-        )
+        ),
     )
 
 

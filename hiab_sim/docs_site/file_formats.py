@@ -72,7 +72,7 @@ def file_formats_markdown() -> str:
         "",
         "Paths: `a.b` is key `b` of mapping `a`; `tasks[]` an element of the list `tasks`; `reference{csv}` the "
         "mapping `reference` with `kind: csv`. A value marked `number or {value, source}` may carry its "
-        "provenance: `{value: 0.268, source: \"read: ...\"}` with a source starting with `read`, `estimate`, "
+        'provenance: `{value: 0.268, source: "read: ..."}` with a source starting with `read`, `estimate`, '
         "`derived` or `model`. *required* keys have no default; *shared* ones default to the shared section's.",
     ]
     for name, fmt in FORMATS.items():

@@ -103,7 +103,7 @@ def result_rows(
     hints = typing.get_type_hints(cls)
     comments = _comments(cls)
     rows = []
-    for field in dataclasses.fields(cls):  # type: ignore[arg-type]
+    for field in dataclasses.fields(cls):
         if field.name == "extra":
             continue
         tp = hints[field.name]
@@ -129,29 +129,33 @@ def result_schema_markdown() -> str:
 
     rows = [(f"`{p}`", t, u, d) for p, t, u, d in result_rows(Result)]
     arrays = [(f"`{name}`", shape, unit, what) for name, (shape, unit, what) in TRAJECTORY_ARRAYS.items()]
-    return "\n".join(
-        [
-            "# result.json and trajectory.npz",
-            "",
-            f"`hiab-sim optimize` writes `result.json` (schema version {SCHEMA_VERSION}) and `trajectory.npz` "
-            "into the result folder; `hiab_sim.results.schema.read_result(folder)` reads the first back as "
-            "frozen dataclasses with the same names. The table is generated from those dataclasses "
-            "(`hiab_sim/results/`): `a[]` is an element of the list `a`, `a.*` any key of the mapping `a` "
-            "(actuator, design or task names). Units follow from each name's suffix; costs of eq. `costf2` are "
-            "in W^2 s (a squared power integrated over time, not an energy). Link lengths are written as "
-            "`{lift: {L, Lc0, Lc}, tilt: {...}}` in m. Optional sections are absent from results that do not "
-            "have them.",
-            "",
-            "## result.json",
-            "",
-            table(("key", "type", "unit", "description"), rows),
-            "",
-            "## trajectory.npz",
-            "",
-            "NumPy arrays on the fine re-check grid (K samples); the columns are per actuator (lift, tilt, "
-            "telescope) or per reference coordinate (x, y, xt2). A duty mix writes each task's arrays with the prefix "
-            "`task<k>_` (k = 0, 1, ... in the order of `tasks:`).",
-            "",
-            table(("array", "shape", "unit", "content"), arrays),
-        ]
-    ) + "\n"
+    return (
+        "\n".join(
+            [
+                "# result.json and trajectory.npz",
+                "",
+                f"`hiab-sim optimize` writes `result.json` (schema version {SCHEMA_VERSION}) and `trajectory.npz` "
+                "into the result folder; `hiab_sim.results.schema.read_result(folder)` reads the first back as "
+                "frozen dataclasses with the same names. The table is generated from those dataclasses "
+                "(`hiab_sim/results/`): `a[]` is an element of the list `a`, `a.*` any key of the mapping `a` "
+                "(actuator, design or task names). Units follow from each name's suffix; costs of eq. `costf2` are "
+                "in W^2 s (a squared power integrated over time, not an energy). Link lengths are written as "
+                "`{lift: {L, Lc0, Lc}, tilt: {...}}` in m. Optional sections are absent from results that do not "
+                "have them.",
+                "",
+                "## result.json",
+                "",
+                table(("key", "type", "unit", "description"), rows),
+                "",
+                "## trajectory.npz",
+                "",
+                "NumPy arrays on the fine re-check grid (K samples); the columns are per actuator (lift, tilt, "
+                "telescope) or per reference coordinate (x, y, xt2). A duty mix writes each task's arrays with "
+                "the prefix "
+                "`task<k>_` (k = 0, 1, ... in the order of `tasks:`).",
+                "",
+                table(("array", "shape", "unit", "content"), arrays),
+            ]
+        )
+        + "\n"
+    )

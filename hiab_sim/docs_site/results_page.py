@@ -38,7 +38,8 @@ def results_block(result: Result) -> str:
         )
     i, o = result.initial, result.optimal
     rows.append(
-        f"| net electrical energy (motor terminals) | {i.net_electrical_energy_J:.1f} → {o.net_electrical_energy_J:.1f} J "
+        f"| net electrical energy (motor terminals) | {i.net_electrical_energy_J:.1f} → "
+        f"{o.net_electrical_energy_J:.1f} J "
         f"({-result.improvement.net_energy_saved_percent:.2f} %) |"
     )
     if result.energy is not None:
@@ -62,8 +63,10 @@ def results_block(result: Result) -> str:
     d = result.improvement.decomposition
     if d.from_lengths_J is not None:
         rows.append(f"| saving from the lengths alone | {d.from_lengths_J:.1f} J |")
-    rows.append(f"| re-check ({result.recheck.id_path}, {result.recheck.grid_points} points): TCP error | "
-                f"{1e3 * result.recheck.tracking_error.position_m:.2f} mm |")
+    rows.append(
+        f"| re-check ({result.recheck.id_path}, {result.recheck.grid_points} points): TCP error | "
+        f"{1e3 * result.recheck.tracking_error.position_m:.2f} mm |"
+    )
     return "\n".join(["| quantity | value |", "|---|---|", *rows])
 
 
