@@ -29,7 +29,13 @@ def question(result: Result, crane: Crane) -> str:
         if result.tasks
         else f"the study's reference motion ({result.settings.fine_grid_points} fine-grid samples)"
     )
-    objective = "the seed paper's cost costf2" if result.energy is None else f"`{result.energy.objective}`"
+    names = {
+        "costf2": "the seed paper's cost costf2 (squared summed electrical power)",
+        "battery_energy": "the battery's energy",
+    }
+    objective = (
+        names["costf2"] if result.energy is None else names.get(result.energy.objective, result.energy.objective)
+    )
     rows = [
         ("study", result.name),
         ("machine", f"{crane.name} ({crane.source})"),
@@ -46,7 +52,7 @@ def question(result: Result, crane: Crane) -> str:
             "Where should the electromechanical linear actuators be mounted so that the machine does this work "
             "on the least energy, within its actuators' envelope, strokes, joint ranges and thermal limits?"
         ),
-        table(("", ""), rows),
+        table(("item", "value"), rows),
     )
 
 
@@ -76,7 +82,7 @@ def design(result: Result, crane: Crane, folder: Path) -> str:
             f" Rounded to the {1e3 * b.tolerance_m:g} mm manufacturing tolerance with a {1e3 * b.stroke_margin_m:g} mm "
             f"stroke margin; every design within ±{1e3 * b.tolerance_m:g} mm stays feasible (worst margin "
             f"{1e3 * b.tolerance_check.margin:.3f} mm) and its net energy differs from the optimum's by "
-            f"{b.net_energy_change_vs_optimum_J:+.1f} J. Export: {b.mjcf_command}"
+            f"{b.net_energy_change_vs_optimum_J + 0.0:+.1f} J. Export: {b.mjcf_command}"
         )
     return section(
         "The answer: the design to build",

@@ -86,4 +86,4 @@ def provenance(result: Result, folder: Path) -> str:
         ("bounds [m]", f"low {list(s.xi_low)}, up {list(s.xi_up)}; envelope margin {s.envelope_margin:g}"),
         ("redundancy", s.redundancy),
     ]
-    return section("Provenance", table(("", ""), rows))
+    return section("Provenance", table(("item", "value"), rows))
