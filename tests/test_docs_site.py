@@ -37,8 +37,15 @@ def test_model_pages_join_the_nav_when_present_and_leave_no_trace_when_absent(tm
     (tmp_path / "zeta.md").write_text("# Zeta checks\n")
     (tmp_path / "plant.md").write_text("# The plant\n")
     (tmp_path / "machine.md").write_text("intro without a heading\n")
+    (tmp_path / "machines").mkdir()
+    (tmp_path / "machines" / "excavator.md").write_text("# The excavator\n")
     section = next(item for item in with_model_pages(nav, tmp_path) if isinstance(item, dict) and SECTION in item)
-    assert section[SECTION] == [{"Machine": "machine.md"}, {"The plant": "plant.md"}, {"Zeta checks": "zeta.md"}]
+    assert section[SECTION] == [
+        {"Machine": "machine.md"},
+        {"The plant": "plant.md"},
+        {"Zeta checks": "zeta.md"},
+        {"The excavator": "machines/excavator.md"},
+    ]
 
 
 def test_cli_reference_names_every_subcommand_and_option() -> None:

@@ -1,8 +1,9 @@
-"""The site's navigation: the pages ``mkdocs.yml`` names, plus a section for every other top-level page.
+"""The site's navigation: the pages ``mkdocs.yml`` names, plus a section for every other page of ``docs/``.
 
-Other pages of ``docs/`` (``machine.md``, ``dynamics.md``, ``structure.md``, ``plant.md``, ``energy.md``,
-``extending.md``, ``outputs.md``, or any new one) land under "Models and checks" when they exist and are
-named nowhere in the nav, so a page may be added or be absent without editing ``mkdocs.yml``.
+Other pages (``machine.md``, ``dynamics.md``, ``structure.md``, ``plant.md``, ``energy.md``,
+``extending.md``, ``outputs.md``, or any new one, in a subfolder too) land under "Models and checks" when
+they exist and the nav names them nowhere, so a page may be added or be absent without editing
+``mkdocs.yml`` (and ``mkdocs build --strict`` never fails on a page left out of the nav).
 """
 
 from __future__ import annotations
@@ -41,11 +42,12 @@ def page_title(path: Path) -> str:
 def with_model_pages(nav: list[Any], docs_dir: Path) -> list[Any]:
     """``nav`` with a "Models and checks" section of the top-level pages it does not name (none: unchanged)."""
     named = set(nav_pages(nav))
-    extra = [p for p in docs_dir.glob("*.md") if p.name not in named]
+    extra = [p.relative_to(docs_dir).as_posix() for p in docs_dir.rglob("*.md")]
+    extra = [p for p in extra if p not in named]
     order = {name: i for i, name in enumerate(PREFERRED)}
-    extra.sort(key=lambda p: (order.get(p.name, len(order)), p.name))
+    extra.sort(key=lambda p: (order.get(p, len(order)), p.count("/"), p))
     if not extra:
         return nav
-    section = {SECTION: [{page_title(p): p.name} for p in extra]}
+    section = {SECTION: [{page_title(docs_dir / p): p} for p in extra]}
     position = next((i for i, item in enumerate(nav) if isinstance(item, dict) and "Reference" in item), len(nav))
     return [*nav[:position], section, *nav[position:]]
