@@ -84,7 +84,7 @@ def sensitivities(result: Result, folder: Path) -> str:
             "not a promise for large moves.",
             "note",
         ),
-        table(("active constraint", "per", "% of the optimal cost", "cost units"), rows, numeric=(2, 3)),
+        table(("active constraint", "per", "% of the optimal cost", "cost decrease per unit"), rows, numeric=(2, 3)),
         figure(folder / "sensitivity.png", "KKT multipliers of the active constraints"),
     )
 
