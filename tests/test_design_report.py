@@ -171,3 +171,52 @@ def test_documentation_page_renders_in_chromium(site: str) -> None:
     block = (ROOT / "docs" / "results" / "default-study.md").read_text().split("<!-- results:start -->")[1]
     battery = next(line for line in block.splitlines() if line.startswith("| battery energy"))
     assert battery.split("|")[2].strip().split(" J")[0] in page.text
+
+
+def test_report_of_a_duty_mix_shows_its_tasks_and_cross_evaluation(
+    run_dir: Path, result: Result, tmp_path: Path
+) -> None:
+    """A result with tasks and a cross-evaluation gets the duty-mix section with each task and each design's cells."""
+    import shutil
+    from dataclasses import replace
+
+    from hiab_sim.results.analysis_sections import CrossEvaluation
+    from hiab_sim.results.schema import TaskResult
+
+    task = TaskResult(
+        name="lifting",
+        weight=20.0,
+        kind="spiral",
+        duration_s=6.25,
+        payload_kg=150.0,
+        telescope="prescribed",
+        spline_control_points=16,
+        collocation_points=13,
+        initial=result.initial,
+        optimal=result.optimal,
+        recheck=result.recheck,
+    )
+    cross = CrossEvaluation(
+        note="test",
+        tasks=("lifting",),
+        weights=(20.0,),
+        designs=("lifting alone", "mix"),
+        lengths=(result.optimal.lengths, result.optimal.lengths),
+        net_energy_J=((1234.5,), (None,)),
+        drawn_energy_J=((1300.0,), (None,)),
+        cost_W2s=((1.0,), (None,)),
+        max_violation=((0.0,), (None,)),
+        mix_net_energy_J=(24690.0, None),
+        mix_cost_W2s=(20.0, None),
+        mix_energy_lost_J=(0.0, None),
+        mix_energy_lost_percent=(0.125, None),
+        mix_cost_lost_percent=(0.0, None),
+    )
+    folder = tmp_path / "mix"
+    shutil.copytree(run_dir, folder)
+    mixed = replace(result, tasks=(task,), cross_evaluation=cross)
+    (folder / "result.json").write_text(json.dumps(mixed.to_json()))
+    assert main(["report", str(folder)]) == 0
+    html = (folder / "report.html").read_text()
+    assert "<h2>Duty mix</h2>" in html and "lifting x 20" in html
+    assert "1234.5" in html and "24690.0" in html and "+0.125 %" in html and "–" in html  # a missing cell: en dash
