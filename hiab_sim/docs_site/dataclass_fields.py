@@ -53,7 +53,7 @@ def _interval(args: list[Any], keywords: dict[str, Any]) -> str:
     high = args[1] if len(args) > 1 else keywords.get("high")
     low_open, high_open = keywords.get("low_open", False), keywords.get("high_open", False)
     integer = " (integer)" if keywords.get("integral") else ""
-    show = lambda v: f"{v:g}" if isinstance(v, int | float) else str(v)  # noqa: E731
+    show = lambda v: f"{v:g}" if isinstance(v, int | float) else str(v).replace("self.", "")  # noqa: E731
     if low is not None and high is not None:
         return f"{'(' if low_open else '['}{show(low)}, {show(high)}{')' if high_open else ']'}{integer}"
     if low is not None:

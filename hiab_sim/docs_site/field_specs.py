@@ -307,11 +307,12 @@ def _reference_keys(where: str) -> list[Key]:
             description="Largest distance of the fit from any sample.",
         ),
     ]
-    rows = [section(f"{where}{{spiral}}", "A TCP spiral in the vertical plane (kind omitted or `spiral`).")]
+    needed = "one of `reference`, `tasks`" if where == "reference" else "required"
+    rows = [section(f"{where}{{spiral}}", "A TCP spiral in the vertical plane (kind omitted or `spiral`).", needed)]
     rows += [replace(k, path=f"{where}{{spiral}}.{k.path.lstrip('.')}") for k in spiral]
-    rows.append(section(f"{where}{{pick_and_place}}", "Rest to rest from `pick` to `place` over a clearance."))
+    rows.append(section(f"{where}{{pick_and_place}}", "Rest to rest from `pick` to `place` over a clearance.", needed))
     rows += [replace(k, path=f"{where}{{pick_and_place}}.{k.path.lstrip('.')}") for k in pick]
-    rows.append(section(f"{where}{{csv}}", "A sampled trajectory from a CSV file, fitted by a B-spline."))
+    rows.append(section(f"{where}{{csv}}", "A sampled trajectory from a CSV file, fitted by a B-spline.", needed))
     rows += [replace(k, path=f"{where}{{csv}}.{k.path.lstrip('.')}") for k in csv]
     return rows
 

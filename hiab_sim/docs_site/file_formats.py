@@ -81,7 +81,7 @@ def file_formats_markdown() -> str:
                 _shown(k.path) + (" (any key)" if k.kind == "free" else ""),
                 k.type,
                 k.unit,
-                k.default,
+                k.default or ("required" if k.kind == "value" else ""),
                 _code(k.allowed),
                 _code(k.description),
             )
