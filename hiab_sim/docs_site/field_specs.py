@@ -363,7 +363,7 @@ def study_keys() -> list[Key]:
             "tasks",
             kind="value",
             type="list",
-            default="none",
+            default="one of `reference`, `tasks`",
             description="Tasks of a duty mix (instead of `reference` and `payload`).",
         ),
         section("tasks[]", "One task."),
