@@ -10,6 +10,7 @@ import subprocess
 import tempfile
 import time
 from dataclasses import dataclass, field
+from html.parser import HTMLParser
 from pathlib import Path
 from typing import Any
 
@@ -131,3 +132,30 @@ def save_artifact(name: str, data: bytes) -> Path:
     path = folder / name
     path.write_bytes(data)
     return path
+
+
+class References(HTMLParser):
+    """Every attribute that can make a browser fetch something, and every tag that can run or pull content."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.urls: list[str] = []
+        self.tags: list[str] = []
+        self.styles: list[str] = []
+        self._in_style = False
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        """Record a fetching tag, its URL attributes and inline styles."""
+        if tag in ("script", "link", "iframe", "object", "embed", "base", "video", "audio", "source"):
+            self.tags.append(tag)
+        self._in_style = tag == "style"
+        for name, value in attrs:
+            if name in ("src", "href", "srcset", "action", "poster", "data", "formaction") and value is not None:
+                self.urls.append(value)
+            if name == "style" and value:
+                self.styles.append(value)
+
+    def handle_data(self, data: str) -> None:
+        """Record the text of a style element."""
+        if self._in_style:
+            self.styles.append(data)

@@ -86,3 +86,21 @@ def test_default_study_results_page_is_current(result: Result) -> None:
 
     page = (Path(__file__).resolve().parents[1] / "docs" / "results" / "default-study.md").read_text()
     assert differences(current_block(page), results_block(result)) == []
+
+
+def test_default_run_report_is_self_contained_and_states_the_design(run: RunOutput, result: Result) -> None:
+    """hiab-sim report on the default run: one HTML file, nothing external, the design to build and battery energy."""
+    from browser_helper import References
+
+    from hiab_sim.design_report import write_report
+
+    (path,) = write_report(run.folder)
+    html = path.read_text()
+    parser = References()
+    parser.feed(html)
+    assert parser.tags == [] and all(url.startswith("data:") for url in parser.urls)
+    assert result.buildable is not None and result.energy is not None
+    lift, tilt = result.buildable.lengths.lift, result.buildable.lengths.tilt
+    assert f"lift L / Lc0 / Lc = {lift.L:.3f} / {lift.Lc0:.3f} / {lift.Lc:.3f} m" in html
+    assert f"tilt L / Lc0 / Lc = {tilt.L:.3f} / {tilt.Lc0:.3f} / {tilt.Lc:.3f} m" in html
+    assert f"{result.energy.optimal.battery_energy_J:.1f} J" in html

@@ -9,11 +9,10 @@ import subprocess
 import sys
 import threading
 from collections.abc import Iterator
-from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
-from browser_helper import chromium, load_page, save_artifact
+from browser_helper import References, chromium, load_page, save_artifact
 from test_study_small import small_study, write_study
 
 from hiab_sim.cli import main
@@ -40,34 +39,9 @@ def result(run_dir: Path) -> Result:
     return read_result(run_dir)
 
 
-class _References(HTMLParser):
-    """Every attribute that can make a browser fetch something, and every tag that can run or pull content."""
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.urls: list[str] = []
-        self.tags: list[str] = []
-        self.styles: list[str] = []
-        self._in_style = False
-
-    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
-        if tag in ("script", "link", "iframe", "object", "embed", "base", "video", "audio", "source"):
-            self.tags.append(tag)
-        self._in_style = tag == "style"
-        for name, value in attrs:
-            if name in ("src", "href", "srcset", "action", "poster", "data", "formaction") and value is not None:
-                self.urls.append(value)
-            if name == "style" and value:
-                self.styles.append(value)
-
-    def handle_data(self, data: str) -> None:
-        if self._in_style:
-            self.styles.append(data)
-
-
 def test_optimize_writes_a_report_with_no_external_reference(run_dir: Path) -> None:
     """report.html loads nothing from outside itself: no script, link or frame; every src a data: URI."""
-    parser = _References()
+    parser = References()
     parser.feed((run_dir / "report.html").read_text())
     assert parser.tags == []
     assert parser.urls and all(url.startswith("data:image/png;base64,") for url in parser.urls)
