@@ -28,6 +28,7 @@ SUBCOMMANDS: dict[str, str] = {
     "validate": "validate",
     "emla-map": "emla_map",
     "optimize": "optimize",
+    "report": "report",
     "render": "render",
     "compare": "compare",
     "simulate": "simulate",
