@@ -16,7 +16,8 @@ from browser_helper import References, chromium, load_page, save_artifact
 from test_study_small import small_study, write_study
 
 from hiab_sim.cli import main
-from hiab_sim.results.schema import Result, read_result
+from hiab_sim.results.read import read_result
+from hiab_sim.results.schema import Result
 
 ROOT = Path(__file__).resolve().parents[1]
 needs_chromium = pytest.mark.skipif(

@@ -9,7 +9,7 @@ from hiab_sim.design_report.analysis import closed_loop, constraints, duty_mix, 
 from hiab_sim.design_report.answer import design, energies, question
 from hiab_sim.design_report.page import document
 from hiab_sim.design_report.provenance import provenance
-from hiab_sim.results.read import read_run, result_crane
+from hiab_sim.results.read import read_result, result_crane
 
 REPORT_FILE = "report.html"
 
@@ -17,7 +17,7 @@ REPORT_FILE = "report.html"
 def report_html(run_dir: str | Path) -> str:
     """The report of ``run_dir`` as one self-contained HTML page (figures embedded, no network reference)."""
     folder = Path(run_dir)
-    result = read_run(folder)
+    result = read_result(folder)
     crane = result_crane(folder, result.crane)
     body = [
         question(result, crane),

@@ -3,7 +3,8 @@
 ``result.json`` is walked from :class:`hiab_sim.results.schema.Result` through the type hints of its
 dataclasses: every key with its type, its unit (from the name's suffix, as the project's naming rule
 states it), the section's docstring and the field's own comment. ``trajectory.npz``'s arrays are
-listed from :data:`TRAJECTORY_ARRAYS`, which a test holds to a written file.
+listed from their declared schema, :data:`hiab_sim.results.trajectory_file.ARRAYS` (the writer refuses
+arrays that lack a declared key, and a test holds a written file to it).
 """
 
 from __future__ import annotations
@@ -35,26 +36,6 @@ SUFFIX_UNITS = (
     ("_Hz", "Hz"),
     ("_percent", "%"),
 )
-
-#: The arrays of ``trajectory.npz`` (fine grid, K samples; columns lift, tilt, telescope or x, y, xt2).
-TRAJECTORY_ARRAYS: dict[str, tuple[str, str, str]] = {
-    "time": ("(K,)", "s", "fine-grid sample times"),
-    "reference_tcp": ("(K, 3)", "m", "reference r = (x, y, xt2): TCP in {W} and the telescope extension"),
-    **{
-        f"{design}_{name}": (shape, unit, f"{design} design: {what}")
-        for design in ("initial", "optimal")
-        for name, shape, unit, what in (
-            ("position", "(K, 3)", "rad, rad, m", "joint positions theta1, theta2, xt2"),
-            ("velocity", "(K, 3)", "rad/s, rad/s, m/s", "joint velocities"),
-            ("acceleration", "(K, 3)", "rad/s^2, rad/s^2, m/s^2", "joint accelerations"),
-            ("tcp", "(K, 3)", "m", "TCP position (x, y) in {W} and xt2"),
-            ("actuator_force", "(K, 3)", "N", "actuator (rod) forces f_x, > 0 pushing"),
-            ("actuator_velocity", "(K, 3)", "m/s", "actuator velocities v_x"),
-            ("actuator_stroke", "(K, 3)", "m", "actuator strokes x (0 at the retracted length x0)"),
-            ("electrical_power", "(K, 3)", "W", "EMLA electrical power P_i per drive (motor side)"),
-        )
-    },
-}
 
 
 def unit_of(name: str) -> str:
@@ -126,16 +107,18 @@ def result_rows(
 def result_schema_markdown() -> str:
     """The page: result.json's keys from the result types, then trajectory.npz's arrays."""
     from hiab_sim.results.schema import SCHEMA_VERSION, Result
+    from hiab_sim.results.trajectory_file import ARRAYS, VERSION_KEY
+    from hiab_sim.results.trajectory_file import SCHEMA_VERSION as ARRAYS_VERSION
 
     rows = [(f"`{p}`", t, u, d) for p, t, u, d in result_rows(Result)]
-    arrays = [(f"`{name}`", shape, unit, what) for name, (shape, unit, what) in TRAJECTORY_ARRAYS.items()]
+    arrays = [(f"`{spec.key}`", f"({spec.shape})", spec.unit, spec.description) for spec in ARRAYS]
     return (
         "\n".join(
             [
                 "# result.json and trajectory.npz",
                 "",
                 f"`hiab-sim optimize` writes `result.json` (schema version {SCHEMA_VERSION}) and `trajectory.npz` "
-                "into the result folder; `hiab_sim.results.schema.read_result(folder)` reads the first back as "
+                "into the result folder; `hiab_sim.results.read.read_result(folder)` reads the first back as "
                 "frozen dataclasses with the same names. The table is generated from those dataclasses "
                 "(`hiab_sim/results/`): `a[]` is an element of the list `a`, `a.*` any key of the mapping `a` "
                 "(actuator, design or task names). Units follow from each name's suffix; costs of eq. `costf2` are "
@@ -149,10 +132,10 @@ def result_schema_markdown() -> str:
                 "",
                 "## trajectory.npz",
                 "",
-                "NumPy arrays on the fine re-check grid (K samples); the columns are per actuator (lift, tilt, "
-                "telescope) or per reference coordinate (x, y, xt2). A duty mix writes each task's arrays with "
-                "the prefix "
-                "`task<k>_` (k = 0, 1, ... in the order of `tasks:`).",
+                f"NumPy arrays on the fine re-check grid (K samples, J joints, A actuators; `{{design}}` is "
+                f"`initial` or `optimal`), array schema version {ARRAYS_VERSION} in `{VERSION_KEY}`. A duty mix "
+                "writes each task's arrays with the prefix `task<k>_` (k = 0, 1, ... in the order of `tasks:`); "
+                "`hiab_sim.results.read.open_run(folder, Result)` reads both files.",
                 "",
                 table(("array", "shape", "unit", "content"), arrays),
             ]

@@ -18,7 +18,8 @@ from pathlib import Path
 
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import CHAIN_NAMES
-from hiab_sim.results.schema import Result, read_result
+from hiab_sim.results.read import read_result
+from hiab_sim.results.schema import Result
 
 START, END = "<!-- results:start -->", "<!-- results:end -->"
 #: How far a page's number may be from a fresh run's (relative), beyond one unit of its last digit.
