@@ -1,4 +1,4 @@
-"""Reports of the cross-validation (``hiab-sim validate``): JSON, the README's markdown table, force plots.
+"""Reports of the cross-validation (``hiab-sim validate``): JSON, the markdown table of docs/validation.md, force plots.
 
 Every file is written atomically (:mod:`hiab_sim.atomic_io`); the computations are in
 :mod:`hiab_sim.validation`.
@@ -18,7 +18,7 @@ from hiab_sim.validation import CaseResult, Tolerances
 
 
 def markdown_table(results: list[CaseResult], tolerances: Tolerances) -> str:
-    """The validation table (markdown), as inserted in the README."""
+    """The validation table (markdown), as inserted in docs/validation.md."""
     lines = [
         "| case | samples | length sets | max abs force error [N] | max rel force error | "
         "max abs velocity error [m/s] | 6D form: max rel force error | balance (analytic) | balance (MuJoCo) | pass |",

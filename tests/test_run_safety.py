@@ -124,7 +124,7 @@ def test_cli_another_study_is_refused_then_forced(two_start_run: Path, tmp_path:
     """Another study exits 2 leaving the folder as it was; with --force it runs and no stale output survives."""
     out = tmp_path / "out"
     shutil.copytree(two_start_run, out)
-    _fill(out, ("objective.png", "playback.mp4"))
+    _fill(out, ("objective.png", "playback.mp4", "simulation.json"))
     before = {p.name: p.read_bytes() for p in out.iterdir()}
     other = write_study(tmp_path, small_study(name="other", tracking={**small_study()["tracking"], "position": 3e-3}))
     capsys.readouterr()
@@ -134,7 +134,7 @@ def test_cli_another_study_is_refused_then_forced(two_start_run: Path, tmp_path:
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
     assert main(["optimize", str(other), "--out", str(out), "--force", *FLAGS]) == 0
     names = sorted(p.name for p in out.iterdir())
-    assert names == sorted([OWNER_FILE, "checkpoint_0.json", "result.json", "trajectory.npz"])
+    assert names == sorted([OWNER_FILE, "checkpoint_0.json", "report.html", "result.json", "trajectory.npz"])
     assert read_owner(out)["name"] == "other"  # type: ignore[index]
 
 

@@ -23,10 +23,12 @@ USES_MUJOCO = {"mjcf", "validate", "optimize", "render", "simulate", "sweep", "p
 #: Subcommand name -> module under ``hiab_sim.cli`` that implements it.
 SUBCOMMANDS: dict[str, str] = {
     "crane": "crane_info",
+    "machine": "machine",
     "mjcf": "mjcf",
     "validate": "validate",
     "emla-map": "emla_map",
     "optimize": "optimize",
+    "report": "report",
     "render": "render",
     "compare": "compare",
     "simulate": "simulate",

@@ -54,6 +54,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--no-video", action="store_true", help="do not render the playback video")
     parser.add_argument("--no-figures", action="store_true", help="do not draw the figures (quick runs)")
     parser.add_argument("--quiet", action="store_true", help="no per-iteration progress lines")
+    parser.add_argument("--no-report", action="store_true", help="do not write the design report (report.html)")
     parser.set_defaults(run=run)
 
 
@@ -147,6 +148,10 @@ def run(args: argparse.Namespace) -> int:
     for line in [*summary_lines(output.result), *energy_lines(output.result), *codesign]:
         print(line)
     print(f"wrote {output.folder}/result.json, trajectory.npz and {len(output.figures)} figures")
+    if not args.no_report:
+        from hiab_sim.design_report import write_report
+
+        print(f"wrote design report: {write_report(output.folder)[0]}")
     if not args.no_video:
         try:
             from hiab_sim.render import render_result

@@ -12,7 +12,7 @@ loops and limits) under the cascade controller of :mod:`hiab_sim.control`. Writt
 * ``closed_loop_*.png`` figures (:mod:`hiab_sim.env.figures`) and ``closed_loop.mp4`` (rendered
   through dm-control's ``Physics.render``, OSMesa; side by side when both designs run).
 
-The table printed at the end is the README's "Closed-loop validation" table.
+The table printed at the end is the one of docs/results/closed-loop.md.
 
 ``--plant realistic|ideal|FILE.yaml`` simulates the plant of :mod:`hiab_sim.env.plant` (default:
 ideal, the planner's own model) and, when the plant has effects on, adds ``plant_effects`` to

@@ -102,7 +102,7 @@ def simulation_report(
 
 
 def table(report: dict[str, object]) -> str:
-    """Markdown table of predicted vs closed-loop energy and tracking errors (the README's table)."""
+    """Markdown table of predicted vs closed-loop energy and tracking errors (docs/results/closed-loop.md)."""
     lines = [
         "| design | end mass | predicted energy [J] | closed-loop energy [J] | difference | TCP error rms / max [mm]"
         " | at current limit | at voltage limit | extra energy [J] |",

@@ -35,6 +35,9 @@ OUTPUT_PATTERNS = (
     "*.png",
     "*.mp4",
     "crane.yaml",
+    "simulation.json",  # hiab-sim simulate's, of the run it validated
+    "report.html",
+    "report.pdf",
     OWNER_FILE,
 )
 NO_CHECKPOINTS = "has no checkpoint_<k>.json to resume from (run without --resume to start afresh)"
