@@ -29,7 +29,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "optimize",
         help="Optimise the link lengths of both closed chains for least EMLA energy.",
         description=(
-            "Minimise the seed's cost (eq. costf2: 1/2 Dt sum (sum_i P_i)^2 with EMLA electrical power) over "
+            "Minimise the seed paper's squared-power cost (costf2 = 1/2 Dt sum over samples of the squared total "
+            "EMLA electrical power, in W^2 s; a smooth stand-in for energy, not an energy) over "
             "both chains' link lengths and the B-spline joint trajectory, subject to inverse dynamics, TCP "
             "tracking of a spiral, the EMLA envelope, stroke, triangle and joint limits (SLSQP). A study may "
             "instead minimise the battery's energy (objective: battery_energy), add the motors' thermal limits "
