@@ -94,5 +94,5 @@ def run(args: argparse.Namespace) -> int:
         raise InvalidInputError("--out", str(out), "must be a folder (it is a file)")
     out.mkdir(parents=True, exist_ok=True)
     paths = write_comparison(out, runs)
-    print(f"wrote {', '.join(str(p) for p in paths)}")
+    print(f"wrote {', '.join(p.name for p in paths)} into {out}")
     return 0
