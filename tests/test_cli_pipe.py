@@ -30,7 +30,7 @@ def _into_closed_pipe(*args: str) -> subprocess.CompletedProcess[str]:
 
 @pytest.mark.parametrize("command", [None, *SUBCOMMANDS])
 def test_help_into_a_closed_pipe_has_no_traceback(command: str | None) -> None:
-    """``hiab-sim [COMMAND] --help`` into a closed pipe: nothing on stderr (argparse itself ignores the failed write)."""
+    """``hiab-sim [COMMAND] --help`` into a closed pipe: nothing on stderr (argparse ignores the failed write)."""
     done = _into_closed_pipe(*([] if command is None else [command]), "--help")
     assert done.stderr == ""
     assert done.returncode in (0, BROKEN_PIPE_STATUS)

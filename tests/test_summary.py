@@ -37,7 +37,7 @@ def test_console_ends_with_the_summary_that_summary_md_holds(run: tuple[Path, st
 
 
 def test_summary_numbers_are_the_results_own(run: tuple[Path, str]) -> None:
-    """The buildable lengths [mm], their moves and the energies before/after in the summary are read from result.json."""
+    """The buildable lengths [mm], their moves and the energies before/after are read from result.json."""
     folder, _ = run
     text = (folder / SUMMARY_FILE).read_text()
     r = read_result(folder)
@@ -65,7 +65,7 @@ def test_verbose_prints_the_iterations_before_the_summary(tmp_path: Path, capsys
 def test_rerun_removes_the_earlier_simulation_too_and_says_so(
     run: tuple[Path, str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """A fresh (quiet) run over an earlier one removes every earlier output, simulation.json included, and says which."""
+    """A fresh (quiet) run over an earlier one removes every earlier output, simulation.json too, and says which."""
     import shutil
 
     folder = tmp_path / "out"
@@ -85,7 +85,10 @@ def test_rerun_removes_the_earlier_simulation_too_and_says_so(
     [
         ("envelope.lift.peak_torque", "lift motor peak torque"),
         ("stroke.tilt.x <= stroke", "tilt end of stroke"),
-        ("working_range.lift.x >= 0 at the low end", "lift cylinder fully retracted over the working range at the lower"),
+        (
+            "working_range.lift.x >= 0 at the low end",
+            "lift cylinder fully retracted over the working range at the lower",
+        ),
         ("bound tilt.L up = 1.3 m", "tilt base pivot to boom hinge at its upper bound (1300 mm)"),
         ("tracking.position.x_tcp <= band", "TCP tracking band (position)"),
     ],

@@ -12,7 +12,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "energy-map",
         help="Map the objective and net energy over two link lengths (the rest and the trajectory fixed).",
         description=(
-            "Evaluate the study's objective (by default the seed paper's squared-power cost costf2 in W^2 s), net electrical energy and the constraints that depend on the link lengths only on an "
+            "Evaluate the study's objective (by default the seed paper's squared-power cost costf2 in W^2 s), "
+            "the net electrical energy and the constraints that depend on the link lengths only on an "
             "N x N grid of two link lengths over their bounds, the other four and the joint trajectory fixed at "
             "the optimum of --result (or the study's start), on the analytic ID path, vectorised over designs. "
             "Infeasible cells are coloured by their binding constraint."

@@ -26,7 +26,7 @@ import numpy as np
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
-from hiab_sim.errors import InvalidInputError
+from hiab_sim.errors import ConfigError, HiabSimError, InvalidInputError
 
 #: Natural frequency of the viewer file's stroke servos [Hz].
 SERVO_FREQUENCY_HZ = 1.0
@@ -37,7 +37,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "mjcf",
         help="write the MJCF crane model for a link-length set",
-        description="Write the MuJoCo MJCF model of the crane (closed chains as connect equalities).",
+        description=(
+            "Write the MuJoCo MJCF model of the crane for one set of link lengths: the closed chains as connect "
+            "equalities, the EMLAs as stroke servos around the home pose, and cameras that frame the machine. "
+            "Opens in 'python -m mujoco.viewer --mjcf=FILE'."
+        ),
     )
     parser.add_argument("--crane", default="xs031", help="preset name or YAML file (default: xs031)")
     parser.add_argument(
@@ -85,6 +89,17 @@ def parse_lengths(text: str) -> LinkLengths:
     return LinkLengths.from_array(values)
 
 
+def given_chain(lengths: LinkLengths, message: str) -> str:
+    """The lengths the user gave for the chain a message names (``lift.joint_range ...``), else all of them."""
+    from dataclasses import fields
+
+    for chain in (f.name for f in fields(LinkLengths)):
+        if message.startswith(f"{chain}."):
+            xi = getattr(lengths, chain)
+            return f"the {chain} chain given as L = {xi.L:g} m, Lc0 = {xi.Lc0:g} m, Lc = {xi.Lc:g} m"
+    return "the lengths given [" + ", ".join(f"{v:g}" for v in lengths.as_array()) + "] m"
+
+
 def home_keyframe(crane: Crane, lengths: LinkLengths) -> tuple[np.ndarray, np.ndarray]:
     """Loop-consistent qpos at the middle of the working ranges and the forces that hold it [N]."""
     from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
@@ -123,7 +138,12 @@ def run(args: argparse.Namespace) -> int:
     from hiab_sim.model.drives import HomePose, SlideDrives, servo_gains
     from hiab_sim.model.mjcf import build_model
 
-    qpos, force = home_keyframe(crane, lengths)
+    try:
+        qpos, force = home_keyframe(crane, lengths)
+    except HiabSimError as error:
+        if not args.lengths:
+            raise
+        raise ConfigError(f"--lengths {args.lengths}: {given_chain(lengths, str(error))}: {error}") from None
     names = [build_model(crane, lengths).joint(j).name for j in range(len(qpos))]
     drives = SlideDrives.from_emla(load_emla_set())
     home = HomePose(

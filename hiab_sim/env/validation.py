@@ -39,7 +39,9 @@ def simulate_designs(
         conditions = [payload_error] if payload_error == 0.0 else [0.0, payload_error]
         for error in conditions:
             label = design if error == 0.0 else f"{design} end mass +{100 * error:g} %"
-            with tqdm(total=1, desc=label, unit="step", disable=quiet, file=sys.stderr, leave=False) as bar:
+            with tqdm(
+                total=1, desc=label, unit="step", disable=quiet or not sys.stderr.isatty(), file=sys.stderr, leave=False
+            ) as bar:
 
                 def progress(done: int, total: int, bar: tqdm = bar) -> None:
                     if bar.total != total:
@@ -136,7 +138,14 @@ def render_video(path: Path, runs: list[ClosedLoopRun], physics: list[CranePhysi
     duration = min(run.time[-1] for run in runs)
     frames = int(np.floor(duration * FPS)) + 1
     with video_sink(path, (width * len(runs), height), FPS) as sink:
-        for frame in tqdm(range(frames), desc="video", unit="frame", disable=quiet, file=sys.stderr, leave=False):
+        for frame in tqdm(
+            range(frames),
+            desc="video",
+            unit="frame",
+            disable=quiet or not sys.stderr.isatty(),
+            file=sys.stderr,
+            leave=False,
+        ):
             images: list[np.ndarray] = []
             for run, item in zip(runs, physics, strict=True):
                 index = int(np.clip(np.searchsorted(run.time, frame / FPS), 0, len(run.time) - 1))

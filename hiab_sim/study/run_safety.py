@@ -87,10 +87,10 @@ def _recorded_digest(folder: Path) -> tuple[str | None, str]:
 
 
 def check_folder(folder: Path, digest: str, resume: bool, force: bool) -> None:
-    """Raise unless this study may use ``folder``: :class:`ConfigError` naming the study that owns it, else
-    :class:`InvalidInputError` (field ``--out`` or ``--resume``).
+    """Raise unless this study may use ``folder``; writes nothing.
 
-    Writes nothing. See the module docstring for the rules.
+    A folder of another study raises :class:`ConfigError` naming that study, a bad ``--out`` or
+    ``--resume`` :class:`InvalidInputError`. See the module docstring for the rules.
     """
     if folder.exists() and not folder.is_dir():
         raise InvalidInputError("--out", str(folder), "must be a folder (it is a file)")

@@ -32,7 +32,11 @@ LENGTH_WORDS = {
 }
 
 _ENVELOPE_WORDS = {"peak_torque": "motor peak torque", "rated_speed": "motor rated speed", "voltage": "drive voltage"}
-_STROKE_WORDS = {"x >= 0": "cylinder fully retracted", "x <= Lc": "rod fully out of the barrel", "x <= stroke": "end of stroke"}
+_STROKE_WORDS = {
+    "x >= 0": "cylinder fully retracted",
+    "x <= Lc": "rod fully out of the barrel",
+    "x <= stroke": "end of stroke",
+}
 _TRACKING = re.compile(r"^tracking\.(\w+)\.(\S+)")
 _BOUND = re.compile(r"^bound (\w+)\.(\w+) (low|up) = (\S+) m$")
 
@@ -61,7 +65,10 @@ def limit_in_words(name: str) -> str:
         for side in ("low", "up"):
             suffix = f" at the {side} end"
             if row.endswith(suffix):
-                row, end = row[: -len(suffix)], f" at the {'lower' if side == 'low' else 'upper'} end of the joint range"
+                row, end = (
+                    row[: -len(suffix)],
+                    f" at the {'lower' if side == 'low' else 'upper'} end of the joint range",
+                )
         where = {"stroke": "", "working_range": " over the working range", "buildable_range": " over the build range"}
         return f"{chain} {_STROKE_WORDS.get(row, row)}{where[block]}{end}"
     if block == "joint_velocity":
@@ -111,7 +118,9 @@ def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[st
         if words not in binding and len(binding) < BINDING_SHOWN:
             binding.append(words)
     if binding:
-        lines.append("Binding limits at the optimum (largest energy gain per unit relaxed first): " + "; ".join(binding) + ".")
+        lines.append(
+            "Binding limits at the optimum (largest energy gain per unit relaxed first): " + "; ".join(binding) + "."
+        )
     else:
         lines.append("Binding limits at the optimum: none reported (no sensitivity section).")
     violation = r.recheck.max_violation_scaled
