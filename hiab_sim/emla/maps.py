@@ -166,7 +166,7 @@ def plot_efficiency_map(
         f_op, v_op = _points(points, f"designs[{name!r}]")
         ax.plot(
             v_op, f_op / 1e3, color=colour(name), linewidth=2.4 if name == "optimal" else 1.6,
-            linestyle="-" if name == "optimal" else "--", label=f"{name} design: operating points over the motion",
+            linestyle="-" if name == "optimal" else "-.", label=f"{name} design: operating points over the motion",
         )  # fmt: skip
     ax.axhline(0.0, color="0.3", linewidth=0.5)
     ax.axvline(0.0, color="0.3", linewidth=0.5)
