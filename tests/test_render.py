@@ -175,9 +175,10 @@ def _luminance(rgb: np.ndarray) -> np.ndarray:
 
 
 def test_dressed_frame_spans_the_machine_and_its_captions_read(result_dir: Path) -> None:
-    """One overlay frame at 640x480: the design-coloured pixels reach from the column to the tool point as
-    projected by an independent pinhole model, stay below the caption band, and the caption text has a
-    contrast ratio above 4.5 (WCAG AA) against its box.
+    """A 640x480 overlay frame shows the whole machine and readable captions.
+
+    The design-coloured pixels reach from the column to the tool point as an independent pinhole
+    model projects them, and the caption text has a contrast ratio above 4.5 (WCAG AA) on its box.
     """
     size = (640, 480)
     data = load_playback(result_dir)

@@ -78,6 +78,7 @@ def run(args: argparse.Namespace) -> int:
 
         ffmpeg_path()
 
+    from hiab_sim.env.plan import read_plan
     from hiab_sim.env.validation import render_video, simulate_designs, simulation_report, table
 
     runs, nominal, physics = simulate_designs(args.result_dir, designs, error, quiet=args.quiet)
@@ -91,7 +92,9 @@ def run(args: argparse.Namespace) -> int:
 
         written += [p.name for p in write_figures(out, runs, nominal)]
     if not args.no_video:
-        written.append(render_video(out / "closed_loop.mp4", runs, physics, quiet=args.quiet).name)
+        crane = read_plan(args.result_dir, runs[0].design).crane
+        video = render_video(out / "closed_loop.mp4", runs, physics, crane, nominal or None, quiet=args.quiet)
+        written.append(video.name)
     for item in physics:
         item.free()
     print(table(report))

@@ -95,14 +95,14 @@ def machine_dress(model: mujoco.MjModel, crane: Crane, tcp_site: str = "tcp") ->
         material = int(model.geom_matid[g])
         if material < 0:
             continue
-        chain = next((c for c in chain_names if body in (f"{c}_cylinder", f"{c}_rod")), None)
+        chain = next((c for c in chain_names if body in (f"{c}_cylinder", f"{c}_rod")), "")
         if material == materials.get("hiab_red"):
             kind[g] = "column" if int(model.geom_bodyid[g]) == base else "structure"
-        elif material == materials.get("cylinder") and chain is None:
+        elif material == materials.get("cylinder") and not chain:
             kind[g] = "extension"
         elif material == materials.get("cylinder"):
             kind[g] = "barrel"
-            data = getattr(cylinders, chain, None) if cylinders is not None else None
+            data = getattr(cylinders, chain, None) if cylinders is not None and chain else None
             radius[g] = 0.5 * data.bore + BARREL_WALL_M if data is not None else float(model.geom_size[g, 0])
         elif material == materials.get("rod"):
             kind[g] = "rod"
@@ -129,7 +129,7 @@ def _next(scene: mujoco.MjvScene) -> mujoco.MjvGeom | None:
 def _add(
     scene: mujoco.MjvScene,
     kind: mujoco.mjtGeom,
-    size: Sequence[float],
+    size: Sequence[float] | Array,
     pos: Array,
     mat: Array,
     rgba: Sequence[float],
@@ -222,7 +222,7 @@ def bed_box(model: mujoco.MjModel, data: mujoco.MjData, dress: MachineDress) -> 
     """Centre and half sizes [m] of the truck bed: on the floor, under the column, reaching behind it."""
     floor = floor_height(model)
     foot = data.xpos[dress.base_body]
-    length, width, height = BED_SIZE_M
+    length, _width, height = BED_SIZE_M
     return np.array([foot[0] - 0.25 * length, foot[1], floor + 0.5 * height]), 0.5 * np.array(BED_SIZE_M)
 
 

@@ -14,6 +14,7 @@ no shadows, reflections, skybox or multisampling; a self-lit backdrop instead of
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
@@ -196,7 +197,7 @@ class PlaybackRenderer:
                     found[name] = np.array(data.site_xpos[site])
                     decor.add_ball(scene, found[name], MARK_RADIUS_M, design.rgba)
             where.append(found)
-        for first, second in zip(where, where[1:], strict=False):
+        for first, second in itertools.pairwise(where):
             for name in first.keys() & second.keys():
                 decor.add_polyline(scene, np.stack([first[name], second[name]]), (0.1, 0.1, 0.1, 1.0), width=2.0)
 
