@@ -97,10 +97,9 @@ CAMERA_ASPECT = 16.0 / 9.0
 
 def workspace_qpos(crane: Crane, lengths: LinkLengths) -> np.ndarray:
     """Loop-consistent qpos (P, nq) at every combination of poses over each joint's working range."""
+    from hiab_sim.crane.mechanism import reachable_joint_range
     from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
     from hiab_sim.dynamics.samples import JointSamples
-
-    from hiab_sim.crane.mechanism import reachable_joint_range
 
     ranges = []
     for chain in crane.chains:  # the working range, within what these lengths reach (1e-9 rad inside)
