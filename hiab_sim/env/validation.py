@@ -156,11 +156,11 @@ def render_video(
         energy = run.cumulative_energy.sum(axis=1) if run.cumulative_energy.ndim == 2 else run.cumulative_energy
         total = float(energy[-1]) / 1e3
         notes = tuple(
-            f"t = {t:5.2f} s   drives' energy {energy[k] / 1e3:6.3f} of {total:.3f} kJ"
+            f"t = {t:5.2f} s   drive energy {energy[k] / 1e3:.3f} of {total:.3f} kJ"
             for t, k in zip(at, index, strict=True)
         )
         mass = "planned end mass" if run.payload_error == 0 else f"end mass +{100 * run.payload_error:g} %"
-        caption = f"{run.design} design, closed loop, {mass}" + (", ghost" if run.design == "initial" else "")
+        caption = f"{run.design}, {mass}" if run.design != "initial" else "initial (ghost)"
         model = models[run.design]
         return Design(
             run.design, model, run.qpos[index], colours.get(run.design, OPTIMAL_RGBA), caption, notes,

@@ -158,7 +158,7 @@ class PlaybackRenderer:
         depth = float(np.max((points - self.camera.lookat) @ forward)) + 1.0
         aspect = panel_width / panel_height
         self._backdrop = (depth, 4.0 * (self.camera.distance + depth) * np.tan(np.radians(fovy)) * max(aspect, 1.0))
-        self._line = max(16, panel_height // 14 if layout == "stacked" else height // 20)
+        self._line = max(16, min(panel_height // 14 if layout == "stacked" else height // 20, panel_width // 28))
         self._captions = [caption_bitmap(d.caption or d.name, text_colour(d.rgba), self._line) for d in self.designs]
 
     def __len__(self) -> int:

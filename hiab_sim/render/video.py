@@ -96,7 +96,7 @@ def energy_notes(time: Array, at: Array, power: Array | None) -> tuple[str, ...]
     cumulative = np.concatenate([[0.0], np.cumsum(steps)])
     total = cumulative[-1] / 1e3
     return tuple(
-        f"t = {t:5.2f} s   drives' net energy {e / 1e3:6.3f} of {total:.3f} kJ"
+        f"t = {t:5.2f} s   drives' net energy {e / 1e3:.3f} of {total:.3f} kJ"
         for t, e in zip(at, np.interp(at, time, cumulative), strict=True)
     )
 

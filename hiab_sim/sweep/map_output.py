@@ -176,15 +176,18 @@ def figure_png(m: EnergyMap) -> bytes:
         ax.set_title(title if feasible.any() else f"{title}: no feasible cell to colour", fontsize=10)
     note = infeasible_note(m)
     if note is not None:
+        import textwrap
+
+        wrapped = "\n".join(textwrap.fill(part, 58) for part in note.split("\n"))
         for ax in axes:
             ax.text(
-                0.5, 0.5, note, transform=ax.transAxes, ha="center", va="center", fontsize=9, wrap=True,
+                0.5, 0.5, wrapped, transform=ax.transAxes, ha="center", va="center", fontsize=8.5,
                 bbox={"boxstyle": "round", "fc": "white", "ec": "0.3", "alpha": 0.92},
             )  # fmt: skip
     handles, names = axes[0].get_legend_handles_labels()
     handles += [Patch(color=palette(n % 10), alpha=0.35) for n in range(len(labels))]
     names += [f"infeasible: {limit_in_words(name)}" for name in labels]
-    fig.legend(handles, names, loc="outside lower center", ncol=3, fontsize=8)
+    fig.legend(handles, names, loc="outside lower center", ncol=2, fontsize=8)
     fig.suptitle(
         f"Energy map over {m.variables[0]} x {m.variables[1]}; the other lengths and the trajectory at the "
         f"{m.base.source}",

@@ -156,6 +156,6 @@ def sensitivity_bars(ax: Axes, sensitivity: Sensitivity, count: int = 12) -> Non
     ax.set_xscale("log")
     ax.set_xlabel("objective saved if the limit were relaxed by one unit [% of the optimal objective]")
     fit = "exact" if sensitivity.kkt_residual < 1e-6 else f"fit residual {sensitivity.kkt_residual:.0e}"
-    ax.set_title(f"Which limits hold the design back, and by how much (optimality-condition multipliers, {fit})")
+    ax.set_title(f"Which limits hold the design back, and by how much\n(optimality-condition multipliers, {fit})")
     ax.margins(x=0.35)
     ax.grid(alpha=0.3, axis="x")

@@ -41,11 +41,12 @@ _TRACKING = re.compile(r"^tracking\.(\w+)\.(\S+)")
 _BOUND = re.compile(r"^bound (\w+)\.(\w+) (low|up) = (\S+) m$")
 
 
-def limit_in_words(name: str) -> str:
+def limit_in_words(name: str, detail: bool = True) -> str:
     """A constraint row name of the NLP (``envelope.lift.peak_torque``, ``bound tilt.L up = 1.3 m``) in words.
 
     Names the sensitivity section groups over samples; an unknown pattern keeps its name with
-    underscores as spaces.
+    underscores as spaces. ``detail`` False drops the coordinate of a tracking band (one phrase
+    for the band, as the summary names it).
     """
     match = _BOUND.match(name)
     if match:
@@ -54,7 +55,8 @@ def limit_in_words(name: str) -> str:
         return f"{chain} {words} at its {'lower' if side == 'low' else 'upper'} bound ({float(value) * 1e3:.0f} mm)"
     match = _TRACKING.match(name)
     if match:
-        return f"TCP tracking band ({match.group(1)})"  # one phrase for every coordinate of the band
+        band = f"TCP tracking band ({match.group(1)})"
+        return f"{band}, {match.group(2).replace('_', ' ')}" if detail else band
     block, _, rest = name.partition(".")
     if block == "envelope":
         actuator, _, limit = rest.partition(".")
@@ -114,7 +116,7 @@ def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[st
     lines += ["", _energy_line(r)]
     binding: list[str] = []
     for m in () if r.sensitivity is None else r.sensitivity.multipliers:
-        words = limit_in_words(m.constraint)
+        words = limit_in_words(m.constraint, detail=False)
         if words not in binding and len(binding) < BINDING_SHOWN:
             binding.append(words)
     if binding:
