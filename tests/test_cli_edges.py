@@ -47,3 +47,36 @@ def test_shipped_files_carry_no_issue_numbers_or_internal_paths() -> None:
     pattern = re.compile(r"\bissue\s*#?\d+|\(issue\b|shared/reference|/work/", re.IGNORECASE)
     found = [f"{p.relative_to(REPO)}: {m.group(0)}" for p in _shipped_files() for m in pattern.finditer(p.read_text())]
     assert found == []
+
+
+def test_simulate_closing_lines_read_the_heavier_load_as_its_energy_not_a_failure() -> None:
+    """The extra energy of a heavier end mass is named as the load's, with the report's own numbers."""
+    from hiab_sim.cli.simulate import closing_lines
+
+    nominal = {"energy_difference_percent": -0.06, "tcp_error_mm": {"max": 0.83}, "payload_error": 0.0}
+    heavy = {
+        "energy_difference_percent": 34.34,
+        "tcp_error_mm": {"max": 4.65},
+        "payload_error": 0.2,
+        "extra_energy_J": 1368.6,
+        "nominal": nominal,
+    }
+    (line,) = closing_lines({"designs": {"optimal": heavy}})
+    assert line.startswith("optimal: the closed loop uses -0.06 % energy against the plan, tracking within 0.83 mm")
+    assert "end mass +20 % it needs 1369 J more (+34.34 % against the plan" in line and "not a failure" in line
+
+
+def test_an_all_infeasible_energy_map_says_which_limit_binds_and_what_to_map(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """lift.L x tilt.L at the start has no feasible cell: console and figure name the limit and a chain's lengths."""
+    import json
+
+    assert main(["energy-map", "--vars", "lift.L,tilt.L", "--grid", "10", "--out", str(tmp_path)]) == 0
+    printed = capsys.readouterr().out
+    summary = json.loads((tmp_path / "energy_map.json").read_text())
+    assert summary["best_feasible_cell"] is None
+    note = next(line for line in printed.splitlines() if line.startswith("no feasible cell of 100"))
+    chain = note.split(" cells break ")[1].split()[0]
+    assert f"map {chain}.Lc0 and {chain}.Lc instead" in note
+    assert "_" not in note.split(" cells break ")[1].split(" with ")[0]  # the limit in words, not a row name

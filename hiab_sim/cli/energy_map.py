@@ -42,7 +42,8 @@ def run(args: argparse.Namespace) -> int:
     from hiab_sim.study.nlp.problem import LinkLengthProblem
     from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
     from hiab_sim.sweep.energy_map import energy_map, optimum_design, parse_variables, result_study, start_design
-    from hiab_sim.sweep.map_output import TRAJECTORY_NOTE, summary, write_map
+    from hiab_sim.study.report.summary import limit_in_words
+    from hiab_sim.sweep.map_output import TRAJECTORY_NOTE, infeasible_note, summary, write_map
 
     variables = parse_variables(args.vars)
     study = load_study(args.study or (result_study(args.result) if args.result else DEFAULT_STUDY))
@@ -57,12 +58,13 @@ def run(args: argparse.Namespace) -> int:
     at = s["at_base"]
     print(
         f"at the base: objective {at['objective']:.6f}, net energy {at['net_electrical_energy_J'] / 1e3:.3f} kJ, "
-        f"binding {at['binding_constraint']} (margin {at['smallest_margin']:.2e})"
+        f"binding: {limit_in_words(at['binding_constraint'])} (margin {at['smallest_margin']:.2e})"
     )
     best = s["best_feasible_cell"]
-    if best is None:
-        print(f"no feasible cell (of {s['cells']})")
-    else:
+    note = infeasible_note(m)
+    if best is None or note is not None:
+        print(note.replace("\n", " ") if note is not None else f"no feasible cell (of {s['cells']})")
+    if best is not None:
         xi = best["xi_m"]
         i0, i1 = variables
         print(

@@ -32,6 +32,29 @@ TCP_MAX_MM = 5.0
 PAYLOAD_TCP_MAX_MM = 20.0
 
 
+def closing_lines(report: dict[str, object]) -> list[str]:
+    """The answer in words: per design the closed loop against the plan, and what a heavier end mass costs."""
+    designs = report["designs"]
+    assert isinstance(designs, dict)
+    lines = []
+    for design, entry in designs.items():
+        rows = [entry["nominal"], entry] if "nominal" in entry else [entry]
+        planned = rows[0]
+        text = (
+            f"{design}: the closed loop uses {planned['energy_difference_percent']:+.2f} % energy against the plan, "
+            f"tracking within {planned['tcp_error_mm']['max']:.2f} mm"
+        )
+        if len(rows) == 2:
+            heavy = rows[1]
+            text += (
+                f"; with the end mass +{100 * heavy['payload_error']:g} % it needs {heavy['extra_energy_J']:.0f} J "
+                f"more ({heavy['energy_difference_percent']:+.2f} % against the plan: the heavier load's energy, "
+                f"not a failure), tracking within {heavy['tcp_error_mm']['max']:.2f} mm"
+            )
+        lines.append(text + ".")
+    return lines
+
+
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register the subcommand."""
     parser = subparsers.add_parser(
@@ -98,5 +121,8 @@ def run(args: argparse.Namespace) -> int:
     for item in physics:
         item.free()
     print(table(report))
+    print()
+    for line in closing_lines(report):
+        print(line)
     print(f"wrote {', '.join(written)} to {out}", file=sys.stderr)
     return 0
