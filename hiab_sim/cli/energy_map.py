@@ -40,9 +40,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Compute and write the map; return the exit status."""
     from hiab_sim.study.nlp.problem import LinkLengthProblem
+    from hiab_sim.study.report.summary import limit_in_words
     from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
     from hiab_sim.sweep.energy_map import energy_map, optimum_design, parse_variables, result_study, start_design
-    from hiab_sim.study.report.summary import limit_in_words
     from hiab_sim.sweep.map_output import TRAJECTORY_NOTE, infeasible_note, summary, write_map
 
     variables = parse_variables(args.vars)
