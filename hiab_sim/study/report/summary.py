@@ -125,6 +125,11 @@ def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[st
         )
     else:
         lines.append("Binding limits at the optimum: none reported (no sensitivity section).")
+    ms = r.multistart
+    if len(ms.starts) > 1:
+        failed = f", {len(ms.failed_starts)} failed" if ms.failed_starts else ""
+        agree = "the same optimum" if ms.same_optimum else f"{len(ms.distinct_optima)} distinct local optima"
+        lines.append(f"Starts: {ms.converged_starts} of {len(ms.starts)} converged, to {agree}{failed}.")
     violation = r.recheck.max_violation_scaled
     lines.append(
         f"Checked on a {r.recheck.grid_points}-point grid with the other dynamics model: "
