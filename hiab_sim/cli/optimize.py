@@ -6,9 +6,10 @@ video and ``summary.md`` into the output folder; the console ends with that summ
 (:mod:`hiab_sim.study.report.summary`). Bad input exits 2 before anything is written; a solver failure exits 1 and
 keeps the partial history (``checkpoint_<k>.json``) for ``--resume``. A start that violates
 constraints goes through the feasibility phase (:mod:`hiab_sim.study.solvers.feasibility`); when no point
-within the bounds is feasible the run exits 3 and names the binding limit. stdout also prints the
-design rounded to the study's ``build.tolerance`` with its re-checks and export command, and the
-largest KKT multipliers (``result.json`` -> ``buildable``, ``feasibility``, ``sensitivity``).
+within the bounds is feasible the run exits 3 and names the binding limit. With ``--verbose`` stdout
+also prints the full report before the summary: the design rounded to the study's ``build.tolerance``
+with its re-checks and export command, and the largest multipliers of the optimality conditions
+(``result.json`` -> ``buildable``, ``feasibility``, ``sensitivity``).
 """
 
 from __future__ import annotations
