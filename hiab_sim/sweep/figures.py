@@ -1,7 +1,7 @@
 """Summary figures of a sweep table: the net-energy saving and the optimal net energy against each parameter.
 
 Failed points (no feasible start, or the solver failed) have no energy: they are drawn as red
-crosses on a strip below each axes (outside the data's range), never at a value that would read as data.
+crosses on a strip above each axes (outside the data's range), never at a value that would read as data.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ import pandas as pd
 
 from hiab_sim.figure_io import new_figure, save_png
 
-#: Failed points: red crosses on a strip at this height of the axes (axes fraction, below the data).
-FAILED_STRIP = -0.12
+#: Failed points: red crosses on a strip at this height of the axes (axes fraction, above the data).
+FAILED_STRIP = 1.05
 
 
 def _words(parameter: str) -> str:
@@ -46,12 +46,16 @@ def summary_figures(frame: pd.DataFrame, parameters: list[str], out: Path, title
                     transform=ax.get_xaxis_transform(), label=f"failed ({int((~ok).sum())}): no result",
                 )  # fmt: skip
                 ax.legend(fontsize=8, loc="best")
+                ax.set_title(" ", fontsize=8, pad=10)  # keeps the strip clear of the figure title
+            values = frame[p].to_numpy(dtype=float)  # failed points included: their x must be on the axis
+            span = max(float(np.ptp(values)), 1e-12)
+            ax.set_xlim(values.min() - 0.06 * span, values.max() + 0.06 * span)
             if others and row == 0:
                 fig.colorbar(sc, ax=ax, label=_words(others[0]))
             ax.set_xlabel(_words(p))
             ax.set_ylabel(label)
             ax.grid(alpha=0.3)
-    fig.suptitle(f"{title}: {int(ok.sum())} of {len(frame)} points optimised (red crosses below an axes: failed)")
+    fig.suptitle(f"{title}: {int(ok.sum())} of {len(frame)} points optimised (red crosses above an axes: failed)")
     paths = [save_png(fig, out / "sweep_summary.png")]
     if len(numeric) == 2 and ok.any():
         xs, ys = np.sort(frame[numeric[0]].unique()), np.sort(frame[numeric[1]].unique())
