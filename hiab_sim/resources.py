@@ -23,6 +23,7 @@ study), else against the working folder.
 
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass
 from importlib import resources
 from importlib.resources.abc import Traversable
@@ -166,12 +167,36 @@ def locate(source: str | Path, kind: Kind, relative_to: Source | None = None) ->
     else:
         candidate = relative_to.sibling(str(path))
     if not candidate.file.is_file():
-        known = ", ".join(shipped_names(kind))
+        offered = listed_names(kind)
+        close = difflib.get_close_matches(str(source), offered, n=1)
+        hint = f"; did you mean '{close[0]}'?" if close else ""
         where = f" (looked for {candidate.label})" if str(candidate.label) != str(source) else ""
         raise ConfigError(
-            f"cannot read {_WHAT[kind]} '{source}': neither a shipped name ({known}) nor a readable file{where}"
+            f"cannot read {_WHAT[kind]} '{source}': neither a shipped name ({', '.join(offered)}) "
+            f"nor a readable file{where}{hint}"
         )
     return candidate
+
+
+#: Top-level keys that make a shipped YAML file of the study folder a study (a reference or tasks, and bands).
+_STUDY_KEYS = (("tracking",), ("reference", "tasks"))
+
+
+def listed_names(kind: Kind) -> list[str]:
+    """The shipped names offered in messages: for studies only the files that are studies.
+
+    The study folder also ships the EMLA set, crane file and sweep specifications the studies
+    name; they resolve as shipped names but are not offered where a study is asked for.
+    """
+    names = shipped_names(kind)
+    if kind != "study":
+        return list(names)
+    kept = []
+    for name, file in names.items():
+        keys = {line.split(":", 1)[0] for line in file.read_text(encoding="utf-8").splitlines() if ":" in line}
+        if all(any(k in keys for k in group) for group in _STUDY_KEYS):
+            kept.append(name)
+    return kept
 
 
 def mjcf_template() -> str:

@@ -22,7 +22,14 @@ from hiab_sim.machine.loader import load_machine
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register the subcommand."""
-    parser = subparsers.add_parser("machine", help="show or check a machine description")
+    parser = subparsers.add_parser(
+        "machine",
+        help="show or check a machine description",
+        description=(
+            "Work with a machine description (links, closed chains of actuators, tool point): print it and draw "
+            "it labelled, or assemble every chain over its working range and report what fails."
+        ),
+    )
     actions = parser.add_subparsers(dest="machine_command", metavar="ACTION", required=True)
     show = actions.add_parser("show", help="print the machine and write a labelled drawing (PNG)")
     show.add_argument("machine", help="shipped machine name (xs031, exact) or a machine YAML file")

@@ -38,6 +38,29 @@ TCP_MAX_MM = 5.0
 PAYLOAD_TCP_MAX_MM = 20.0
 
 
+def closing_lines(report: dict[str, object]) -> list[str]:
+    """The answer in words: per design the closed loop against the plan, and what a heavier end mass costs."""
+    designs = report["designs"]
+    assert isinstance(designs, dict)
+    lines = []
+    for design, entry in designs.items():
+        rows = [entry["nominal"], entry] if "nominal" in entry else [entry]
+        planned = rows[0]
+        text = (
+            f"{design}: the closed loop uses {planned['energy_difference_percent']:+.2f} % energy against the plan, "
+            f"tracking within {planned['tcp_error_mm']['max']:.2f} mm"
+        )
+        if len(rows) == 2:
+            heavy = rows[1]
+            text += (
+                f"; with the end mass +{100 * heavy['payload_error']:g} % it needs {heavy['extra_energy_J']:.0f} J "
+                f"more ({heavy['energy_difference_percent']:+.2f} % against the plan: the heavier load's energy, "
+                f"not a failure), tracking within {heavy['tcp_error_mm']['max']:.2f} mm"
+            )
+        lines.append(text + ".")
+    return lines
+
+
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register the subcommand."""
     parser = subparsers.add_parser(
@@ -96,6 +119,7 @@ def run(args: argparse.Namespace) -> int:
 
         ffmpeg_path()
 
+    from hiab_sim.env.plan import read_plan
     from hiab_sim.env.validation import render_video, simulate_designs, simulation_report, table
 
     runs, nominal, physics = simulate_designs(
@@ -121,7 +145,9 @@ def run(args: argparse.Namespace) -> int:
 
             written.append(effect_figure(out / "closed_loop_plant_effects.png", effects).name)
     if not args.no_video:
-        written.append(render_video(out / "closed_loop.mp4", runs, physics, quiet=args.quiet).name)
+        crane = read_plan(args.result_dir, runs[0].design).crane
+        video = render_video(out / "closed_loop.mp4", runs, physics, crane, nominal or None, quiet=args.quiet)
+        written.append(video.name)
     for item in physics:
         item.free()
     print(table(report))
@@ -130,5 +156,8 @@ def run(args: argparse.Namespace) -> int:
 
         print()
         print(effect_table(effects))
+    print()
+    for line in closing_lines(report):
+        print(line)
     print(f"wrote {', '.join(written)} to {out}", file=sys.stderr)
     return 0
