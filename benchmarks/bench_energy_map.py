@@ -17,7 +17,7 @@ import numpy as np
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import HiabSimError
 from hiab_sim.study.nlp.task_problem import TaskProblem
-from hiab_sim.study.report.result_folder import fine_problem
+from hiab_sim.study.report.design_check import fine_problem
 from hiab_sim.study.spec.study_file import load_study
 from hiab_sim.sweep.energy_map import energy_map, start_design
 

@@ -34,7 +34,6 @@ def test_the_readme_python_example_runs_as_written(tmp_path: Path) -> None:
     )
     assert result.returncode == 0, result.stderr[-2000:]
     assert (tmp_path / "runs" / "x" / "result.json").is_file()
-    assert "feasible: True" in result.stdout
 
 
 def test_importing_hiab_sim_leaves_the_environment_alone() -> None:

@@ -244,7 +244,7 @@ def test_failed_start_is_listed_not_grouped_as_an_optimum(
     monkeypatch.setattr(run_module, "solve", solve)
     path = write_study(tmp_path, small_study())
     out = tmp_path / "out"
-    assert main(["optimize", str(path), "--out", str(out), "--starts", "2", *FLAGS]) == 0
+    assert main(["optimize", str(path), "--out", str(out), "--starts", "2", *FLAGS, "--verbose"]) == 0
     raw = json.loads((out / "result.json").read_text())["multistart"]
     assert set(raw["failed_starts"][0]) == {"start", "initial_xi", "message"}
     assert set(raw["distinct_optima"][0]) == {"xi", "cost_W2s", "starts", "net_electrical_energy_J"}
@@ -258,3 +258,4 @@ def test_failed_start_is_listed_not_grouped_as_an_optimum(
     assert row.success is False and row.optimal_lengths is None and row.cost_W2s is None
     printed = capsys.readouterr().out
     assert "all 1 converged starts" in printed and "start 1 failed (not an optimum)" in printed
+    assert "Starts: 1 of 2 converged" in printed and "1 failed." in printed  # the summary says it too
