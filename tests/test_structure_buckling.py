@@ -135,9 +135,7 @@ def test_utilisation_gradient_matches_finite_differences_of_the_whole_chain(cran
         e[j] = h
         df_dq[:, :, j] = (_forces(crane, xi0, q + e) - _forces(crane, xi0, q - e)) / (2 * h)
         du_dq_fd[:, :, j] = (u(xi0, q + e) - u(xi0, q - e)) / (2 * h)
-    du_dq, du_dxi = utilisation_partials(
-        crane, emlas, crane.default_lengths, q, _forces(crane, xi0, q), df_dq, df_dxi
-    )
+    du_dq, du_dxi = utilisation_partials(crane, emlas, crane.default_lengths, q, _forces(crane, xi0, q), df_dq, df_dxi)
     np.testing.assert_allclose(du_dxi, du_dxi_fd, atol=1e-5)
     np.testing.assert_allclose(du_dq, du_dq_fd, atol=1e-5)
     assert np.max(np.abs(du_dxi)) > 0.1  # the rows do depend on Xi
