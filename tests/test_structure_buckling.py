@@ -74,21 +74,21 @@ def test_critical_load_falls_with_length_and_never_exceeds_the_squash_load(a: fl
 def test_critical_load_slope_matches_finite_differences() -> None:
     """dP_cr/dl of both branches agrees with central differences."""
     screw = ScrewColumn(0.0435, 2.06e11, 6.5e8, 1.0)
-    l = np.array([0.3, 0.6, 0.85, 1.2, 2.0])
+    size = np.array([0.3, 0.6, 0.85, 1.2, 2.0])
     h = 1e-6
-    _, slope = critical_load(screw, l)
-    fd = (critical_load(screw, l + h)[0] - critical_load(screw, l - h)[0]) / (2 * h)
+    _, slope = critical_load(screw, size)
+    fd = (critical_load(screw, size + h)[0] - critical_load(screw, size - h)[0]) / (2 * h)
     np.testing.assert_allclose(slope, fd, rtol=1e-6)
 
 
 def test_column_length_is_the_pin_to_pin_distance_with_exact_partials(crane: Crane) -> None:
-    """s equals x + x0 of a chain; ds/dtheta and ds/dXi match central differences of s."""
+    """The column length is x + x0 of a chain; ds/dtheta and ds/dXi match central differences of s."""
     q = _poses(crane)
     base = crane.default_lengths
     for actuator in actuators(crane):
         if actuator.chain is None:
             continue
-        s, ds_dq, ds_dxi = column_length(crane, base, actuator, q)
+        _, ds_dq, ds_dxi = column_length(crane, base, actuator, q)
         h = 1e-7
         for j in range(6):
             up, down = base.as_array(), base.as_array()

@@ -1,4 +1,4 @@
-"""Natural frequencies: two mass-matrix paths agree, and a free vibration of the spring-mounted MuJoCo model confirms them."""
+"""Natural frequencies: two mass-matrix paths agree; a free vibration of the spring-mounted model confirms them."""
 
 from __future__ import annotations
 

@@ -361,7 +361,7 @@ def _require_keys(
     where: str,
     name: str,
 ) -> None:
-    """Raise :class:`ConfigError` unless the shared ``section`` overlaid with the actuator's gives every required key."""
+    """Raise :class:`ConfigError` unless the shared ``section`` and the actuator's give every required key."""
     shared = mapping(root.get(section, {}), f"{where}: {section}", set(keys), set())
     override = mapping(actuator.get(section, {}), f"{where}: actuators.{name}.{section}", set(keys), set())
     missing = sorted(set(keys) - set(optional) - set(shared) - set(override))

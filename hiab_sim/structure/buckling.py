@@ -50,19 +50,19 @@ def transition_slenderness(screw: ScrewColumn) -> float:
 
 def critical_load(screw: ScrewColumn, length: ArrayLike) -> tuple[Array, Array]:
     """Critical load P_cr [N] of the screw as a column of ``length`` [m], and dP_cr/dlength [N/m]."""
-    l = np.asarray(length, dtype=float)
+    size = np.asarray(length, dtype=float)
     d, E, sy = screw.root_diameter, screw.elastic_modulus, screw.yield_strength
     area = math.pi * d**2 / 4.0
     radius = d / 4.0
-    slender = l / (math.sqrt(screw.end_fixity_factor) * radius)
+    slender = size / (math.sqrt(screw.end_fixity_factor) * radius)
     euler = math.pi**2 * E * area / np.maximum(slender, 1e-300) ** 2
     johnson = area * sy * (1.0 - sy * slender**2 / (4.0 * math.pi**2 * E))
     is_euler = slender >= transition_slenderness(screw)
     load = np.where(is_euler, euler, johnson)
     slope = np.where(
         is_euler,
-        -2.0 * euler / np.maximum(l, 1e-300),
-        -area * sy**2 * slender / (2.0 * math.pi**2 * E * np.maximum(l, 1e-300)) * slender,
+        -2.0 * euler / np.maximum(size, 1e-300),
+        -area * sy**2 * slender / (2.0 * math.pi**2 * E * np.maximum(size, 1e-300)) * slender,
     )
     return load, slope
 

@@ -197,11 +197,12 @@ def bandwidth_margin(bandwidth_Hz: float, lowest_Hz: ArrayLike, max_ratio: float
 
 
 def working_range_poses(crane: Crane, counts: tuple[int, ...] = (9, 9, 3)) -> Array:
-    """A grid of static poses (N, n) over every joint's working range (chains' ``joint_range``, then the direct joint's)."""
+    """A grid of static poses (N, n) over every joint's working range (the chains', then the direct joint's)."""
     ranges = [chain.joint_range for chain in crane.chains] + [crane.telescope.joint_range]
     if len(counts) != len(ranges) or any(isinstance(c, bool) or int(c) != c or c < 1 for c in counts):
         raise InvalidInputError("counts", list(counts), f"must be {len(ranges)} positive integers")
     axes = [
-        np.linspace(lo, hi, int(c)) if c > 1 else np.array([0.5 * (lo + hi)]) for (lo, hi), c in zip(ranges, counts)
+        np.linspace(lo, hi, int(c)) if c > 1 else np.array([0.5 * (lo + hi)])
+        for (lo, hi), c in zip(ranges, counts, strict=True)
     ]
     return np.stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")], axis=1)

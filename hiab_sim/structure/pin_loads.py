@@ -132,7 +132,7 @@ class PinLoads:
         return {pin.name: float(v) for pin, v in zip(self.pins, np.max(self.magnitude, axis=0), strict=True)}
 
     def magnitude_range(self) -> dict[str, float]:
-        """max |F| - min |F| over the samples per pin [N]."""
+        """Range of |F| (largest minus smallest) over the samples per pin [N]."""
         m = self.magnitude
         return {pin.name: float(v) for pin, v in zip(self.pins, np.ptp(m, axis=0), strict=True)}
 
@@ -175,8 +175,8 @@ def analytic_pin_loads(
     wrench = link_wrenches(crane, lengths, motion)
     if external is not None:
         carrier = next(f"{a.name}_rod" for a in actuators(crane) if a.chain is None)
-        rod = motion.links[carrier]
-        point = rod.position + rotate(rod.rotation, np.asarray(crane.tcp_in_telescope_rod.position))
+        held = motion.links[carrier]
+        point = held.position + rotate(held.rotation, np.asarray(crane.tcp_in_telescope_rod.position))
         wrench[carrier] = wrench[carrier] - np.concatenate([np.cross(point, external), external], axis=-1)
     world = np.zeros((T, 3 * len(crane.chains), 3))
     local = np.zeros_like(world)

@@ -103,7 +103,7 @@ class MujocoPinLoads:
                 self._apply(int(mo.site_bodyid[self._tcp]), do.site_xpos[self._tcp], external[i])
             mujoco.mj_inverse(mo, do)
             mujoco.mj_rnePostConstraint(mo, do)
-            for c, chain in enumerate(self.crane.chains):
+            for c in range(len(self._chains)):
                 boom, cylinder, _ = self._bodies[c]
                 world[i, 3 * c] = -do.cfrc_int[cylinder, 3:]
                 world[i, 3 * c + 1] = -do.cfrc_int[boom, 3:]
