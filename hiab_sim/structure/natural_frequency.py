@@ -38,7 +38,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.checks import check_range
@@ -106,8 +105,6 @@ def geometric_stiffness(
     """J_x^T df/dq of the static actuator forces, symmetrised (T, n, n) (module docstring)."""
     q = np.atleast_2d(np.asarray(position, dtype=float))
     T, n = q.shape
-    if tcp_force is not None and np.ndim(tcp_force) == 2:
-        raise InvalidInputError("tcp_force", "per sample", "must be one constant force (3,) here", "N")
     df = np.zeros((T, jx.shape[1], n))
     for k in range(n):
         step = np.zeros(n)
@@ -155,7 +152,7 @@ def natural_frequencies(
         emlas: EMLA set; every actuator needs ``screw`` and ``drive_stiffness`` data.
         lengths: Link lengths Xi [m].
         position: Joint samples (T, n) [rad, m].
-        tcp_force: Constant force of the environment on the TCP in {W} [N] (3,) (a payload), or None.
+        tcp_force: Force of the environment on the TCP in {W} [N], (3,) or (T, 3) (a payload), or None.
         mass: Optional mass matrix (T, n, n) from another path (MuJoCo); default the analytic one.
         actuator_jacobian: With ``mass``: J_x (T, n_a, n) from the same path.
 
@@ -170,16 +167,23 @@ def natural_frequencies(
     motion = crane_motion(crane, lengths, q, np.zeros_like(q), np.zeros_like(q))
     k = np.stack([axial_stiffness(by_name[a.name], motion.actuators[a.name].stroke) for a in acts], axis=1)
     K = np.einsum("tai,ta,taj->tij", jx, k, jx) + geometric_stiffness(crane, lengths, q, jx, tcp_force)
-    T, n = q.shape
-    freq = np.zeros((T, n))
-    shape = np.zeros((T, n, n))
-    for t in range(T):
-        w2, phi = scipy.linalg.eigh(K[t], M[t])
-        if np.any(w2 <= 0.0):
-            raise InvalidInputError("stiffness", f"omega^2 = {w2.min():.3g}", "the pose must be stable (K > 0)")
-        freq[t] = np.sqrt(w2) / (2.0 * math.pi)
-        shape[t] = phi
+    w2, shape = generalized_eigh(K, M)
+    if np.any(w2 <= 0.0):
+        raise InvalidInputError("stiffness", f"omega^2 = {w2.min():.3g}", "every pose must be stable (K > 0)")
+    freq = np.sqrt(w2) / (2.0 * math.pi)
     return Modes(freq, shape, np.einsum("tai,tij->taj", jx, shape), k, tuple(a.name for a in acts))
+
+
+def generalized_eigh(K: Array, M: Array) -> tuple[Array, Array]:
+    """K phi = w M phi for stacks of symmetric K and SPD M (T, n, n): w ascending (T, n), phi^T M phi = I.
+
+    With M = C C^T (Cholesky), A = C^-1 K C^-T is symmetric; its eigenvectors v give phi = C^-T v.
+    """
+    C = np.linalg.cholesky(M)
+    Ci = np.linalg.inv(C)
+    A = Ci @ K @ np.swapaxes(Ci, 1, 2)
+    w, v = np.linalg.eigh(0.5 * (A + np.swapaxes(A, 1, 2)))
+    return w, np.swapaxes(Ci, 1, 2) @ v
 
 
 def bandwidth_margin(bandwidth_Hz: float, lowest_Hz: ArrayLike, max_ratio: float = 0.5) -> float:

@@ -169,9 +169,19 @@ def analytic_pin_loads(
 
     """
     check_analytic_inputs(crane, lengths, joints)
-    T = len(joints)
-    external = tcp_force_samples(tcp_force, T)
-    motion = crane_motion(crane, lengths, joints.position, joints.velocity, joints.acceleration)
+    external = tcp_force_samples(tcp_force, len(joints))
+    return pin_forces(crane, lengths, joints.position, joints.velocity, joints.acceleration, external)
+
+
+def pin_forces(
+    crane: Crane, lengths: LinkLengths, position: Array, velocity: Array, acceleration: Array, external: Array | None
+) -> PinLoads:
+    """:func:`analytic_pin_loads` without input checks (for difference stencils that step past a range end).
+
+    ``external``: TCP force (T, 3) in {W} [N] or None.
+    """
+    T = position.shape[0]
+    motion = crane_motion(crane, lengths, position, velocity, acceleration)
     wrench = link_wrenches(crane, lengths, motion)
     if external is not None:
         carrier = next(f"{a.name}_rod" for a in actuators(crane) if a.chain is None)
@@ -195,7 +205,7 @@ def analytic_pin_loads(
         det = _cross_z(a1, a2)
         if np.any(np.abs(det) <= 1e-12 * np.hypot(a1[:, 0], a1[:, 1]) * np.hypot(a2[:, 0], a2[:, 1])):
             raise InvalidInputError(f"{chain.name} triangle", "flat", "pin forces need a non-flat triangle (const_k)")
-        # -a1y Px + a1x Py = -m_pair ;  -a2y Px + a2x Py = m_sub
+        # (Tc - Bc) x P = -m_pair and (Tc - B1) x P = m_sub, with r x P = r_x P_y - r_y P_x
         px = (-m_pair * a2[:, 0] - a1[:, 0] * m_sub) / det
         py = (-a1[:, 1] * m_sub - a2[:, 1] * m_pair) / det
         p = np.stack([px, py, np.zeros(T)], axis=1)

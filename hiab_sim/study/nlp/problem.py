@@ -62,6 +62,7 @@ from hiab_sim.study.nlp.interface import (
     SampleState,
 )
 from hiab_sim.study.nlp.objectives import make_objective
+from hiab_sim.study.nlp.structure_rows import structure_blocks
 from hiab_sim.study.nlp.thermal_rows import thermal_blocks
 from hiab_sim.study.references.kinds import ik_start
 from hiab_sim.study.spec.study_file import Study
@@ -235,6 +236,7 @@ class LinkLengthProblem:
             bl.WorkingRange(self.crane.chains, self.working, self.working_clearance),
             *thermal_blocks(self.emlas, self.study.energy.duty, self.task.reference.duration),
             *buildable_blocks(self.study, self.working, self.tightened),
+            *structure_blocks(self.study.structure, t, self.crane, self.emlas, self.tcp_force, self.fd_step),
         ]
 
     # -- variables ---------------------------------------------------------------------------
