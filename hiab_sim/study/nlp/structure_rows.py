@@ -137,7 +137,7 @@ class NaturalFrequencyRows(PerSampleBlock):
         return self._rows(state.lengths, state.joints.position)
 
     def jacobian(self, state: SampleState, partials: SamplePartials) -> SampleRows:
-        """Central differences in each position (all samples at once) and in Xi; rates and accelerations do not enter."""
+        """Central differences in each position (all samples at once) and in Xi; rates do not enter."""
         q = state.joints.position
         K = q.shape[0]
         dq = np.zeros((K, 1, N_Q))

@@ -28,10 +28,10 @@ from hiab_sim.checks import check_choice, check_range
 from hiab_sim.crane.description import CHAIN_NAMES, ChainLengths, Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.crane.mounting import MountingSpace
-from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import DEFAULT_STUDY, Source, locate
+from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.references.kinds import TaskReference
 from hiab_sim.study.spec.build import BuildSettings
 from hiab_sim.study.spec.energy import ENERGY_KEYS, EnergySettings, energy_settings
