@@ -8,7 +8,8 @@ import pytest
 from hiab_sim.crane.description import Crane
 from hiab_sim.crane.kinematics import Frames, forward_kinematics
 from hiab_sim.dynamics import JointSamples
-from hiab_sim.structure.pin_loads import PinLoads, pin_loads
+from hiab_sim.structure.pin_loads import PinLoads
+from hiab_sim.structure.pin_paths import pin_loads
 
 PAYLOAD_KG = 200.0
 

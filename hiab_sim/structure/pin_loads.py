@@ -215,21 +215,3 @@ def pin_forces(
             world[:, 3 * c + k] = forces[kind]
             local[:, 3 * c + k] = rotate_back(frames[bracket], forces[kind])
     return PinLoads(pins(crane), world[..., :2], local[..., :2])
-
-
-def pin_loads(
-    crane: Crane,
-    lengths: LinkLengths | None,
-    joints: JointSamples,
-    path: str = "analytic",
-    tcp_force: ArrayLike | None = None,
-) -> PinLoads:
-    """Pin forces along the motion by the chosen inverse-dynamics path (``analytic`` or ``mujoco``)."""
-    lengths = crane.default_lengths if lengths is None else lengths
-    if path == "analytic":
-        return analytic_pin_loads(crane, lengths, joints, tcp_force)
-    if path == "mujoco":
-        from hiab_sim.structure.pin_loads_mujoco import MujocoPinLoads
-
-        return MujocoPinLoads(crane, lengths)(joints, tcp_force)
-    raise InvalidInputError("id_path", path, "must be one of analytic, mujoco")

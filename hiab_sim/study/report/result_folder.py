@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.atomic_io import write_atomic
+from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla import energy_summary, operating_point
 from hiab_sim.errors import HiabSimError
 from hiab_sim.quadrature import trapezoid
@@ -48,6 +49,7 @@ from hiab_sim.results.schema import (
     TrackingError,
     WorstConstraint,
 )
+from hiab_sim.structure.summary import StructureSummary, design_structure
 from hiab_sim.study.nlp.mix import Problem
 from hiab_sim.study.nlp.objectives import SquaredPowerCost
 from hiab_sim.study.nlp.problem import ACTUATORS, Evaluation, LinkLengthProblem
@@ -211,8 +213,27 @@ def build_result(
         ),
         energy=energy,
         hydraulic_baseline=hydraulic_report(fine, checks["initial"].evaluation, checks["optimal"].evaluation, energy),
+        structure=structure_section(fine, checks),
     )
     return result, trajectory_arrays(fine, checks), checks
+
+
+def structure_section(fine: LinkLengthProblem, checks: dict[str, DesignCheck]) -> StructureSummary:
+    """Pin loads, buckling utilisation and lowest natural frequencies of both designs on the fine grid."""
+    out = {}
+    for name in ("initial", "optimal"):
+        ev = checks[name].evaluation
+        joints = JointSamples(ev.joints.position, ev.joints.velocity, ev.joints.acceleration)
+        out[name] = design_structure(
+            fine.crane,
+            fine.emlas,
+            ev.lengths,
+            joints,
+            ev.actuators.force,
+            fine.tcp_force,
+            fine.study.structure.buckling_safety_factor,
+        )
+    return StructureSummary(initial=out["initial"], optimal=out["optimal"])
 
 
 def trajectory_arrays(fine: LinkLengthProblem, checks: dict[str, DesignCheck], prefix: str = "") -> dict[str, Array]:
