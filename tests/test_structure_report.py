@@ -5,6 +5,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.results.codec import from_json, to_json
 from hiab_sim.structure.pin_paths import pin_loads
@@ -34,3 +36,19 @@ def test_structure_section_matches_the_mujoco_pin_loads_and_round_trips(tmp_path
     table = structure_table(summary, velocity_bandwidth_Hz=2.0)
     assert all(f"pin {name}" in table for name in design.pins)
     assert "velocity loop 2 Hz" in table
+
+
+def test_optimised_result_reports_structure_and_the_figure_draws_it(tmp_path: Path) -> None:
+    """An optimisation writes the structure section for both designs; it reads back; the figure is written."""
+    from hiab_sim.api import optimize
+    from hiab_sim.results.schema import read_result
+    from hiab_sim.structure.report import structure_figure
+
+    study = study_from_dict(small_study(payload=200.0), tmp_path / "study.yaml")
+    result = optimize(study, tmp_path / "run", figures=False, progress=None)
+    assert result.structure is not None
+    assert set(result.structure.optimal.buckling) == {p.name for p in study.emlas if p.screw is not None}
+    assert read_result(tmp_path / "run").structure == result.structure
+    arrays = dict(np.load(tmp_path / "run" / "trajectory.npz"))
+    png = structure_figure(study.crane, study.emlas, result, arrays, tmp_path / "structure.png")
+    assert png.stat().st_size > 10_000
