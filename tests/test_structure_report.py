@@ -42,7 +42,7 @@ def test_optimised_result_reports_structure_and_the_figure_draws_it(tmp_path: Pa
     """An optimisation writes the structure section for both designs; it reads back; the figure is written."""
     from hiab_sim.api import optimize
     from hiab_sim.results.schema import read_result
-    from hiab_sim.structure.report import structure_figure
+    from hiab_sim.structure.report import natural_frequency_figure
 
     study = study_from_dict(small_study(payload=200.0), tmp_path / "study.yaml")
     result = optimize(study, tmp_path / "run", figures=False, progress=None)
@@ -50,5 +50,5 @@ def test_optimised_result_reports_structure_and_the_figure_draws_it(tmp_path: Pa
     assert set(result.structure.optimal.buckling) == {p.name for p in study.emlas if p.screw is not None}
     assert read_result(tmp_path / "run").structure == result.structure
     arrays = dict(np.load(tmp_path / "run" / "trajectory.npz"))
-    png = structure_figure(study.crane, study.emlas, result, arrays, tmp_path / "structure.png")
+    png = natural_frequency_figure(study.crane, study.emlas, result, arrays, tmp_path / "structure.png")
     assert png.stat().st_size > 10_000

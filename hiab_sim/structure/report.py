@@ -3,9 +3,10 @@
 :func:`structure_table` prints a result's ``structure`` section (:mod:`hiab_sim.structure.summary`)
 as a Markdown table, initial vs optimal: each pin's peak load and fatigue range, each screw's
 buckling utilisation, the lowest natural frequency and, given the velocity loop's bandwidth, its
-margin (:func:`hiab_sim.structure.natural_frequency.bandwidth_margin`). :func:`structure_figure`
-draws the lowest natural frequency over the working range (the chains' joints, the direct joint at
-the trajectory's mean) for both designs with their trajectories and names the most loaded pin.
+margin (:func:`hiab_sim.structure.natural_frequency.bandwidth_margin`).
+:func:`natural_frequency_figure` draws the lowest natural frequency over the working range (the
+chains' joints, the direct joint at the trajectory's mean) for both designs with their trajectories
+and names the most loaded pin.
 """
 
 from __future__ import annotations
@@ -82,7 +83,9 @@ def frequency_grid(
     return first, second, lowest
 
 
-def structure_figure(crane: Crane, emlas: EmlaSet, result: Result, arrays: Mapping[str, Array], path: Path) -> Path:
+def natural_frequency_figure(
+    crane: Crane, emlas: EmlaSet, result: Result, arrays: Mapping[str, Array], path: Path
+) -> Path:
     """PNG of the lowest natural frequency over the working range, initial and optimal design (module docstring).
 
     ``arrays``: the result folder's ``trajectory.npz`` (``<design>_position``, (T, 3)).
