@@ -67,6 +67,17 @@ def test_lowest_frequency_matches_a_free_vibration_in_mujoco(crane: Crane, emlas
     assert simulated == pytest.approx(float(modes.lowest_Hz[0]), rel=0.01)
 
 
+def test_payload_held_at_the_tcp_matches_a_free_vibration_with_a_point_mass(crane: Crane, emlas: EmlaSet) -> None:
+    """300 kg at the TCP (a body in MuJoCo; mass and weight in the eigenproblem): frequencies agree within 1 %."""
+    pose = (0.5, -1.0, 0.5)
+    weight = np.array([0.0, -300.0 * crane.gravity, 0.0])
+    loaded = natural_frequencies(crane, emlas, crane.default_lengths, np.array([pose]), weight, payload_kg=300.0)
+    empty = natural_frequencies(crane, emlas, crane.default_lengths, np.array([pose]))
+    simulated = free_vibration_frequency(crane, emlas, crane.default_lengths, pose, mode=0, payload_kg=300.0)
+    assert simulated == pytest.approx(float(loaded.lowest_Hz[0]), rel=0.01)
+    assert loaded.lowest_Hz[0] < 0.9 * empty.lowest_Hz[0]  # the payload matters
+
+
 @pytest.mark.slow
 def test_second_frequency_matches_a_free_vibration_in_mujoco(crane: Crane, emlas: EmlaSet) -> None:
     """The second mode too: the FFT of its free vibration within 1 % of its eigenvalue."""

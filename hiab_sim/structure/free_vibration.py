@@ -55,15 +55,28 @@ def free_vibration_frequency(
     timestep: float = 1e-4,
     periods: float = 30.0,
     stroke_amplitude: float = 1e-5,
+    payload_kg: float = 0.0,
 ) -> float:
-    """Frequency [Hz] of mode ``mode`` at a static pose (n,), from a free-vibration simulation (module docstring)."""
+    """Frequency [Hz] of mode ``mode`` at a static pose (n,), from a free-vibration simulation (module docstring).
+
+    ``payload_kg``: a point mass added to the MuJoCo model at the TCP site (its weight and inertia
+    then come from MuJoCo); the eigenvalue problem gets it as ``payload_kg`` and a TCP force.
+    """
     q0 = np.asarray(pose, dtype=float).reshape(1, -1)
-    modes = natural_frequencies(crane, emlas, lengths, q0)
+    weight = np.array([0.0, -payload_kg * crane.gravity, 0.0]) if payload_kg > 0.0 else None
+    modes = natural_frequencies(crane, emlas, lengths, q0, weight, payload_kg=payload_kg)
     phi = modes.shape[0][:, mode]
     omega = 2.0 * math.pi * modes.frequency_Hz[0, mode]
-    force = static_forces(crane, lengths, q0, None)[0]
+    force = static_forces(crane, lengths, q0, weight)[0]
 
     spec = build_spec(crane, lengths)
+    if payload_kg > 0.0:
+        tcp = spec.site("tcp")
+        load = tcp.parent.add_body(name="payload", pos=list(tcp.pos))
+        load.explicitinertial = True
+        load.mass = payload_kg
+        load.ipos = [0.0, 0.0, 0.0]
+        load.inertia = [1e-9, 1e-9, 1e-9]
     spec.option.timestep = timestep
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_RK4
     for equality in spec.equalities:
@@ -85,7 +98,7 @@ def free_vibration_frequency(
     rate = omega * stroke_amplitude / float(np.max(np.abs(modes.actuator_shape[0][:, mode])))
     data.qvel[:] = Z @ (phi * rate)
     mass, _ = mujoco_mass_matrix(crane, lengths, q0)
-    weights = phi @ mass[0]
+    weights = phi @ mass[0]  # the crane's M without the payload still picks this mode out
     independent = np.array([model.joint(name).qposadr[0] for name in JOINT_NAMES])
     period = 2.0 * math.pi / omega
     record_every = max(1, int(period / (40.0 * timestep)))

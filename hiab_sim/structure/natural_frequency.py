@@ -78,8 +78,14 @@ def _unit_motions(crane: Crane, lengths: LinkLengths, position: Array) -> list:
     return out
 
 
-def mass_matrix(crane: Crane, lengths: LinkLengths, position: ArrayLike) -> tuple[Array, Array]:
-    """Joint-space mass matrix M (T, n, n) [kg, kg m, kg m^2] and actuator Jacobian J_x = dx/dq (T, n_a, n)."""
+def mass_matrix(
+    crane: Crane, lengths: LinkLengths, position: ArrayLike, payload_kg: float = 0.0
+) -> tuple[Array, Array]:
+    """Joint-space mass matrix M (T, n, n) [kg, kg m, kg m^2] and actuator Jacobian J_x = dx/dq (T, n_a, n).
+
+    ``payload_kg``: a point mass rigidly held at the TCP, adding m J_tcp^T J_tcp (J_tcp the TCP's
+    velocity per unit joint rate).
+    """
     q = np.atleast_2d(np.asarray(position, dtype=float))
     motions = _unit_motions(crane, lengths, q)
     T, n = q.shape
@@ -87,6 +93,13 @@ def mass_matrix(crane: Crane, lengths: LinkLengths, position: ArrayLike) -> tupl
     for name, inertia in link_inertias(crane, lengths).items():
         J = np.stack([m.links[name].twist for m in motions], axis=-1)  # (T, 6, n)
         M += np.einsum("tik,ij,tjl->tkl", J, inertia.spatial, J)
+    if payload_kg > 0.0:
+        carrier = next(f"{a.name}_rod" for a in actuators(crane) if a.chain is None)
+        point = np.asarray(crane.tcp_in_telescope_rod.position)
+        Jp = np.stack(
+            [m.links[carrier].twist[:, 3:] + np.cross(m.links[carrier].twist[:, :3], point) for m in motions], axis=-1
+        )  # (T, 3, n), in the carrier's axes
+        M += payload_kg * np.einsum("tik,til->tkl", Jp, Jp)
     names = [a.name for a in actuators(crane)]
     Jx = np.stack([np.stack([m.actuators[a].velocity for m in motions], axis=-1) for a in names], axis=1)
     return 0.5 * (M + np.swapaxes(M, 1, 2)), Jx
@@ -144,6 +157,7 @@ def natural_frequencies(
     tcp_force: ArrayLike | None = None,
     mass: Array | None = None,
     actuator_jacobian: Array | None = None,
+    payload_kg: float = 0.0,
 ) -> Modes:
     """Locked-rotor natural frequencies and mode shapes at static poses (T, n) (module docstring).
 
@@ -155,10 +169,12 @@ def natural_frequencies(
         tcp_force: Force of the environment on the TCP in {W} [N], (3,) or (T, 3) (a payload), or None.
         mass: Optional mass matrix (T, n, n) from another path (MuJoCo); default the analytic one.
         actuator_jacobian: With ``mass``: J_x (T, n_a, n) from the same path.
+        payload_kg: Mass held at the TCP [kg] (its inertia; its weight belongs in ``tcp_force``).
 
     """
     q = np.atleast_2d(np.asarray(position, dtype=float))
-    M, jx = mass_matrix(crane, lengths, q)
+    check_range("payload_kg", payload_kg, 0.0, unit="kg")
+    M, jx = mass_matrix(crane, lengths, q, payload_kg)
     if mass is not None:
         M = np.asarray(mass, dtype=float)
         jx = np.asarray(actuator_jacobian, dtype=float) if actuator_jacobian is not None else jx

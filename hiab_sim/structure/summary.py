@@ -91,11 +91,14 @@ def design_structure(
     force: ArrayLike,
     tcp_force: ArrayLike | None = None,
     safety_factor: float = DEFAULT_SAFETY_FACTOR,
+    payload_kg: float = 0.0,
 ) -> DesignStructure:
     """Structural summary of one design (module docstring); ``force`` (T, n_a) [N] from the inverse dynamics.
 
     The working-range grid spans the chains' ``joint_range`` of ``crane`` (a study's problem narrows
-    them to the range its design serves) and carries the largest TCP force of the samples as a constant load.
+    them to the range its design serves) and carries the largest TCP force of the samples as a constant
+    load. ``payload_kg``: the payload's mass, held rigidly at the TCP for the frequencies (its weight is
+    in ``tcp_force``).
     """
     loads = analytic_pin_loads(crane, lengths, joints, tcp_force)
     peak_index = np.argmax(loads.magnitude, axis=0)
@@ -118,9 +121,11 @@ def design_structure(
     trajectory_Hz = grid_Hz = None
     if has_stiffness(emlas):
         external = None if tcp_force is None else np.asarray(tcp_force, dtype=float)
-        trajectory_Hz = float(np.min(natural_frequencies(crane, emlas, lengths, joints.position, external).lowest_Hz))
+        on_path = natural_frequencies(crane, emlas, lengths, joints.position, external, payload_kg=payload_kg)
+        trajectory_Hz = float(np.min(on_path.lowest_Hz))
         poses = working_range_poses(crane, WORKING_GRID)
-        grid_Hz = float(np.min(natural_frequencies(crane, emlas, lengths, poses, largest(external)).lowest_Hz))
+        grid = natural_frequencies(crane, emlas, lengths, poses, largest(external), payload_kg=payload_kg)
+        grid_Hz = float(np.min(grid.lowest_Hz))
     return DesignStructure(
         pins=pins,
         most_loaded_pin=loads.most_loaded()[0],

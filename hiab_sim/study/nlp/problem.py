@@ -236,7 +236,9 @@ class LinkLengthProblem:
             bl.WorkingRange(self.crane.chains, self.working, self.working_clearance),
             *thermal_blocks(self.emlas, self.study.energy.duty, self.task.reference.duration),
             *buildable_blocks(self.study, self.working, self.tightened),
-            *structure_blocks(self.study.structure, t, self.crane, self.emlas, self.tcp_force, self.fd_step),
+            *structure_blocks(
+                self.study.structure, t, self.crane, self.emlas, self.tcp_force, self.fd_step, self.task.payload.mass
+            ),
         ]
 
     # -- variables ---------------------------------------------------------------------------

@@ -9,7 +9,8 @@ Each block is a :class:`~hiab_sim.study.nlp.interface.PerSampleBlock` (the same 
   (:mod:`hiab_sim.structure.pin_loads`, the analytic path); partials by central differences of the
   vectorised pin forces (all samples perturbed together, as the ID partials are);
 * :class:`NaturalFrequencyRows` (``structure.min_natural_frequency_Hz``): f_1 / f_min - 1 >= 0, the
-  lowest locked-rotor frequency at the sample's pose (:mod:`hiab_sim.structure.natural_frequency`);
+  lowest locked-rotor frequency at the sample's pose with the payload held at the TCP
+  (:mod:`hiab_sim.structure.natural_frequency`);
   partials w.r.t. the sample's positions and Xi by central differences.
 
 :func:`structure_blocks` builds the blocks a study's ``structure`` section asks for.
@@ -117,9 +118,17 @@ class NaturalFrequencyRows(PerSampleBlock):
     """f_1(q_k, Xi) / f_min - 1 per sample: the lowest locked-rotor frequency at the sample's pose."""
 
     def __init__(
-        self, times: Array, crane: Crane, emlas: EmlaSet, minimum_Hz: float, tcp_force: Array | None, step: float
+        self,
+        times: Array,
+        crane: Crane,
+        emlas: EmlaSet,
+        minimum_Hz: float,
+        tcp_force: Array | None,
+        step: float,
+        payload_kg: float = 0.0,
     ) -> None:
         self.name = "structure.natural_frequency"
+        self.payload_kg = payload_kg
         self.times = times
         self.crane = crane
         self.emlas = emlas
@@ -129,7 +138,9 @@ class NaturalFrequencyRows(PerSampleBlock):
         self.sample_rows = (f"lowest frequency >= {minimum_Hz:.6g} Hz",)
 
     def _rows(self, lengths: LinkLengths, position: Array) -> Array:
-        modes = natural_frequencies(self.crane, self.emlas, lengths, position, self.tcp_force)
+        modes = natural_frequencies(
+            self.crane, self.emlas, lengths, position, self.tcp_force, payload_kg=self.payload_kg
+        )
         return modes.lowest_Hz / self.minimum - 1.0
 
     def values(self, state: SampleState) -> Array:
@@ -167,13 +178,18 @@ def structure_blocks(
     emlas: EmlaSet,
     tcp_force: Array | None,
     step: float,
+    payload_kg: float = 0.0,
 ) -> list[PerSampleBlock]:
-    """The structural blocks the study's ``structure`` section asks for (none by default)."""
+    """The structural blocks the study's ``structure`` section asks for (none by default).
+
+    ``tcp_force``: the task's TCP force per sample [N]; ``payload_kg``: its payload, held at the TCP.
+    """
     out: list[PerSampleBlock] = []
     if settings.buckling and buckled_actuators(crane, emlas):
         out.append(BucklingRows(times, crane, emlas, settings.buckling_safety_factor))
     if settings.pin_load_limits_N:
         out.append(PinLoadRows(times, crane, settings.pin_load_limits_N, tcp_force, step))
     if settings.min_natural_frequency_Hz is not None:
-        out.append(NaturalFrequencyRows(times, crane, emlas, settings.min_natural_frequency_Hz, tcp_force, step))
+        floor = settings.min_natural_frequency_Hz
+        out.append(NaturalFrequencyRows(times, crane, emlas, floor, tcp_force, step, payload_kg))
     return out

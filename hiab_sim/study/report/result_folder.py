@@ -232,6 +232,7 @@ def structure_section(fine: LinkLengthProblem, checks: dict[str, DesignCheck]) -
             ev.actuators.force,
             fine.tcp_force,
             fine.study.structure.buckling_safety_factor,
+            fine.task.payload.mass,
         )
     return StructureSummary(initial=out["initial"], optimal=out["optimal"])
 
