@@ -70,7 +70,7 @@ def structure_table(summary: StructureSummary, velocity_bandwidth_Hz: float | No
 
 
 def frequency_grid(
-    crane: Crane, emlas: EmlaSet, lengths: object, telescope: float, count: int = 41
+    crane: Crane, emlas: EmlaSet, lengths: object, direct_joint: float, count: int = 41
 ) -> tuple[Array, Array, Array]:
     """Lowest frequency [Hz] on a count x count grid of the chains' working ranges, direct joint fixed."""
     from hiab_sim.crane.description import LinkLengths
@@ -78,7 +78,7 @@ def frequency_grid(
     assert isinstance(lengths, LinkLengths)
     (a0, a1), (b0, b1) = (chain.joint_range for chain in crane.chains[:2])
     first, second = np.meshgrid(np.linspace(a0, a1, count), np.linspace(b0, b1, count), indexing="xy")
-    poses = np.stack([first.ravel(), second.ravel(), np.full(first.size, telescope)], axis=1)
+    poses = np.stack([first.ravel(), second.ravel(), np.full(first.size, direct_joint)], axis=1)
     lowest = natural_frequencies(crane, emlas, lengths, poses).lowest_Hz.reshape(first.shape)
     return first, second, lowest
 

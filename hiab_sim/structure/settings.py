@@ -1,6 +1,6 @@
 """A study's structural limits: the ``structure`` section of a study file, validated against its crane.
 
-Example (every key optional; without the section no structural row enters the NLP)::
+Example for the XS 031 (every key optional; without the section no structural row enters the NLP)::
 
     structure:
       buckling: true                    # hold every screw's push force below P_cr / n at every sample
