@@ -138,3 +138,26 @@ def test_vector_range_covers_the_magnitude_range(crane: Crane) -> None:
     assert all(vector[name] >= magnitude[name] - 1e-9 for name in vector)
     name, peak = loads.most_loaded()
     assert peak == max(loads.peak().values()) and name in loads.peak()
+
+
+def test_pins_on_the_base_carry_the_whole_moving_weight_at_rest(crane: Crane) -> None:
+    """At rest, the forces the base's pins receive add up to the weight of every moving body and the payload."""
+    q = np.array([[0.3, -1.6, 0.2], [1.1, -0.4, 0.9]])
+    tcp = np.array([0.0, -PAYLOAD_KG * crane.gravity, 0.0])
+    loads = pin_loads(crane, None, JointSamples.at_rest(q), "mujoco", tcp_force=tcp)
+    frames = forward_kinematics(crane, crane.default_lengths, *q.T)
+    points = _pin_points(crane, frames)
+    on_base = [k for k, pin in enumerate(loads.pins) if pin.bracket == "base"]
+    force = sum(loads.force_world[:, k] for k in on_base)
+    moment = sum(_cross_z(points[loads.pins[k].name], loads.force_world[:, k]) for k in on_base)
+    weight = np.zeros(2)
+    weight_moment = np.zeros(2)
+    for body in crane.bodies_for(crane.default_lengths):
+        if body.link != "base":
+            w = np.array([0.0, -body.mass * crane.gravity])
+            weight = weight + w
+            weight_moment = weight_moment + _cross_z(frames.point(body.link, body.com), w)
+    weight = weight + tcp[:2]
+    weight_moment = weight_moment + _cross_z(frames.position["tcp"], tcp[:2])
+    np.testing.assert_allclose(force, np.broadcast_to(weight, force.shape), rtol=1e-10, atol=1e-6)
+    np.testing.assert_allclose(moment, weight_moment, rtol=1e-10, atol=1e-6)
