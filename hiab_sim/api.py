@@ -38,7 +38,8 @@ from hiab_sim.crane.description import ChainLengths, LinkLengths
 from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.results.energy_sections import DesignEnergy
-from hiab_sim.results.schema import DesignSummary, Result, read_result
+from hiab_sim.results.read import read_result
+from hiab_sim.results.schema import DesignSummary, Result
 from hiab_sim.study.nlp.interface import N_XI
 from hiab_sim.study.nlp.problem import LinkLengthProblem
 from hiab_sim.study.spec.study_file import Study, load_study

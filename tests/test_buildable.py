@@ -24,6 +24,9 @@ from hiab_sim.study.solvers.feasibility import feasible_start
 from hiab_sim.study.solvers.slsqp import solve
 from hiab_sim.study.spec.study_file import Study, study_from_dict
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 
 @pytest.fixture(scope="module")
 def solved() -> tuple[LinkLengthProblem, np.ndarray]:
@@ -328,7 +331,7 @@ def test_mjcf_stroke_margin_shortens_the_range_the_lengths_must_serve(
 
 def test_result_sections_round_trip_typed(tmp_path: Path) -> None:
     """buildable, feasibility and sensitivity load back as typed sections from result.json."""
-    from hiab_sim.results.schema import read_result
+    from hiab_sim.results.read import read_result
 
     study = small_study(initial_lengths={"lift": {"L": 1.0071227324212, "Lc0": 0.0865, "Lc": 0.745},
                                          "tilt": {"L": 1.132185817991, "Lc0": 0.085, "Lc": 0.745}})  # fmt: skip

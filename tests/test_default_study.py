@@ -9,9 +9,13 @@ import pytest
 from result_checks import four_designs
 
 from hiab_sim.emla import load_emla_set
-from hiab_sim.results.schema import Result, read_result
+from hiab_sim.results.read import read_result
+from hiab_sim.results.schema import Result
 from hiab_sim.study.run import RunOutput, run_study
 from hiab_sim.study.spec.study_file import load_study
+
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
 
 
 @pytest.fixture(scope="module")
@@ -77,4 +81,3 @@ def test_saving_decomposes_into_lengths_and_trajectory(run: RunOutput, result: R
     assert d.from_lengths_J is not None and d.from_lengths_J > 0.0
     assert d.from_lengths_J == pytest.approx(e00 - e10, abs=1e-6)
     assert d.from_trajectory_J == pytest.approx(e00 - e01, abs=1e-6)
-    assert d.interaction_J == pytest.approx(e10 + e01 - e00 - e11, abs=1e-6)

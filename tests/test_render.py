@@ -208,6 +208,7 @@ def _count_frames(path: Path) -> int:
     return len(mediapy.read_video(path))
 
 
+@pytest.mark.e2e
 @pytest.mark.skipif(shutil.which("ffmpeg") is None, reason="needs Debian ffmpeg (scripts/setup.sh installs it)")
 def test_mp4_holds_every_frame_and_no_temporary_file(result_dir: Path, tmp_path: Path) -> None:
     """render_result writes an H.264 mp4 with one frame per tick and leaves nothing else behind."""
@@ -306,6 +307,7 @@ def test_missing_ffmpeg_is_one_line(
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.e2e
 def test_cli_prints_nothing_at_exit(result_dir: Path, tmp_path: Path) -> None:
     """The GL contexts are freed before exit: the process's stderr stays empty (CI: MUJOCO_GL=osmesa)."""
     output = tmp_path / "still.png"

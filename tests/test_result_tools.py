@@ -15,6 +15,9 @@ from test_study_small import small_study, write_study
 from hiab_sim.cli import main
 from hiab_sim.crane.loader import load_crane
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 CRANE = load_crane("xs031")
 
 

@@ -20,6 +20,9 @@ from hiab_sim.study.run_safety import (
     resolve_starts,
 )
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 FLAGS = ["--no-video", "--quiet", "--no-figures"]
 OUTPUTS = ("result.json", "trajectory.npz", "checkpoint_0.json", "checkpoint_3.json", "objective.png", "playback.mp4")
 

@@ -11,6 +11,9 @@ from test_study_small import small_study, write_study
 from hiab_sim.cli import main
 from hiab_sim.study.run import run_study
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 
 @pytest.fixture(scope="module")
 def small_result(tmp_path_factory: pytest.TempPathFactory) -> Path:
@@ -59,10 +62,10 @@ def test_bad_input_exits_2_with_one_line(
 
 
 def test_a_folder_without_a_result_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """RESULT_DIR without result.json is named in a one-line error, exit 2."""
+    """RESULT_DIR without result.json: a one-line error naming the folder and the missing file, exit 2."""
     assert main(["simulate", str(tmp_path), "--no-video", "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "RESULT_DIR" in err[0]
+    assert len(err) == 1 and str(tmp_path) in err[0] and "result.json" in err[0]
 
 
 @pytest.mark.slow
