@@ -41,7 +41,7 @@ def test_structure_section_matches_the_mujoco_pin_loads_and_round_trips(tmp_path
 def test_optimised_result_reports_structure_and_the_figure_draws_it(tmp_path: Path) -> None:
     """An optimisation writes the structure section for both designs; it reads back; the figure is written."""
     from hiab_sim.api import optimize
-    from hiab_sim.results.schema import read_result
+    from hiab_sim.results.read import read_result
     from hiab_sim.structure.report import natural_frequency_figure
 
     study = study_from_dict(small_study(payload=200.0), tmp_path / "study.yaml")
