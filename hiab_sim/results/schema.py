@@ -25,6 +25,7 @@ from hiab_sim.errors import ConfigError
 from hiab_sim.results.analysis_sections import Buildable, CrossEvaluation, FeasibilityPhase, Sensitivity
 from hiab_sim.results.codec import from_json, optional, to_json
 from hiab_sim.results.energy_sections import Codesign, EnergyReport, HydraulicBaseline
+from hiab_sim.structure.summary import StructureSummary
 
 #: Version of the result.json layout; files without the key are version 1 (the same keys). Version 2
 #: renames the ``sensitivity`` keys that held the objective's value whatever its unit (``cost_W2s``
@@ -325,6 +326,7 @@ class Result:
     buildable: Buildable | None = optional()
     feasibility: tuple[FeasibilityPhase, ...] | None = optional()
     sensitivity: Sensitivity | None = optional()
+    structure: StructureSummary | None = optional()  # pin loads, buckling, natural frequencies
     extra: dict[str, Any] = field(default_factory=dict)  # keys of a newer writer, kept verbatim
 
     def __post_init__(self) -> None:

@@ -67,6 +67,7 @@ from hiab_sim.study.nlp.interface import (
     SampleState,
 )
 from hiab_sim.study.nlp.objectives import make_objective
+from hiab_sim.study.nlp.structure_rows import structure_blocks
 from hiab_sim.study.nlp.thermal_rows import thermal_blocks
 from hiab_sim.study.references.kinds import ik_start
 from hiab_sim.study.spec.study_file import Study
@@ -401,7 +402,7 @@ def _tracking(p: TaskProblem) -> list[ConstraintBlock]:
     ]
 
 
-# the built-in blocks, in row order (const_b..const_k, thermal limits, buildable design)
+# the built-in blocks, in row order (const_b..const_k, thermal limits, buildable design, structure)
 register_block("tracking", _tracking)
 register_block("envelope", lambda p: [bl.EnvelopeMargins(p.times, p.emlas, p.envelope_margin)])
 register_block("stroke", lambda p: [bl.StrokeLimits(p.times, p.crane.chains)])
@@ -410,3 +411,9 @@ register_block("joint_velocity", lambda p: [bl.JointVelocityLimits(p.times, np.a
 register_block("working_range", lambda p: [bl.WorkingRange(p.crane.chains, p.working, p.working_clearance)])
 register_block("thermal", lambda p: thermal_blocks(p.emlas, p.study.energy.duty, p.task.reference.duration))
 register_block("buildable", lambda p: buildable_blocks(p.study, p.working, p.tightened))
+register_block(
+    "structure",
+    lambda p: structure_blocks(
+        p.study.structure, p.times, p.crane, p.emlas, p.tcp_force, p.fd_step, p.task.payload.mass
+    ),
+)

@@ -58,6 +58,7 @@ from hiab_sim.study.report.energy_section import (
     weighted_energy_report,
 )
 from hiab_sim.study.report.solver_section import solver_summary
+from hiab_sim.study.report.structure_section import structure_section
 from hiab_sim.study.report.weighted import (
     TELESCOPE,
     is_one_task,
@@ -201,6 +202,8 @@ def build_result(
         ),
         tasks=tuple(task_results) if problem.n_tasks > 1 else None,
         cross_evaluation=cross,
+        # the structure of the one task's motion; a mix's tasks load the structure differently (not reported yet)
+        structure=structure_section(fines[0], first_checks) if one else None,
     )
     return result, arrays, first_checks
 
