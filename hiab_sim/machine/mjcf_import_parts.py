@@ -214,7 +214,8 @@ def chain_entry(imported: Imported, frames: _Frames, role: Role, link_frames: di
     h = frames.edge_point(role.link_edge, role.rocker)
     c_group = mech.edges[role.driven].b
     c = frames.edge_point(role.coupler_edge, c_group)
-    side = 1 if float(np.cross((c - r)[:2], (h - r)[:2])) > 0.0 else -1
+    cross = (c - r)[0] * (h - r)[1] - (c - r)[1] * (h - r)[0]
+    side = 1 if float(cross) > 0.0 else -1
     rocker_len, coupler_len = float(np.linalg.norm((h - r)[:2])), float(np.linalg.norm((c - h)[:2]))
     rocker = _one_body(frames.bodies(role.rocker, r, in_plane_angle(h - r)), "rocker")
     coupler = _one_body(frames.bodies(role.coupler, np.array([h[0], h[1], r[2]]), in_plane_angle(c - h)), "coupler")
