@@ -33,6 +33,8 @@ Array = NDArray[np.float64]
 
 #: Parallelism tolerance of joint axes with the plane normal (|sin| of the angle).
 AXIS_TOLERANCE = 1e-6
+_HINGE, _SLIDE = int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)
+_BALL, _FREE = int(mujoco.mjtJoint.mjJNT_BALL), int(mujoco.mjtJoint.mjJNT_FREE)
 PLANES = {"xz": 1, "xy": 2, "yz": 0}  # plane -> index of the world axis that is its normal
 
 
@@ -107,7 +109,7 @@ def _locks(model: mujoco.MjModel, locks: dict[str, float]) -> dict[int, float]:
         j = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
         if j < 0:
             raise UnsupportedMJCF([f"--lock {name}={value:g}: the MJCF has no joint '{name}'"])
-        if model.jnt_type[j] not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
+        if int(model.jnt_type[j]) not in (_HINGE, _SLIDE):
             raise UnsupportedMJCF([f"--lock {name}: only hinge and slide joints can be locked"])
         out[j] = float(value)
     return out
@@ -150,7 +152,7 @@ def read_mechanism(model: mujoco.MjModel, locks: dict[str, float], plane: str = 
     joints_of_body: dict[int, list[int]] = {}
     for j in range(model.njnt):
         jname = name_of(model, mujoco.mjtObj.mjOBJ_JOINT, j, "joint")
-        if model.jnt_type[j] in (mujoco.mjtJoint.mjJNT_BALL, mujoco.mjtJoint.mjJNT_FREE):
+        if int(model.jnt_type[j]) in (_BALL, _FREE):
             kind = "ball" if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_BALL else "free"
             problems.append(f"joint '{jname}' ({kind}): ball and free joints cannot move in a plane chain")
             continue
