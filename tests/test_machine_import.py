@@ -81,7 +81,9 @@ def _rot_y(angle: float) -> np.ndarray:
     return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
-def handmade_mjcf(ball: bool = False, extra: str = "", second_slide: bool = False, unlocked: str = "") -> str:
+def handmade_mjcf(
+    ball: bool = False, extra: str = "", second_slide: bool = False, unlocked: str = "", rigid_ram: bool = False
+) -> str:
     """A digger written by hand, not in the exporter's style.
 
     x-z plane with hinges about +y (so the machine's x is MuJoCo's -x), a slewing column, degree
@@ -141,7 +143,7 @@ def handmade_mjcf(ball: bool = False, extra: str = "", second_slide: bool = Fals
           <inertial pos="0 0 0.3" mass="20" diaginertia="0.6 0.6 0.02"/>
           {mid}
           <body name="boom_rod" pos="0 0 0.3">
-            <joint name="boom_ram" class="ram" range="-0.25 0.25"/>
+            <joint name="boom_ram" {'type="hinge" axis="0 1 0"' if rigid_ram else 'class="ram"'} range="-0.25 0.25"/>
             <inertial pos="0 0 0.4" mass="8" diaginertia="0.3 0.3 0.005"/>
           </body>
           {"</body>" if second_slide else ""}
@@ -208,3 +210,82 @@ def test_importing_a_handwritten_mjcf_with_a_locked_slewing_joint_reproduces_its
     assert [c.kind for c in machine.chains] == ["triangle", "triangle", "linkage"]
     assert machine.actuator_names == ["boom", "arm", "bucket"]
     assert max(round_trip(imported, machine, samples=12).values()) < TOLERANCE
+
+
+def _run_import(tmp_path: Path, text: str, *extra: str) -> tuple[int, Path]:
+    source = tmp_path / "model.xml"
+    source.write_text(text)
+    output = tmp_path / "machine.yaml"
+    return main(["machine", "import", str(source), "-o", str(output), "--samples", "4", *extra]), output
+
+
+UNSUPPORTED = {
+    "ball joint in a chain": (dict(ball=True), "joint 'boom_pin' (ball)"),
+    "tendon": (
+        dict(extra='<tendon><fixed name="coupling"><joint joint="lift" coef="1"/></fixed></tendon>'),
+        "tendon 'coupling'",
+    ),
+    "two actuators in one loop": (dict(second_slide=True), "two actuators"),
+    "slewing joint not locked": (dict(), "joint 'slew': hinge axis"),
+    "loop with no slide": (dict(rigid_ram=True), "equality 'boom_end': closes a loop with no slide joint"),
+    "weld equality": (
+        dict(extra='<equality><weld name="glue" body1="arm" body2="boom"/></equality>'),
+        "equality 'glue' (weld)",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(UNSUPPORTED))
+def test_every_unsupported_construct_exits_2_with_one_line_naming_it_and_writes_nothing(
+    case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Ball joints, tendons, two slides in a loop, an unlocked slewing hinge, a loop without a slide, a weld: exit 2."""
+    kwargs, needle = UNSUPPORTED[case]
+    locks = [] if case == "slewing joint not locked" else ["--lock", "slew=0.3"]
+    status, output = _run_import(tmp_path, handmade_mjcf(**kwargs), "--tcp", "teeth", *locks)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2
+    assert len(err) == 1 and needle in err[0], err
+    assert not output.exists()
+
+
+def test_an_out_of_plane_hinge_axis_names_the_joint(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A hinge tilted out of the plane is one line naming it (with the lock hint), exit 2."""
+    text = handmade_mjcf().replace('<joint name="curl" range="-23 23"/>', '<joint name="curl" axis="0 1 0.3" range="-23 23"/>')
+    status, output = _run_import(tmp_path, text, "--tcp", "teeth", "--lock", "slew=0")
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and "joint 'curl'" in err[0] and "--lock curl=VALUE" in err[0]
+    assert not output.exists()
+
+
+@pytest.mark.parametrize("text", [None, "<mujoco><worldbody><body></mujoco>"])
+def test_a_missing_or_malformed_file_is_one_line_and_writes_nothing(
+    text: str | None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """No file, or XML MuJoCo cannot compile: one line, exit 2, no output."""
+    output = tmp_path / "machine.yaml"
+    source = tmp_path / "model.xml"
+    if text is not None:
+        source.write_text(text)
+    assert main(["machine", "import", str(source), "-o", str(output)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "model.xml" in err[0]
+    assert not output.exists()
+
+
+def test_the_import_command_writes_a_commented_file_that_machine_check_passes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The CLI prints the round trip on both paths, writes every value with a comment, and ``machine check`` passes."""
+    status, output = _run_import(tmp_path, handmade_mjcf(), "--tcp", "teeth", "--lock", "slew=0.3")
+    out = capsys.readouterr().out
+    assert status == 0
+    values = [float(line.rsplit(" ", 1)[1]) for line in out.splitlines() if line.startswith("round trip")]
+    assert len(values) == 2 and max(values) < TOLERANCE
+    for line in output.read_text().splitlines():
+        body = line.split("#", 1)[0]
+        if body.strip() and not body.rstrip().endswith(":") and ": " in body:
+            assert "#" in line, line  # every value says where it came from
+    assert main(["machine", "check", str(output)]) == 0
+    machine = load_machine(output)
+    assert {v.key for v in machine.decision_variables} >= {"boom.L", "boom.Lc0", "boom.Lc", "bucket.x0"}
