@@ -1,4 +1,4 @@
-"""``hiab-sim machine import``: an MJCF with slide actuators and connect loops becomes a machine file with the same forces."""
+"""``hiab-sim machine import``: an MJCF with slide actuators and connect loops becomes a machine with its forces."""
 
 from __future__ import annotations
 
@@ -49,7 +49,7 @@ def exported_mjcf(name: str, folder: Path) -> Path:
 
 @pytest.mark.parametrize("name", ["xs031", "exact"])
 def test_importing_the_exporters_mjcf_reproduces_its_actuator_forces_on_both_paths(name: str, tmp_path: Path) -> None:
-    """The shipped machines' MJCF (mjcf_build) imports to a machine whose forces match the MJCF's to 1e-9, and it checks."""
+    """The shipped machines' MJCF (mjcf_build) imports to a machine with the MJCF's forces to 1e-9; it checks."""
     imported = import_mjcf(exported_mjcf(name, tmp_path))
     machine = fit_ranges(imported)
     assert check_machine(machine) == []
@@ -101,7 +101,6 @@ def handmade_mjcf(
     arm_rot = _rot_y(np.radians(20.0))  # arm euler="0 20 0" in the boom
     e_boom, f_arm = np.array([1.0, 0.0, 0.3]), np.array([-0.25, 0.0, 0.15])
     f_boom = np.array([2.0, 0.0, 0.0]) + arm_rot @ f_arm
-    arm_dir = arm_rot.T @ (f_boom - e_boom)  # in the arm cylinder's parent frame: the boom's; keep boom axes
     arm_dir = f_boom - e_boom
     j_arm, h_arm, k_arm = np.array([0.8, 0.0, 0.15]), np.array([0.86, 0.0, 0.33]), np.array([1.1, 0.0, 0.14])
     g_arm = np.array([0.0, 0.0, 0.32])
@@ -116,6 +115,7 @@ def handmade_mjcf(
         return float(np.linalg.norm(v))
 
     joint = "ball" if ball else "hinge"
+    boom_rod_end = length(boom_dir) - 0.3 - (0.1 if second_slide else 0.0)
     mid = (
         '<body name="mid" pos="0 0 0.1"><joint name="mid_slide" class="ram" range="-0.1 0.1"/>'
         '<inertial pos="0 0 0" mass="1" diaginertia="0.01 0.01 0.01"/>'
@@ -185,7 +185,7 @@ def handmade_mjcf(
     </body>
   </worldbody>
   <equality>
-    <connect name="boom_end" body1="boom_rod" body2="column" anchor="0 0 {length(boom_dir) - 0.3 - (0.1 if second_slide else 0.0):.12g}"/>
+    <connect name="boom_end" body1="boom_rod" body2="column" anchor="0 0 {boom_rod_end:.12g}"/>
     <connect name="arm_end" body1="arm_rod" body2="arm" anchor="0 0 {length(arm_dir) - 0.3:.12g}"/>
     <connect name="bucket_rod_end" body1="bucket_rod" body2="rocker" anchor="0 0 {length(bucket_dir) - 0.25:.12g}"/>
     <connect name="bucket_link" body1="coupler" body2="bucket" anchor="{z(k_in_coupler)}"/>
@@ -201,7 +201,7 @@ def handmade_mjcf(
 
 
 def test_importing_a_handwritten_mjcf_with_a_locked_slewing_joint_reproduces_its_forces(tmp_path: Path) -> None:
-    """Another style (nesting, frames, euler, classes, fullinertia, four-bar, slewing locked off-zero): forces to 1e-9."""
+    """Another style (nesting, frames, euler, classes, fullinertia, four-bar, slewing locked): forces to 1e-9."""
     path = tmp_path / "digger.xml"
     path.write_text(handmade_mjcf())
     imported = import_mjcf(path, tcp="teeth", locks={"slew": 0.3})
@@ -251,7 +251,9 @@ def test_every_unsupported_construct_exits_2_with_one_line_naming_it_and_writes_
 
 def test_an_out_of_plane_hinge_axis_names_the_joint(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """A hinge tilted out of the plane is one line naming it (with the lock hint), exit 2."""
-    text = handmade_mjcf().replace('<joint name="curl" range="-23 23"/>', '<joint name="curl" axis="0 1 0.3" range="-23 23"/>')
+    text = handmade_mjcf().replace(
+        '<joint name="curl" range="-23 23"/>', '<joint name="curl" axis="0 1 0.3" range="-23 23"/>'
+    )
     status, output = _run_import(tmp_path, text, "--tcp", "teeth", "--lock", "slew=0")
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1 and "joint 'curl'" in err[0] and "--lock curl=VALUE" in err[0]

@@ -153,16 +153,16 @@ def run_import(args: argparse.Namespace) -> int:
     """Import the MJCF, check it, print the round trip, then write the file (nothing written on failure)."""
     import sys
 
-    from hiab_sim.atomic_io import write_atomic
     import yaml
 
+    from hiab_sim.atomic_io import write_atomic
     from hiab_sim.machine.loader import machine_from_dict
-    from hiab_sim.machine.mjcf_import import UnsupportedMJCF, import_mjcf
+    from hiab_sim.machine.mjcf_import import UnsupportedMJCFError, import_mjcf
     from hiab_sim.machine.mjcf_import_check import fit_ranges, machine_yaml, round_trip
 
     try:
         imported = import_mjcf(args.model, tcp=args.tcp, locks=_locks(args.lock), plane=args.plane)
-    except UnsupportedMJCF as error:
+    except UnsupportedMJCFError as error:
         for line in error.lines:
             print(f"hiab-sim machine import: unsupported: {line}", file=sys.stderr)
         return 2
@@ -179,7 +179,10 @@ def run_import(args: argparse.Namespace) -> int:
     for line in describe(machine):
         print(line)
     for path, value in errors.items():
-        print(f"round trip ({args.samples} random loop-consistent states): {path} vs the MJCF, max relative force difference {value:.2e}")
+        print(
+            f"round trip ({args.samples} random loop-consistent states): {path} vs the MJCF, "
+            f"max relative force difference {value:.2e}"
+        )
     if not args.output.parent.is_dir():
         from hiab_sim.errors import InvalidInputError
 
@@ -187,4 +190,3 @@ def run_import(args: argparse.Namespace) -> int:
     write_atomic(args.output, text)
     print(f"wrote {args.output}")
     return 0
-

@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.errors import ConfigError
-from hiab_sim.machine.mjcf_import_graph import ClosedChain, Mechanism, UnsupportedMJCF, connect_points, name_of
+from hiab_sim.machine.mjcf_import_graph import ClosedChain, Mechanism, UnsupportedMJCFError, connect_points, name_of
 from hiab_sim.machine.mjcf_import_graph import read_mechanism as _read
 from hiab_sim.machine.mjcf_import_pose import close, plane_axes, residual_and_jacobian
 
@@ -146,7 +146,10 @@ def _reference_pose(mech: Mechanism, dependent: list[int]) -> tuple[mujoco.MjDat
     """Data at a loop-consistent pose: a keyframe or qpos0 whose pins close, else Newton from qpos0."""
     model = mech.model
     data = mujoco.MjData(model)
-    starts = [(model.key_qpos[k], f"keyframe '{name_of(model, mujoco.mjtObj.mjOBJ_KEY, k, 'key')}'") for k in range(model.nkey)]
+    starts = [
+        (model.key_qpos[k], f"keyframe '{name_of(model, mujoco.mjtObj.mjOBJ_KEY, k, 'key')}'")
+        for k in range(model.nkey)
+    ]
     starts.append((model.qpos0, "qpos0 (the joints' ref)"))
     for qpos, label in [*starts, (model.qpos0, "Newton from qpos0")]:
         data.qpos[:] = qpos
@@ -158,22 +161,24 @@ def _reference_pose(mech: Mechanism, dependent: list[int]) -> tuple[mujoco.MjDat
         if label.startswith("Newton") or (residual.size == 0 or np.max(np.abs(residual)) < CLOSED_TOL):
             if close(mech, data, dependent) < 1e-10:
                 return data, label
-    raise UnsupportedMJCF(["model: no loop-consistent pose found (no keyframe or qpos0 closes the connects)"])
+    raise UnsupportedMJCFError(["model: no loop-consistent pose found (no keyframe or qpos0 closes the connects)"])
 
 
 def _range(model: mujoco.MjModel, j: int, what: str) -> tuple[float, float]:
     jname = name_of(model, mujoco.mjtObj.mjOBJ_JOINT, j, "joint")
     if not model.jnt_limited[j]:
-        raise UnsupportedMJCF([f"joint '{jname}': {what} needs a range (range=\"min max\")"])
+        raise UnsupportedMJCFError([f"joint '{jname}': {what} needs a range (range=\"min max\")"])
     return float(model.jnt_range[j, 0]), float(model.jnt_range[j, 1])
 
 
-def import_mjcf(path: str | Path, tcp: str | None = None, locks: dict[str, float] | None = None, plane: str = "auto") -> Imported:
+def import_mjcf(
+    path: str | Path, tcp: str | None = None, locks: dict[str, float] | None = None, plane: str = "auto"
+) -> Imported:
     """Read an MJCF into machine-file content (see the module docstring).
 
     Raises:
         ConfigError: a missing or malformed file.
-        UnsupportedMJCF: one line per construct the machine format cannot represent.
+        UnsupportedMJCFError: one line per construct the machine format cannot represent.
 
     """
     model = load_model(path)
@@ -190,4 +195,4 @@ def import_mjcf(path: str | Path, tcp: str | None = None, locks: dict[str, float
     return imported
 
 
-__all__ = ["ClosedChain", "Imported", "Note", "UnsupportedMJCF", "import_mjcf", "load_model"]
+__all__ = ["ClosedChain", "Imported", "Note", "UnsupportedMJCFError", "import_mjcf", "load_model"]

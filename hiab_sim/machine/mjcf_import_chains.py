@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import numpy as np
 
-from hiab_sim.machine.mjcf_import_graph import ClosedChain, Mechanism, UnsupportedMJCF, name_of
+from hiab_sim.machine.mjcf_import_graph import ClosedChain, Mechanism, UnsupportedMJCFError, name_of
 
 if TYPE_CHECKING:
     from hiab_sim.machine.mjcf_import import Imported, _Frames
@@ -85,13 +85,17 @@ def chain_roles(mech: Mechanism) -> list[Role]:
         for g in role.own_groups:
             extra = [k for k in mech.incident(g) if k not in role.block.edges]
             if extra:
-                problems.append(f"{mech.edges[extra[0]].element}: hangs on a chain body (cylinder, rod, rocker, coupler)")
+                problems.append(
+                    f"{mech.edges[extra[0]].element}: hangs on a chain body (cylinder, rod, rocker, coupler)"
+                )
     if problems:
-        raise UnsupportedMJCF(problems)
+        raise UnsupportedMJCFError(problems)
     return roles
 
 
-def _linkage(mech: Mechanism, block: ClosedChain, x: int, y: int, ex: int, a: int, ey: int, b: int, rest: list[int]) -> Role:
+def _linkage(
+    mech: Mechanism, block: ClosedChain, x: int, y: int, ex: int, a: int, ey: int, b: int, rest: list[int]
+) -> Role:
     """A four-bar's roles: the rod's pin is the rocker-coupler pin H; the base is on the driven joint's parent.
 
     H is the four-bar edge at the rod's partner body whose pin coincides with the rod end on that
@@ -123,7 +127,9 @@ def _linkage(mech: Mechanism, block: ClosedChain, x: int, y: int, ex: int, a: in
     (coupler_edge,) = [k for k in rest if ends(k) == {coupler, c}]
     if mech.edges[driven].a != a:
         raise ValueError(f"{slide}: a four-bar's actuator base and rocker must be on the driven joint's parent")
-    return Role("linkage", block, block.slide, x, y, ex, a, ey, b, driven, rocker_edge, at_h[0], coupler_edge, rocker, coupler)
+    return Role(
+        "linkage", block, block.slide, x, y, ex, a, ey, b, driven, rocker_edge, at_h[0], coupler_edge, rocker, coupler
+    )
 
 
 def _note(value: Any, origin: str) -> Any:

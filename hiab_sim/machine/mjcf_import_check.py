@@ -95,7 +95,9 @@ def fit_ranges(imported: Imported) -> Machine:
         imported.tree["links"][link.name]["joint_range"] = Note(
             fitted, f"{note.origin}, narrowed to what the stroke of chain {chain.name} reaches"
         )
-        imported.notes.append(f"working range of {link.joint} narrowed from [{low:.9g}, {high:.9g}] to [{fitted[0]:.9g}, {fitted[1]:.9g}]")
+        imported.notes.append(
+            f"working range of {link.joint} narrowed from [{low:.9g}, {high:.9g}] to [{fitted[0]:.9g}, {fitted[1]:.9g}]"
+        )
     return machine_from_dict(plain(imported.tree), check_assembly=False)
 
 
@@ -114,12 +116,16 @@ def _bare(model: mujoco.MjModel) -> mujoco.MjModel:
     return bare
 
 
-def original_forces(imported: Imported, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, tcp_force: np.ndarray) -> np.ndarray:
-    """Actuator forces f_x [N] of the original MJCF (T, n_chains) at machine joint samples (see the module docstring)."""
+def original_forces(
+    imported: Imported, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, tcp_force: np.ndarray
+) -> np.ndarray:
+    """Actuator forces f_x [N] of the original MJCF (T, n_chains) at machine joint samples (module docstring)."""
     mech = imported.mech
     model = _bare(mech.model)
     data = mujoco.MjData(model)
-    held_dofs = [int(model.jnt_dofadr[j]) for j, _, _ in imported.joint_map] + [int(model.jnt_dofadr[j]) for j in mech.locked]
+    held_dofs = [int(model.jnt_dofadr[j]) for j, _, _ in imported.joint_map] + [
+        int(model.jnt_dofadr[j]) for j in mech.locked
+    ]
     dependent = [d for d in range(model.nv) if d not in held_dofs]
     act = [int(model.jnt_dofadr[j]) for j, _ in imported.actuators]
     kappa = np.array([k for _, k in imported.actuators])

@@ -16,7 +16,7 @@ every orientation form, ``fullinertia``/``diaginertia``, ``inertiafromgeom``, ``
 * a slide joint outside every loop is a prismatic joint driven directly by its actuator.
 
 What the machine format cannot represent is one line each naming the MJCF element
-(:class:`UnsupportedMJCF`). Positions in m, in MuJoCo's world frame unless said otherwise.
+(:class:`UnsupportedMJCFError`). Positions in m, in MuJoCo's world frame unless said otherwise.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ _BALL, _FREE = int(mujoco.mjtJoint.mjJNT_BALL), int(mujoco.mjtJoint.mjJNT_FREE)
 PLANES = {"xz": 1, "xy": 2, "yz": 0}  # plane -> index of the world axis that is its normal
 
 
-class UnsupportedMJCF(HiabSimError):
+class UnsupportedMJCFError(HiabSimError):
     """The MJCF holds constructs the machine format cannot represent; one line per construct."""
 
     def __init__(self, lines: list[str]) -> None:
@@ -108,9 +108,9 @@ def _locks(model: mujoco.MjModel, locks: dict[str, float]) -> dict[int, float]:
     for name, value in locks.items():
         j = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
         if j < 0:
-            raise UnsupportedMJCF([f"--lock {name}={value:g}: the MJCF has no joint '{name}'"])
+            raise UnsupportedMJCFError([f"--lock {name}={value:g}: the MJCF has no joint '{name}'"])
         if int(model.jnt_type[j]) not in (_HINGE, _SLIDE):
-            raise UnsupportedMJCF([f"--lock {name}: only hinge and slide joints can be locked"])
+            raise UnsupportedMJCFError([f"--lock {name}: only hinge and slide joints can be locked"])
         out[j] = float(value)
     return out
 
@@ -126,7 +126,7 @@ def _plane_normal(model: mujoco.MjModel, data: mujoco.MjData, hinges: list[int],
                 return normal * np.sign(float(axis @ normal))
         return normal
     if not axes:
-        raise UnsupportedMJCF(["model: no hinge joint to find the plane from; name it with --plane xz|xy|yz"])
+        raise UnsupportedMJCFError(["model: no hinge joint to find the plane from; name it with --plane xz|xy|yz"])
     best = max(axes, key=lambda a: sum(abs(float(a @ b)) > 1.0 - AXIS_TOLERANCE for b in axes))
     return best / np.linalg.norm(best)
 
@@ -135,12 +135,14 @@ def read_mechanism(model: mujoco.MjModel, locks: dict[str, float], plane: str = 
     """Groups, edges, plane and closed chains of a compiled model (see the module docstring).
 
     Raises:
-        UnsupportedMJCF: one line per construct the machine format cannot represent.
+        UnsupportedMJCFError: one line per construct the machine format cannot represent.
 
     """
     problems: list[str] = []
     for t in range(model.ntendon):
-        problems.append(f"tendon '{name_of(model, mujoco.mjtObj.mjOBJ_TENDON, t, 'tendon')}': tendons are not supported")
+        problems.append(
+            f"tendon '{name_of(model, mujoco.mjtObj.mjOBJ_TENDON, t, 'tendon')}': tendons are not supported"
+        )
     for f in range(model.nflex):
         problems.append(f"flex '{name_of(model, mujoco.mjtObj.mjOBJ_FLEX, f, 'flex')}': flexes are not supported")
     locked = _locks(model, locks)
@@ -211,8 +213,10 @@ def read_mechanism(model: mujoco.MjModel, locks: dict[str, float], plane: str = 
         b1, b2 = _connect_bodies(model, e)
         edges.append(Edge("pin", group[b1], group[b2], e, f"equality '{ename}'"))
     if problems:
-        raise UnsupportedMJCF(problems)
-    mech = Mechanism(model, group, edges, normal, in_plane / np.linalg.norm(in_plane), float(np.linalg.norm(in_plane)), locked)
+        raise UnsupportedMJCFError(problems)
+    mech = Mechanism(
+        model, group, edges, normal, in_plane / np.linalg.norm(in_plane), float(np.linalg.norm(in_plane)), locked
+    )
     mech.chains = _closed_chains(mech)
     return mech
 
@@ -282,5 +286,5 @@ def _closed_chains(mech: Mechanism) -> list[ClosedChain]:
         else:
             chains.append(ClosedChain(tuple(edges), tuple(groups), slides[0]))
     if problems:
-        raise UnsupportedMJCF(problems)
+        raise UnsupportedMJCFError(problems)
     return chains

@@ -13,7 +13,7 @@ import mujoco
 import numpy as np
 
 from hiab_sim.machine.mjcf_import_chains import Role, in_plane_angle
-from hiab_sim.machine.mjcf_import_graph import UnsupportedMJCF, name_of
+from hiab_sim.machine.mjcf_import_graph import UnsupportedMJCFError, name_of
 
 if TYPE_CHECKING:
     from hiab_sim.machine.mjcf_import import Imported, _Frames
@@ -82,7 +82,10 @@ def link_entries(imported: Imported, frames: _Frames, roles: list[Role]) -> tupl
             angle = parent_angle + kappa * qref
             joint_origin = origin
             frame_angle = 0.0
-            kind, where = "revolute", f"{edge.element}: hinge, q = {kappa:+g} qpos (axis along {'+' if kappa > 0 else '-'}normal)"
+            kind, where = (
+                "revolute",
+                f"{edge.element}: hinge, q = {kappa:+g} qpos (axis along {'+' if kappa > 0 else '-'}normal)",
+            )
             if not model.jnt_limited[j]:
                 problems.append(f"{edge.element}: a driven hinge needs a range (its working range)")
                 continue
@@ -97,13 +100,18 @@ def link_entries(imported: Imported, frames: _Frames, roles: list[Role]) -> tupl
             angle = in_plane_angle(w)
             joint_origin = origin - w * (qref - low)
             frame_angle = angle - parent_angle
-            kind, where = "prismatic", f"{edge.element}: slide, q = qpos - {low:g} (the stroke from its range's lower end)"
+            kind, where = (
+                "prismatic",
+                f"{edge.element}: slide, q = qpos - {low:g} (the stroke from its range's lower end)",
+            )
             span = [0.0, high - low]
             imported.joint_map.append((j, 1.0, -low))
             range_origin = f"{edge.element} range [{low:g}, {high:g}] m, shifted to start at 0"
         link_frames[g] = (origin, angle)
         joint_frame: dict[str, Any] = {
-            "r": _note(_local((parent_origin, parent_angle), joint_origin), f"{edge.element} anchor in the parent's frame")
+            "r": _note(
+                _local((parent_origin, parent_angle), joint_origin), f"{edge.element} anchor in the parent's frame"
+            )
         }
         if frame_angle != 0.0:
             joint_frame["angle"] = _note(float(frame_angle), f"{edge.element} axis direction in the parent's frame")
@@ -121,7 +129,7 @@ def link_entries(imported: Imported, frames: _Frames, roles: list[Role]) -> tupl
             "bodies": bodies,
         }
     if problems:
-        raise UnsupportedMJCF(problems)
+        raise UnsupportedMJCFError(problems)
     return links, link_frames
 
 
@@ -141,7 +149,9 @@ def _one_body(parts: dict[str, Any], origin: str) -> Any:
     return _note(value, f"body {names}: mass, centre of mass and inertia in the {origin} frame")
 
 
-def chain_entry(imported: Imported, frames: _Frames, role: Role, link_frames: dict[int, Frame]) -> tuple[str, dict[str, Any]]:
+def chain_entry(
+    imported: Imported, frames: _Frames, role: Role, link_frames: dict[int, Frame]
+) -> tuple[str, dict[str, Any]]:
     """One chain's entry (triangle or linkage) with its proposed decision variables."""
     from hiab_sim.machine.mjcf_import_chains import _actuator_on
 
@@ -159,10 +169,10 @@ def chain_entry(imported: Imported, frames: _Frames, role: Role, link_frames: di
     w = frames.point(frames.data.xaxis[j])
     kappa = float(w @ u)
     if abs(abs(kappa) - 1.0) > 1e-6:
-        raise UnsupportedMJCF([f"{slide.element}: the slide axis is not along the line of its two pins"])
+        raise UnsupportedMJCFError([f"{slide.element}: the slide axis is not along the line of its two pins"])
     kappa = float(np.sign(kappa))
     if not model.jnt_limited[j]:
-        raise UnsupportedMJCF([f"{slide.element}: an actuator slide needs a range (its stroke)"])
+        raise UnsupportedMJCFError([f"{slide.element}: an actuator slide needs a range (its stroke)"])
     low, high = (float(v) for v in model.jnt_range[j])
     qref = float(imported.qpos_ref[model.jnt_qposadr[j]])
     x0 = s_ref + kappa * ((low if kappa > 0 else high) - qref)
@@ -201,7 +211,9 @@ def chain_entry(imported: Imported, frames: _Frames, role: Role, link_frames: di
     x0_origin = f"{range_text}: pin-to-pin length at the retracted end (x0 = {x0:.6g} m)"
     entry: dict[str, Any] = {"kind": None, "joint": _note(joint, mech.edges[role.driven].element)}
     if role.kind == "triangle":
-        entry["kind"] = _note("triangle", f"loop of {slide.element}, its two pins and {mech.edges[role.driven].element}")
+        entry["kind"] = _note(
+            "triangle", f"loop of {slide.element}, its two pins and {mech.edges[role.driven].element}"
+        )
         entry["pivots"] = {
             "base": pivot(role.base_group, a, role.base_edge),
             "end": pivot(role.end_group, b, role.end_edge),
@@ -220,8 +232,12 @@ def chain_entry(imported: Imported, frames: _Frames, role: Role, link_frames: di
     rocker = _one_body(frames.bodies(role.rocker, r, in_plane_angle(h - r)), "rocker")
     coupler = _one_body(frames.bodies(role.coupler, np.array([h[0], h[1], r[2]]), in_plane_angle(c - h)), "coupler")
     linkage: dict[str, Any] = {
-        "rocker_length": _note(rocker_len, f"{mech.edges[role.rocker_edge].element} to {mech.edges[role.link_edge].element}"),
-        "coupler_length": _note(coupler_len, f"{mech.edges[role.link_edge].element} to {mech.edges[role.coupler_edge].element}"),
+        "rocker_length": _note(
+            rocker_len, f"{mech.edges[role.rocker_edge].element} to {mech.edges[role.link_edge].element}"
+        ),
+        "coupler_length": _note(
+            coupler_len, f"{mech.edges[role.link_edge].element} to {mech.edges[role.coupler_edge].element}"
+        ),
         "pin_side": _note(side, "the side of rocker -> coupler pivots the pin H is on at the reference pose"),
     }
     if rocker is not None:
@@ -247,7 +263,7 @@ def chain_entry(imported: Imported, frames: _Frames, role: Role, link_frames: di
     return name, entry
 
 
-def PIVOT_SPAN_M(x0: float) -> float:  # noqa: N802
+def PIVOT_SPAN_M(x0: float) -> float:
     """Half-width of a proposed pivot coordinate's bounds: 10 % of the retracted length [m]."""
     return 0.1 * x0
 
@@ -260,8 +276,13 @@ def _triangle_variables(hinge_distance: float, lc0: float, lc: float, stroke: fl
             {"kind": "hinge_distance", "pivot": "base", "bounds": [0.85 * hinge_distance, 1.15 * hinge_distance]},
             f"proposed: +-15 % of the base pin's distance from the hinge ({hinge_distance:.6g} m); edit",
         )
-    out["Lc0"] = _note({"kind": "piston_offset", "bounds": [0.7 * lc0, 1.3 * lc0]}, f"proposed: +-30 % of Lc0; {x0_origin}")
-    out["Lc"] = _note({"kind": "rod_length", "bounds": [max(stroke, 0.7 * lc), 1.3 * lc]}, "proposed: +-30 % of Lc, not below the stroke")
+    out["Lc0"] = _note(
+        {"kind": "piston_offset", "bounds": [0.7 * lc0, 1.3 * lc0]}, f"proposed: +-30 % of Lc0; {x0_origin}"
+    )
+    out["Lc"] = _note(
+        {"kind": "rod_length", "bounds": [max(stroke, 0.7 * lc), 1.3 * lc]},
+        "proposed: +-30 % of Lc, not below the stroke",
+    )
     return out
 
 
@@ -276,11 +297,11 @@ def tcp_entry(imported: Imported, frames: _Frames, link_frames: dict[int, Frame]
         body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
         if body < 0:
             hint = "" if tcp else ": name it with --tcp SITE_OR_BODY"
-            raise UnsupportedMJCF([f"--tcp {name}: the MJCF has no site or body '{name}'{hint}"])
+            raise UnsupportedMJCFError([f"--tcp {name}: the MJCF has no site or body '{name}'{hint}"])
         p, rot, what = data.xpos[body], data.xmat[body], f"body '{name}'"
     group = mech.group_of_body[body]
     if group not in link_frames:
-        raise UnsupportedMJCF([f"{what}: the TCP must be on a machine link, not on a chain body"])
+        raise UnsupportedMJCFError([f"{what}: the TCP must be on a machine link, not on a chain body"])
     xmat = data.xmat[body].reshape(3, 3)
     imported.tcp = (body, xmat.T @ (np.asarray(p) - data.xpos[body]))
     frame = link_frames[group]

@@ -75,7 +75,7 @@ def _bodies(model: mujoco.MjModel, e: int) -> tuple[int, int]:
 
 
 def close(mech: Mechanism, data: mujoco.MjData, dependent: list[int]) -> float:
-    """Newton on the dependent dofs (qpos = qvel dofs: hinges and slides only) from the data's qpos; the final |residual| [m]."""
+    """Newton on the dependent dofs (hinges and slides: qpos = qvel) from the data's qpos; the final |residual| [m]."""
     model = mech.model
     dofs = np.array(dependent, dtype=int)
     qadr = model.jnt_qposadr[model.dof_jntid[dofs]] if len(dofs) else dofs
