@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from hiab_sim.errors import InvalidInputError
@@ -60,6 +60,7 @@ def test_blade_force_equals_the_wedge_equilibrium(
     alpha: float, depth: float, phi: float, cohesion: float, delta_ratio: float, adhesion: float, surcharge: float
 ) -> None:
     """For any soil and rake angle, the closed-form N factors give the wedge's own force balance at beta*."""
+    assume(alpha + (1.0 + delta_ratio) * phi < np.pi - 0.2)  # a failure wedge exists (alpha + delta + phi < pi)
     soil = SoilProperties(1800.0, phi, cohesion, delta_ratio * phi, adhesion, surcharge, "test values")
     beta = float(failure_plane_angle(soil, G, alpha, depth)[0])
     along, up = blade_force(soil, G, alpha, depth, width_m=1.0)
@@ -86,3 +87,10 @@ def test_world_force_opposes_the_travel_and_vanishes_above_ground() -> None:
         SoilProperties(1600.0, 2.0, 0.0, 0.0, 0.0, 0.0, "test values")
     with pytest.raises(InvalidInputError, match=r"soil\.source"):
         SoilProperties(1600.0, 0.5, 0.0, 0.0, 0.0, 0.0, " ")
+
+
+def test_a_blade_too_steep_for_a_failure_wedge_is_refused() -> None:
+    """A rake angle with alpha + delta + phi >= pi leaves no failure wedge: refused, naming rake_angle_rad."""
+    soil = SoilProperties(1700.0, np.radians(39.0), 0.0, np.radians(24.0), 0.0, 0.0, "test values")
+    with pytest.raises(InvalidInputError, match="rake_angle_rad"):
+        blade_force(soil, G, np.radians(118.0), 0.3, 0.5)
