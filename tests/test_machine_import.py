@@ -290,4 +290,9 @@ def test_the_import_command_writes_a_commented_file_that_machine_check_passes(
             assert "#" in line, line  # every value says where it came from
     assert main(["machine", "check", str(output)]) == 0
     machine = load_machine(output)
-    assert {v.key for v in machine.decision_variables} >= {"boom.L", "boom.Lc0", "boom.Lc", "bucket.x0"}
+    assert {v.key for v in machine.decision_variables} >= {
+        "boom.hinge_distance",
+        "boom.piston_offset",
+        "boom.rod_length",
+        "bucket.retracted_length",
+    }

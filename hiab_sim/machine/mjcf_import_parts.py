@@ -258,7 +258,9 @@ def chain_entry(
     entry["variables"] = {
         "base_x": _note({"kind": "pivot_x", "pivot": "base", "bounds": [base[0] - span, base[0] + span]}, proposed),
         "base_y": _note({"kind": "pivot_y", "pivot": "base", "bounds": [base[1] - span, base[1] + span]}, proposed),
-        "x0": _note({"kind": "retracted_length", "bounds": [0.9 * x0, 1.1 * x0]}, "proposed: +-10 % of " + x0_origin),
+        "retracted_length": _note(
+            {"kind": "retracted_length", "bounds": [0.9 * x0, 1.1 * x0]}, "proposed: +-10 % of " + x0_origin
+        ),
     }
     return name, entry
 
@@ -272,14 +274,14 @@ def _triangle_variables(hinge_distance: float, lc0: float, lc: float, stroke: fl
     """The seed's xi = [L, Lc0, Lc] with bounds around the imported values (proposed; edit them)."""
     out: dict[str, Any] = {}
     if hinge_distance > 1e-6:
-        out["L"] = _note(
+        out["hinge_distance"] = _note(
             {"kind": "hinge_distance", "pivot": "base", "bounds": [0.85 * hinge_distance, 1.15 * hinge_distance]},
             f"proposed: +-15 % of the base pin's distance from the hinge ({hinge_distance:.6g} m); edit",
         )
-    out["Lc0"] = _note(
+    out["piston_offset"] = _note(
         {"kind": "piston_offset", "bounds": [0.7 * lc0, 1.3 * lc0]}, f"proposed: +-30 % of Lc0; {x0_origin}"
     )
-    out["Lc"] = _note(
+    out["rod_length"] = _note(
         {"kind": "rod_length", "bounds": [max(stroke, 0.7 * lc), 1.3 * lc]},
         "proposed: +-30 % of Lc, not below the stroke",
     )
