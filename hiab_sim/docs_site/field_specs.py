@@ -193,14 +193,19 @@ def crane_keys() -> list[Key]:
 def emla_keys() -> list[Key]:
     """The EMLA file (:func:`hiab_sim.emla.config.emla_set_from_mapping`); values may carry a provenance."""
     from hiab_sim.emla.battery import BatteryParams
-    from hiab_sim.emla.config import EmlaParams, PmsmParams
+    from hiab_sim.emla.config import DriveStiffness, EmlaParams, PmsmParams, ScrewColumn
     from hiab_sim.emla.losses import DriveLosses
     from hiab_sim.emla.thermal import ThermalParams
 
     pmsm = _sourced(from_class("", PmsmParams))
     actuator = [
-        k for k in _sourced(from_class("", EmlaParams, skip=("name", "motor", "losses", "thermal", "provenance")))
+        k
+        for k in _sourced(
+            from_class("", EmlaParams, skip=("name", "motor", "losses", "thermal", "provenance", "screw", "stiffness"))
+        )
     ]
+    screw = _sourced(from_class("", ScrewColumn))
+    stiffness = _sourced(from_class("", DriveStiffness))
     thermal = _sourced(from_class("", ThermalParams))
     losses = _sourced(from_class("", DriveLosses), required=False)
     rows = [
@@ -218,6 +223,12 @@ def emla_keys() -> list[Key]:
         rows += [replace(k, path=f"{where}.thermal.{k.path}", default="shared") for k in thermal]
         rows.append(section(f"{where}.drive_losses", "Overrides of the shared `drive_losses` keys.", default="none"))
         rows += [replace(k, path=f"{where}.drive_losses.{k.path}", default="shared") for k in losses]
+        rows.append(section(f"{where}.screw", "Overrides of the shared `screw` keys.", default="none"))
+        rows += [replace(k, path=f"{where}.screw.{k.path}", default="shared") for k in screw]
+        rows.append(
+            section(f"{where}.drive_stiffness", "Overrides of the shared `drive_stiffness` keys.", default="none")
+        )
+        rows += [replace(k, path=f"{where}.drive_stiffness.{k.path}", default="shared") for k in stiffness]
     rows += [
         section(
             "thermal",
@@ -235,6 +246,18 @@ def emla_keys() -> list[Key]:
             description="`false` keeps every loss off (the keys below are then ignored).",
         ),
         *[replace(k, path=f"drive_losses.{k.path}") for k in losses],
+        section(
+            "screw",
+            "Every screw as a column under its push force (buckling rows and margins); none: no buckling check.",
+            default="none",
+        ),
+        *[replace(k, path=f"screw.{k.path}") for k in screw],
+        section(
+            "drive_stiffness",
+            "Axial stiffness of every drive train (natural frequencies); none: no frequency check.",
+            default="none",
+        ),
+        *[replace(k, path=f"drive_stiffness.{k.path}") for k in stiffness],
         section("battery", "Shared DC bus and battery efficiencies (battery energy).", default="defaults"),
         *[replace(k, path=f"battery.{k.path}") for k in _sourced(from_class("", BatteryParams), required=False)],
     ]
@@ -327,6 +350,23 @@ def _payload_keys(where: str) -> list[Key]:
     return rows
 
 
+def _structure_keys() -> list[Key]:
+    """The study's ``structure`` section (:meth:`hiab_sim.structure.settings.StructureSettings.from_mapping`)."""
+    from hiab_sim.structure.settings import StructureSettings
+
+    rows = from_class("structure", StructureSettings, skip=("pin_load_limits_N",))
+    return [
+        section("structure", "Structural rows of the NLP: buckling, pin loads, natural frequency.", "none"),
+        *rows,
+        free(
+            "structure.pin_load_limits",
+            "Pin name (`<chain>.<pin>`, as `hiab-sim machine show` lists them) -> largest |F| [N] > 0; "
+            "one row per pin and sample.",
+            "number",
+        ),
+    ]
+
+
 def study_keys() -> list[Key]:
     """The study file (:func:`hiab_sim.study.spec.study_file.study_from_dict`)."""
     from hiab_sim.study.nlp.objectives import OBJECTIVES
@@ -381,6 +421,7 @@ def study_keys() -> list[Key]:
         *_payload_keys("tasks[].payload"),
     ]
     rows += [section("tracking", "Tolerance bands of const_b..const_d.", "defaults"), *from_class("tracking", Tracking)]
+    rows += _structure_keys()
     rows += [
         section("bounds", "Box and path bounds of the NLP."),
         *[
