@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from hiab_sim.cli import main
-from hiab_sim.machine.assembly import check_machine
-from hiab_sim.machine.dynamics_mujoco import MujocoMachineDynamics
+from hiab_sim.machine.dynamics.mjcf_build import build_machine_spec
+from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
+from hiab_sim.machine.kinematics.assembly import check_machine
 from hiab_sim.machine.loader import load_machine
-from hiab_sim.machine.mjcf_build import build_machine_spec
-from hiab_sim.machine.mjcf_import import import_mjcf
-from hiab_sim.machine.mjcf_import_check import fit_ranges, round_trip
+from hiab_sim.machine.mjcf_import.importer import import_mjcf
+from hiab_sim.machine.mjcf_import.round_trip import fit_ranges, round_trip
 
 TOLERANCE = 1e-9
 

@@ -14,9 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-from hiab_sim.machine.assembly import check_machine, reachable_joint_range, usable_stroke
-from hiab_sim.machine.closure import joint_to_stroke
 from hiab_sim.machine.description import Machine
+from hiab_sim.machine.kinematics.assembly import check_machine, reachable_joint_range, usable_stroke
+from hiab_sim.machine.kinematics.closure import joint_to_stroke
 from hiab_sim.machine.loader import load_machine
 
 
@@ -164,8 +164,8 @@ def run_import(args: argparse.Namespace) -> int:
 
     from hiab_sim.atomic_io import write_atomic
     from hiab_sim.machine.loader import machine_from_dict
-    from hiab_sim.machine.mjcf_import import UnsupportedMJCFError, import_mjcf
-    from hiab_sim.machine.mjcf_import_check import fit_ranges, machine_yaml, round_trip
+    from hiab_sim.machine.mjcf_import.importer import UnsupportedMJCFError, import_mjcf
+    from hiab_sim.machine.mjcf_import.round_trip import fit_ranges, machine_yaml, round_trip
 
     try:
         imported = import_mjcf(args.model, tcp=args.tcp, locks=_locks(args.lock), plane=args.plane)

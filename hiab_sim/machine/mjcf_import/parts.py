@@ -1,32 +1,24 @@
 """Machine-file entries of an imported MJCF: links with their joint frames, chains with their pivots, the TCP.
 
-Conventions and units in :mod:`hiab_sim.machine.mjcf_import`; every entry is a
-:class:`~hiab_sim.machine.mjcf_import.Note` (value and its MJCF origin).
+Conventions and units in :mod:`hiab_sim.machine.mjcf_import.importer`; every entry is a
+:class:`~hiab_sim.machine.mjcf_import.frames.Note` (value and its MJCF origin).
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import mujoco
 import numpy as np
 
-from hiab_sim.machine.mjcf_import_chains import Role, in_plane_angle
-from hiab_sim.machine.mjcf_import_graph import UnsupportedMJCFError, name_of
-
-if TYPE_CHECKING:
-    from hiab_sim.machine.mjcf_import import Imported, _Frames
+from hiab_sim.machine.mjcf_import.chains import Role, in_plane_angle
+from hiab_sim.machine.mjcf_import.frames import Frames, Imported, Note
+from hiab_sim.machine.mjcf_import.graph import UnsupportedMJCFError, actuator_on, name_of
 
 #: Name of the root link: the world body and everything welded or locked to it.
 ROOT = "ground"
 Frame = tuple[np.ndarray, float]  # origin (3,) in machine coordinates [m], angle about z [rad]
-
-
-def _note(value: Any, origin: str) -> Any:
-    from hiab_sim.machine.mjcf_import import Note
-
-    return Note(value, origin)
 
 
 def _rz(angle: float) -> np.ndarray:
@@ -46,7 +38,7 @@ def group_name(imported: Imported, g: int) -> str:
     return name_of(imported.mech.model, mujoco.mjtObj.mjOBJ_BODY, body, "body")
 
 
-def link_entries(imported: Imported, frames: _Frames, roles: list[Role]) -> tuple[dict[str, Any], dict[int, Frame]]:
+def link_entries(imported: Imported, frames: Frames, roles: list[Role]) -> tuple[dict[str, Any], dict[int, Frame]]:
     """Links (root first, parents before children) and each main group's machine frame at the reference pose."""
     mech, model = imported.mech, imported.mech.model
     own = {g for r in roles for g in r.own_groups}
@@ -109,23 +101,23 @@ def link_entries(imported: Imported, frames: _Frames, roles: list[Role]) -> tupl
             range_origin = f"{edge.element} range [{low:g}, {high:g}] m, shifted to start at 0"
         link_frames[g] = (origin, angle)
         joint_frame: dict[str, Any] = {
-            "r": _note(
+            "r": Note(
                 _local((parent_origin, parent_angle), joint_origin), f"{edge.element} anchor in the parent's frame"
             )
         }
         if frame_angle != 0.0:
-            joint_frame["angle"] = _note(float(frame_angle), f"{edge.element} axis direction in the parent's frame")
+            joint_frame["angle"] = Note(float(frame_angle), f"{edge.element} axis direction in the parent's frame")
         bodies = frames.bodies(g, origin, angle)
         name = group_name(imported, g)
         if not bodies:
             problems.append(f"body '{name}': a moving link needs mass")
             continue
         links[name] = {
-            "parent": _note(group_name(imported, edge.a), "the parent body in the MJCF tree"),
-            "joint": _note(jname, edge.element),
-            "kind": _note(kind, where),
+            "parent": Note(group_name(imported, edge.a), "the parent body in the MJCF tree"),
+            "joint": Note(jname, edge.element),
+            "kind": Note(kind, where),
             "joint_frame": joint_frame,
-            "joint_range": _note([float(v) for v in span], range_origin),
+            "joint_range": Note([float(v) for v in span], range_origin),
             "bodies": bodies,
         }
     if problems:
@@ -146,20 +138,18 @@ def _one_body(parts: dict[str, Any], origin: str) -> Any:
         inertia += np.asarray(v["inertia"]) + v["mass"] * (float(d @ d) * np.eye(3) - np.outer(d, d))
     names = ", ".join(f"'{n}'" for n in parts)
     value = {"mass": float(mass), "com": [float(c) for c in com], "inertia": [[float(x) for x in r] for r in inertia]}
-    return _note(value, f"body {names}: mass, centre of mass and inertia in the {origin} frame")
+    return Note(value, f"body {names}: mass, centre of mass and inertia in the {origin} frame")
 
 
 def chain_entry(
-    imported: Imported, frames: _Frames, role: Role, link_frames: dict[int, Frame]
+    imported: Imported, frames: Frames, role: Role, link_frames: dict[int, Frame]
 ) -> tuple[str, dict[str, Any]]:
     """One chain's entry (triangle or linkage) with its proposed decision variables."""
-    from hiab_sim.machine.mjcf_import_chains import _actuator_on
-
     mech, model = imported.mech, imported.mech.model
     slide = mech.edges[role.slide]
     j = slide.index
     jname = name_of(model, mujoco.mjtObj.mjOBJ_JOINT, j, "joint")
-    name = _actuator_on(model, j) or jname
+    name = actuator_on(model, j) or jname
     a = frames.edge_point(role.base_edge, role.base_group)
     b = frames.edge_point(role.end_edge, role.end_group)
     d = (b - a)[:2]
@@ -191,29 +181,27 @@ def chain_entry(
 
     def pivot(group: int, p: np.ndarray, edge: int) -> dict[str, Any]:
         return {
-            "link": _note(group_name(imported, group), mech.edges[edge].element),
-            "position": _note(_local(link_frames[group], p), f"{mech.edges[edge].element} pin in the link frame"),
+            "link": Note(group_name(imported, group), mech.edges[edge].element),
+            "position": Note(_local(link_frames[group], p), f"{mech.edges[edge].element} pin in the link frame"),
         }
 
     joint = name_of(model, mujoco.mjtObj.mjOBJ_JOINT, mech.edges[role.driven].index, "joint")
     range_text = f"{slide.element} range [{low:g}, {high:g}]"
     actuator: dict[str, Any] = {
-        "stroke": _note(stroke, f"{range_text}: max - min"),
-        "piston_offset": _note(x0 - lc, "x0 - Lc"),
-        "rod_length": _note(lc, lc_origin),
-        "emla": _note(name, "the actuator's name (edit: the EMLA in your EMLA file)"),
-        "body_scaling": _note("fixed", "chosen: an imported body's shape is unknown, so it does not rescale"),
+        "stroke": Note(stroke, f"{range_text}: max - min"),
+        "piston_offset": Note(x0 - lc, "x0 - Lc"),
+        "rod_length": Note(lc, lc_origin),
+        "emla": Note(name, "the actuator's name (edit: the EMLA in your EMLA file)"),
+        "body_scaling": Note("fixed", "chosen: an imported body's shape is unknown, so it does not rescale"),
     }
     if cylinder is not None:
         actuator["cylinder_body"] = cylinder
     if rod is not None:
         actuator["rod_body"] = rod
     x0_origin = f"{range_text}: pin-to-pin length at the retracted end (x0 = {x0:.6g} m)"
-    entry: dict[str, Any] = {"kind": None, "joint": _note(joint, mech.edges[role.driven].element)}
+    entry: dict[str, Any] = {"kind": None, "joint": Note(joint, mech.edges[role.driven].element)}
     if role.kind == "triangle":
-        entry["kind"] = _note(
-            "triangle", f"loop of {slide.element}, its two pins and {mech.edges[role.driven].element}"
-        )
+        entry["kind"] = Note("triangle", f"loop of {slide.element}, its two pins and {mech.edges[role.driven].element}")
         entry["pivots"] = {
             "base": pivot(role.base_group, a, role.base_edge),
             "end": pivot(role.end_group, b, role.end_edge),
@@ -232,19 +220,19 @@ def chain_entry(
     rocker = _one_body(frames.bodies(role.rocker, r, in_plane_angle(h - r)), "rocker")
     coupler = _one_body(frames.bodies(role.coupler, np.array([h[0], h[1], r[2]]), in_plane_angle(c - h)), "coupler")
     linkage: dict[str, Any] = {
-        "rocker_length": _note(
+        "rocker_length": Note(
             rocker_len, f"{mech.edges[role.rocker_edge].element} to {mech.edges[role.link_edge].element}"
         ),
-        "coupler_length": _note(
+        "coupler_length": Note(
             coupler_len, f"{mech.edges[role.link_edge].element} to {mech.edges[role.coupler_edge].element}"
         ),
-        "pin_side": _note(side, "the side of rocker -> coupler pivots the pin H is on at the reference pose"),
+        "pin_side": Note(side, "the side of rocker -> coupler pivots the pin H is on at the reference pose"),
     }
     if rocker is not None:
         linkage["rocker_body"] = rocker
     if coupler is not None:
         linkage["coupler_body"] = coupler
-    entry["kind"] = _note("linkage", f"four-bar driven by {slide.element} on its rocker-coupler pin")
+    entry["kind"] = Note("linkage", f"four-bar driven by {slide.element} on its rocker-coupler pin")
     entry["pivots"] = {
         "base": pivot(role.base_group, a, role.base_edge),
         "rocker": pivot(role.base_group, r, role.rocker_edge),
@@ -256,9 +244,9 @@ def chain_entry(
     span = PIVOT_SPAN_M(x0)
     proposed = "proposed: +-10 % of x0 around the imported value; edit"
     entry["variables"] = {
-        "base_x": _note({"kind": "pivot_x", "pivot": "base", "bounds": [base[0] - span, base[0] + span]}, proposed),
-        "base_y": _note({"kind": "pivot_y", "pivot": "base", "bounds": [base[1] - span, base[1] + span]}, proposed),
-        "retracted_length": _note(
+        "base_x": Note({"kind": "pivot_x", "pivot": "base", "bounds": [base[0] - span, base[0] + span]}, proposed),
+        "base_y": Note({"kind": "pivot_y", "pivot": "base", "bounds": [base[1] - span, base[1] + span]}, proposed),
+        "retracted_length": Note(
             {"kind": "retracted_length", "bounds": [0.9 * x0, 1.1 * x0]}, "proposed: +-10 % of " + x0_origin
         ),
     }
@@ -274,21 +262,21 @@ def _triangle_variables(hinge_distance: float, lc0: float, lc: float, stroke: fl
     """The seed's xi = [L, Lc0, Lc] with bounds around the imported values (proposed; edit them)."""
     out: dict[str, Any] = {}
     if hinge_distance > 1e-6:
-        out["hinge_distance"] = _note(
+        out["hinge_distance"] = Note(
             {"kind": "hinge_distance", "pivot": "base", "bounds": [0.85 * hinge_distance, 1.15 * hinge_distance]},
             f"proposed: +-15 % of the base pin's distance from the hinge ({hinge_distance:.6g} m); edit",
         )
-    out["piston_offset"] = _note(
+    out["piston_offset"] = Note(
         {"kind": "piston_offset", "bounds": [0.7 * lc0, 1.3 * lc0]}, f"proposed: +-30 % of Lc0; {x0_origin}"
     )
-    out["rod_length"] = _note(
+    out["rod_length"] = Note(
         {"kind": "rod_length", "bounds": [max(stroke, 0.7 * lc), 1.3 * lc]},
         "proposed: +-30 % of Lc, not below the stroke",
     )
     return out
 
 
-def tcp_entry(imported: Imported, frames: _Frames, link_frames: dict[int, Frame], tcp: str | None) -> dict[str, Any]:
+def tcp_entry(imported: Imported, frames: Frames, link_frames: dict[int, Frame], tcp: str | None) -> dict[str, Any]:
     """The TCP: the named site or body (default: a site called ``tcp``) in its link's frame."""
     mech, model, data = imported.mech, imported.mech.model, frames.data
     name = tcp or "tcp"
@@ -309,7 +297,7 @@ def tcp_entry(imported: Imported, frames: _Frames, link_frames: dict[int, Frame]
     frame = link_frames[group]
     rotation = _rz(frame[1]).T @ frames.axes.T @ np.asarray(rot).reshape(3, 3)
     return {
-        "link": _note(group_name(imported, group), f"{what}: the link it is on"),
-        "r": _note(_local(frame, frames.point(p)), f"{what} position in the link frame"),
-        "R": _note([[float(x) for x in row] for row in rotation], f"{what} orientation in the link frame"),
+        "link": Note(group_name(imported, group), f"{what}: the link it is on"),
+        "r": Note(_local(frame, frames.point(p)), f"{what} position in the link frame"),
+        "R": Note([[float(x) for x in row] for row in rotation], f"{what} orientation in the link frame"),
     }

@@ -288,3 +288,11 @@ def _closed_chains(mech: Mechanism) -> list[ClosedChain]:
     if problems:
         raise UnsupportedMJCFError(problems)
     return chains
+
+
+def actuator_on(model: mujoco.MjModel, joint: int) -> str | None:
+    """The name of the MJCF actuator that drives ``joint``, if one does."""
+    for a in range(model.nu):
+        if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT and int(model.actuator_trnid[a, 0]) == joint:
+            return name_of(model, mujoco.mjtObj.mjOBJ_ACTUATOR, a, "actuator")
+    return None

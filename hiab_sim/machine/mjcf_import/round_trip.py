@@ -9,7 +9,7 @@ gravity compensation and fluid forces set to zero; actuators play no part in inv
     tau - J_tcp^T F = S^T Q + J^T lambda,
 
 S selecting the actuator slides and the locked joints, against both ID paths of the machine built
-from the written file (:mod:`hiab_sim.machine.dynamics_paths`). The original's state is closed by
+from the written file (:mod:`hiab_sim.machine.dynamics.paths`). The original's state is closed by
 Newton on its own pins with the machine's joints held (continuation from the reference pose in
 steps), so the two models share only the joint values, never their kinematics.
 """
@@ -23,9 +23,9 @@ import numpy as np
 import yaml
 
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.dynamics_paths import MACHINE_ID_PATHS, make_machine_dynamics
-from hiab_sim.machine.mjcf_import import Imported, Note
-from hiab_sim.machine.mjcf_import_pose import close, jac_dot_qvel, plane_axes, residual_and_jacobian
+from hiab_sim.machine.dynamics.paths import MACHINE_ID_PATHS, make_machine_dynamics
+from hiab_sim.machine.mjcf_import.frames import Imported, Note
+from hiab_sim.machine.mjcf_import.pose import close, jac_dot_qvel, plane_axes, residual_and_jacobian
 
 #: Continuation steps from the reference pose to each sample.
 STEPS = 8
@@ -78,7 +78,7 @@ def fit_ranges(imported: Imported) -> Machine:
     A range given by the MJCF may need a little more stroke than the slide's range gives (rounded
     numbers in the file); the working range is then the part the stroke serves.
     """
-    from hiab_sim.machine.assembly import reachable_joint_range
+    from hiab_sim.machine.kinematics.assembly import reachable_joint_range
     from hiab_sim.machine.loader import machine_from_dict
 
     machine = machine_from_dict(plain(imported.tree), check_assembly=False)

@@ -12,7 +12,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.machine.mjcf_import_graph import Mechanism, connect_points
+from hiab_sim.machine.mjcf_import.graph import Mechanism, connect_points
 
 Array = NDArray[np.float64]
 

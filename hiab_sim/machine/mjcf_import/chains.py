@@ -1,21 +1,18 @@
 """Roles of an imported MJCF's bodies (links, cylinder, rod, rocker, coupler) and the machine tree they give.
 
-Conventions and units in :mod:`hiab_sim.machine.mjcf_import`.
+Conventions and units in :mod:`hiab_sim.machine.mjcf_import.importer`.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
 
-from hiab_sim.machine.mjcf_import_graph import ClosedChain, Mechanism, UnsupportedMJCFError, name_of
-
-if TYPE_CHECKING:
-    from hiab_sim.machine.mjcf_import import Imported, _Frames
+from hiab_sim.machine.mjcf_import.frames import Frames
+from hiab_sim.machine.mjcf_import.graph import ClosedChain, Mechanism, UnsupportedMJCFError
 
 #: In-plane distance under which two pins are one pin [m].
 SAME_PIN = 1e-6
@@ -101,12 +98,10 @@ def _linkage(
     H is the four-bar edge at the rod's partner body whose pin coincides with the rod end on that
     body (points fixed on one body keep their distance in any pose, so ``qpos0`` serves).
     """
-    from hiab_sim.machine.mjcf_import import _Frames
-
     data = mujoco.MjData(mech.model)
     data.qpos[:] = mech.model.qpos0
     mujoco.mj_kinematics(mech.model, data)
-    frames = _Frames(mech, data)
+    frames = Frames(mech, data)
     slide = mech.edges[block.slide].element
     rod_end = frames.edge_point(ey, b)
     ends = lambda k: {mech.edges[k].a, mech.edges[k].b}  # noqa: E731
@@ -130,55 +125,6 @@ def _linkage(
     return Role(
         "linkage", block, block.slide, x, y, ex, a, ey, b, driven, rocker_edge, at_h[0], coupler_edge, rocker, coupler
     )
-
-
-def _note(value: Any, origin: str) -> Any:
-    from hiab_sim.machine.mjcf_import import Note
-
-    return Note(value, origin)
-
-
-def write_tree(imported: Imported, frames: _Frames, roles: list[Role], tcp: str | None, filename: str) -> None:
-    """Fill ``imported.tree`` (links, chains, tcp) and its maps, at the reference pose of ``frames``."""
-    from hiab_sim.machine.mjcf_import_parts import chain_entry, link_entries, tcp_entry
-
-    mech = imported.mech
-    model = mech.model
-    links, link_frames = link_entries(imported, frames, roles)
-    chains = {}
-    for role in roles:
-        name, entry = chain_entry(imported, frames, role, link_frames)
-        chains[name] = entry
-    for k, edge in enumerate(mech.edges):
-        if edge.kind == "slide" and not any(k in r.block.edges for r in roles):
-            jname = name_of(model, mujoco.mjtObj.mjOBJ_JOINT, edge.index, "joint")
-            act = _actuator_on(model, edge.index) or jname
-            low, high = model.jnt_range[edge.index]
-            imported.actuators.append((edge.index, 1.0))
-            chains[act] = {
-                "kind": _note("direct", f"{edge.element}: a slide outside every loop, its own actuator"),
-                "joint": _note(jname, edge.element),
-                "actuator": {
-                    "stroke": _note(float(high - low), f"{edge.element} range [{low:g}, {high:g}]: max - min"),
-                    "emla": _note(act, "the actuator's name (edit: the EMLA in your EMLA file)"),
-                },
-            }
-    gravity = _note(mech.gravity, f"option gravity {np.round(model.opt.gravity, 9).tolist()}: its in-plane magnitude")
-    imported.tree = {
-        "name": _note(f"{filename} (imported)", "the MJCF file"),
-        "source": _note(f"MJCF {filename} imported by hiab-sim machine import", "the MJCF file"),
-        "gravity": gravity,
-        "links": links,
-        "chains": chains,
-        "tcp": tcp_entry(imported, frames, link_frames, tcp),
-    }
-
-
-def _actuator_on(model: mujoco.MjModel, joint: int) -> str | None:
-    for a in range(model.nu):
-        if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT and int(model.actuator_trnid[a, 0]) == joint:
-            return name_of(model, mujoco.mjtObj.mjOBJ_ACTUATOR, a, "actuator")
-    return None
 
 
 def in_plane_angle(v: np.ndarray) -> float:
