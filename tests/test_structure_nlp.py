@@ -70,6 +70,7 @@ def test_buckling_row_changes_the_optimum_of_a_study_whose_screws_would_buckle(t
     assert held_task.evaluate(z_held).cost > p_free.problems[0].evaluate(z_free).cost
 
 
+@pytest.mark.e2e
 def test_min_natural_frequency_above_the_free_optimum_moves_it_and_is_active(tmp_path: Path) -> None:
     """A floor 0.2 % above the free optimum's lowest frequency moves it, binds, and shows in the sensitivities."""
     free = _study(tmp_path)
