@@ -107,3 +107,7 @@ def test_default_run_report_is_self_contained_and_states_the_design(run: RunOutp
     assert f"lift L / Lc0 / Lc = {lift.L:.3f} / {lift.Lc0:.3f} / {lift.Lc:.3f} m" in html
     assert f"tilt L / Lc0 / Lc = {tilt.L:.3f} / {tilt.Lc0:.3f} / {tilt.Lc:.3f} m" in html
     assert f"{result.energy.optimal.battery_energy_J:.1f} J" in html
+    assert result.structure is not None
+    most = result.structure.optimal.most_loaded_pin
+    peak = result.structure.optimal.pins[most].peak_N
+    assert f"Most loaded pin of the optimal design: {most}, {peak / 1e3:.1f} kN peak" in html

@@ -56,8 +56,9 @@ def test_optimum_is_feasible_better_and_reported(solved: Path) -> None:
     for design in ("initial", "optimal"):
         assert set(raw[design]["lengths"]) == {"lift", "tilt"}
         assert set(raw[design]["lengths"]["lift"]) == {"L", "Lc0", "Lc"}
-    assert len(list(solved.glob("*.png"))) == 10  # 8 + energy_emla_vs_hydraulic.png + sensitivity.png
-    assert (solved / "sensitivity.png").is_file()
+    # 8 + energy_emla_vs_hydraulic.png + sensitivity.png + structure_natural_frequency.png
+    assert len(list(solved.glob("*.png"))) == 11
+    assert (solved / "sensitivity.png").is_file() and (solved / "structure_natural_frequency.png").is_file()
 
 
 def test_result_json_keeps_every_key_of_schema_1_and_round_trips(solved: Path) -> None:

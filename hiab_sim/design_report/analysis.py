@@ -196,3 +196,51 @@ def duty_mix(result: Result, folder: Path) -> str:
             figure(folder / "cross_evaluation.png", "Cross-evaluation"),
         ]
     return section("Duty mix", *parts)
+
+
+def structure(result: Result, folder: Path) -> str:
+    """Pin loads, screw buckling and natural frequencies of both designs (the result's ``structure`` section)."""
+    s = result.structure
+    if s is None:
+        return ""
+    pins = [
+        (
+            name,
+            f"{s.initial.pins[name].peak_N / 1e3:.1f} kN",
+            f"{pin.peak_N / 1e3:.1f} kN",
+            f"{pin.magnitude_range_N / 1e3:.1f} kN",
+        )
+        for name, pin in s.optimal.pins.items()
+    ]
+    screws = [
+        (
+            name,
+            f"{s.initial.buckling[name].max_utilisation:.3f}",
+            f"{b.max_utilisation:.3f}",
+            f"{b.min_critical_load_N / 1e3:.0f} kN at {b.max_column_length_m:.2f} m",
+        )
+        for name, b in s.optimal.buckling.items()
+    ]
+    freq = [
+        (where, num(getattr(s.initial, key), ".2f", " Hz"), num(getattr(s.optimal, key), ".2f", " Hz"))
+        for where, key in (
+            ("along the motion", "lowest_frequency_trajectory_Hz"),
+            ("over the working range", "lowest_frequency_working_range_Hz"),
+        )
+    ]
+    most = s.optimal.most_loaded_pin
+    return section(
+        "Structure: pins, screws, natural frequency",
+        paragraph(
+            f"Most loaded pin of the optimal design: {most}, {s.optimal.pins[most].peak_N / 1e3:.1f} kN peak. "
+            f"Safety factor of the buckling utilisation n = {s.optimal.buckling_safety_factor:g}. Boundaries: "
+            + s.note
+            + "."
+        ),
+        table(("pin", "peak, initial", "peak, optimal", "magnitude range, optimal"), pins, numeric=(1, 2, 3)),
+        table(
+            ("screw", "utilisation, initial", "utilisation, optimal", "smallest P_cr, optimal"), screws, numeric=(1, 2)
+        ),
+        table(("lowest natural frequency", "initial", "optimal"), freq, numeric=(1, 2)),
+        figure(folder / "structure_natural_frequency.png", "Lowest natural frequency over the working range"),
+    )

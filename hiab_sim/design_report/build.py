@@ -5,7 +5,15 @@ from __future__ import annotations
 from pathlib import Path
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.design_report.analysis import closed_loop, constraints, duty_mix, hydraulics, sensitivities, thermal
+from hiab_sim.design_report.analysis import (
+    closed_loop,
+    constraints,
+    duty_mix,
+    hydraulics,
+    sensitivities,
+    structure,
+    thermal,
+)
 from hiab_sim.design_report.answer import design, energies, question
 from hiab_sim.design_report.page import document
 from hiab_sim.design_report.provenance import provenance
@@ -26,6 +34,7 @@ def report_html(run_dir: str | Path) -> str:
         constraints(result),
         thermal(result),
         sensitivities(result, folder),
+        structure(result, folder),
         hydraulics(result, folder),
         closed_loop(folder),
         duty_mix(result, folder),

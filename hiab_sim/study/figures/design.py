@@ -58,8 +58,19 @@ def _lengths_label(name: str, lengths: LinkLengths) -> str:
     )
 
 
-def structure_overlay(ax: Axes, crane: Crane, designs: dict[str, LinkLengths], pose: Array, pose_label: str) -> None:
-    """Both designs on one axes at ``pose``, each base pivot's shift as an arrow labelled in mm."""
+def structure_overlay(
+    ax: Axes,
+    crane: Crane,
+    designs: dict[str, LinkLengths],
+    pose: Array,
+    pose_label: str,
+    most_loaded: tuple[str, float] | None = None,
+) -> None:
+    """Both designs on one axes at ``pose``, each base pivot's shift as an arrow labelled in mm.
+
+    ``most_loaded``: (pin name ``<chain>.<pin>``, its peak force [N] over the motion) of the last design,
+    ringed and labelled at its place in the pose.
+    """
     pivots: dict[str, dict[str, Array]] = {}
     for name, lengths in designs.items():
         draw_crane(ax, crane, lengths, pose, colour(name), alpha=0.9)
@@ -85,12 +96,35 @@ def structure_overlay(ax: Axes, crane: Crane, designs: dict[str, LinkLengths], p
                 fontsize=8,
                 arrowprops={"arrowstyle": "-", "color": "0.5", "linewidth": 0.6},
             )
+    if most_loaded is not None:
+        _mark_pin(ax, crane, designs[names[-1]], pose, *most_loaded)
     ax.set_aspect("equal")
     ax.grid(alpha=0.3)
     ax.set_xlabel("horizontal distance from the column [m]")
     ax.set_ylabel("height above the column base [m]")
     ax.set_title(f"Initial and optimal structure at {pose_label}")
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), fontsize=8, frameon=False)
+
+
+def _mark_pin(ax: Axes, crane: Crane, lengths: LinkLengths, pose: Array, pin: str, peak_N: float) -> None:
+    """Ring the pin ``<chain>.<kind>`` at ``pose`` and label it with its peak force in kN."""
+    from hiab_sim.structure.pin_loads import chain_links
+
+    chain, kind = pin.split(".", 1)
+    boom, cylinder, rod = chain_links(chain)
+    link = {"base_pivot": cylinder, "boom_hinge": boom, "rod_end": rod}[kind]
+    f = forward_kinematics(crane, lengths, pose[0:1], pose[1:2], pose[2:3])
+    x, y = f.position[link][0, :2]
+    ax.plot([x], [y], "o", markersize=14, markerfacecolor="none", markeredgecolor="tab:red", markeredgewidth=2)
+    ax.annotate(
+        f"most loaded pin: {chain} {kind.replace('_', ' ')}\n{peak_N / 1e3:.1f} kN peak over the motion",
+        xy=(x, y),
+        xytext=(40, 20),
+        textcoords="offset points",
+        fontsize=8,
+        color="tab:red",
+        arrowprops={"arrowstyle": "-", "color": "tab:red", "linewidth": 0.8},
+    )
 
 
 def decision_panels(axes: Any, history: tuple[HistoryRow, ...], chain: int, low: Array, up: Array) -> None:

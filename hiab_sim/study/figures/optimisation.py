@@ -78,10 +78,20 @@ def decision_figure(
     save_png(fig, path)
 
 
-def structure_figure(crane: Crane, designs: dict[str, LinkLengths], pose: np.ndarray, path: Path, label: str) -> None:
-    """Both structures overlaid in one pose, pivot shifts dimensioned (seed Fig. Initial_Structure_Modified)."""
+def structure_figure(
+    crane: Crane,
+    designs: dict[str, LinkLengths],
+    pose: np.ndarray,
+    path: Path,
+    label: str,
+    most_loaded: tuple[str, float] | None = None,
+) -> None:
+    """Both structures overlaid in one pose, pivot shifts dimensioned (seed Fig. Initial_Structure_Modified).
+
+    ``most_loaded``: the optimal design's most loaded pin and its peak force [N], marked.
+    """
     fig = new_figure((8.0, 6.4))
-    structure_overlay(fig.add_subplot(), crane, designs, pose, label)
+    structure_overlay(fig.add_subplot(), crane, designs, pose, label, most_loaded)
     save_png(fig, path)
 
 
@@ -223,7 +233,12 @@ def write_figures(
     joints = arrays["optimal_position"]
     mid = len(joints) // 2
     label = f"t = {arrays['time'][mid]:.2f} s of the optimal motion"
-    structure_figure(crane, designs, joints[mid], paths["structure"], label)
+    loads = result.structure
+    most = None
+    if loads is not None:
+        pin = loads.optimal.most_loaded_pin
+        most = (pin, loads.optimal.pins[pin].peak_N)
+    structure_figure(crane, designs, joints[mid], paths["structure"], label, most)
     spiral_figure(
         crane,
         designs["optimal"],
@@ -239,5 +254,11 @@ def write_figures(
     if result.sensitivity is not None:
         paths["sensitivity"] = out / "sensitivity.png"
         sensitivity_figure(result.sensitivity, paths["sensitivity"])
+    if result.structure is not None:
+        from hiab_sim.structure.report import natural_frequency_figure
+
+        paths["frequency"] = natural_frequency_figure(
+            crane, emlas, result, arrays, out / "structure_natural_frequency.png"
+        )
     hydraulic = hydraulic_figure(out / "energy_emla_vs_hydraulic.png", result)
     return list(paths.values()) + hydraulic
