@@ -35,6 +35,21 @@ def small_study(**overrides: Any) -> dict[str, Any]:
     return study
 
 
+#: A smaller spiral on a coarse grid: each point optimises in a few seconds.
+TINY = {
+    "spline": {"control_points": 16, "degree": 5},
+    "grid": {"duration": 6.25, "intervals": 8, "fine_factor": 4},
+    "reference": {
+        "centre_joints": [0.6, -1.3],
+        "start_radius": 0.05,
+        "end_radius": 0.15,
+        "turns": 1.0,
+        "telescope_start": 0.4,
+        "telescope_amplitude": 0.1,
+    },
+}
+
+
 def write_study(folder: Path, study: dict[str, Any], name: str = "study.yaml") -> Path:
     """Write a study mapping as YAML; return its path."""
     path = folder / name
