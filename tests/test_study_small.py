@@ -37,16 +37,9 @@ def small_study(**overrides: Any) -> dict[str, Any]:
 
 #: A smaller spiral on a coarse grid: each point optimises in a few seconds.
 TINY = {
-    "spline": {"control_points": 16, "degree": 5},
-    "grid": {"duration": 6.25, "intervals": 8, "fine_factor": 4},
-    "reference": {
-        "centre_joints": [0.6, -1.3],
-        "start_radius": 0.05,
-        "end_radius": 0.15,
-        "turns": 1.0,
-        "telescope_start": 0.4,
-        "telescope_amplitude": 0.1,
-    },
+    "spline": small_study()["spline"],
+    "grid": {**small_study()["grid"], "intervals": 8, "fine_factor": 4},
+    "reference": {**small_study()["reference"], "end_radius": 0.15, "telescope_amplitude": 0.1},
 }
 
 
