@@ -29,6 +29,7 @@ import numpy as np
 from hiab_sim.checks import check_range
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.hydraulics.cylinders import HydraulicCylinders
+from hiab_sim.machine.parts import check_rotation, homogeneous
 
 Vector3 = tuple[float, float, float]
 Matrix3 = tuple[Vector3, Vector3, Vector3]
@@ -60,18 +61,12 @@ class Pose:
     rotation: Matrix3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
     def __post_init__(self) -> None:
-        matrix = np.asarray(self.rotation, dtype=float)
-        error = float(np.max(np.abs(matrix @ matrix.T - np.eye(3))))
-        if not error <= 1e-6 or np.linalg.det(matrix) < 0.0:
-            raise InvalidInputError("R", f"|R R^T - I| = {error:.3g}", "must be a rotation matrix")
+        check_rotation(self.rotation)
 
     @property
     def matrix(self) -> np.ndarray:
         """4x4 homogeneous transform parent_T_frame."""
-        out = np.eye(4)
-        out[:3, :3] = self.rotation
-        out[:3, 3] = self.position
-        return out
+        return homogeneous(self.position, self.rotation)
 
 
 @dataclass(frozen=True)
