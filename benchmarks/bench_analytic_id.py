@@ -8,23 +8,14 @@ outside the timing, as the optimiser does per link-length set); the best time is
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
+from timing_helper import best_wall
 
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics, spatial_inverse_dynamics
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.validation import random_states
-
-
-def best_time(function, repeats: int) -> float:  # type: ignore[no-untyped-def]
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def main() -> None:
@@ -40,10 +31,10 @@ def main() -> None:
     analytic_out = analytic_inverse_dynamics(crane, lengths, joints, tcp_force=payload)
     mujoco_out = mujoco(joints, tcp_force=payload)
     error = np.max(np.abs(analytic_out.force - mujoco_out.force) / np.max(np.abs(analytic_out.force), axis=0))
-    t_analytic = best_time(lambda: analytic_inverse_dynamics(crane, lengths, joints, tcp_force=payload), args.repeats)
-    t_spatial = best_time(lambda: spatial_inverse_dynamics(crane, lengths, joints, tcp_force=payload), args.repeats)
-    t_mujoco = best_time(lambda: mujoco(joints, tcp_force=payload), args.repeats)
-    t_build = best_time(lambda: MujocoInverseDynamics(crane, lengths), args.repeats)
+    t_analytic = best_wall(args.repeats, lambda: analytic_inverse_dynamics(crane, lengths, joints, tcp_force=payload))
+    t_spatial = best_wall(args.repeats, lambda: spatial_inverse_dynamics(crane, lengths, joints, tcp_force=payload))
+    t_mujoco = best_wall(args.repeats, lambda: mujoco(joints, tcp_force=payload))
+    t_build = best_wall(args.repeats, lambda: MujocoInverseDynamics(crane, lengths))
     n = args.samples
     print(f"samples: {n} (random states over the working ranges, 250 kg payload), best of {args.repeats}")
     print(f"analytic ID: {t_analytic * 1e3:8.2f} ms total, {t_analytic / n * 1e6:7.2f} us/sample")

@@ -8,24 +8,15 @@ qfrc_inverse) on the same model in the same run, their ratio, and the model rebu
 from __future__ import annotations
 
 import argparse
-import time
 
 import mujoco
 import numpy as np
+from timing_helper import best_wall
 
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.model import build_model
-
-
-def best_of(repeat: int, func) -> float:
-    best = float("inf")
-    for _ in range(repeat):
-        start = time.perf_counter()
-        func()
-        best = min(best, time.perf_counter() - start)
-    return best
 
 
 def main() -> None:
@@ -55,12 +46,12 @@ def main() -> None:
             out[i] = data.qfrc_inverse
 
     n = args.samples
-    t_bare = best_of(args.repeat, bare) / n * 1e6
-    t_full = best_of(args.repeat, lambda: inverse(joints)) / n * 1e6
-    t_load = best_of(args.repeat, lambda: inverse(joints, tcp_force=[0.0, -2000.0, 0.0])) / n * 1e6
-    t_state = best_of(args.repeat, lambda: inverse.state(joints)) / n * 1e6
-    rebuild = best_of(args.repeat * 5, lambda: build_model(crane)) * 1e3
-    construct = best_of(args.repeat * 5, lambda: MujocoInverseDynamics(crane)) * 1e3
+    t_bare = best_wall(args.repeat, bare) / n * 1e6
+    t_full = best_wall(args.repeat, lambda: inverse(joints)) / n * 1e6
+    t_load = best_wall(args.repeat, lambda: inverse(joints, tcp_force=[0.0, -2000.0, 0.0])) / n * 1e6
+    t_state = best_wall(args.repeat, lambda: inverse.state(joints)) / n * 1e6
+    rebuild = best_wall(args.repeat * 5, lambda: build_model(crane)) * 1e3
+    construct = best_wall(args.repeat * 5, lambda: MujocoInverseDynamics(crane)) * 1e3
 
     print(f"samples per call                     {n}")
     print(f"bare mj_inverse loop                 {t_bare:8.2f} us/sample")

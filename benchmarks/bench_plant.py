@@ -13,26 +13,16 @@ drive train's Python side) is the remainder; the environment's build is timed on
 from __future__ import annotations
 
 import argparse
-import time
 from collections.abc import Callable
 from dataclasses import replace
 
 import mujoco
 import numpy as np
+from timing_helper import best_of
 
 from hiab_sim.env import default_result_dir, make_environment, read_plan
 from hiab_sim.env.plant import load_plant
 from hiab_sim.env.rollout import run_closed_loop
-
-
-def _best(repeat: int, fn: Callable[[], object]) -> tuple[float, float]:
-    walls, cpus = [], []
-    for _ in range(repeat):
-        w, c = time.perf_counter(), time.process_time()
-        fn()
-        walls.append(time.perf_counter() - w)
-        cpus.append(time.process_time() - c)
-    return min(walls), min(cpus)
 
 
 def main() -> None:
@@ -49,8 +39,8 @@ def main() -> None:
         run, physics = run_closed_loop(plan, plant=plant)
         holder["run"], holder["physics"] = run, physics
 
-    build = _best(args.repeat, lambda: make_environment(plan, plant=plant).physics.free())
-    total = _best(args.repeat, cycle)
+    build = best_of(args.repeat, lambda: make_environment(plan, plant=plant).physics.free())
+    total = best_of(args.repeat, cycle)
     total = (total[0] - build[0], total[1] - build[1])
     run, physics = holder["run"], holder["physics"]
     steps = physics.steps  # type: ignore[attr-defined]
@@ -76,7 +66,7 @@ def main() -> None:
         parts.append(("winding temperature, R_s", heat))
     sensor = physics.sensor  # type: ignore[attr-defined]
     parts.append(("encoder and delay", lambda: [sensor.push(*physics.motor_state()) for _ in range(steps)]))  # type: ignore[attr-defined]
-    timed = [(label, _best(args.repeat, fn)) for label, fn in parts]
+    timed = [(label, best_of(args.repeat, fn)) for label, fn in parts]
     physics.free()  # type: ignore[attr-defined]
     simulated = float(run.time[-1])  # type: ignore[attr-defined]
     print(f"{plant.name} plant, effects {', '.join(plant.enabled)}: {simulated:.2f} s simulated, {steps} physics steps")

@@ -12,23 +12,13 @@ and process CPU time (the machine may be shared).
 from __future__ import annotations
 
 import argparse
-import time
 
 import mujoco
 import numpy as np
+from timing_helper import best_of
 
 from hiab_sim.env import default_result_dir, make_environment, read_plan
 from hiab_sim.env.rollout import run_closed_loop
-
-
-def _best(repeat: int, fn) -> tuple[float, float]:  # type: ignore[no-untyped-def]
-    walls, cpus = [], []
-    for _ in range(repeat):
-        w, c = time.perf_counter(), time.process_time()
-        fn()
-        walls.append(time.perf_counter() - w)
-        cpus.append(time.process_time() - c)
-    return min(walls), min(cpus)
 
 
 def main() -> None:
@@ -47,8 +37,8 @@ def main() -> None:
         holder["run"], holder["physics"] = run, physics
 
     # The environment is built inside the timed call; its construction is timed on its own too.
-    build = _best(args.repeat, lambda: make_environment(plan).physics.free())
-    total = _best(args.repeat, cycle)
+    build = best_of(args.repeat, lambda: make_environment(plan).physics.free())
+    total = best_of(args.repeat, cycle)
     cycle_time = (total[0] - build[0], total[1] - build[1])
     run, physics = holder["run"], holder["physics"]
     steps = physics.steps  # type: ignore[attr-defined]
@@ -69,8 +59,8 @@ def main() -> None:
             drives.step(refs, speeds, 1e-3)
 
     physics.reset()  # type: ignore[attr-defined]
-    in_mujoco = _best(args.repeat, mujoco_only)
-    in_drives = _best(args.repeat, drives_only)
+    in_mujoco = best_of(args.repeat, mujoco_only)
+    in_drives = best_of(args.repeat, drives_only)
     physics.free()  # type: ignore[attr-defined]
     simulated = float(run.time[-1])  # type: ignore[attr-defined]
     rest = (cycle_time[0] - in_mujoco[0] - in_drives[0], cycle_time[1] - in_mujoco[1] - in_drives[1])

@@ -11,6 +11,7 @@ Goal: 2 local workers >= 1.7x faster than 1.
 from __future__ import annotations
 
 import argparse
+import sys
 import tempfile
 import time
 from concurrent.futures import Executor
@@ -23,26 +24,12 @@ from hiab_sim.sweep.executors import make_executor
 from hiab_sim.sweep.runner import run_sweep
 from hiab_sim.sweep.spec import load_sweep
 
-STUDY = {
-    "name": "bench",
-    "crane": "xs031",
-    "spline": {"control_points": 16, "degree": 5},
-    "grid": {"duration": 6.25, "intervals": 8, "fine_factor": 4},
-    "reference": {
-        "centre_joints": [0.6, -1.3],
-        "start_radius": 0.05,
-        "end_radius": 0.15,
-        "turns": 1.0,
-        "telescope_start": 0.4,
-        "telescope_amplitude": 0.1,
-    },
-    "tracking": {"position": 2e-3, "velocity": 1e-2, "acceleration": 0.1, "collocation_fraction": 0.5},
-    "bounds": {
-        "lift": {"low": [0.8, 0.04, 0.6], "up": [1.25, 0.3, 1.0]},
-        "tilt": {"low": [0.9, 0.04, 0.6], "up": [1.35, 0.3, 1.0]},
-    },
-    "solver": {"maxiter": 100, "ftol": 1e-9, "id_path": "analytic"},
-}
+# The benchmark reuses the tests' shared small study (tests/ is a folder of modules, not a package).
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from test_study_small import TINY, small_study
+
+#: The tests' small study on their tiny grid (a few seconds per optimisation).
+STUDY = small_study(name="bench", **TINY)
 
 
 def trivial(k: int) -> int:

@@ -6,6 +6,7 @@ import dataclasses
 import itertools
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -17,7 +18,7 @@ from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.mechanism import check_lengths, joint_to_stroke
 from hiab_sim.crane.tolerance import buildable_crane
 from hiab_sim.resources import shipped
-from hiab_sim.study.analysis.buildable import RobustXi, rounded_design
+from hiab_sim.study.analysis.buildable import RobustXi, replace_lengths, rounded_design
 from hiab_sim.study.analysis.sensitivity import sensitivity
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import TaskProblem
@@ -77,23 +78,24 @@ def test_robust_rows_match_the_worst_corner_to_second_order(solved: tuple[StudyP
     np.testing.assert_allclose(robust, worst, atol=1e-5)  # t^2 / (2 s 0.1 m) ~ 5e-6 scaled
 
 
+def _xi_central_differences(block: Any, ev: Any, h: float = 1e-6) -> np.ndarray:
+    """Central differences (step ``h`` [m]) of a block's row values over the six link lengths, one column each."""
+    xi = ev.lengths.as_array()
+    return np.column_stack(
+        [
+            (block.values(replace_lengths(ev, xi + h * e)) - block.values(replace_lengths(ev, xi - h * e))) / (2 * h)
+            for e in np.eye(6)
+        ]
+    )
+
+
 def test_robust_jacobian_matches_finite_differences(solved: tuple[StudyProblem, np.ndarray]) -> None:
     """The robust rows' Jacobian (with the curvature term) agrees with central differences of their values."""
     problem, z = solved
     block = next(b.block for b in problem.blocks if isinstance(b.block, RobustXi))
     ev = problem.evaluate(z).tasks[0]
     jac = block.jacobian(ev, None).dxi  # type: ignore[arg-type]
-    h = 1e-6
-    from hiab_sim.study.analysis.buildable import replace_lengths
-
-    xi = ev.lengths.as_array()
-    fd = np.column_stack(
-        [
-            (block.values(replace_lengths(ev, xi + h * e)) - block.values(replace_lengths(ev, xi - h * e))) / (2 * h)
-            for e in np.eye(6)
-        ]
-    )
-    np.testing.assert_allclose(jac, fd, atol=1e-6)
+    np.testing.assert_allclose(jac, _xi_central_differences(block, ev), atol=1e-6)
 
 
 def test_multipliers_predict_the_cost_change_of_a_bound_move(solved: tuple[StudyProblem, np.ndarray]) -> None:
@@ -257,17 +259,8 @@ def test_mounting_rows_hold_the_pivots_in_their_polygons_for_every_built_design(
     assert check.ok, check.summary()
     block = next(b.block for b in problem.blocks if b.block.name == "mounting")
     ev = problem.evaluate(z).tasks[0]
-    from hiab_sim.study.analysis.buildable import replace_lengths
-
     jac = block.jacobian(ev, None).dxi  # type: ignore[arg-type, union-attr]
-    xi, h = ev.lengths.as_array(), 1e-6
-    fd = np.column_stack(
-        [
-            (block.values(replace_lengths(ev, xi + h * e)) - block.values(replace_lengths(ev, xi - h * e))) / (2 * h)
-            for e in np.eye(6)
-        ]
-    )
-    np.testing.assert_allclose(jac, fd, atol=1e-5)
+    np.testing.assert_allclose(jac, _xi_central_differences(block, ev), atol=1e-5)
 
 
 def test_tracking_band_multipliers_predict_a_wider_band(solved: tuple[StudyProblem, np.ndarray]) -> None:

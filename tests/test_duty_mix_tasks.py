@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
+from script_helper import load_script
 
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
@@ -26,10 +26,7 @@ KIN = tr.TcpKinematics(CRANE)
 
 def test_shipped_loading_cycle_is_what_its_script_writes() -> None:
     """optimize/xs031_loading_cycle.csv is exactly the output of optimize/make_loading_cycle.py."""
-    spec = importlib.util.spec_from_file_location("make_loading_cycle", OPTIMIZE / "make_loading_cycle.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_script("make_loading_cycle", OPTIMIZE / "make_loading_cycle.py")
     assert module.render(KIN) == (OPTIMIZE / "xs031_loading_cycle.csv").read_text(encoding="utf-8")
 
 

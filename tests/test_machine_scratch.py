@@ -18,6 +18,20 @@ def _part(mass: float, com: list[float], izz: float) -> dict[str, Any]:
     return {"part": {"mass": mass, "com": com, "inertia_zz": izz}}
 
 
+def _moving(
+    parent: str, joint: str, kind: str, r: list[float], joint_range: list[float], bodies: dict[str, Any]
+) -> dict[str, Any]:
+    """A moving link: its parent, joint (name, kind, frame offset [m], range) and bodies."""
+    return {
+        "parent": parent,
+        "joint": joint,
+        "kind": kind,
+        "joint_frame": {"r": r},
+        "joint_range": joint_range,
+        "bodies": bodies,
+    }
+
+
 def _actuator(stroke: float, piston_offset: float, rod_length: float, emla: str) -> dict[str, Any]:
     return {"stroke": stroke, "piston_offset": piston_offset, "rod_length": rod_length, "emla": emla}
 
@@ -30,38 +44,10 @@ def three_boom_crane_with_jib() -> dict[str, Any]:
         "gravity": 9.81,
         "links": {
             "column": {"bodies": _part(200.0, [0.0, 1.0], 40.0)},
-            "inner": {
-                "parent": "column",
-                "joint": "q_inner",
-                "kind": "revolute",
-                "joint_frame": {"r": [0.0, 2.0]},
-                "joint_range": [-0.2, 1.0],
-                "bodies": _part(120.0, [1.5, 0.0], 90.0),
-            },
-            "outer": {
-                "parent": "inner",
-                "joint": "q_outer",
-                "kind": "revolute",
-                "joint_frame": {"r": [3.0, 0.0]},
-                "joint_range": [-2.2, -0.4],
-                "bodies": _part(80.0, [1.2, 0.0], 40.0),
-            },
-            "extension": {
-                "parent": "outer",
-                "joint": "q_ext",
-                "kind": "prismatic",
-                "joint_frame": {"r": [0.5, 0.0]},
-                "joint_range": [0.0, 1.5],
-                "bodies": _part(40.0, [1.2, 0.0], 15.0),
-            },
-            "jib": {
-                "parent": "extension",
-                "joint": "q_jib",
-                "kind": "revolute",
-                "joint_frame": {"r": [2.5, 0.0]},
-                "joint_range": [-1.5, 0.6],
-                "bodies": _part(30.0, [0.8, 0.0], 5.0),
-            },
+            "inner": _moving("column", "q_inner", "revolute", [0.0, 2.0], [-0.2, 1.0], _part(120.0, [1.5, 0.0], 90.0)),
+            "outer": _moving("inner", "q_outer", "revolute", [3.0, 0.0], [-2.2, -0.4], _part(80.0, [1.2, 0.0], 40.0)),
+            "extension": _moving("outer", "q_ext", "prismatic", [0.5, 0.0], [0.0, 1.5], _part(40.0, [1.2, 0.0], 15.0)),
+            "jib": _moving("extension", "q_jib", "revolute", [2.5, 0.0], [-1.5, 0.6], _part(30.0, [0.8, 0.0], 5.0)),
         },
         "chains": {
             "c_inner": {

@@ -6,12 +6,12 @@ The optima are tests/data/shipped_optima.json: main's before the one study path,
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 from types import ModuleType
 
 import pytest
+from script_helper import load_script
 
 from hiab_sim.study.run import run_study
 
@@ -20,11 +20,7 @@ STUDIES = sorted(json.loads((ROOT / "tests" / "data" / "shipped_optima.json").re
 
 
 def _checker() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("shipped_optima", ROOT / "scripts" / "shipped_optima.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("shipped_optima", ROOT / "scripts" / "shipped_optima.py")
 
 
 def test_every_shipped_study_has_a_recorded_optimum() -> None:

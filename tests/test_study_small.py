@@ -35,6 +35,14 @@ def small_study(**overrides: Any) -> dict[str, Any]:
     return study
 
 
+#: A smaller spiral on a coarse grid: each point optimises in a few seconds.
+TINY = {
+    "spline": small_study()["spline"],
+    "grid": {**small_study()["grid"], "intervals": 8, "fine_factor": 4},
+    "reference": {**small_study()["reference"], "end_radius": 0.15, "telescope_amplitude": 0.1},
+}
+
+
 def write_study(folder: Path, study: dict[str, Any], name: str = "study.yaml") -> Path:
     """Write a study mapping as YAML; return its path."""
     path = folder / name

@@ -8,7 +8,7 @@ from typing import Any
 import pandas as pd
 import pytest
 import yaml
-from test_study_small import small_study, write_study
+from test_study_small import TINY, small_study, write_study
 
 from hiab_sim.cli import main
 from hiab_sim.crane.loader import load_crane
@@ -22,19 +22,6 @@ from hiab_sim.sweep.table import read_table
 #: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
 pytestmark = pytest.mark.e2e
 
-#: A smaller spiral on a coarse grid: each point optimises in a few seconds.
-TINY = {
-    "spline": {"control_points": 16, "degree": 5},
-    "grid": {"duration": 6.25, "intervals": 8, "fine_factor": 4},
-    "reference": {
-        "centre_joints": [0.6, -1.3],
-        "start_radius": 0.05,
-        "end_radius": 0.15,
-        "turns": 1.0,
-        "telescope_start": 0.4,
-        "telescope_amplitude": 0.1,
-    },
-}
 GRID = {"payload": [0.0, 150.0], "emla.lift.gear_ratio": [4.0, 5.0]}
 
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 from typing import Any
@@ -10,6 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from script_helper import load_script
 
 from hiab_sim.cli import main
 from hiab_sim.crane.description import Crane
@@ -100,10 +100,7 @@ def test_validate_rejects_a_non_positive_sample_count() -> None:
 
 def test_update_readme_replaces_only_the_marked_block(tmp_path: Path) -> None:
     """validate/update_readme.py swaps the table between the markers and leaves the rest alone."""
-    spec = importlib.util.spec_from_file_location("update_readme", UPDATE_README)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_script("update_readme", UPDATE_README)
     readme = tmp_path / "README.md"
     readme.write_text(f"intro\n{module.START}\nold table\n{module.END}\noutro\n")
     table = tmp_path / "table.md"

@@ -22,13 +22,13 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
-from typing import Any
 
 import numpy as np
 
 from hiab_sim.checks import check_range
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.hydraulics.cylinders import HydraulicCylinders
+from hiab_sim.machine.parts import check_interval, check_rotation, homogeneous, mat3, vec3
 
 Vector3 = tuple[float, float, float]
 Matrix3 = tuple[Vector3, Vector3, Vector3]
@@ -60,18 +60,12 @@ class Pose:
     rotation: Matrix3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
     def __post_init__(self) -> None:
-        matrix = np.asarray(self.rotation, dtype=float)
-        error = float(np.max(np.abs(matrix @ matrix.T - np.eye(3))))
-        if not error <= 1e-6 or np.linalg.det(matrix) < 0.0:
-            raise InvalidInputError("R", f"|R R^T - I| = {error:.3g}", "must be a rotation matrix")
+        check_rotation(self.rotation)
 
     @property
     def matrix(self) -> np.ndarray:
         """4x4 homogeneous transform parent_T_frame."""
-        out = np.eye(4)
-        out[:3, :3] = self.rotation
-        out[:3, 3] = self.position
-        return out
+        return homogeneous(self.position, self.rotation)
 
 
 @dataclass(frozen=True)
@@ -147,7 +141,7 @@ class ClosedChain:
             check_range(f"{name}.{key}", getattr(self, key), 0.0, unit="m", low_open=True)
         for key in ("L", "Lc0", "Lc"):
             check_range(f"{name}.{key}", getattr(self.default_lengths, key), 0.0, unit="m", low_open=True)
-        _check_interval(f"{name}.joint_range", self.joint_range, "rad")
+        check_interval(f"{name}.joint_range", self.joint_range, "rad")
 
     @property
     def base_axis(self) -> np.ndarray:
@@ -179,7 +173,7 @@ class Telescope:
         check_range("telescope.rod_offset", self.rod_offset, unit="m")
         check_range("telescope.rod_length", self.rod_length, 0.0, unit="m", low_open=True)
         check_range("telescope.stroke", self.stroke, 0.0, unit="m", low_open=True)
-        low, high = _check_interval("telescope.joint_range", self.joint_range, "m")
+        low, high = check_interval("telescope.joint_range", self.joint_range, "m")
         if low < 0.0 or high > self.stroke:
             raise InvalidInputError(
                 "telescope.joint_range", f"{[low, high]}", f"must lie in [0, stroke] = [0, {self.stroke:.6g}]", "m"
@@ -273,16 +267,6 @@ def scale_slender_body(body: RigidBody, factor: float) -> RigidBody:
     )
 
 
-def _check_interval(where: str, interval: tuple[float, float], unit: str) -> tuple[float, float]:
-    """A finite [min, max] with min < max."""
-    low, high = interval
-    check_range(f"{where}[0]", low, unit=unit)
-    check_range(f"{where}[1]", high, unit=unit)
-    if not low < high:
-        raise InvalidInputError(where, f"[{low:.6g}, {high:.6g}]", "must satisfy min < max", unit)
-    return (low, high)
-
-
 def check_positive_lengths(lengths: LinkLengths) -> None:
     """Raise :class:`InvalidInputError` unless every L, Lc0, Lc is finite and > 0 (const_g)."""
     for name, xi in zip(CHAIN_NAMES, lengths, strict=True):
@@ -290,15 +274,3 @@ def check_positive_lengths(lengths: LinkLengths) -> None:
             value = getattr(xi, key)
             if not (isinstance(value, int | float) and math.isfinite(value) and value > 0.0):
                 raise InvalidInputError(f"{name}.{key}", value, "must be a finite length > 0", "m")
-
-
-def vec3(values: Any) -> Vector3:
-    """A 3-vector of floats from any sequence of 3 numbers."""
-    a = [float(v) for v in values]
-    return (a[0], a[1], a[2])
-
-
-def mat3(values: Any) -> Matrix3:
-    """A 3x3 nested tuple of floats from any 3x3 array."""
-    m = np.asarray(values, dtype=float)
-    return (vec3(m[0]), vec3(m[1]), vec3(m[2]))

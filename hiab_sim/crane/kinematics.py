@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths, Pose
+from hiab_sim.machine.kinematics.forward import rotation_z  # the one rotation about z, shared with the generic model
 
 Array = NDArray[np.float64]
 
@@ -29,14 +30,6 @@ class Frames:
     def point(self, link: str, local: ArrayLike) -> Array:
         """World position (T, 3) of a point given in a link frame [m]."""
         return self.position[link] + self.rotation[link] @ np.asarray(local, dtype=float)
-
-
-def rotation_z(angle: Array) -> Array:
-    """Rotation matrices about z by ``angle`` [rad], shape (*angle.shape, 3, 3)."""
-    c, s = np.cos(angle), np.sin(angle)
-    out = np.zeros((*np.shape(angle), 3, 3))
-    out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1], out[..., 2, 2] = c, -s, s, c, 1.0
-    return out
 
 
 def _compose(frames: Frames, parent: str, child: str, rotation: Array, position: Array) -> None:

@@ -8,6 +8,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -90,30 +91,49 @@ def write_figures(folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedL
             ax.legend(fontsize=7)
     paths.append(save_png(fig, folder / "closed_loop_drives.png", DPI))
 
-    fig = new_figure((8.0, 3.6))
-    ax = fig.add_subplot()
-    for run in every:
-        ax.plot(run.time, run.electrical_power.sum(axis=1) / 1e3, label=f"{_label(run)}: closed loop", **_style(run))
-    for run in runs:
-        colour = _colour(run)
-        predicted = run.predicted_power.sum(axis=1) / 1e3
-        ax.plot(run.plan_time, predicted, color=colour, linestyle="--", label=f"{run.design}: predicted")
-    ax.set(xlabel="time [s]", ylabel="DC bus power [kW]", title="Electrical power, closed loop vs predicted")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    paths.append(save_png(fig, folder / "closed_loop_power.png", DPI))
-
-    fig = new_figure((8.0, 3.6))
-    ax = fig.add_subplot()
-    for run in every:
-        energy = run.cumulative_energy.sum(axis=1) / 1e3
-        ax.plot(run.time, energy, label=f"{_label(run)}: closed loop", **_style(run))
-    for run in runs:
-        predicted = _cumulative(run.predicted_power.sum(axis=1), run.plan_time)
-        colour = _colour(run)
-        ax.plot(run.plan_time, predicted / 1e3, color=colour, linestyle="--", label=f"{run.design}: predicted")
-    ax.set(xlabel="time [s]", ylabel="net electrical energy [kJ]", title="Cumulative net electrical energy")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    paths.append(save_png(fig, folder / "closed_loop_energy.png", DPI))
+    paths.append(
+        _closed_vs_predicted(
+            folder / "closed_loop_power.png",
+            every,
+            runs,
+            lambda run: run.electrical_power.sum(axis=1) / 1e3,
+            lambda run: run.predicted_power.sum(axis=1) / 1e3,
+            ylabel="DC bus power [kW]",
+            title="Electrical power, closed loop vs predicted",
+        )
+    )
+    paths.append(
+        _closed_vs_predicted(
+            folder / "closed_loop_energy.png",
+            every,
+            runs,
+            lambda run: run.cumulative_energy.sum(axis=1) / 1e3,
+            lambda run: _cumulative(run.predicted_power.sum(axis=1), run.plan_time) / 1e3,
+            ylabel="net electrical energy [kJ]",
+            title="Cumulative net electrical energy",
+        )
+    )
     return paths
+
+
+def _closed_vs_predicted(
+    path: Path,
+    every: list[ClosedLoopRun],
+    runs: list[ClosedLoopRun],
+    closed: Callable[[ClosedLoopRun], np.ndarray],
+    predicted: Callable[[ClosedLoopRun], np.ndarray],
+    *,
+    ylabel: str,
+    title: str,
+) -> Path:
+    """One figure: ``closed`` of every run against time, dashed ``predicted`` of each design on its plan's time."""
+    fig = new_figure((8.0, 3.6))
+    ax = fig.add_subplot()
+    for run in every:
+        ax.plot(run.time, closed(run), label=f"{_label(run)}: closed loop", **_style(run))
+    for run in runs:
+        ax.plot(run.plan_time, predicted(run), color=_colour(run), linestyle="--", label=f"{run.design}: predicted")
+    ax.set(xlabel="time [s]", ylabel=ylabel, title=title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return save_png(fig, path, DPI)

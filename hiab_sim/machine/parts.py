@@ -7,6 +7,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from hiab_sim.checks import check_positive, check_range
 from hiab_sim.errors import InvalidInputError
@@ -51,6 +52,22 @@ def check_interval(where: str, interval: tuple[float, float], unit: str) -> tupl
     return (low, high)
 
 
+def check_rotation(rotation: ArrayLike) -> None:
+    """Raise :class:`InvalidInputError` (field ``R``) unless ``rotation`` is a proper rotation (|R R^T - I| <= 1e-6)."""
+    matrix = np.asarray(rotation, dtype=float)
+    error = float(np.max(np.abs(matrix @ matrix.T - np.eye(3))))
+    if not error <= 1e-6 or np.linalg.det(matrix) < 0.0:
+        raise InvalidInputError("R", f"|R R^T - I| = {error:.3g}", "must be a rotation matrix")
+
+
+def homogeneous(position: ArrayLike, rotation: ArrayLike) -> np.ndarray:
+    """4x4 homogeneous transform of a frame at ``position`` [m] with ``rotation`` in its parent."""
+    out = np.eye(4)
+    out[:3, :3] = rotation
+    out[:3, 3] = position
+    return out
+
+
 @dataclass(frozen=True)
 class Pose:
     """Rigid placement of a frame in its parent: position [m] and rotation matrix."""
@@ -63,17 +80,12 @@ class Pose:
         matrix = np.asarray(self.rotation, dtype=float)
         if matrix.shape != (3, 3) or not np.all(np.isfinite(matrix)):
             raise InvalidInputError("R", "not a finite 3x3 matrix", "must be a rotation matrix")
-        error = float(np.max(np.abs(matrix @ matrix.T - np.eye(3))))
-        if not error <= 1e-6 or np.linalg.det(matrix) < 0.0:
-            raise InvalidInputError("R", f"|R R^T - I| = {error:.3g}", "must be a rotation matrix")
+        check_rotation(matrix)
 
     @property
     def matrix(self) -> np.ndarray:
         """4x4 homogeneous transform parent_T_frame."""
-        out = np.eye(4)
-        out[:3, :3] = self.rotation
-        out[:3, 3] = self.position
-        return out
+        return homogeneous(self.position, self.rotation)
 
 
 @dataclass(frozen=True)

@@ -173,15 +173,7 @@ def _add_chain(
     _set_inertial(rod, links[f"{chain.name}_rod"])
     _capsule(rod, np.zeros(3), np.array([xi.Lc, 0.0, 0.0]), spec.find_default("rod"))
 
-    spec.add_equality(
-        name=f"{chain.name}_loop",
-        type=mujoco.mjtEq.mjEQ_CONNECT,
-        objtype=mujoco.mjtObj.mjOBJ_SITE,
-        name1=f"{chain.name}_rod_end",
-        name2=f"{chain.name}_boom_pivot",
-        solref=list(EQUALITY_SOLREF),
-        solimp=list(EQUALITY_SOLIMP),
-    )
+    add_site_connect(spec, f"{chain.name}_loop", f"{chain.name}_rod_end", f"{chain.name}_boom_pivot")
     return boom
 
 
@@ -381,3 +373,16 @@ def _text(values: np.ndarray) -> str:
 def _set(element: ElementTree.Element, **attributes: np.ndarray | list[float]) -> None:
     for key, values in attributes.items():
         element.set(key, _text(np.asarray(values)))
+
+
+def add_site_connect(spec: mujoco.MjSpec, name: str, site_a: str, site_b: str) -> None:
+    """Close a loop: a connect equality ``name`` pinning site ``site_a`` to ``site_b`` (EQUALITY_SOLREF/SOLIMP)."""
+    spec.add_equality(
+        name=name,
+        type=mujoco.mjtEq.mjEQ_CONNECT,
+        objtype=mujoco.mjtObj.mjOBJ_SITE,
+        name1=site_a,
+        name2=site_b,
+        solref=list(EQUALITY_SOLREF),
+        solimp=list(EQUALITY_SOLIMP),
+    )

@@ -35,7 +35,7 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.tree import MachineTree, SimulationExtras, actuator_lengths, machine_tree
 from hiab_sim.machine.parts import RigidBody
-from hiab_sim.model.mjcf import EQUALITY_SOLIMP, EQUALITY_SOLREF, SOURCE_TO_WORLD
+from hiab_sim.model.mjcf import SOURCE_TO_WORLD, add_site_connect
 from hiab_sim.resources import mjcf_template
 
 __all__ = ["SimulationExtras", "build_machine_model", "build_machine_spec", "spec_of_tree"]
@@ -115,15 +115,7 @@ def spec_of_tree(tree: MachineTree, extras: SimulationExtras | None = None) -> m
     for loop in tree.loops:
         made[loop.body_a].add_site(name=f"{loop.name}.a", pos=list(loop.point_a))
         made[loop.body_b].add_site(name=f"{loop.name}.b", pos=list(loop.point_b))
-        spec.add_equality(
-            name=loop.name,
-            type=mujoco.mjtEq.mjEQ_CONNECT,
-            objtype=mujoco.mjtObj.mjOBJ_SITE,
-            name1=f"{loop.name}.a",
-            name2=f"{loop.name}.b",
-            solref=list(EQUALITY_SOLREF),
-            solimp=list(EQUALITY_SOLIMP),
-        )
+        add_site_connect(spec, loop.name, f"{loop.name}.a", f"{loop.name}.b")
     site = made[tree.tcp_body].add_site(
         name="tcp", pos=list(tree.tcp.position), quat=_quat(np.asarray(tree.tcp.rotation)), size=[0.04, 0.04, 0.04]
     )

@@ -168,6 +168,7 @@ def machine_tree(machine: Machine) -> MachineTree:
                 f"links.{link.name}.joint", link.joint, "every moving joint needs a chain driving it"
             )
     z = _world_z(machine)
+    loops: list[LoopPin] = []
 
     def pivot_z(link: str, point: Array) -> float:
         origin, rotation = z[link]
@@ -179,7 +180,24 @@ def machine_tree(machine: Machine) -> MachineTree:
         bodies.append(TreeBody(name, parent, kind, joint, np.asarray(position, float), np.eye(3), inertia, chain))
         return len(bodies) - 1
 
-    loops: list[LoopPin] = []
+    def hinge_at(chain: Chain, role: str, name: str, pin: str, inertia: RigidBody | None) -> tuple[int, float]:
+        """Add ``<chain>.<name>`` hinged at the chain's pivot ``role``; return its index and the pivot's world z [m]."""
+        pivot = chain.pivot(role)
+        xyz = np.asarray(pivot.position, dtype=float)
+        parent = index[pivot.link]
+        body = add(f"{chain.name}.{name}", parent, "revolute", f"{chain.name}.{pin}", xyz, inertia, chain.name)
+        return body, pivot_z(pivot.link, xyz)
+
+    def close_at(chain: Chain, role: str, pin: str, body: int, length: float, z_from: float) -> None:
+        """Close a loop: ``body``'s point ``length`` [m] along its x axis meets the chain's pivot ``role``.
+
+        ``z_from`` is the world z [m] of ``body``'s frame; the point sits at the pivot's height above it.
+        """
+        pivot = chain.pivot(role)
+        xyz = np.asarray(pivot.position, dtype=float)
+        end = np.array([length, 0.0, pivot_z(pivot.link, xyz) - z_from])
+        loops.append(LoopPin(f"{chain.name}.{pin}", body, end, index[pivot.link], xyz))
+
     actuated: list[int] = []
     for chain in machine.chains:
         if chain.kind == "direct":
@@ -187,44 +205,26 @@ def machine_tree(machine: Machine) -> MachineTree:
             continue
         act = chain.actuator
         piston, rod_length = actuator_lengths(chain)
-        base = chain.pivot("base")
-        base_xyz = np.asarray(base.position, dtype=float)
-        cylinder = add(
-            f"{chain.name}.cylinder", index[base.link], "revolute", f"{chain.name}.base_pin", base_xyz,
-            act.cylinder_body, chain.name,
-        )  # fmt: skip
+        cylinder, z_base = hinge_at(chain, "base", "cylinder", "base_pin", act.cylinder_body)
         rod = add(
             f"{chain.name}.rod", cylinder, "prismatic", f"{chain.name}.stroke",
             np.array([piston, 0.0, 0.0]), act.rod_body, chain.name,
         )  # fmt: skip
         actuated.append(rod)
-        z_base = pivot_z(base.link, base_xyz)
         if chain.kind == "triangle":
-            end = chain.pivot("end")
-            end_xyz = np.asarray(end.position, dtype=float)
-            rod_end = np.array([rod_length, 0.0, pivot_z(end.link, end_xyz) - z_base])
-            loops.append(LoopPin(f"{chain.name}.end_pin", rod, rod_end, index[end.link], end_xyz))
+            close_at(chain, "end", "end_pin", rod, rod_length, z_base)
             continue
         linkage = chain.linkage
         if linkage is None:
             raise AssertionError("a linkage chain carries its four-bar")
-        rocker_pivot = chain.pivot("rocker")
-        rocker_xyz = np.asarray(rocker_pivot.position, dtype=float)
-        rocker = add(
-            f"{chain.name}.rocker", index[rocker_pivot.link], "revolute", f"{chain.name}.rocker_pin", rocker_xyz,
-            linkage.rocker_body, chain.name,
-        )  # fmt: skip
+        rocker, z_rocker = hinge_at(chain, "rocker", "rocker", "rocker_pin", linkage.rocker_body)
         coupler = add(
             f"{chain.name}.coupler", rocker, "revolute", f"{chain.name}.link_pin",
             np.array([linkage.rocker_length, 0.0, 0.0]), linkage.coupler_body, chain.name,
         )  # fmt: skip
-        z_rocker = pivot_z(rocker_pivot.link, rocker_xyz)
         rod_end = np.array([rod_length, 0.0, z_rocker - z_base])
         loops.append(LoopPin(f"{chain.name}.rod_pin", rod, rod_end, rocker, np.array([linkage.rocker_length, 0, 0.0])))
-        far = chain.pivot("coupler")
-        far_xyz = np.asarray(far.position, dtype=float)
-        coupler_end = np.array([linkage.coupler_length, 0.0, pivot_z(far.link, far_xyz) - z_rocker])
-        loops.append(LoopPin(f"{chain.name}.coupler_pin", coupler, coupler_end, index[far.link], far_xyz))
+        close_at(chain, "coupler", "coupler_pin", coupler, linkage.coupler_length, z_rocker)
     independent = tuple(index[machine.joint_link(j).name] for j in machine.joint_names)
     return MachineTree(
         machine=machine,

@@ -8,6 +8,8 @@ angles in rad, MuJoCo's world frame.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
+
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
@@ -35,36 +37,37 @@ def pins(mech: Mechanism) -> list[int]:
 
 def residual_and_jacobian(mech: Mechanism, data: mujoco.MjData) -> tuple[Array, Array]:
     """In-plane pin residuals (2 n_pins,) and their Jacobian (2 n_pins, nv) at the data's kinematics."""
-    model = mech.model
-    axes = plane_axes(mech)[:, :2].T
     eqs = pins(mech)
     residual = np.empty(2 * len(eqs))
-    jac = np.empty((2 * len(eqs), model.nv))
-    ja, jb = np.zeros((3, model.nv)), np.zeros((3, model.nv))
-    for k, e in enumerate(eqs):
-        p1, p2 = connect_points(model, data, e)
-        b1, b2 = _bodies(model, e)
-        mujoco.mj_jac(model, data, ja, None, p1, b1)
-        mujoco.mj_jac(model, data, jb, None, p2, b2)
-        residual[2 * k : 2 * k + 2] = axes @ (p1 - p2)
-        jac[2 * k : 2 * k + 2] = axes @ (ja - jb)
+    jac = np.empty((2 * len(eqs), mech.model.nv))
+    for k, axes, gap, djac in _pin_terms(mech, data, eqs, mujoco.mj_jac):
+        residual[2 * k : 2 * k + 2] = axes @ gap
+        jac[2 * k : 2 * k + 2] = axes @ djac
     return residual, jac
 
 
 def jac_dot_qvel(mech: Mechanism, data: mujoco.MjData) -> Array:
     """d/dt of the pin Jacobian times qvel (2 n_pins,) at the data's kinematics and velocities."""
-    model = mech.model
-    axes = plane_axes(mech)[:, :2].T
     eqs = pins(mech)
     out = np.empty(2 * len(eqs))
+    for k, axes, _, djac in _pin_terms(mech, data, eqs, mujoco.mj_jacDot):
+        out[2 * k : 2 * k + 2] = axes @ (djac @ data.qvel)
+    return out
+
+
+def _pin_terms(
+    mech: Mechanism, data: mujoco.MjData, eqs: list[int], jac_fn: Callable[..., None]
+) -> Iterator[tuple[int, Array, Array, Array]]:
+    """Per pin k: the plane's axes (2, 3), the points' gap p1 - p2 [m] (3,) and ``jac_fn``'s J1 - J2 (3, nv)."""
+    model = mech.model
+    axes = plane_axes(mech)[:, :2].T
     ja, jb = np.zeros((3, model.nv)), np.zeros((3, model.nv))
     for k, e in enumerate(eqs):
         p1, p2 = connect_points(model, data, e)
         b1, b2 = _bodies(model, e)
-        mujoco.mj_jacDot(model, data, ja, None, p1, b1)
-        mujoco.mj_jacDot(model, data, jb, None, p2, b2)
-        out[2 * k : 2 * k + 2] = axes @ ((ja - jb) @ data.qvel)
-    return out
+        jac_fn(model, data, ja, None, p1, b1)
+        jac_fn(model, data, jb, None, p2, b2)
+        yield k, axes, p1 - p2, ja - jb
 
 
 def _bodies(model: mujoco.MjModel, e: int) -> tuple[int, int]:
