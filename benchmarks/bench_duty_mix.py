@@ -4,7 +4,7 @@ Solves from the built XS 031's lengths, each ``--repeat`` times (fresh problem e
 minimum and the median wall time are printed): the default study (``xs031_spiral``, dense SLSQP,
 its result unchanged by the tasks loader), the duty mix with its own solver (IPOPT, sparse
 Jacobians) and, with ``--slsqp N``, the duty mix with dense SLSQP for at most N iterations (its
-seconds per iteration are the measure of whether dense SLSQP serves the mix). Goals (issue 12):
+seconds per iteration are the measure of whether dense SLSQP serves the mix). Goals:
 the duty mix <= 10 s wall on 2 cores and <= 100 iterations; the default study no slower than
 before (~0.6-1 s). Wall times depend on the machine's load: compare them with the default
 study's in the same run.
@@ -22,9 +22,9 @@ from dataclasses import replace
 import numpy as np
 
 from hiab_sim.errors import SolverError
-from hiab_sim.study.config import DEFAULT_STUDY, Study, load_study
-from hiab_sim.study.mix import make_problem
-from hiab_sim.study.solve import solve
+from hiab_sim.study.nlp.mix import make_problem
+from hiab_sim.study.solvers.slsqp import solve
+from hiab_sim.study.spec.study_file import DEFAULT_STUDY, Study, load_study
 
 
 def _run(study: Study, maxiter: int | None = None) -> dict[str, object]:

@@ -16,9 +16,9 @@ import numpy as np
 
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import HiabSimError
-from hiab_sim.study.config import load_study
-from hiab_sim.study.problem import LinkLengthProblem
-from hiab_sim.study.report import fine_problem
+from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.report.result_folder import fine_problem
+from hiab_sim.study.spec.study_file import load_study
 from hiab_sim.sweep.energy_map import energy_map, start_design
 
 

@@ -3,7 +3,7 @@
 Both runs start from the same point (the XS 031's real lengths, inverse-kinematics spline), use the
 same tolerances (the study's ftol and maxiter) and the same inverse-dynamics path; the baseline
 passes jac=None for the cost and every constraint, so scipy differences all 72 variables itself.
-Goals (issue 6): <= 10 s wall, >= 10x faster than the baseline, <= 100 SQP iterations.
+Goals: <= 10 s wall, >= 10x faster than the baseline, <= 100 SQP iterations.
 
 Run: .venv/bin/python benchmarks/bench_optimize.py [STUDY.yaml] [--id mujoco|analytic]
 """
@@ -16,9 +16,9 @@ import time
 import numpy as np
 
 from hiab_sim.errors import SolverError
-from hiab_sim.study.config import DEFAULT_STUDY, load_study
-from hiab_sim.study.problem import LinkLengthProblem
-from hiab_sim.study.solve import solve
+from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.solvers.slsqp import solve
+from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
 
 
 def _run(study_path: str, id_path: str | None, gradients: bool) -> dict[str, object]:

@@ -25,7 +25,7 @@ from hiab_sim.render.frames import LAYOUTS, Layout
 
 
 def write_demo_result(folder: Path, duration: float = 4.0, samples: int = 401) -> Path:
-    """A result folder (issue 6 contract): a joint-space loop around (0.6, -1.3, 0.4), two designs."""
+    """A result folder: a joint-space loop around (0.6, -1.3, 0.4), two designs."""
     crane = load_crane("xs031")
     initial = crane.default_lengths
     optimal = LinkLengths.from_array(initial.as_array() * np.array([1.03, 1.2, 1.0, 1.0, 1.0, 1.0]))

@@ -1,4 +1,4 @@
-"""Cross-validation of the MuJoCo and analytic inverse dynamics (issue 4), behind ``hiab-sim validate``.
+"""Cross-validation of the MuJoCo and analytic inverse dynamics, behind ``hiab-sim validate``.
 
 Cases (``validate/cases.yaml``), each run without and with a TCP payload force:
 

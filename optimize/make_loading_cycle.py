@@ -13,7 +13,7 @@ loaded move up over the load-space stakes and in (12 s); the load is released (1
 settling move inside the load space (2 s); rest. Moving time: 30 % empty, 60 % loaded, 10 % in the
 load space. Slewing, which the real cycles also contain, is out of the crane's plane and not part
 of this planar model. Every move is rest to rest along the pick-and-place path of
-:class:`hiab_sim.study.references.PickAndPlace` (a Bezier over a clearance height, septic timing),
+:class:`hiab_sim.study.references.kinds.PickAndPlace` (a Bezier over a clearance height, septic timing),
 the telescope moving with the same law. The geometry (metres in {W}, y up; the origin is at the
 lift cylinder's base pivot on the column) is placed in the XS 031's workspace, with TCP speeds
 (<= 0.6 m/s) and joint rates like the sizing spiral's, so the reference sheet's EMLAs can follow it.
@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 
 from hiab_sim.crane.loader import load_crane
-from hiab_sim.study.csv_reference import CsvReference, read_table
-from hiab_sim.study.references import PickAndPlace
-from hiab_sim.study.trajectory import TcpKinematics
+from hiab_sim.study.motion.trajectory import TcpKinematics
+from hiab_sim.study.references.csv_file import CsvReference, read_table
+from hiab_sim.study.references.kinds import PickAndPlace
 
 OUT = Path(__file__).resolve().parent / "xs031_loading_cycle.csv"
 RATE = 20.0  # Hz

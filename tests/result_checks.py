@@ -17,7 +17,7 @@ from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla import EmlaSet, electrical_power
-from hiab_sim.study.result import Result
+from hiab_sim.results.schema import Result
 
 DESIGNS = ("initial", "optimal")
 

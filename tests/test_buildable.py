@@ -1,4 +1,4 @@
-"""Buildable designs (issue 14): robust rows, the rounded design, the feasibility phase and KKT sensitivities."""
+"""Buildable designs: robust rows, the rounded design, the feasibility phase and KKT sensitivities."""
 
 from __future__ import annotations
 
@@ -17,12 +17,12 @@ from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.mechanism import check_lengths, joint_to_stroke
 from hiab_sim.crane.tolerance import buildable_crane
 from hiab_sim.resources import shipped
-from hiab_sim.study.buildable import RobustXi, rounded_design
-from hiab_sim.study.config import Study, study_from_dict
-from hiab_sim.study.feasibility import feasible_start
-from hiab_sim.study.problem import LinkLengthProblem
-from hiab_sim.study.sensitivity import sensitivity
-from hiab_sim.study.solve import solve
+from hiab_sim.study.analysis.buildable import RobustXi, rounded_design
+from hiab_sim.study.analysis.sensitivity import sensitivity
+from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.solvers.feasibility import feasible_start
+from hiab_sim.study.solvers.slsqp import solve
+from hiab_sim.study.spec.study_file import Study, study_from_dict
 
 
 @pytest.fixture(scope="module")
@@ -80,7 +80,7 @@ def test_robust_jacobian_matches_finite_differences(solved: tuple[LinkLengthProb
     ev = problem.evaluate(z)
     jac = block.jacobian(ev, None).dxi  # type: ignore[arg-type]
     h = 1e-6
-    from hiab_sim.study.buildable import replace_lengths
+    from hiab_sim.study.analysis.buildable import replace_lengths
 
     xi = ev.lengths.as_array()
     fd = np.column_stack(
@@ -251,7 +251,7 @@ def test_mounting_rows_hold_the_pivots_in_their_polygons_for_every_built_design(
     assert check.ok, check.summary()
     block = next(b for b in problem.layout.blocks if b.name == "mounting")
     ev = problem.evaluate(z)
-    from hiab_sim.study.buildable import replace_lengths
+    from hiab_sim.study.analysis.buildable import replace_lengths
 
     jac = block.jacobian(ev, None).dxi  # type: ignore[arg-type, union-attr]
     xi, h = ev.lengths.as_array(), 1e-6
@@ -328,7 +328,7 @@ def test_mjcf_stroke_margin_shortens_the_range_the_lengths_must_serve(
 
 def test_result_sections_round_trip_typed(tmp_path: Path) -> None:
     """buildable, feasibility and sensitivity load back as typed sections from result.json."""
-    from hiab_sim.study.result import read_result
+    from hiab_sim.results.schema import read_result
 
     study = small_study(initial_lengths={"lift": {"L": 1.0071227324212, "Lc0": 0.0865, "Lc": 0.745},
                                          "tilt": {"L": 1.132185817991, "Lc0": 0.085, "Lc": 0.745}})  # fmt: skip

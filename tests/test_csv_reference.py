@@ -10,10 +10,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study import trajectory as tr
-from hiab_sim.study.config import load_study
-from hiab_sim.study.csv_reference import CsvReference, read_table
-from hiab_sim.study.references import PickAndPlace, reference_from_mapping
+from hiab_sim.study.motion import trajectory as tr
+from hiab_sim.study.references.csv_file import CsvReference, read_table
+from hiab_sim.study.references.kinds import PickAndPlace, reference_from_mapping
+from hiab_sim.study.spec.study_file import load_study
 
 STUDY = load_study()
 CRANE = STUDY.crane

@@ -1,4 +1,4 @@
-"""The default study end to end: what issue 6 says its optimum must show (one start; three starts under -m slow)."""
+"""The default study end to end: what its optimum must show (one start; three starts under -m slow)."""
 
 from __future__ import annotations
 
@@ -9,9 +9,9 @@ import pytest
 from result_checks import four_designs
 
 from hiab_sim.emla import load_emla_set
-from hiab_sim.study.config import load_study
-from hiab_sim.study.result import Result, read_result
+from hiab_sim.results.schema import Result, read_result
 from hiab_sim.study.run import RunOutput, run_study
+from hiab_sim.study.spec.study_file import load_study
 
 
 @pytest.fixture(scope="module")

@@ -13,10 +13,10 @@ from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla import ACTUATOR_NAMES, envelope_margins, load_emla_set
-from hiab_sim.study import trajectory as tr
-from hiab_sim.study.payload import Payload
-from hiab_sim.study.references import reference_from_mapping
-from hiab_sim.study.workspace import initial_joints
+from hiab_sim.study.motion import trajectory as tr
+from hiab_sim.study.motion.workspace import initial_joints
+from hiab_sim.study.references.kinds import reference_from_mapping
+from hiab_sim.study.spec.payload import Payload
 
 OPTIMIZE = Path(__file__).resolve().parents[1] / "optimize"
 MIX = yaml.safe_load((OPTIMIZE / "xs031_duty_mix.yaml").read_text())

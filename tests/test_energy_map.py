@@ -20,9 +20,9 @@ from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import HiabSimError
-from hiab_sim.study.config import load_study
-from hiab_sim.study.problem import LinkLengthProblem
+from hiab_sim.study.nlp.problem import LinkLengthProblem
 from hiab_sim.study.run import run_study
+from hiab_sim.study.spec.study_file import load_study
 from hiab_sim.sweep.energy_map import (
     VARIABLES,
     energy_map,

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from hiab_sim.study.result import Result
+from hiab_sim.results.schema import Result
 from hiab_sim.study.run import run_study
 
 pytestmark = pytest.mark.slow

@@ -8,12 +8,12 @@ from test_mix import LOCAL_SPREAD, two_tasks
 
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.study.config import study_from_dict
-from hiab_sim.study.id_partials import id_length_partials
-from hiab_sim.study.ipopt import SparseJacobian, range_pairs, task_rows, task_z
-from hiab_sim.study.mix import MixProblem
-from hiab_sim.study.problem import XI_SCALE
-from hiab_sim.study.solve import solve
+from hiab_sim.study.nlp.id_partials import id_length_partials
+from hiab_sim.study.nlp.mix import MixProblem
+from hiab_sim.study.nlp.problem import XI_SCALE
+from hiab_sim.study.solvers.ipopt import SparseJacobian, range_pairs, task_rows, task_z
+from hiab_sim.study.solvers.slsqp import solve
+from hiab_sim.study.spec.study_file import study_from_dict
 
 
 @pytest.fixture(scope="module")

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 from test_study_small import small_study
 
-from hiab_sim.study.config import Study, study_from_dict
-from hiab_sim.study.ipopt import SparseJacobian, task_rows
-from hiab_sim.study.mix import MixProblem
-from hiab_sim.study.payload import Payload
-from hiab_sim.study.problem import LinkLengthProblem
+from hiab_sim.study.nlp.mix import MixProblem
+from hiab_sim.study.nlp.problem import LinkLengthProblem
 from hiab_sim.study.run import run_study
+from hiab_sim.study.solvers.ipopt import SparseJacobian, task_rows
+from hiab_sim.study.spec.payload import Payload
+from hiab_sim.study.spec.study_file import Study, study_from_dict
 
 #: Relative cost spread of the NLP's local optima on the two-task study (measured 1.3e-5).
 LOCAL_SPREAD = 1e-4
@@ -143,7 +143,7 @@ def solved(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.mark.slow
 def test_two_task_mix_converges_feasible_on_every_task_and_rechecks(solved: Path) -> None:
     """Success, violation <= 1e-6 on every task, re-checked on the fine grid with the other ID path."""
-    from hiab_sim.study.result import read_result
+    from hiab_sim.results.schema import read_result
 
     r = read_result(solved)
     assert r.solver.success and r.tasks is not None and len(r.tasks) == 2
@@ -156,7 +156,7 @@ def test_two_task_mix_converges_feasible_on_every_task_and_rechecks(solved: Path
 @pytest.mark.slow
 def test_cross_evaluation_is_consistent(solved: Path) -> None:
     """The mix optimum costs the mix no more than any task's optimum; each task's optimum is best on its task."""
-    from hiab_sim.study.result import read_result
+    from hiab_sim.results.schema import read_result
 
     pytest.importorskip("casadi")  # the fixed-Xi re-optimisations run on IPOPT
     cross = read_result(solved).cross_evaluation
@@ -174,8 +174,8 @@ def test_cross_evaluation_is_consistent(solved: Path) -> None:
 @pytest.mark.slow
 def test_duty_mix_converges_from_the_built_crane_and_three_starts_agree(tmp_path: Path) -> None:
     """The shipped duty mix: violation <= 1e-6 on every task (fine grid, other ID path); 3 starts agree or listed."""
-    from hiab_sim.study.config import load_study
-    from hiab_sim.study.result import read_result
+    from hiab_sim.results.schema import read_result
+    from hiab_sim.study.spec.study_file import load_study
 
     pytest.importorskip("casadi")
     run_study(load_study("xs031_duty_mix"), tmp_path, starts=3, progress=None, figures=False, cross=False)
@@ -194,7 +194,7 @@ def test_duty_mix_converges_from_the_built_crane_and_three_starts_agree(tmp_path
 def test_study_file_with_tasks_loads_them_and_one_without_either_form_is_refused() -> None:
     """``tasks:`` gives the Study its tasks in order; a study with neither ``tasks:`` nor ``reference:`` is refused."""
     from hiab_sim.errors import ConfigError
-    from hiab_sim.study.config import load_study
+    from hiab_sim.study.spec.study_file import load_study
 
     mix = load_study("xs031_duty_mix")
     assert [t.name for t in mix.tasks] == ["spiral", "pick_and_place", "loading_cycle"]
@@ -208,8 +208,8 @@ def test_study_file_with_tasks_loads_them_and_one_without_either_form_is_refused
 
 def test_an_infeasible_mix_start_goes_through_the_feasibility_phase_and_converges(tmp_path: Path) -> None:
     """Lift Lc0 + 1.5 mm leaves x < 0 at the low end of the range on both tasks: repaired (IPOPT projection), solved."""
-    from hiab_sim.study.feasibility import feasible_start
-    from hiab_sim.study.result import read_result
+    from hiab_sim.results.schema import read_result
+    from hiab_sim.study.solvers.feasibility import feasible_start
 
     pytest.importorskip("casadi")
     data = two_tasks()
@@ -253,8 +253,8 @@ def test_each_task_reports_its_thermal_state_over_its_own_cycle_and_the_hourly_r
     The mix's hourly RMS torque (weights as cycles per hour) sums w_k rms_k^2 P_k, so it must not
     depend on the duty the tasks' own RMS values were taken over.
     """
-    from hiab_sim.study.energy_report import energy_report, study_duty, weighted_energy_report
-    from hiab_sim.study.report import design_summary, fine_problem
+    from hiab_sim.study.report.energy_section import energy_report, study_duty, weighted_energy_report
+    from hiab_sim.study.report.result_folder import design_summary, fine_problem
 
     rms, hourly = {}, {}
     for per_hour in (60.0, 120.0):

@@ -7,12 +7,12 @@ import pytest
 from test_study_small import small_study
 
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.study.blocks import ObjectiveBound
-from hiab_sim.study.config import study_from_dict
-from hiab_sim.study.nlp import ConstraintBlock, DenseRows, SamplePartials, SampleState
-from hiab_sim.study.objectives import SquaredPowerCost, make_objective
-from hiab_sim.study.problem import LinkLengthProblem
-from hiab_sim.study.solve import start_points
+from hiab_sim.study.nlp.blocks import ObjectiveBound
+from hiab_sim.study.nlp.interface import ConstraintBlock, DenseRows, SamplePartials, SampleState
+from hiab_sim.study.nlp.objectives import SquaredPowerCost, make_objective
+from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.solvers.slsqp import start_points
+from hiab_sim.study.spec.study_file import study_from_dict
 
 STUDY = study_from_dict(small_study(), "small.yaml")
 

@@ -11,9 +11,9 @@ from test_study_small import small_study, write_study
 from test_sweep import TINY
 
 from hiab_sim.cli import main
-from hiab_sim.study.config import study_from_dict
-from hiab_sim.study.problem import LinkLengthProblem
-from hiab_sim.study.solve import SolveResult, solve
+from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.solvers.slsqp import SolveResult, solve
+from hiab_sim.study.spec.study_file import study_from_dict
 from hiab_sim.sweep.pareto import EpsilonProblem, criterion, pareto_front, samples_of_points
 
 

@@ -12,9 +12,9 @@ from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics, energy_rate
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study import trajectory as tr
-from hiab_sim.study.config import load_study
-from hiab_sim.study.payload import Payload
+from hiab_sim.study.motion import trajectory as tr
+from hiab_sim.study.spec.payload import Payload
+from hiab_sim.study.spec.study_file import load_study
 
 STUDY = load_study()
 CRANE = STUDY.crane

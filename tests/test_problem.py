@@ -12,10 +12,10 @@ from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla import electrical_power, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study import problem as problem_module
-from hiab_sim.study.config import load_study, study_from_dict
-from hiab_sim.study.problem import LinkLengthProblem
-from hiab_sim.study.solve import START_TOLERANCE, check_start, start_points
+from hiab_sim.study.nlp import problem as problem_module
+from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.solvers.slsqp import START_TOLERANCE, check_start, start_points
+from hiab_sim.study.spec.study_file import load_study, study_from_dict
 
 STUDY = study_from_dict(small_study(), "small.yaml")
 

@@ -13,10 +13,10 @@ from hypothesis import strategies as st
 from hiab_sim.crane import kinematics
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import DEFAULT_STUDY, shipped
-from hiab_sim.study import trajectory as tr
-from hiab_sim.study.config import load_study
-from hiab_sim.study.references import PickAndPlace, Spiral, reference_from_mapping, septic_law
-from hiab_sim.study.workspace import initial_joints, planar_ik
+from hiab_sim.study.motion import trajectory as tr
+from hiab_sim.study.motion.workspace import initial_joints, planar_ik
+from hiab_sim.study.references.kinds import PickAndPlace, Spiral, reference_from_mapping, septic_law
+from hiab_sim.study.spec.study_file import load_study
 
 STUDY = load_study()
 CRANE = STUDY.crane

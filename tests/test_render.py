@@ -1,4 +1,4 @@
-"""Off-screen playback rendering (issue 7): frames, camera, video files and one-line errors.
+"""Off-screen playback rendering: frames, camera, video files and one-line errors.
 
 Renders through the OpenGL backend that hiab_sim selects (OSMesa on CI, MUJOCO_GL=osmesa) from a
 fabricated result folder that follows the ``hiab-sim optimize`` contract: a smooth joint
@@ -51,7 +51,7 @@ def _motion(time: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def write_result(folder: Path, crane: Crane, samples: int = 201) -> Path:
-    """A result folder as ``hiab-sim optimize`` writes it (issue 6 contract)."""
+    """A result folder as ``hiab-sim optimize`` writes it."""
     folder.mkdir(parents=True, exist_ok=True)
     initial = crane.default_lengths
     optimal = LinkLengths.from_array(initial.as_array() * np.array([1.03, 1.2, 1.0, 1.0, 1.0, 1.0]))

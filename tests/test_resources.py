@@ -11,7 +11,7 @@ from hiab_sim.cli import main
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.errors import ConfigError
 from hiab_sim.resources import locate, shipped, shipped_names
-from hiab_sim.study.config import load_study, study_from_dict
+from hiab_sim.study.spec.study_file import load_study, study_from_dict
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -15,8 +15,8 @@ from hypothesis import strategies as st
 
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import ConfigError
-from hiab_sim.study.codec import from_json, optional, to_json
-from hiab_sim.study.result import SCHEMA_VERSION, PlaybackView, Result, read_result
+from hiab_sim.results.codec import from_json, optional, to_json
+from hiab_sim.results.schema import SCHEMA_VERSION, PlaybackView, Result, read_result
 
 # Link lengths inside a crane's range (LinkLengths may validate); every other field from its type hint.
 st.register_type_strategy(
@@ -225,7 +225,7 @@ def test_a_missing_or_mistyped_key_is_named_with_its_path(tmp_path: Path, damage
 
 
 def test_the_renderer_view_needs_only_the_crane_and_both_designs_lengths() -> None:
-    """PlaybackView reads the issue-7 contract and ignores every other key."""
+    """PlaybackView reads the renderer's contract and ignores every other key."""
     data = _minimal_result_json()
     view = PlaybackView.from_json({k: data[k] for k in ("crane", "initial", "optimal")})
     assert view.crane == "xs031" and view.initial.lengths == Result.from_json(data).initial.lengths

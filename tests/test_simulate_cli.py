@@ -67,7 +67,7 @@ def test_a_folder_without_a_result_exits_2(tmp_path: Path, capsys: pytest.Captur
 
 @pytest.mark.slow
 def test_default_study_validates_in_closed_loop(tmp_path: Path) -> None:
-    """Issue 11's claims on the default study, both designs, and with the end mass 20 % heavier.
+    """The closed-loop claims on the default study, both designs, and with the end mass 20 % heavier.
 
     Energy within 2 % of the prediction, TCP error rms <= 2 mm and max <= 5 mm, the optimal design
     cheaper than the initial one in closed loop too; with +20 % end mass the cycle completes within

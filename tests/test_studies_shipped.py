@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from hiab_sim.crane.kinematics import tcp_position
-from hiab_sim.study.config import load_study
-from hiab_sim.study.problem import LinkLengthProblem
-from hiab_sim.study.solve import START_TOLERANCE, check_start
+from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.solvers.slsqp import START_TOLERANCE, check_start
+from hiab_sim.study.spec.study_file import load_study
 
 STUDIES = sorted((Path(__file__).resolve().parents[1] / "optimize").glob("*spiral*.yaml"))
 #: The start each shipped study documents: the built XS 031 (lengths omitted) or the seed paper's own.

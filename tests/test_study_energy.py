@@ -1,4 +1,4 @@
-"""Issue 13 in the study: battery-energy objective, thermal rows, energy report, co-design and bad input."""
+"""Energy in the study: battery-energy objective, thermal rows, energy report, co-design and bad input."""
 
 from __future__ import annotations
 
@@ -14,12 +14,12 @@ from test_study_small import small_study, write_study
 
 from hiab_sim.cli import main
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.study.codesign import combinations, solve_combination, with_transmission
-from hiab_sim.study.config import study_from_dict
-from hiab_sim.study.energy_result import TransmissionChoice
-from hiab_sim.study.problem import LinkLengthProblem
-from hiab_sim.study.result import read_result
-from hiab_sim.study.thermal_blocks import ThermalLimits
+from hiab_sim.results.energy_sections import TransmissionChoice
+from hiab_sim.results.schema import read_result
+from hiab_sim.study.analysis.codesign import combinations, solve_combination, with_transmission
+from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.thermal_rows import ThermalLimits
+from hiab_sim.study.spec.study_file import study_from_dict
 
 FLAGS = ["--no-video", "--quiet", "--no-figures"]
 
@@ -209,7 +209,7 @@ def _losses_on(tmp_path: Path) -> Path:
 
 def test_drive_losses_enabled_in_the_emla_file_flow_into_the_objective_and_the_report(tmp_path: Path) -> None:
     """Losses on: the NLP's battery energy rises, its gradient still matches differences, the report names them."""
-    from hiab_sim.study.energy_report import design_energy
+    from hiab_sim.study.report.energy_section import design_energy
 
     study_on = _study(objective="battery_energy", emla=str(_losses_on(tmp_path)))
     study_off = _study(objective="battery_energy")
@@ -243,7 +243,7 @@ def test_drive_losses_enabled_in_the_emla_file_flow_into_the_objective_and_the_r
 @given(cycle=st.floats(0.5, 600.0), fraction=st.floats(1e-3, 1.0))
 def test_cycles_per_hour_give_a_duty_period_of_3600_over_n(cycle: float, fraction: float) -> None:
     """N cycles an hour of a T-second cycle: rest 3600/n - T >= 0 and period 3600/n [s]."""
-    from hiab_sim.study.energy_config import DutySettings
+    from hiab_sim.study.spec.energy import DutySettings
 
     n = fraction * 3600.0 / cycle
     duty = DutySettings(cycles_per_hour=n).duty(cycle)

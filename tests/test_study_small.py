@@ -44,8 +44,8 @@ def write_study(folder: Path, study: dict[str, Any], name: str = "study.yaml") -
 
 def test_small_study_loads_with_a_feasible_start() -> None:
     """The shared small study is valid and its start satisfies every constraint."""
-    from hiab_sim.study.config import study_from_dict
-    from hiab_sim.study.problem import LinkLengthProblem
+    from hiab_sim.study.nlp.problem import LinkLengthProblem
+    from hiab_sim.study.spec.study_file import study_from_dict
 
     study = study_from_dict(small_study(), "small.yaml")
     problem = LinkLengthProblem(study)

@@ -10,11 +10,11 @@ import pytest
 import yaml
 
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study import trajectory as tr
-from hiab_sim.study.config import load_study
-from hiab_sim.study.csv_reference import CsvReference
-from hiab_sim.study.references import PickAndPlace, Spiral
-from hiab_sim.study.tasks import check_tasks, tasks_from_mapping
+from hiab_sim.study.motion import trajectory as tr
+from hiab_sim.study.references.csv_file import CsvReference
+from hiab_sim.study.references.kinds import PickAndPlace, Spiral
+from hiab_sim.study.spec.study_file import load_study
+from hiab_sim.study.spec.tasks import check_tasks, tasks_from_mapping
 
 OPTIMIZE = Path(__file__).resolve().parents[1] / "optimize"
 MIX = yaml.safe_load((OPTIMIZE / "xs031_duty_mix.yaml").read_text())

@@ -58,7 +58,7 @@ def test_margins_agree_with_the_cranes_own_check(values: tuple[float, ...]) -> N
 
 
 def test_the_built_crane_rounded_to_a_millimetre_fails_both_checks() -> None:
-    """The built crane's lengths rounded to 1 mm leave the stroke at the low end (issue 14): both checks say so."""
+    """The built crane's lengths rounded to 1 mm leave the stroke at the low end: both checks say so."""
     rounded = round_lengths(CRANE.default_lengths)
     margins = working_range_margins(CRANE, rounded)
     assert margins.worst()[1] < 0.0

@@ -8,9 +8,9 @@ import pytest
 from hiab_sim.crane import kinematics
 from hiab_sim.crane.description import Crane
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.study import trajectory as tr
-from hiab_sim.study.config import load_study
-from hiab_sim.study.references import Spiral
+from hiab_sim.study.motion import trajectory as tr
+from hiab_sim.study.references.kinds import Spiral
+from hiab_sim.study.spec.study_file import load_study
 
 STUDY = load_study()
 

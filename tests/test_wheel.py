@@ -79,7 +79,7 @@ def test_wheel_installed_in_a_fresh_environment_optimizes_and_writes_mjcf(tmp_pa
         [
             str(python),
             "-c",
-            "from hiab_sim.study.config import load_study; print(load_study('seed_scale_spiral').path)",
+            "from hiab_sim.study.spec.study_file import load_study; print(load_study('seed_scale_spiral').path)",
         ],
         cwd=work,
         env=environment,

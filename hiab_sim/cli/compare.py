@@ -1,7 +1,7 @@
 """``hiab-sim compare RUN_DIR...``: one table and one figure over several optimisation results.
 
 Prints the table (lengths, energies, peaks, envelope margins, violations, savings; see
-:mod:`hiab_sim.study.compare`) and writes ``comparison.csv``, ``comparison.txt`` and
+:mod:`hiab_sim.study.analysis.compare`) and writes ``comparison.csv``, ``comparison.txt`` and
 ``comparison.png`` into ``--out``. A folder that is missing or holds no result exits 2 with one line.
 """
 
@@ -27,8 +27,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Read every result, print the table, write the files."""
-    from hiab_sim.study.compare import format_table, rows, write_comparison
-    from hiab_sim.study.result_read import summarise
+    from hiab_sim.results.read import summarise
+    from hiab_sim.study.analysis.compare import format_table, rows, write_comparison
 
     runs = [summarise(folder) for folder in args.runs]  # every folder is read before anything is written
     out = Path(args.out)

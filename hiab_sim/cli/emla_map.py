@@ -1,4 +1,4 @@
-"""``hiab-sim emla-map``: plot an EMLA efficiency map over load force and rod velocity (issue 5)."""
+"""``hiab-sim emla-map``: plot an EMLA efficiency map over load force and rod velocity."""
 
 from __future__ import annotations
 

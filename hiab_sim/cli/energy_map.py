@@ -38,8 +38,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Compute and write the map; return the exit status."""
-    from hiab_sim.study.config import DEFAULT_STUDY, load_study
-    from hiab_sim.study.problem import LinkLengthProblem
+    from hiab_sim.study.nlp.problem import LinkLengthProblem
+    from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
     from hiab_sim.sweep.energy_map import energy_map, optimum_design, parse_variables, result_study, start_design
     from hiab_sim.sweep.map_output import TRAJECTORY_NOTE, summary, write_map
 

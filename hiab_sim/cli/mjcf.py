@@ -1,4 +1,4 @@
-"""``hiab-sim mjcf``: write the MJCF crane model for a link-length set (issue 3).
+"""``hiab-sim mjcf``: write the MJCF crane model for a link-length set.
 
 ``--lengths`` takes six numbers in metres, comma-separated, lift chain first:
 ``L,Lc0,Lc,L,Lc0,Lc`` (seed eq. Xi). The file is written atomically (a temporary file in the
@@ -104,7 +104,7 @@ def _crane_and_lengths(args: argparse.Namespace) -> tuple[Crane, LinkLengths]:
         return crane, parse_lengths(args.lengths) if args.lengths else crane.default_lengths
     if args.lengths:
         raise InvalidInputError("--lengths", args.lengths, "cannot be combined with --from-result")
-    from hiab_sim.study.result_read import design_lengths, read_run, result_crane
+    from hiab_sim.results.read import design_lengths, read_run, result_crane
 
     result = read_run(args.from_result)
     return result_crane(args.from_result, result.crane), design_lengths(result, args.design)

@@ -1,10 +1,10 @@
-"""``hiab-sim optimize``: energy-optimal link lengths of both closed chains (issue 6).
+"""``hiab-sim optimize``: energy-optimal link lengths of both closed chains.
 
 Runs a study (default ``optimize/xs031_spiral.yaml``) with SQP, prints one line per iteration to
 stderr, and writes ``result.json``, ``trajectory.npz``, the figures and the playback video into
 the output folder. Bad input exits 2 before anything is written; a solver failure exits 1 and
 keeps the partial history (``checkpoint_<k>.json``) for ``--resume``. A start that violates
-constraints goes through the feasibility phase (:mod:`hiab_sim.study.feasibility`); when no point
+constraints goes through the feasibility phase (:mod:`hiab_sim.study.solvers.feasibility`); when no point
 within the bounds is feasible the run exits 3 and names the binding limit. stdout also prints the
 design rounded to the study's ``build.tolerance`` with its re-checks and export command, and the
 largest KKT multipliers (``result.json`` -> ``buildable``, ``feasibility``, ``sensitivity``).
@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 from hiab_sim.errors import BackendUnavailableError
 
 if TYPE_CHECKING:
-    from hiab_sim.study.result import Decomposition, Result
+    from hiab_sim.results.schema import Decomposition, Result
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -98,7 +98,7 @@ def summary_lines(r: Result) -> list[str]:
         f"re-check ({rc.id_path}, {rc.grid_points} points): max violation {rc.max_violation_scaled:.1e}, "
         f"TCP tracking error {rc.tracking_error.position_m * 1e3:.3f} mm"
     )
-    from hiab_sim.study.report_extra import extra_lines
+    from hiab_sim.study.report.analysis_sections import extra_lines
 
     lines += extra_lines(r)
     ms = r.multistart
@@ -124,9 +124,9 @@ def summary_lines(r: Result) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     """Run the study and print a summary; return the exit status."""
-    from hiab_sim.study.config import DEFAULT_STUDY, load_study
     from hiab_sim.study.run import run_study
     from hiab_sim.study.run_safety import resolve_starts
+    from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
 
     study = load_study(args.study or DEFAULT_STUDY)
     out = Path(args.out) if args.out else Path("runs") / study.name
@@ -140,8 +140,8 @@ def run(args: argparse.Namespace) -> int:
         progress=None if args.quiet else sys.stderr,
         figures=not args.no_figures,
     )
-    from hiab_sim.study.codesign import codesign_lines
-    from hiab_sim.study.energy_report import energy_lines
+    from hiab_sim.study.analysis.codesign import codesign_lines
+    from hiab_sim.study.report.energy_section import energy_lines
 
     codesign = [] if output.result.codesign is None else codesign_lines(output.result.codesign)
     for line in [*summary_lines(output.result), *energy_lines(output.result), *codesign]:

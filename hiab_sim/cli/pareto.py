@@ -33,9 +33,9 @@ def run(args: argparse.Namespace) -> int:
     import pandas as pd
 
     from hiab_sim.atomic_io import write_atomic
-    from hiab_sim.study.config import DEFAULT_STUDY, load_study
-    from hiab_sim.study.problem import LinkLengthProblem
-    from hiab_sim.study.solve import check_start, solve
+    from hiab_sim.study.nlp.problem import LinkLengthProblem
+    from hiab_sim.study.solvers.slsqp import check_start, solve
+    from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
     from hiab_sim.sweep.pareto import CRITERIA, front_figure_png, pareto_front
 
     if args.points < 2:

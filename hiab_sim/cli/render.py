@@ -1,4 +1,4 @@
-"""``hiab-sim render``: a playback video of an optimisation result, rendered off-screen (issue 7).
+"""``hiab-sim render``: a playback video of an optimisation result, rendered off-screen.
 
 Needs an OpenGL backend (OSMesa on CPU: ``apt-get install libosmesa6``) and an ffmpeg binary
 (``apt-get install ffmpeg`` or ``pip install imageio-ffmpeg``); a missing one is reported on one

@@ -1,4 +1,4 @@
-"""``hiab-sim simulate``: validate a result in closed loop, the crane driven by simulated EMLA drives (issue 11).
+"""``hiab-sim simulate``: validate a result in closed loop, the crane driven by simulated EMLA drives.
 
 For each design of an ``hiab-sim optimize`` folder, one cycle of the study is simulated on the
 dm-control environment of :mod:`hiab_sim.env` (MuJoCo multibody + PMSM drives with their current
@@ -25,7 +25,7 @@ from pathlib import Path
 
 from hiab_sim.errors import InvalidInputError
 
-#: Checks of issue 11: energy within this fraction of the prediction, TCP error rms and max [mm].
+#: Closed-loop checks: energy within this fraction of the prediction, TCP error rms and max [mm].
 ENERGY_TOLERANCE = 0.02
 TCP_RMS_MM = 2.0
 TCP_MAX_MM = 5.0

@@ -1,4 +1,4 @@
-"""``hiab-sim validate``: cross-validate the MuJoCo and analytic inverse dynamics (issue 4).
+"""``hiab-sim validate``: cross-validate the MuJoCo and analytic inverse dynamics.
 
 Runs the cases of ``validate/cases.yaml`` (see :mod:`hiab_sim.validation`), writes
 ``report.json``, ``table.md`` and one ``forces_<case>.png`` per case into ``--out``, prints the

@@ -1,6 +1,6 @@
 """Time samples exchanged by the inverse-dynamics paths (their one data type, no path imported here).
 
-Conventions shared by both paths (issue 3, 4):
+Conventions shared by both paths:
 - Independent joints, in this order: ``theta1`` [rad], ``theta2`` [rad], ``xt2`` [m] (the
   source's Theta1, Theta2 and telescope extension, same zero and sign).
 - Actuators, in this order: ``lift`` (stroke x1), ``tilt`` (x2), ``telescope`` (xt2); strokes

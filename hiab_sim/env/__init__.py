@@ -1,4 +1,4 @@
-"""The EMLA-driven crane in closed loop as a dm-control environment (issue 11).
+"""The EMLA-driven crane in closed loop as a dm-control environment.
 
 ``load(result_dir, design=..., payload_error=...)`` returns a :class:`dm_control.rl.control.Environment`
 whose Physics is the crane regenerated for the design's link lengths with simulated EMLA drives

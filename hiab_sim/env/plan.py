@@ -3,7 +3,7 @@
 ``read_plan(result_dir, design)`` returns what the closed-loop validation needs: the crane, the EMLA
 set and the payload of the study, the design's link lengths, its planned joint trajectory
 (positions, rates, accelerations on the fine grid), the study's TCP reference and the optimiser's
-predicted net electrical energy. When the study results become typed (``hiab_sim.study.result``),
+predicted net electrical energy. When the study results become typed (``hiab_sim.results.schema``),
 only this function changes.
 """
 
@@ -18,9 +18,9 @@ from numpy.typing import NDArray
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study.config import load_study
-from hiab_sim.study.result import read_result
-from hiab_sim.study.result_read import result_crane
+from hiab_sim.results.read import result_crane
+from hiab_sim.results.schema import read_result
+from hiab_sim.study.spec.study_file import load_study
 
 Array = NDArray[np.float64]
 

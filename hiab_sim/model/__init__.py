@@ -1,4 +1,4 @@
-"""The MJCF crane model, regenerated per link-length set (issue 3)."""
+"""The MJCF crane model, regenerated per link-length set."""
 
 from hiab_sim.model.mjcf import build_model, build_spec, to_xml
 

@@ -1,4 +1,4 @@
-"""MJCF model of the crane for one link-length set Xi, built with :class:`mujoco.MjSpec` (issue 3).
+"""MJCF model of the crane for one link-length set Xi, built with :class:`mujoco.MjSpec`.
 
 The shared pieces (materials, visual defaults, lights, cameras, floor, options) are the template
 ``assets/mjcf/crane_template.xml`` (read through :func:`hiab_sim.resources.mjcf_template`);

@@ -1,4 +1,4 @@
-"""Off-screen playback videos of optimisation results (issue 7).
+"""Off-screen playback videos of optimisation results.
 
 Importing this package checks the OpenGL backend first (see :mod:`hiab_sim.render.backend`),
 so a broken set-up gives a one-line :class:`~hiab_sim.errors.BackendUnavailableError` instead of

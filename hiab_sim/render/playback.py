@@ -1,6 +1,6 @@
 """Playback of an optimisation result: read the result folder, build the states, render the video.
 
-A result folder (written by ``hiab-sim optimize``, issue 6) holds ``result.json`` with the crane
+A result folder (written by ``hiab-sim optimize``) holds ``result.json`` with the crane
 (``crane``: preset name or YAML path) and the link lengths of the ``initial`` and ``optimal``
 designs, and ``trajectory.npz`` with ``time`` (K,), ``reference_tcp`` (K, 3) in the source world
 {W} (y up) and, per design d, ``{d}_position``, ``{d}_velocity``, ``{d}_acceleration`` (K, 3) of
@@ -30,8 +30,8 @@ from numpy.typing import NDArray
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study.result import RESULT_FILE, PlaybackView, read_json_as
-from hiab_sim.study.result_read import result_crane
+from hiab_sim.results.read import result_crane
+from hiab_sim.results.schema import RESULT_FILE, PlaybackView, read_json_as
 
 Array = NDArray[np.float64]
 Mode = Literal["kinematic", "simulate"]

@@ -10,23 +10,23 @@ from typing import TextIO
 
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.errors import ConfigError, SolverError
+from hiab_sim.results.schema import Result
 from hiab_sim.study import run_safety
-from hiab_sim.study.codesign import run_codesign
-from hiab_sim.study.config import Study, load_study
-from hiab_sim.study.cross import cross_evaluation
-from hiab_sim.study.feasibility import feasible_starts, moved_start_phase, phase_lines
-from hiab_sim.study.mix import MixProblem, make_problem
-from hiab_sim.study.mix_report import build_mix_result
-from hiab_sim.study.problem import LinkLengthProblem
-from hiab_sim.study.report import build_result, write_results
-from hiab_sim.study.report_extra import issue14_sections
-from hiab_sim.study.result import Result
-from hiab_sim.study.solve import (
+from hiab_sim.study.analysis.codesign import run_codesign
+from hiab_sim.study.analysis.cross_evaluation import cross_evaluation
+from hiab_sim.study.nlp.mix import MixProblem, make_problem
+from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.report.analysis_sections import analysis_sections
+from hiab_sim.study.report.mix import build_mix_result
+from hiab_sim.study.report.result_folder import build_result, write_results
+from hiab_sim.study.solvers.feasibility import feasible_starts, moved_start_phase, phase_lines
+from hiab_sim.study.solvers.slsqp import (
     SolveResult,
     check_checkpoint,
     solve,
     study_digest,
 )
+from hiab_sim.study.spec.study_file import Study, load_study
 
 
 @dataclass(frozen=True)
@@ -55,8 +55,9 @@ def run_study(
     another study, ID path or start) raises before anything is written. A fresh run (no
     ``resume``) deletes every output of earlier runs; a folder of another study is refused unless
     ``force`` (:mod:`hiab_sim.study.run_safety`). A study of several tasks is solved as one
-    :class:`~hiab_sim.study.mix.MixProblem` and reported by :mod:`hiab_sim.study.mix_report`, with
-    the cross-evaluation of :mod:`hiab_sim.study.cross` unless ``cross`` is False. A failure of SLSQP on the
+    :class:`~hiab_sim.study.nlp.mix.MixProblem` and reported by :mod:`hiab_sim.study.report.mix`, with
+    the cross-evaluation of :mod:`hiab_sim.study.analysis.cross_evaluation` unless ``cross`` is False.
+    A failure of SLSQP on the
     study's own start raises :class:`SolverError` after its checkpoint (the partial history) is
     on disk; failures of extra starts are reported (``multistart.failed_starts``).
     """
@@ -64,7 +65,7 @@ def run_study(
     if not isinstance(study, Study):
         study = load_study(study)
     codesign = None
-    if study.energy.transmission is not None:  # issue 13: mounting x transmission catalogue, then the best
+    if study.energy.transmission is not None:  # mounting x transmission catalogue, then the best
         codesign, emlas = run_codesign(study, progress=progress)
         study = replace(study, emlas=emlas)
     problem = make_problem(study, id_path)
@@ -118,12 +119,12 @@ def run_study(
         result = replace(result, crane="crane.yaml", crane_source=study.crane_source)
     crane_label = study.crane_source if result.crane != "crane.yaml" else str(folder / "crane.yaml")
     if isinstance(problem, LinkLengthProblem):  # buildable design, feasibility, sensitivity: single-task studies
-        result = replace(result, **issue14_sections(problem, results[0].z, result, crane_label, phases))
+        result = replace(result, **analysis_sections(problem, results[0].z, result, crane_label, phases))
     write_results(folder, result, arrays)
     paths: list[Path] = []
     if figures:
-        from hiab_sim.study.cross_figure import cross_figure
-        from hiab_sim.study.figures import write_figures
+        from hiab_sim.study.figures.cross_evaluation import cross_figure
+        from hiab_sim.study.figures.optimisation import write_figures
 
         paths = write_figures(folder, problem.study.crane, problem.emlas, result, arrays, checks)
         if result.cross_evaluation is not None:

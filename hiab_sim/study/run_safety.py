@@ -1,7 +1,7 @@
 """Run safety: a result folder belongs to one study; fresh runs leave no stale output; resume restores its run.
 
 A run claims its output folder with an ownership marker ``owner.json`` (study path, name, content
-hash :func:`hiab_sim.study.solve.study_digest`, number of starts). Rules:
+hash :func:`hiab_sim.study.solvers.slsqp.study_digest`, number of starts). Rules:
 
 - a folder owned by another study (another content hash) is refused without ``force``; so is a
   non-empty folder that is not a result folder (nothing in it is hiab-sim's), so that ``--out``
@@ -11,7 +11,7 @@ hash :func:`hiab_sim.study.solve.study_digest`, number of starts). Rules:
   ``--no-figures`` re-run leaves no old figure beside a new result;
 - ``resume`` needs the folder's checkpoints (a typo in ``--out`` is an error, not a fresh run),
   and restores the run's own number of starts unless it is given; whether the checkpoints are
-  this run's is checked per start by :func:`hiab_sim.study.solve.check_checkpoint`.
+  this run's is checked per start by :func:`hiab_sim.study.solvers.slsqp.check_checkpoint`.
 
 Only files matching :data:`OUTPUT_PATTERNS` are ever deleted. Checks (:func:`check_folder`,
 :func:`resolve_starts`) write nothing; :func:`claim_folder` deletes and writes.

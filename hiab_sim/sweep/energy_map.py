@@ -37,10 +37,10 @@ from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.emla import ENVELOPE_LIMIT_NAMES, electrical_power, energy_summary, envelope_margins
 from hiab_sim.emla.battery import battery_power, trapezoid_weights
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study import trajectory as tr
-from hiab_sim.study.buildable import RobustXi, replace_lengths
-from hiab_sim.study.problem import ACTUATORS, STROKE_SCALE, LinkLengthProblem
-from hiab_sim.study.result import read_result
+from hiab_sim.results.schema import read_result
+from hiab_sim.study.analysis.buildable import RobustXi, replace_lengths
+from hiab_sim.study.motion import trajectory as tr
+from hiab_sim.study.nlp.problem import ACTUATORS, STROKE_SCALE, LinkLengthProblem
 
 Array = NDArray[np.float64]
 
@@ -194,10 +194,10 @@ def evaluate_designs(problem: LinkLengthProblem, base: BaseDesign, xi: Array) ->
 
 
 def _robust_rows(problem: LinkLengthProblem, base: BaseDesign, xi: Array) -> tuple[Array, list[str]]:
-    """The optimiser's rows of Xi only held within the manufacturing tolerance (issue 14), per design (D, R).
+    """The optimiser's rows of Xi only held within the manufacturing tolerance, per design (D, R).
 
     They depend on the link lengths alone (no samples), so each design is one call of the block
-    (:class:`hiab_sim.study.buildable.RobustXi`: the buildable range, the mounting space).
+    (:class:`hiab_sim.study.analysis.buildable.RobustXi`: the buildable range, the mounting space).
     """
     blocks = [b for b in problem.layout.blocks if isinstance(b, RobustXi)]
     if not blocks:

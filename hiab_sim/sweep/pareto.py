@@ -9,7 +9,7 @@ and one more, criterion(z) <= epsilon:
   ``torque_torque`` at the collocation samples (a proxy of the motors' thermal load).
 
 The epsilon rows are appended to the NLP's own rows (:class:`EpsilonProblem` wraps a
-:class:`~hiab_sim.study.problem.LinkLengthProblem` through its public methods); their Jacobian is
+:class:`~hiab_sim.study.nlp.problem.LinkLengthProblem` through its public methods); their Jacobian is
 by central differences in z. The front's epsilon runs from the plain optimum's criterion c_0
 (epsilon inactive: the plain study) down to the least criterion c_min the constraints allow
 (:func:`minimise_criterion`, the epigraph form min t s.t. -t <= s_k <= t), equally spaced, so
@@ -29,7 +29,7 @@ from scipy.optimize import minimize
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.emla.drive import drive_state
 from hiab_sim.errors import HiabSimError, InvalidInputError, SolverError
-from hiab_sim.study.problem import C_SCALE, XI_SCALE, LinkLengthProblem
+from hiab_sim.study.nlp.problem import C_SCALE, XI_SCALE, LinkLengthProblem
 
 Array = NDArray[np.float64]
 CRITERIA = {"peak_force": "N", "rms_torque": "N m"}
@@ -215,7 +215,7 @@ def pareto_front(problem: LinkLengthProblem, z_optimum: Array, name: str, points
 
     Args:
         problem: The study's NLP.
-        z_optimum: The plain study's optimum (scaled z), e.g. from :func:`hiab_sim.study.solve.solve`.
+        z_optimum: The plain study's optimum (scaled z), e.g. from :func:`hiab_sim.study.solvers.slsqp.solve`.
         name: ``peak_force`` or ``rms_torque``.
         points: Number of epsilon values (>= 2), equally spaced from c_0 to c_min.
 

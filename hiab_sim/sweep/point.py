@@ -19,7 +19,7 @@ from typing import Any
 import yaml
 
 from hiab_sim.crane.description import CHAIN_NAMES
-from hiab_sim.study.result import Result
+from hiab_sim.results.schema import Result
 
 #: Result columns of a row, in table order (the parameter columns come first, then these).
 RESULT_COLUMNS = (
@@ -102,8 +102,8 @@ def failed_row(message: str, wall_time: float) -> dict[str, Any]:
 
 def run_point(task: PointTask) -> PointOutcome:
     """Optimise one point's study (no figures, no video) and return its row."""
-    from hiab_sim.study.config import study_from_dict
     from hiab_sim.study.run import run_study
+    from hiab_sim.study.spec.study_file import study_from_dict
 
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="hiab-sweep-") as tmp:

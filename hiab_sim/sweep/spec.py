@@ -36,7 +36,7 @@ from typing import Any
 from hiab_sim.emla.config import ACTUATOR_NAMES, emla_set_from_mapping
 from hiab_sim.errors import ConfigError, HiabSimError
 from hiab_sim.resources import Source, locate
-from hiab_sim.study.config import study_from_dict
+from hiab_sim.study.spec.study_file import study_from_dict
 from hiab_sim.sweep.paths import parse_path, set_path
 from hiab_sim.yaml_fields import read_yaml
 

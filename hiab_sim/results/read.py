@@ -1,0 +1,99 @@
+"""Reading a result folder's designs for other tools (``mjcf --from-result``, ``compare``).
+
+The folder is read once, as a typed :class:`~hiab_sim.results.schema.Result`
+(:func:`read_run`); everything else here works on :class:`RunSummary`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.crane.loader import load_crane
+from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.resources import Source
+from hiab_sim.results.schema import RESULT_FILE, Result, read_result
+
+#: Designs a result holds, in the order tools show them.
+DESIGNS = ("initial", "optimal")
+#: Actuators whose peaks a result reports.
+ACTUATORS = ("lift", "tilt", "telescope")
+_HINT = "write one with 'hiab-sim optimize'"
+
+
+@dataclass(frozen=True)
+class DesignSummary:
+    """One design of a run: lengths [m], energies [J], per-actuator peaks and envelope margins."""
+
+    lengths: LinkLengths
+    net_energy_J: float
+    drawn_energy_J: float
+    battery_energy_J: float | None  # the energy the battery delivers (results with an energy section)
+    peak_force_N: dict[str, float]
+    peak_power_W: dict[str, float]
+    min_envelope_margin: dict[str, float]
+    max_violation: float
+
+
+@dataclass(frozen=True)
+class RunSummary:
+    """What other tools need from a result folder."""
+
+    folder: Path
+    name: str
+    crane: Crane
+    designs: dict[str, DesignSummary]
+    saved_percent: float  # net energy saved by the optimum [%]
+    recheck_max_violation: float  # fine-grid re-check of the optimum (scaled)
+
+
+def read_run(run_dir: str | Path) -> Result:
+    """The typed result of ``RUN_DIR``; a missing folder or file is a one-line :class:`ConfigError`."""
+    folder = Path(run_dir)
+    if not folder.is_dir():
+        raise ConfigError(f"result folder {folder} does not exist ({_HINT})")
+    if not (folder / RESULT_FILE).is_file():
+        raise ConfigError(f"{folder} is not a result folder: it has no {RESULT_FILE} ({_HINT})")
+    return read_result(folder)
+
+
+def result_crane(run_dir: str | Path, crane: str) -> Crane:
+    """The crane a result was computed for (its ``crane`` entry): a preset name, or a YAML file in the result folder."""
+    path = Path(run_dir) / RESULT_FILE
+    return load_crane(crane, relative_to=Source(str(path), path, False))
+
+
+def design_lengths(result: Result, design: str) -> LinkLengths:
+    """The link lengths of ``design`` (``initial`` or ``optimal``) of a result [m]."""
+    if design not in DESIGNS:
+        raise InvalidInputError("--design", design, f"must be one of {list(DESIGNS)}")
+    return (result.optimal if design == "optimal" else result.initial).lengths
+
+
+def summarise(run_dir: str | Path) -> RunSummary:
+    """Read a result folder into a :class:`RunSummary`."""
+    folder = Path(run_dir)
+    result = read_run(folder)
+    designs = {}
+    for name in DESIGNS:
+        entry = result.optimal if name == "optimal" else result.initial
+        energy = None if result.energy is None else getattr(result.energy, name)
+        designs[name] = DesignSummary(
+            lengths=entry.lengths,
+            net_energy_J=entry.net_electrical_energy_J,
+            drawn_energy_J=entry.drawn_energy_without_regeneration_J,
+            battery_energy_J=None if energy is None else energy.battery_energy_J,
+            peak_force_N={a: entry.actuators[a].peak_force_N for a in ACTUATORS},
+            peak_power_W={a: entry.actuators[a].peak_electrical_power_W for a in ACTUATORS},
+            min_envelope_margin={a: entry.actuators[a].min_envelope_margin for a in ACTUATORS},
+            max_violation=entry.max_violation,
+        )
+    return RunSummary(
+        folder=folder,
+        name=result.name,
+        crane=result_crane(folder, result.crane),
+        designs=designs,
+        saved_percent=result.improvement.net_energy_saved_percent,
+        recheck_max_violation=result.recheck.max_violation_scaled,
+    )

@@ -1,0 +1,381 @@
+"""Typed result of an optimisation run: the frozen dataclasses behind ``result.json``.
+
+Every key ``result.json`` had before it was typed is kept under its name (users read those
+names), and ``schema_version`` is written on top. Energies in [J], costs of eq. ``costf2`` in
+[W^2 s] (a squared-power integral, not an energy), lengths in [m], times in [s]; "scaled" values
+are the NLP's O(1) units. Link lengths are :class:`~hiab_sim.config.LinkLengths`, written as
+``{"lift": {"L", "Lc0", "Lc"}, "tilt": {...}}``.
+
+Extending the format: a new section is a field ``name: Section | None = optional()`` (added at the
+end of its dataclass), so files written before it still load (the field is None) and results
+without it do not write the key. ``schema_version`` changes only when a key is removed, renamed
+or changes its meaning; a reader refuses files of a newer schema. Unknown top-level keys are kept
+in :attr:`Result.extra` and written back.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TypeVar
+
+from hiab_sim.crane.description import LinkLengths
+from hiab_sim.errors import ConfigError
+from hiab_sim.results.analysis_sections import Buildable, CrossEvaluation, FeasibilityPhase, Sensitivity
+from hiab_sim.results.codec import from_json, optional, to_json
+from hiab_sim.results.energy_sections import Codesign, EnergyReport, HydraulicBaseline
+
+#: Version of the result.json layout; files without the key are version 1 (the same keys).
+SCHEMA_VERSION = 1
+RESULT_FILE = "result.json"
+#: Keys of :class:`EnergyBreakdown`, in the order the figures and tables show them.
+T = TypeVar("T")
+ENERGY_PARTS = ("mechanical", "copper", "rotor_friction", "screw_viscous", "inertial", "electrical")
+
+
+@dataclass(frozen=True)
+class EnergyBreakdown:
+    """Energy over the motion by power flow (:func:`hiab_sim.emla.operating_point`) [J].
+
+    electrical = mechanical + copper + rotor_friction + screw_viscous + inertial.
+    """
+
+    mechanical: float
+    copper: float
+    rotor_friction: float
+    screw_viscous: float
+    inertial: float
+    electrical: float
+
+    def as_tuple(self) -> tuple[float, ...]:
+        """The six energies in :data:`ENERGY_PARTS` order [J]."""
+        return tuple(getattr(self, k) for k in ENERGY_PARTS)
+
+
+@dataclass(frozen=True)
+class ActuatorSummary:
+    """One actuator over the motion: peaks, envelope margin, energies."""
+
+    peak_force_N: float
+    peak_velocity_m_per_s: float
+    peak_electrical_power_W: float
+    min_envelope_margin: float  # scaled, >= 0 inside the envelope
+    net_energy_J: float
+    drawn_energy_J: float
+    energy_J: EnergyBreakdown
+
+
+@dataclass(frozen=True)
+class WorstConstraint:
+    """The constraint row with the smallest scaled margin."""
+
+    name: str
+    scaled_margin: float
+
+
+@dataclass(frozen=True)
+class TrackingError:
+    """Largest deviation from the reference over the grid: TCP in the plane, telescope extension xt2."""
+
+    position_m: float
+    velocity_m_per_s: float
+    acceleration_m_per_s2: float
+    telescope_m: float
+
+
+@dataclass(frozen=True)
+class DesignSummary:
+    """One design (link lengths and trajectory) evaluated on a grid by one ID path.
+
+    ``collocation_cost_W2s`` and ``collocation_max_violation`` are set on the result's initial and
+    optimal designs (the optimiser's grid), not on the other fine-grid checks.
+    """
+
+    lengths: LinkLengths
+    id_path: str
+    grid_points: int
+    cost_W2s: float
+    cost_note: str
+    net_electrical_energy_J: float
+    drawn_energy_without_regeneration_J: float
+    drawn_energy_sum_of_actuators_J: float
+    energy_breakdown_J: EnergyBreakdown
+    actuators: dict[str, ActuatorSummary]
+    max_violation: float
+    worst_constraint: WorstConstraint
+    tracking_error: TrackingError
+    collocation_cost_W2s: float | None = optional()
+    collocation_max_violation: float | None = optional()
+
+
+@dataclass(frozen=True)
+class DecompositionDesign:
+    """One (lengths from, trajectory from) combination of the decomposition; mixed designs may fail to evaluate."""
+
+    lengths: str  # "initial" or "optimal"
+    trajectory: str  # "initial" or "optimal"
+    evaluable: bool
+    error: str | None = optional()
+    net_electrical_energy_J: float | None = optional()
+    drawn_energy_without_regeneration_J: float | None = optional()
+    cost_W2s: float | None = optional()
+    collocation_cost_W2s: float | None = optional()
+    max_violation: float | None = optional()
+    worst_constraint: WorstConstraint | None = optional()
+
+
+@dataclass(frozen=True)
+class Decomposition:
+    """The saving split into the lengths' and the trajectory's parts.
+
+    See :func:`~hiab_sim.study.report.result_folder.energy_decomposition`. Savings are relative to the initial
+    design [J, %]; None where a mixed design is not evaluable.
+    """
+
+    note: str
+    designs: dict[str, DecompositionDesign]
+    from_lengths_J: float | None
+    from_lengths_percent: float | None
+    from_trajectory_J: float | None
+    from_trajectory_percent: float | None
+    interaction_J: float | None
+    total_J: float | None
+
+
+@dataclass(frozen=True)
+class Improvement:
+    """Optimal vs initial design: collocation cost ratio and fine-grid net-energy saving."""
+
+    cost_ratio: float
+    net_energy_saved_J: float
+    net_energy_saved_percent: float
+    decomposition: Decomposition
+
+
+@dataclass(frozen=True)
+class SolverSummary:
+    """The SQP run of the study's own start."""
+
+    method: str
+    id_path: str
+    success: bool
+    status: int
+    message: str
+    iterations: int
+    wall_time_s: float
+    total_wall_time_s: float
+    max_violation_scaled: float
+    function_evaluations: int
+    gradient_evaluations: int
+
+
+@dataclass(frozen=True)
+class Recheck:
+    """The optimum re-evaluated on the fine grid with the other ID path and nominal bands."""
+
+    id_path: str
+    grid_points: int
+    note: str
+    max_violation_scaled: float
+    worst_constraint: WorstConstraint
+    tracking_error: TrackingError
+    net_electrical_energy_J: float
+    initial_max_violation_scaled: float
+    force_difference_between_paths_N: float
+
+
+@dataclass(frozen=True)
+class StartRow:
+    """One start of a multi-start run; a failed start has no optimal lengths or cost."""
+
+    start: int
+    initial_lengths: LinkLengths
+    optimal_lengths: LinkLengths | None
+    cost_W2s: float | None
+    success: bool
+    message: str
+    iterations: int
+
+
+@dataclass(frozen=True)
+class DistinctOptimum:
+    """Converged starts whose Xi agree within the tolerance; energy written with more than one start."""
+
+    xi: tuple[float, ...]  # [m], lift L, Lc0, Lc, tilt L, Lc0, Lc
+    cost_W2s: float | None
+    starts: tuple[int, ...]
+    net_electrical_energy_J: float | None = optional()
+
+
+@dataclass(frozen=True)
+class FailedStart:
+    """A start whose solver failed (no optimum)."""
+
+    start: int
+    initial_xi: tuple[float, ...]
+    message: str
+
+
+@dataclass(frozen=True)
+class MultiStart:
+    """Whether every converged start reached the same Xi within ``tolerance_m``; else the distinct optima."""
+
+    starts: tuple[StartRow, ...]
+    tolerance_m: float
+    converged_starts: int
+    same_optimum: bool
+    distinct_optima: tuple[DistinctOptimum, ...]
+    failed_starts: tuple[FailedStart, ...]
+
+
+@dataclass(frozen=True)
+class TrackingBands:
+    """The study's nominal tracking bands and the fraction of them held at the collocation points."""
+
+    position_m: float
+    velocity_m_per_s: float
+    acceleration_m_per_s2: float
+    collocation_fraction: float
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Discretisation, bounds and load of the run."""
+
+    spline_control_points: int
+    spline_degree: int
+    collocation_points: int
+    collocation_step_s: float
+    fine_grid_points: int
+    redundancy: str
+    tracking_bands: TrackingBands
+    xi_low: tuple[float, ...]
+    xi_up: tuple[float, ...]
+    envelope_margin: float
+    payload_kg: float
+
+
+@dataclass(frozen=True)
+class HistoryRow:
+    """One SQP iteration: cost [W^2 s], scaled cost, max violation (scaled), Xi [m], wall time [s]."""
+
+    iteration: int
+    cost: float
+    scaled_cost: float
+    max_violation: float
+    xi: tuple[float, ...]
+    wall_time: float
+
+
+@dataclass(frozen=True)
+class TaskResult:
+    """One task of a duty mix (:mod:`hiab_sim.study.report.mix`): share, load, grid, designs on its fine grid, re-check.
+
+    ``telescope`` says how the crane's redundancy is set for the task (prescribed by the reference).
+    """
+
+    name: str
+    weight: float
+    kind: str
+    duration_s: float
+    payload_kg: float
+    telescope: str
+    spline_control_points: int
+    collocation_points: int
+    initial: DesignSummary
+    optimal: DesignSummary
+    recheck: Recheck
+    energy: EnergyReport | None = optional()  # battery energy, costf2, thermal at the study's duty
+
+
+@dataclass(frozen=True)
+class Result:
+    """What ``hiab-sim optimize`` writes to ``result.json``.
+
+    ``crane`` is the preset name, or ``crane.yaml`` (a copy in the result folder) when the study
+    gave a file, then named in ``crane_source``; ``study`` is the study's path.
+    """
+
+    crane: str
+    study: str
+    name: str
+    initial: DesignSummary
+    optimal: DesignSummary
+    improvement: Improvement
+    solver: SolverSummary
+    recheck: Recheck
+    multistart: MultiStart
+    settings: Settings
+    history: tuple[HistoryRow, ...]
+    schema_version: int = SCHEMA_VERSION
+    crane_source: str | None = optional()
+    energy: EnergyReport | None = optional()  # battery energy and costf2, thermal
+    hydraulic_baseline: HydraulicBaseline | None = optional()
+    codesign: Codesign | None = optional()
+    tasks: tuple[TaskResult, ...] | None = optional()
+    cross_evaluation: CrossEvaluation | None = optional()
+    buildable: Buildable | None = optional()
+    feasibility: tuple[FeasibilityPhase, ...] | None = optional()
+    sensitivity: Sensitivity | None = optional()
+    extra: dict[str, Any] = field(default_factory=dict)  # keys of a newer writer, kept verbatim
+
+    def __post_init__(self) -> None:
+        if self.schema_version > SCHEMA_VERSION:
+            raise ConfigError(
+                f"result.json has schema_version {self.schema_version}; this hiab-sim reads up to {SCHEMA_VERSION}"
+            )
+
+    def to_json(self) -> dict[str, Any]:
+        """JSON-ready dict (``schema_version`` first)."""
+        data = to_json(self)
+        return {"schema_version": data.pop("schema_version"), **data}
+
+    @classmethod
+    def from_json(cls, data: Any) -> Result:
+        """Build from a parsed result.json (ConfigError names a missing or mistyped key)."""
+        return from_json(cls, data)
+
+
+@dataclass(frozen=True)
+class DesignLengths:
+    """The part of a design the renderer needs: its link lengths."""
+
+    lengths: LinkLengths
+
+
+@dataclass(frozen=True)
+class PlaybackView:
+    """The renderer's contract with a result: the crane and both designs' lengths."""
+
+    crane: str
+    initial: DesignLengths
+    optimal: DesignLengths
+
+    @classmethod
+    def from_json(cls, data: Any) -> PlaybackView:
+        """Build from a parsed result.json (other keys are ignored)."""
+        return from_json(cls, data)
+
+
+def parse_json(path: Path) -> Any:
+    """Parsed JSON of ``path``; ConfigError when it cannot be read or is not JSON."""
+    try:
+        return json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise ConfigError(f"{path}: not valid JSON: {error}") from None
+
+
+def read_json_as(cls: type[T], path: Path) -> T:
+    """``cls`` built from the JSON file ``path``; ConfigError names the file and the bad key."""
+    data = parse_json(path)
+    try:
+        return from_json(cls, data)
+    except ConfigError as error:
+        raise ConfigError(f"{path}: {error}") from None
+
+
+def read_result(folder: str | Path) -> Result:
+    """The :class:`Result` in ``folder/result.json`` (or the file itself); ConfigError names what is wrong."""
+    path = Path(folder)
+    return read_json_as(Result, path / RESULT_FILE if path.is_dir() else path)

@@ -1,0 +1,1 @@
+"""Analyses of an optimum: sensitivities, buildable designs, cross-evaluation, co-design, comparisons."""

@@ -1,0 +1,136 @@
+"""The price of robustness: every task's optimum alone and the mix optimum, each evaluated on every task.
+
+A design is a set of link lengths Xi. Evaluating it on a task re-optimises that task's trajectory
+at fixed Xi (:func:`fixed_lengths_optimum`: the task's NLP over its spline coefficients only, i.e.
+the Xi bounds collapsed to the design), because a crane built with those lengths would be driven
+as well as it can on that task. Evaluating it on the mix is the weighted sum over the tasks (the
+mix's NLP decouples into the tasks once Xi is fixed). The matrix rows are the designs, the columns
+the tasks: net electrical energy and energy drawn on each task's fine grid (nominal bands), the
+cost of eq. ``costf2`` on its collocation grid, and the largest violation. ``mix_energy_lost``
+is what a single-task design costs the mix in net energy over the mix optimum. The optimum
+minimises the squared-power cost, so an energy "loss" may be negative; so may the cost loss, by
+the spread of the non-convex NLP's local optima (~1e-5 relative on the test studies): each
+optimum is local, from its own start.
+"""
+
+from __future__ import annotations
+
+import copy
+
+from hiab_sim.crane.description import LinkLengths
+from hiab_sim.errors import HiabSimError
+from hiab_sim.results.analysis_sections import CrossEvaluation
+from hiab_sim.study.nlp.interface import N_XI, Array
+from hiab_sim.study.nlp.mix import MixProblem
+from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.report.result_folder import design_summary, fine_problem
+from hiab_sim.study.solvers.ipopt import solve_ipopt
+from hiab_sim.study.solvers.slsqp import solve
+
+#: Largest scaled violation of a design's re-optimised trajectory that counts as serving the task.
+FEASIBLE = 1e-6
+
+
+def fixed_lengths_optimum(
+    problem: LinkLengthProblem, lengths: LinkLengths, coefficients: Array | None = None
+) -> tuple[Array, bool, str]:
+    """The task's best trajectory for fixed link lengths: IPOPT on the task's NLP with Xi fixed.
+
+    The Xi bounds are collapsed to the design (IPOPT treats Xi as fixed parameters). IPOPT, not
+    SLSQP: started from the inverse-kinematics fit at a fixed Xi, SLSQP over the coefficients
+    stops with "positive directional derivative for linesearch" at violations of ~1e-3 (measured
+    on the two-task test study, even for a task's own optimal Xi), where IPOPT converges to < 1e-8.
+
+    Args:
+        problem: The task's NLP (collocation grid, tightened bands).
+        lengths: The design Xi [m].
+        coefficients: Start coefficients (3, N) (default: the inverse-kinematics fit).
+
+    Returns:
+        (z of the task's NLP, success, solver message); the point is used when it is feasible
+        (:data:`FEASIBLE`).
+
+    """
+    z0 = problem.initial_point(lengths, coefficients)
+    settings = problem.study.solver
+    fixed = copy.copy(problem)  # the same NLP (and caches) with the Xi bounds collapsed to the design
+    fixed.lower, fixed.upper = problem.lower.copy(), problem.upper.copy()
+    fixed.lower[:N_XI] = fixed.upper[:N_XI] = z0[:N_XI]
+    outcome = solve_ipopt(fixed, z0, settings.maxiter, settings.ftol)
+    return outcome.z, outcome.success, outcome.message
+
+
+def single_task_optima(mix: MixProblem) -> list[LinkLengths]:
+    """Each task's optimum alone, from the study's start (its own NLP, the study's solver settings)."""
+    out = []
+    for p in mix.problems:
+        result = solve(p, mix.study.initial_lengths, progress=None)
+        out.append(p.unpack(result.z)[0])
+    return out
+
+
+def cross_evaluation(mix: MixProblem, z_mix: Array, alone: list[LinkLengths] | None = None) -> CrossEvaluation:
+    """Rows: each task's optimum alone, then the mix optimum ``z_mix``; columns: the tasks (module docstring)."""
+    alone = single_task_optima(mix) if alone is None else alone
+    mix_lengths, mix_c = mix.unpack(z_mix)
+    designs = [f"{task.name} alone" for task in mix.tasks] + ["mix"]
+    lengths = [*alone, mix_lengths]
+    fines = [fine_problem(p) for p in mix.problems]
+    rows: dict[str, list[list[float | None]]] = {k: [] for k in ("net", "drawn", "cost", "viol")}
+    for d, xi in enumerate(lengths):
+        row: dict[str, list[float | None]] = {k: [] for k in rows}
+        for k, (p, fine) in enumerate(zip(mix.problems, fines, strict=True)):
+            start = mix_c[k] if d == len(alone) else None
+            values: tuple[float | None, ...] = (None, None, None, None)
+            try:
+                z, _, _ = fixed_lengths_optimum(p, xi, start)
+                summary = design_summary(fine, z).summary
+                if p.max_violation(z) <= FEASIBLE:
+                    values = (
+                        summary.net_electrical_energy_J,
+                        summary.drawn_energy_without_regeneration_J,
+                        p.evaluate(z).cost,
+                        summary.max_violation,
+                    )
+            except HiabSimError:
+                pass
+            for key, value in zip(row, values, strict=True):
+                row[key].append(value)
+        for key in rows:
+            rows[key].append(row[key])
+    w = mix.weights
+
+    def weighted(values: list[float | None]) -> float | None:
+        if any(v is None for v in values):
+            return None
+        return float(sum(wk * float(v) for wk, v in zip(w, values, strict=True) if v is not None))
+
+    mix_net = [weighted(r) for r in rows["net"]]
+    mix_cost = [weighted(r) for r in rows["cost"]]
+    best_net, best_cost = mix_net[-1], mix_cost[-1]
+
+    def lost(values: list[float | None], best: float | None, percent: bool) -> list[float | None]:
+        if best is None:
+            return [None] * len(values)
+        return [None if v is None else (100.0 * (v - best) / abs(best) if percent else v - best) for v in values]
+
+    return CrossEvaluation(
+        note=(
+            "rows: designs (each task's optimum alone, then the mix optimum); columns: tasks; trajectory "
+            "re-optimised at fixed Xi; energies on each task's fine grid, costs on its collocation grid; "
+            "mix = weighted sum over the tasks; None: the design cannot serve the task"
+        ),
+        tasks=tuple(task.name for task in mix.tasks),
+        weights=tuple(float(v) for v in w),
+        designs=tuple(designs),
+        lengths=tuple(lengths),
+        net_energy_J=tuple(tuple(r) for r in rows["net"]),
+        drawn_energy_J=tuple(tuple(r) for r in rows["drawn"]),
+        cost_W2s=tuple(tuple(r) for r in rows["cost"]),
+        max_violation=tuple(tuple(r) for r in rows["viol"]),
+        mix_net_energy_J=tuple(mix_net),
+        mix_cost_W2s=tuple(mix_cost),
+        mix_energy_lost_J=tuple(lost(mix_net, best_net, False)),
+        mix_energy_lost_percent=tuple(lost(mix_net, best_net, True)),
+        mix_cost_lost_percent=tuple(lost(mix_cost, best_cost, True)),
+    )

@@ -1,0 +1,1 @@
+"""Figures of a result: optimisation history, designs, energy and cross-evaluation."""

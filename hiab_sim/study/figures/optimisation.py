@@ -1,0 +1,183 @@
+"""Figures of an optimisation result (Agg backend, written atomically as PNG).
+
+Seed figures: objective per iteration (Fig. ``Objective_function``), decision variables per
+iteration (Figs. ``Decision_variables_1/2``), initial vs optimal structure (Fig.
+``Initial_Structure_Modified``), the crane with the spiral (Fig. ``hiab``); plus actuator force,
+velocity and electrical power over time, operating points on the efficiency maps, and the energy
+breakdown, initial vs optimal.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.emla import EmlaSet
+from hiab_sim.figure_io import new_figure, save_png
+from hiab_sim.results.analysis_sections import Sensitivity
+from hiab_sim.results.schema import HistoryRow, Result
+from hiab_sim.study.figures.design import (
+    cumulative_energy,
+    decision_panels,
+    draw_crane,
+    energy_bars,
+    sensitivity_bars,
+    structure_overlay,
+)
+from hiab_sim.study.figures.energy import hydraulic_figure
+from hiab_sim.study.nlp.problem import ACTUATORS
+from hiab_sim.study.report.result_folder import DesignCheck
+from hiab_sim.style import colour
+
+__all__ = ["draw_crane", "write_figures"]
+
+
+def objective_figure(history: tuple[HistoryRow, ...], path: Path) -> None:
+    """Scaled cost and max violation per SQP iteration (seed Fig. Objective_function)."""
+    fig = new_figure((6.5, 4.0))
+    ax = fig.add_subplot()
+    it = [h.iteration for h in history]
+    ax.plot(it, [h.scaled_cost for h in history], "o-", color=colour("optimal"), markersize=3)
+    ax.set_xlabel("SQP iteration")
+    ax.set_ylabel("cost f / f(start)  (eq. costf2)")
+    ax2 = ax.twinx()
+    ax2.semilogy(it, [max(h.max_violation, 1e-16) for h in history], ".--", color="tab:gray", markersize=3)
+    ax2.set_ylabel("max constraint violation (scaled)")
+    ax.set_title("Objective per iteration")
+    save_png(fig, path)
+
+
+def decision_figure(
+    history: tuple[HistoryRow, ...], chain: int, name: str, path: Path, low: np.ndarray, up: np.ndarray
+) -> None:
+    """L, Lc0, Lc of one chain per iteration with the bounds shaded (seed Figs. Decision_variables_1/2)."""
+    fig = new_figure((6.5, 6.0))
+    axes = fig.subplots(3, 1, sharex=True)
+    decision_panels(axes, history, chain, low, up)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(f"Decision variables of the {name} chain (grey: outside the bounds)")
+    save_png(fig, path)
+
+
+def structure_figure(crane: Crane, designs: dict[str, LinkLengths], pose: np.ndarray, path: Path, label: str) -> None:
+    """Both structures overlaid in one pose, pivot shifts dimensioned (seed Fig. Initial_Structure_Modified)."""
+    fig = new_figure((8.0, 6.4))
+    structure_overlay(fig.add_subplot(), crane, designs, pose, label)
+    save_png(fig, path)
+
+
+def spiral_figure(
+    crane: Crane, lengths: LinkLengths, joints: np.ndarray, ref: np.ndarray, tcp: np.ndarray, path: Path
+) -> None:
+    """The crane at a few poses along the motion, with the reference spiral (seed Fig. hiab)."""
+    fig = new_figure((7.0, 5.0))
+    ax = fig.add_subplot()
+    for i, idx in enumerate(np.linspace(0, len(joints) - 1, 5).astype(int)):
+        draw_crane(ax, crane, lengths, joints[idx], colour("optimal"), alpha=0.2 + 0.15 * i)
+    ax.plot(ref[:, 0], ref[:, 1], "-", color=colour("reference"), linewidth=2, label="reference spiral")
+    ax.plot(tcp[:, 0], tcp[:, 1], "--", color=colour("optimal"), linewidth=1, label="TCP (optimal design)")
+    ax.set_aspect("equal")
+    ax.grid(alpha=0.3)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m] (up)")
+    ax.legend(loc="lower left", fontsize=8)
+    ax.set_title("Crane following the spiral (vertical plane of {W})")
+    save_png(fig, path)
+
+
+def actuator_figure(time: np.ndarray, checks: dict[str, DesignCheck], path: Path) -> None:
+    """Force, velocity and electrical power per actuator over time, initial vs optimal."""
+    fig = new_figure((12.0, 8.0))
+    axes = fig.subplots(3, 3, sharex=True)
+    for name in ("initial", "optimal"):
+        ev = checks[name].evaluation
+        for i, act in enumerate(ACTUATORS):
+            axes[0, i].plot(time, ev.actuators.force[:, i] / 1e3, color=colour(name), label=name)
+            axes[1, i].plot(time, ev.actuators.velocity[:, i], color=colour(name))
+            axes[2, i].plot(time, ev.power[:, i] / 1e3, color=colour(name))
+            axes[0, i].set_title(act)
+    for i in range(3):
+        axes[2, i].set_xlabel("time [s]")
+    axes[0, 0].set_ylabel("force f_x [kN]")
+    axes[1, 0].set_ylabel("velocity v_x [m/s]")
+    axes[2, 0].set_ylabel("electrical power [kW]")
+    axes[0, 0].legend()
+    for ax in axes.ravel():
+        ax.grid(alpha=0.3)
+    save_png(fig, path)
+
+
+def efficiency_figure(emlas: EmlaSet, checks: dict[str, DesignCheck], path: Path) -> None:
+    """Operating points (initial, optimal) over each actuator's efficiency map."""
+    from hiab_sim.emla.maps import efficiency_map, plot_efficiency_map
+
+    fig = new_figure((19.0, 6.0))
+    axes = fig.subplots(1, 3)
+    for i, (ax, params) in enumerate(zip(axes, emlas, strict=True)):
+        emap = efficiency_map(params, n_force=81, n_velocity=81)
+        ini = checks["initial"].evaluation.actuators
+        opt = checks["optimal"].evaluation.actuators
+        designs = {"initial": (ini.force[:, i], ini.velocity[:, i]), "optimal": (opt.force[:, i], opt.velocity[:, i])}
+        plot_efficiency_map(emap, ax=ax, designs=designs)
+    save_png(fig, path)
+
+
+def energy_figure(time: np.ndarray, checks: dict[str, DesignCheck], path: Path) -> None:
+    """Energy breakdown with values on the bars, and the cumulative net electrical energy, initial vs optimal."""
+    fig = new_figure((12.0, 4.4))
+    left, right = fig.subplots(1, 2, width_ratios=(1.3, 1.0))
+    names = ("initial", "optimal")
+    energy_bars(left, {n: checks[n].summary.energy_breakdown_J.as_tuple() for n in names})
+    left.set_title("Energy breakdown (all actuators, fine grid)")
+    cumulative_energy(right, time, {n: checks[n].evaluation.power for n in names})
+    right.set_title("Cumulative net electrical energy")
+    save_png(fig, path)
+
+
+def sensitivity_figure(sensitivity: Sensitivity, path: Path) -> None:
+    """The active constraints' multipliers in physical units (result.json -> sensitivity)."""
+    fig = new_figure((10.0, 5.0))
+    sensitivity_bars(fig.add_subplot(), sensitivity)
+    save_png(fig, path)
+
+
+def write_figures(
+    out: Path,
+    crane: Crane,
+    emlas: EmlaSet,
+    result: Result,
+    arrays: dict[str, np.ndarray],
+    checks: dict[str, DesignCheck],
+) -> list[Path]:
+    """Write every figure into ``out``; return their paths."""
+    designs = {"initial": result.initial.lengths, "optimal": result.optimal.lengths}
+    history = result.history
+    paths = {
+        "objective": out / "objective.png",
+        "lift": out / "decision_variables_lift.png",
+        "tilt": out / "decision_variables_tilt.png",
+        "structure": out / "structure_initial_vs_optimal.png",
+        "spiral": out / "crane_spiral.png",
+        "actuators": out / "actuators_force_velocity_power.png",
+        "maps": out / "efficiency_maps.png",
+        "energy": out / "energy_breakdown.png",
+    }
+    objective_figure(history, paths["objective"])
+    low, up = np.asarray(result.settings.xi_low), np.asarray(result.settings.xi_up)
+    decision_figure(history, 0, "lift", paths["lift"], low, up)
+    decision_figure(history, 1, "tilt", paths["tilt"], low, up)
+    joints = arrays["optimal_position"]
+    mid = len(joints) // 2
+    label = f"t = {arrays['time'][mid]:.2f} s of the optimal motion"
+    structure_figure(crane, designs, joints[mid], paths["structure"], label)
+    spiral_figure(crane, designs["optimal"], joints, arrays["reference_tcp"], arrays["optimal_tcp"], paths["spiral"])
+    actuator_figure(arrays["time"], checks, paths["actuators"])
+    efficiency_figure(emlas, checks, paths["maps"])
+    energy_figure(arrays["time"], checks, paths["energy"])
+    if result.sensitivity is not None:
+        paths["sensitivity"] = out / "sensitivity.png"
+        sensitivity_figure(result.sensitivity, paths["sensitivity"])
+    hydraulic = hydraulic_figure(out / "energy_emla_vs_hydraulic.png", crane, result, checks["optimal"].evaluation)
+    return list(paths.values()) + hydraulic

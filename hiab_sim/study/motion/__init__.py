@@ -1,0 +1,1 @@
+"""B-spline joint trajectories, planar TCP kinematics and inverse kinematics of the reference."""

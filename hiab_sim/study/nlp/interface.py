@@ -1,0 +1,231 @@
+"""The building blocks of the NLP: what a constraint block or an objective sees, returns and owns.
+
+A point z of the NLP is turned by :class:`hiab_sim.study.nlp.problem.LinkLengthProblem` into a
+:class:`SampleState` (link lengths Xi, joint samples q9 = (theta, dtheta, ddtheta) per sample,
+TCP samples, actuator samples [f_x, v_x, a_x] from the inverse dynamics, EMLA electrical power).
+Blocks and objectives read only that state and, for gradients, :class:`SamplePartials` (the
+inverse dynamics' partials, computed at most once per point and only when asked for). They
+return partials w.r.t. the per-sample q9 and the unscaled Xi [per m]; the problem chains them
+through the B-spline matrices and the variable scaling to z, so no block knows the layout of z.
+
+A constraint block (:class:`ConstraintBlock`) owns its ``name``, its row names, its values
+(scaled to O(1), feasible where >= 0), its partials, and an optional clearance (a margin the
+optimiser keeps that is not part of the nominal constraint). Its Jacobian is either
+:class:`SampleRows` (row k * r + i depends on sample k only: tracking, envelope, strokes) or
+:class:`DenseRows` (a row depends on many samples, e.g. an RMS-torque integral, or on Xi only,
+e.g. the working range). :class:`BlockLayout` assembles row names, row slices, clearances and
+the Jacobian of one list of blocks, and splits any row vector (margins, multipliers) by block.
+
+An objective (:class:`Objective`) returns its value [its unit] and gradient w.r.t. q9 (K, 9)
+and Xi (6,); the problem divides both by its ``cost_scale``.
+
+Extending (one edit each):
+
+- a block: subclass :class:`PerSampleBlock` (same rows at every sample, return :class:`SampleRows`)
+  or :class:`ConstraintBlock` (return :class:`DenseRows`), and add an instance to
+  ``LinkLengthProblem._build_blocks``. An integral row (RMS torque over the duty, a thermal
+  steady state) returns ``DenseRows(dq=(m, K, 9), dxi=(m, 6))``; a row of Xi only (working
+  range, mounting-space polygons) ``DenseRows(dxi=...)``; an epsilon constraint on any objective
+  is :class:`hiab_sim.study.nlp.blocks.ObjectiveBound`.
+- an objective: a class with ``name``, ``unit``, ``value`` and ``gradient`` and one entry in
+  :data:`hiab_sim.study.nlp.objectives.OBJECTIVES`.
+- several tasks: each task's blocks read that task's state; the problem's ``to_z(block, jacobian,
+  rows)`` (passed to :meth:`BlockLayout.jacobian`) receives the block, so it can map q9 partials
+  to the block's task's spline matrices and coefficient columns.
+- multipliers or margins by name: :meth:`BlockLayout.split` and :meth:`BlockLayout.named` cut any
+  row vector into blocks and rows.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiab_sim.crane.description import LinkLengths
+from hiab_sim.dynamics.samples import ActuatorSamples
+from hiab_sim.study.motion import trajectory as tr
+
+Array = NDArray[np.float64]
+
+#: Per-sample joint quantities a block may depend on: q9 = (theta 0-2, dtheta 3-5, ddtheta 6-8).
+N_Q = 9
+#: Link-length variables Xi = (lift L, Lc0, Lc, tilt L, Lc0, Lc) [m].
+N_XI = 6
+
+
+@dataclass(frozen=True)
+class SampleState:
+    """What blocks and objectives read at one point (SI units, K samples at ``joints.time``)."""
+
+    lengths: LinkLengths
+    joints: tr.JointTrajectory  # (K, 3) each
+    tcp: tr.TcpSamples  # (K, 3) each, partials (K, 3, 9)
+    actuators: ActuatorSamples  # (K, 3) each
+    power: Array  # (K, 3) EMLA electrical power [W]
+
+
+class SamplePartials:
+    """Inverse-dynamics partials at one point, each computed on first use and then kept.
+
+    ``id_q``: d(f, v, a)/d(q9) per sample, (K, 9 outputs, 9 inputs); outputs in the order
+    (f_lift, f_tilt, f_tele, v_lift, ..., a_tele). ``id_xi``: d(f, v, a)/dXi per sample,
+    (K, 9, 6) [per m].
+    """
+
+    def __init__(self, id_q: Callable[[], Array], id_xi: Callable[[], Array]) -> None:
+        self._id_q = id_q
+        self._id_xi = id_xi
+
+    @cached_property
+    def id_q(self) -> Array:
+        """d(f, v, a)/d(theta, dtheta, ddtheta), (K, 9, 9)."""
+        return self._id_q()
+
+    @cached_property
+    def id_xi(self) -> Array:
+        """d(f, v, a)/dXi, (K, 9, 6) [per m]."""
+        return self._id_xi()
+
+
+@dataclass(frozen=True)
+class SampleRows:
+    """Jacobian of r rows per sample (row k * r + i depends on sample k only).
+
+    ``dq``: (K, r, 9) w.r.t. that sample's q9; ``dxi``: (K, r, 6) w.r.t. Xi [per m], None if zero.
+    """
+
+    dq: Array
+    dxi: Array | None = None
+
+
+@dataclass(frozen=True)
+class DenseRows:
+    """Jacobian of m rows that may depend on every sample (integrals) or on Xi only.
+
+    ``dq``: (m, K, 9) w.r.t. every sample's q9, None if zero; ``dxi``: (m, 6) [per m], None if zero.
+    """
+
+    dq: Array | None = None
+    dxi: Array | None = None
+
+
+BlockJacobian = SampleRows | DenseRows
+
+
+class ConstraintBlock(ABC):
+    """One named group of inequality rows g >= 0 (scaled to O(1)).
+
+    Subclasses set ``name`` and implement :meth:`row_names`, :meth:`values` and :meth:`jacobian`;
+    they may override :meth:`clearance`. Row names start with ``name + "."``.
+    """
+
+    name: str
+
+    @abstractmethod
+    def row_names(self) -> list[str]:
+        """One name per row, in row order."""
+
+    @abstractmethod
+    def values(self, state: SampleState) -> Array:
+        """The solver's rows at ``state``, (m,), feasible where >= 0."""
+
+    @abstractmethod
+    def jacobian(self, state: SampleState, partials: SamplePartials) -> BlockJacobian:
+        """Partials of :meth:`values` w.r.t. q9 and Xi."""
+
+    def clearance(self) -> Array | float:
+        """Added to :meth:`values` gives the nominal margins (a safety only the optimiser keeps); default 0."""
+        return 0.0
+
+
+class PerSampleBlock(ConstraintBlock):
+    """A block with the same rows at every sample time, named ``<name>.<row> at t=<t> s``."""
+
+    times: Array
+    sample_rows: tuple[str, ...]
+    #: Pairs (a, b) of this block's per-sample rows whose values add up to a constant (the lower
+    #: and upper limit of one quantity): g_a + g_b does not depend on z. A sparse solver may hold
+    #: such a pair as one two-sided row 0 <= g_a <= g_a + g_b (half the rows, same feasible set).
+    pairs: tuple[tuple[int, int], ...] = ()
+
+    def row_names(self) -> list[str]:
+        """Sample-major names: every row of sample 0, then of sample 1, ..."""
+        return [f"{self.name}.{row} at t={t:.4g} s" for t in self.times for row in self.sample_rows]
+
+
+class Objective(Protocol):
+    """The NLP's objective: a value and its gradient w.r.t. per-sample q9 and Xi."""
+
+    name: str
+    unit: str
+
+    def value(self, state: SampleState) -> float:
+        """Objective at ``state`` [``unit``]."""
+        ...
+
+    def gradient(self, state: SampleState, partials: SamplePartials) -> tuple[Array, Array]:
+        """(d/dq9 per sample (K, 9), d/dXi (6,) [per m]) [``unit`` per unit of q9 or m]."""
+        ...
+
+
+class BlockLayout:
+    """Rows of an ordered list of constraint blocks: names, slices, clearances, values and Jacobian."""
+
+    def __init__(self, blocks: Sequence[ConstraintBlock]) -> None:
+        names = [block.name for block in blocks]
+        if len(set(names)) != len(names):
+            raise ValueError(f"constraint block names must be unique: {names}")
+        self.blocks = tuple(blocks)
+        self.names: list[str] = []
+        self.slices: dict[str, slice] = {}
+        for block in self.blocks:
+            rows = block.row_names()
+            self.slices[block.name] = slice(len(self.names), len(self.names) + len(rows))
+            self.names += rows
+        #: added to the solver's rows gives the nominal margins
+        self.clearance = np.zeros(len(self.names))
+        for block in self.blocks:
+            self.clearance[self.slices[block.name]] = block.clearance()
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def values(self, state: SampleState) -> Array:
+        """Every block's rows, concatenated in block order."""
+        out = np.concatenate([block.values(state) for block in self.blocks])
+        if len(out) != len(self.names):
+            raise AssertionError(f"{len(out)} constraint values for {len(self.names)} named rows")
+        return out
+
+    def jacobian(
+        self,
+        state: SampleState,
+        partials: SamplePartials,
+        to_z: Callable[[ConstraintBlock, BlockJacobian, int], Array],
+    ) -> Array:
+        """Jacobian (m, n): each block's partials mapped to z by ``to_z(block, jacobian, rows)``.
+
+        ``to_z`` belongs to the problem, which alone knows the layout of z (for several tasks it
+        picks the block's task's spline matrices and columns).
+        """
+        parts = []
+        for block in self.blocks:
+            rows = self.slices[block.name]
+            parts.append(to_z(block, block.jacobian(state, partials), rows.stop - rows.start))
+        return np.concatenate(parts, axis=0)
+
+    def split(self, rows: Array) -> dict[str, Array]:
+        """A row vector (margins, multipliers) cut into blocks by name."""
+        rows = np.asarray(rows)
+        return {name: rows[s] for name, s in self.slices.items()}
+
+    def named(self, rows: Array) -> dict[str, dict[str, float]]:
+        """A row vector as {block name: {row name: value}} (e.g. multipliers for a sensitivity report)."""
+        rows = np.asarray(rows, dtype=float)
+        return {name: dict(zip(self.names[s], map(float, rows[s]), strict=True)) for name, s in self.slices.items()}

@@ -1,0 +1,103 @@
+"""Objectives of the NLP, each a value and a gradient w.r.t. per-sample q9 and Xi (see :mod:`.nlp`).
+
+* :class:`SquaredPowerCost` (``costf2``, the seed's eq. ``costf2``, the default):
+  f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 [W^2 s], a rectangle sum over every sample of the squared
+  summed EMLA electrical power P_i (:mod:`hiab_sim.emla`, never f v / eta). It is a
+  squared-power integral, not an energy.
+* :class:`BatteryEnergyCost` (``battery_energy``): the energy the battery delivers over the cycle
+  through a DC bus shared by the drives (:func:`hiab_sim.emla.battery_energy`: inverter, bus,
+  battery charge/discharge efficiencies; regeneration of one drive feeds the others first),
+  trapezoid rule on the sample grid [J]. The solver sees the softplus-smoothed kinks (width
+  ``battery.smoothing_power`` of the EMLA set, error <= :meth:`BatteryParams.smoothing_bound`);
+  reports use the exact value (:mod:`hiab_sim.study.report.energy_section`).
+
+An objective is chosen by name with :func:`make_objective`; a new one is a class with ``name``,
+``unit``, ``value(state)`` and ``gradient(state, partials)`` plus one entry in :data:`OBJECTIVES`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from hiab_sim.emla import EmlaSet, battery_energy, electrical_power_partials
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.study.nlp.interface import Array, Objective, SamplePartials, SampleState
+
+
+class SquaredPowerCost:
+    """f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 (seed eq. ``costf2``) [W^2 s].
+
+    Args:
+        emlas: the EMLA set whose electrical power P_i the state carries.
+        dt: the sample step Dt [s].
+
+    """
+
+    name = "costf2"
+    unit = "W^2 s"
+
+    def __init__(self, emlas: EmlaSet, dt: float) -> None:
+        self.emlas = emlas
+        self.dt = dt
+
+    def value(self, state: SampleState) -> float:
+        """1/2 Dt sum_k (sum_i P_i)^2 [W^2 s]."""
+        total = state.power.sum(axis=1)
+        return 0.5 * self.dt * float(np.sum(total**2))
+
+    def gradient(self, state: SampleState, partials: SamplePartials) -> tuple[Array, Array]:
+        """Dt (sum_i P_i) dP/d(f, v, a) chained through the inverse dynamics' partials."""
+        total = state.power.sum(axis=1)
+        return _chain(self.emlas, state, partials, self.dt * np.repeat(total[:, None], 3, axis=1))
+
+
+class BatteryEnergyCost:
+    """E_bat = int P_bat dt over the sample grid (trapezoid), smooth kinks [J] (:mod:`hiab_sim.emla.battery`).
+
+    Args:
+        emlas: the EMLA set (its ``battery`` section gives the efficiencies and the smoothing).
+        dt: the sample step Dt [s] (unused: the trapezoid weights come from the state's times).
+
+    """
+
+    name = "battery_energy"
+    unit = "J"
+
+    def __init__(self, emlas: EmlaSet, dt: float) -> None:
+        self.emlas = emlas
+        self.dt = dt
+
+    def value(self, state: SampleState) -> float:
+        """Smooth battery energy [J] (within the smoothing bound of the exact one)."""
+        return battery_energy(state.joints.time, state.power, self.emlas.battery, smooth=True).energy
+
+    def gradient(self, state: SampleState, partials: SamplePartials) -> tuple[Array, Array]:
+        """dE/dP_i (per sample and drive) chained through dP/d(f, v, a) and the inverse dynamics' partials."""
+        dE_dP = battery_energy(state.joints.time, state.power, self.emlas.battery, smooth=True).gradient
+        return _chain(self.emlas, state, partials, dE_dP)
+
+
+def _chain(emlas: EmlaSet, state: SampleState, partials: SamplePartials, df_dP: Array) -> tuple[Array, Array]:
+    """(d/dq9 (K, 9), d/dXi (6,)) of an objective from its partials w.r.t. each drive's power, df_dP (K, 3)."""
+    act = state.actuators
+    dY = np.zeros((len(state.power), 9))  # w.r.t. Y = (f0 f1 f2 v0 v1 v2 a0 a1 a2)
+    for i, p in enumerate(emlas):
+        pf, pv, pa = electrical_power_partials(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
+        dY[:, i], dY[:, 3 + i], dY[:, 6 + i] = df_dP[:, i] * pf, df_dP[:, i] * pv, df_dP[:, i] * pa
+    return np.einsum("ky,kyq->kq", dY, partials.id_q), np.einsum("ky,kyx->x", dY, partials.id_xi)
+
+
+#: Objectives by the name a study gives, each built from (EMLA set, sample step Dt [s]).
+OBJECTIVES: dict[str, Callable[[EmlaSet, float], Objective]] = {
+    "costf2": SquaredPowerCost,
+    "battery_energy": BatteryEnergyCost,
+}
+
+
+def make_objective(name: str, emlas: EmlaSet, dt: float) -> Objective:
+    """The objective called ``name`` (one of :data:`OBJECTIVES`)."""
+    if name not in OBJECTIVES:
+        raise InvalidInputError("objective", name, f"must be one of {', '.join(OBJECTIVES)}")
+    return OBJECTIVES[name](emlas, dt)

@@ -1,0 +1,92 @@
+"""Motor thermal limits as NLP constraint rows: RMS torque and periodic winding temperature.
+
+For every EMLA with thermal data (:class:`hiab_sim.emla.ThermalParams`), over the study's duty
+(the cycle on the problem's grid followed by a rest at zero torque, :mod:`hiab_sim.emla.thermal`):
+
+* ``thermal.<actuator> rms torque``: 1 - tau_rms / tau_cont >= 0 [-];
+* ``thermal.<actuator> winding temperature``: (T_max - T_peak) / ``TEMPERATURE_SCALE`` >= 0.
+
+Values and partials w.r.t. the actuator samples (f_x, v_x, a_x) come from
+:func:`hiab_sim.emla.thermal_check` (smooth model, exact gradients); they are chained here through
+the inverse dynamics' partials to q9 and Xi. Each row depends on every sample (an integral over
+the cycle), so the Jacobian is :class:`~hiab_sim.study.nlp.interface.DenseRows`. The trapezoid rule on the
+collocation grid is the optimiser's quadrature; the result re-checks on the 10x finer grid.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hiab_sim.emla import EmlaSet, ThermalCheck, thermal_check
+from hiab_sim.emla.thermal import Duty
+from hiab_sim.study.nlp.interface import Array, ConstraintBlock, DenseRows, SamplePartials, SampleState
+from hiab_sim.study.spec.energy import DutySettings
+
+#: Winding-temperature margins are divided by this [K] (O(1) rows).
+TEMPERATURE_SCALE = 100.0
+
+
+class ThermalLimits(ConstraintBlock):
+    """RMS-torque and winding-temperature margins of the EMLAs with thermal data (two rows each)."""
+
+    name = "thermal"
+
+    def __init__(self, emlas: EmlaSet, duty: Duty) -> None:
+        self.indices = [i for i, p in enumerate(emlas) if p.thermal is not None]
+        self.emlas = emlas.as_tuple()
+        self.duty = duty
+
+    def row_names(self) -> list[str]:
+        """Two rows per actuator: ``thermal.<name> rms torque``, ``thermal.<name> winding temperature``."""
+        out = []
+        for i in self.indices:
+            out += [
+                f"{self.name}.{self.emlas[i].name} rms torque",
+                f"{self.name}.{self.emlas[i].name} winding temperature",
+            ]
+        return out
+
+    def _checks(self, state: SampleState) -> list[tuple[int, ThermalCheck]]:
+        act, t = state.actuators, state.joints.time
+        return [
+            (
+                i,
+                thermal_check(self.emlas[i], t, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], self.duty),
+            )
+            for i in self.indices
+        ]
+
+    def values(self, state: SampleState) -> Array:
+        """[1 - tau_rms/tau_cont, (T_max - T_peak)/100 K] per actuator."""
+        out = []
+        for _, c in self._checks(state):
+            out += [c.torque_margin, c.temperature_margin / TEMPERATURE_SCALE]
+        return np.asarray(out, dtype=float)
+
+    def jacobian(self, state: SampleState, partials: SamplePartials) -> DenseRows:
+        """Rows' partials: d/d(f, v, a)_k from the thermal check, chained through the ID partials."""
+        K = len(state.joints.time)
+        rows = []
+        for i, c in self._checks(state):
+            for d, scale in ((c.d_rms, -1.0 / c.continuous_torque), (c.d_peak, -1.0 / TEMPERATURE_SCALE)):
+                dY = np.zeros((K, 9))
+                dY[:, i], dY[:, 3 + i], dY[:, 6 + i] = scale * d[0], scale * d[1], scale * d[2]
+                rows.append(dY)
+        dYs = np.stack(rows) if rows else np.zeros((0, K, 9))
+        dq = np.einsum("mky,kyq->mkq", dYs, partials.id_q)
+        dxi = np.einsum("mky,kyx->mx", dYs, partials.id_xi)
+        return DenseRows(dq=dq, dxi=dxi)
+
+
+def thermal_blocks(emlas: EmlaSet, duty: DutySettings | None, cycle_time: float) -> list[ConstraintBlock]:
+    """``[ThermalLimits]`` when the study has a duty and some EMLA has thermal data, else ``[]``.
+
+    Args:
+        emlas: The EMLA set.
+        duty: The study's ``duty`` (None: no thermal rows).
+        cycle_time: The cycle's duration T [s] (the study's grid duration).
+
+    """
+    if duty is None or not any(p.thermal is not None for p in emlas):
+        return []
+    return [ThermalLimits(emlas, duty.duty(cycle_time))]

@@ -1,0 +1,109 @@
+"""The ``buildable`` section of a result: the optimum rounded to the tolerance and re-checked three ways.
+
+1. the crane's own length check (:func:`hiab_sim.crane.mechanism.check_lengths`) over the buildable
+   working range (:func:`hiab_sim.crane.tolerance.buildable_crane`), what ``hiab-sim mjcf
+   --stroke-margin M --lengths ...`` runs;
+2. every design within +-tolerance of the optimum (the 64 corners of the box, the nominal and the
+   rounded design) on the working-range and mounting rows (:func:`hiab_sim.crane.tolerance.check_tolerance`);
+3. the fine-grid re-check of the rounded lengths with the optimal trajectory: the nominal NLP rows
+   (tracking bands, EMLA envelope, strokes, joints, working range) of a study whose crane has the
+   buildable range, on the other inverse-dynamics path, with its energy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from hiab_sim.crane import mechanism
+from hiab_sim.crane.description import LinkLengths
+from hiab_sim.crane.tolerance import buildable_crane, check_tolerance, design_margins, range_cost_deg
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.results.analysis_sections import Buildable, RoundedCheck
+from hiab_sim.results.schema import DesignSummary
+from hiab_sim.study.analysis.buildable import rounded_design
+from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.report.result_folder import design_summary, other_path
+
+Array = np.ndarray
+
+
+def rounded_point(problem: LinkLengthProblem, z: Array) -> tuple[LinkLengths, Array]:
+    """The rounded lengths of the optimum z and the point (rounded Xi, optimal trajectory)."""
+    lengths, _ = problem.unpack(z)
+    study = problem.study
+    rounded = rounded_design(
+        lengths, study.build.tolerance, np.asarray(study.bounds.xi_low), np.asarray(study.bounds.xi_up)
+    )
+    z_rounded = np.array(z, dtype=float)
+    z_rounded[: problem.n_xi] = rounded.as_array()
+    return rounded, z_rounded
+
+
+def mjcf_command(study_crane: str, stroke_margin: float, lengths: LinkLengths) -> str:
+    """The ``hiab-sim mjcf`` command that exports a rounded design."""
+    xi = ",".join(f"{v:g}" for v in lengths.as_array())
+    return f"hiab-sim mjcf --crane {study_crane} --stroke-margin {stroke_margin:g} --lengths {xi}"
+
+
+def buildable_section(problem: LinkLengthProblem, z: Array, optimum: DesignSummary, crane_label: str) -> Buildable:
+    """Round the optimum z to the study's tolerance and re-check it (module docstring)."""
+    study = problem.study
+    t, margin = study.build.tolerance, study.build.stroke_margin
+    rounded, z_rounded = rounded_point(problem, z)
+    short = buildable_crane(study.crane, margin)
+    try:
+        mechanism.check_lengths(short, rounded)
+        crane_check = RoundedCheck(True, "check_lengths over the buildable working range", 0.0, "m")
+    except InvalidInputError as error:
+        crane_check = RoundedCheck(False, str(error), float("nan"), "m")
+    lengths, _ = problem.unpack(z)
+    tol = check_tolerance(design_margins(short, study.mounting), lengths, t)
+    label, row, value = tol.worst()
+    tolerance_check = RoundedCheck(tol.ok, f"{row} at the {label} design", value, "m")
+    fine = LinkLengthProblem(
+        replace(study, crane=short),
+        emlas=problem.emlas,
+        id_path=other_path(problem.id_path),
+        times=study.grid.fine_times(),
+        cost_scale=problem.cost_scale,
+        tightened=False,
+    )
+    summary = design_summary(fine, z_rounded).summary
+    worst = summary.worst_constraint
+    recheck = RoundedCheck(
+        summary.max_violation <= 1e-6,
+        worst.name if worst is not None else "none",
+        summary.max_violation,
+        "scaled max violation",
+    )
+    return Buildable(
+        tolerance_m=t,
+        stroke_margin_m=margin,
+        range_given_up_deg={k: tuple(v) for k, v in range_cost_deg(study.crane, margin).items()},
+        lengths=rounded,
+        crane_check=crane_check,
+        tolerance_check=tolerance_check,
+        recheck=recheck,
+        recheck_id_path=fine.id_path,
+        recheck_grid_points=len(fine.times),
+        net_electrical_energy_J=summary.net_electrical_energy_J,
+        drawn_energy_without_regeneration_J=summary.drawn_energy_without_regeneration_J,
+        net_energy_change_vs_optimum_J=summary.net_electrical_energy_J - optimum.net_electrical_energy_J,
+        mjcf_command=mjcf_command(crane_label, margin, rounded),
+    )
+
+
+def buildable_line(b: Buildable) -> str:
+    """One stdout line: the rounded design, its checks and energy."""
+    lift, tilt = b.lengths.lift, b.lengths.tilt
+    ok = all(c.passed for c in (b.crane_check, b.tolerance_check, b.recheck))
+    return (
+        f"buildable (rounded to {b.tolerance_m * 1e3:g} mm, stroke margin {b.stroke_margin_m * 1e3:g} mm): "
+        f"lift L={lift.L:g} Lc0={lift.Lc0:g} Lc={lift.Lc:g}  tilt L={tilt.L:g} Lc0={tilt.Lc0:g} Lc={tilt.Lc:g} m  "
+        f"net energy {b.net_electrical_energy_J / 1e3:.3f} kJ ({b.net_energy_change_vs_optimum_J:+.1f} J vs optimum); "
+        f"{'checks passed' if ok else 'CHECK FAILED'}: crane check {'ok' if b.crane_check.passed else 'FAILED'}, "
+        f"+-{b.tolerance_m * 1e3:g} mm worst margin {b.tolerance_check.margin * 1e3:.3f} mm, "
+        f"fine-grid re-check max violation {b.recheck.margin:.1e}"
+    )

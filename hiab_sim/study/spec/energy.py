@@ -1,0 +1,162 @@
+"""The study's energy settings: objective, thermal duty and transmission catalogue.
+
+Three optional top-level keys of a study file, each validated here into a frozen dataclass:
+
+* ``objective: costf2 | battery_energy`` (default ``costf2``, the seed's eq. ``costf2``);
+  the names are those of :data:`hiab_sim.study.nlp.objectives.OBJECTIVES`.
+* ``duty: {cycles_per_hour: n}`` or ``duty: {rest_time: T_rest}`` [s]: the cycle (the study's
+  trajectory, duration T) repeats with a rest of T_rest at zero torque, or n times an hour
+  (T_rest = 3600/n - T). With a duty and an EMLA set that has thermal data, the NLP holds the
+  motors' thermal limits (:mod:`hiab_sim.study.nlp.thermal_rows`).
+* ``transmission: {lift: [{gear_ratio: G, screw_lead: rho}, ...], tilt: [...], ...}``: a catalogue
+  of discrete (G, rho) options per actuator; actuators not listed keep the EMLA file's. The
+  co-design (:mod:`hiab_sim.study.analysis.codesign`) optimises the mounting for every combination.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from hiab_sim.checks import check_range
+from hiab_sim.crane.names import ACTUATOR_NAMES
+from hiab_sim.emla.thermal import Duty
+from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.yaml_fields import mapping, number
+
+#: Objective names a study may give (the keys of ``hiab_sim.study.nlp.objectives.OBJECTIVES``).
+OBJECTIVE_NAMES: tuple[str, ...] = ("costf2", "battery_energy")
+
+
+@dataclass(frozen=True)
+class DutySettings:
+    """Rest between cycles: exactly one of ``rest_time`` [s] >= 0 or ``cycles_per_hour`` [1/h] > 0."""
+
+    rest_time: float | None = None
+    cycles_per_hour: float | None = None
+
+    def __post_init__(self) -> None:
+        if (self.rest_time is None) == (self.cycles_per_hour is None):
+            raise InvalidInputError(
+                "duty",
+                "{}" if self.rest_time is None else "both",
+                "give exactly one of rest_time [s] or cycles_per_hour",
+            )
+        if self.rest_time is not None:
+            check_range("duty.rest_time", self.rest_time, 0.0, unit="s")
+        if self.cycles_per_hour is not None:
+            check_range("duty.cycles_per_hour", self.cycles_per_hour, 0.0, unit="1/h", low_open=True)
+
+    def duty(self, cycle_time: float) -> Duty:
+        """The :class:`~hiab_sim.emla.thermal.Duty` of a cycle of ``cycle_time`` [s]."""
+        if self.cycles_per_hour is not None:
+            return Duty.from_cycles_per_hour(cycle_time, self.cycles_per_hour)
+        assert self.rest_time is not None
+        return Duty(cycle_time, self.rest_time)
+
+    def describe(self, cycle_time: float) -> str:
+        """E.g. ``60 cycles/hour (6.25 s cycle + 53.75 s rest)``."""
+        d = self.duty(cycle_time)
+        head = f"{self.cycles_per_hour:g} cycles/hour" if self.cycles_per_hour is not None else "rest between cycles"
+        return f"{head} ({d.cycle_time:g} s cycle + {d.rest_time:g} s rest)"
+
+
+@dataclass(frozen=True)
+class TransmissionOption:
+    """One (gear ratio G > 1, screw lead rho > 0 [m per screw revolution]) of the catalogue."""
+
+    gear_ratio: float
+    screw_lead: float
+    label: str = "transmission"
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.gear_ratio) and self.gear_ratio > 1.0):
+            raise InvalidInputError(f"{self.label}.gear_ratio", self.gear_ratio, "must be finite and > 1 (a reduction)")
+        check_range(f"{self.label}.screw_lead", self.screw_lead, 0.0, unit="m", low_open=True)
+
+    @property
+    def transmission_ratio(self) -> float:
+        """2 pi G / rho [rad/m] (eq. ``torque_force``)."""
+        return 2.0 * math.pi * self.gear_ratio / self.screw_lead
+
+
+@dataclass(frozen=True)
+class TransmissionCatalogue:
+    """Discrete transmission options per actuator, as ((actuator, (option, ...)), ...), each non-empty."""
+
+    options: tuple[tuple[str, tuple[TransmissionOption, ...]], ...]
+
+    def __post_init__(self) -> None:
+        if not self.options:
+            raise InvalidInputError("transmission", "{}", f"must list options for at least one of {ACTUATOR_NAMES}")
+        for name, opts in self.options:
+            if name not in ACTUATOR_NAMES:
+                raise InvalidInputError("transmission", name, f"keys must be among {', '.join(ACTUATOR_NAMES)}")
+            if not opts:
+                raise InvalidInputError(f"transmission.{name}", "[]", "must list at least one {gear_ratio, screw_lead}")
+
+    @property
+    def combinations(self) -> int:
+        """Number of combinations (the product of the option counts)."""
+        return math.prod(len(opts) for _, opts in self.options)
+
+
+@dataclass(frozen=True)
+class EnergySettings:
+    """The three optional keys (see the module docstring)."""
+
+    objective: str = "costf2"
+    duty: DutySettings | None = None
+    transmission: TransmissionCatalogue | None = None
+
+    def __post_init__(self) -> None:
+        if self.objective not in OBJECTIVE_NAMES:
+            raise InvalidInputError("objective", self.objective, f"must be one of {', '.join(OBJECTIVE_NAMES)}")
+
+
+#: Top-level study keys this module reads.
+ENERGY_KEYS = {"objective", "duty", "transmission"}
+
+
+def energy_settings(top: Any) -> EnergySettings:
+    """Read ``objective``, ``duty`` and ``transmission`` from a study's top-level mapping."""
+    objective = top.get("objective", "costf2")
+    if not isinstance(objective, str):
+        raise InvalidInputError("objective", objective, f"must be one of {', '.join(OBJECTIVE_NAMES)}")
+    duty = None
+    if top.get("duty") is not None:
+        d = mapping(top["duty"], "duty", {"rest_time", "cycles_per_hour"}, set())
+        duty = DutySettings(**{k: number(v, f"duty.{k}") for k, v in d.items()})
+    elif "duty" in top:
+        raise InvalidInputError("duty", None, "give exactly one of rest_time [s] or cycles_per_hour")
+    transmission = None
+    if "transmission" in top:
+        transmission = _catalogue(top["transmission"])
+    return EnergySettings(objective, duty, transmission)
+
+
+def _catalogue(data: Any) -> TransmissionCatalogue:
+    if data is None:
+        raise InvalidInputError("transmission", None, f"must list options for at least one of {ACTUATOR_NAMES}")
+    d = mapping(data, "transmission", set(ACTUATOR_NAMES), set())
+    options = []
+    for name in ACTUATOR_NAMES:
+        if name not in d:
+            continue
+        items = d[name]
+        if not isinstance(items, list):
+            raise ConfigError(f"transmission.{name} must be a list of {{gear_ratio, screw_lead}}, got {items!r}")
+        opts = []
+        for j, item in enumerate(items):
+            where = f"transmission.{name}[{j}]"
+            m = mapping(item, where, {"gear_ratio", "screw_lead"}, {"gear_ratio", "screw_lead"})
+            opts.append(
+                TransmissionOption(
+                    number(m["gear_ratio"], f"{where}.gear_ratio"),
+                    number(m["screw_lead"], f"{where}.screw_lead"),
+                    where,
+                )
+            )
+        options.append((name, tuple(opts)))
+    return TransmissionCatalogue(tuple(options))

@@ -1,0 +1,159 @@
+"""A study's tasks: each a name, a weight, a reference and a payload; ``tasks:`` or today's single reference.
+
+Schema (a study file's top level; every other key is the study's, shared by all tasks)::
+
+    tasks:
+      - name: pick_and_place          # unique
+        weight: 20                    # > 0: the task's share of the crane's work (e.g. cycles per hour)
+        reference: {kind: pick_and_place, ...}   # spiral | pick_and_place | csv (hiab_sim.study.references.kinds)
+        payload: {mass: 200, pick: 0.75, release: 14.25}   # or a number [kg]; default 0
+        control_points: 30            # optional: the task's spline; default in proportion to its duration
+
+Without ``tasks:``, today's ``reference:`` (a spiral unless it names another ``kind``) and
+``payload:`` make one task named after the study, with weight 1, so every existing study file
+keeps its meaning. A payload's pick and release must lie within the task's duration.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiab_sim.crane.description import Crane
+from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.study.motion.trajectory import TcpKinematics
+from hiab_sim.study.references.kinds import TaskReference, reference_from_mapping
+from hiab_sim.study.spec.payload import Payload
+from hiab_sim.yaml_fields import mapping, number
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Task:
+    """One duty cycle of the crane (module docstring).
+
+    Attributes:
+        name: Unique name, used in reports and messages.
+        weight: Share of the crane's work (> 0); the mix's objective is sum weight_i f_i.
+        reference: What the TCP and the telescope must do.
+        payload: The mass at the TCP and when it is held.
+        control_points: Spline control points of the task's trajectory, or None (by duration).
+
+    """
+
+    name: str
+    weight: float
+    reference: TaskReference
+    payload: Payload
+    control_points: int | None = None
+
+    def __post_init__(self) -> None:
+        if not self.name:
+            raise InvalidInputError("task.name", self.name, "must be a non-empty string")
+        if not (math.isfinite(self.weight) and self.weight > 0.0):
+            raise InvalidInputError("weight", self.weight, "must be > 0 and finite")
+        duration = self.reference.duration
+        for key in ("pick", "release"):
+            value = getattr(self.payload, key)
+            if value is not None and value > duration:
+                raise InvalidInputError(
+                    f"payload.{key}", value, f"must lie within the task's duration [0, {duration:.6g}]", "s"
+                )
+
+    def spline_points(self, points: int, per_duration: float, degree: int) -> int:
+        """Control points: the task's own, or ``points`` per ``per_duration`` [s] scaled to its duration."""
+        if self.control_points is not None:
+            return self.control_points
+        return max(degree + 2, round(points * self.reference.duration / per_duration))
+
+    def times(self, step: float) -> Array:
+        """Collocation times on [0, duration] [s] with a step <= ``step`` [s]."""
+        duration = self.reference.duration
+        return np.linspace(0.0, duration, max(2, math.ceil(duration / step - 1e-9)) + 1)
+
+    def tcp_force(self, kin: TcpKinematics, gravity: float, times: Array) -> Array | None:
+        """Payload force on the TCP at ``times``, (K, 3) in {W} [N] (reference's acceleration); None without mass."""
+        if self.payload.mass == 0.0:
+            return None
+        acceleration = self.reference.sample(kin, times).acceleration[:, :2]
+        return self.payload.tcp_force(times, acceleration, gravity)
+
+    def id_force(self, kin: TcpKinematics, gravity: float, times: Array) -> Array | None:
+        """The payload's force on the TCP as the inverse dynamics takes it [N] in {W}: None, (3,) or (K, 3).
+
+        A constant weight without inertia (a single-reference study's plain ``payload: <kg>``) is
+        the constant vector (0, -m g, 0), as before tasks; a schedule or a payload with inertia is
+        the per-sample F(t) of :meth:`tcp_force` (at the reference's acceleration, so it does not
+        depend on the NLP's variables).
+        """
+        payload = self.payload
+        if payload.mass == 0.0:
+            return None
+        if payload.pick is None and payload.release is None and not payload.inertia:
+            return np.array([0.0, -payload.mass * gravity, 0.0])
+        return self.tcp_force(kin, gravity, times)
+
+
+def tasks_from_mapping(top: Mapping[str, Any], folder: Path, grid_duration: float, study_name: str) -> tuple[Task, ...]:
+    """The study's tasks from its top-level mapping (``tasks:`` or today's ``reference:`` + ``payload:``).
+
+    Args:
+        top: The study file's parsed top level.
+        folder: The study file's folder (CSV paths resolve there).
+        grid_duration: ``grid.duration`` [s], a spiral's default duration.
+        study_name: Name of the single task of the one-reference form.
+
+    """
+    if "tasks" not in top:
+        reference = reference_from_mapping(top["reference"], "reference", folder, grid_duration)
+        return (Task(study_name, 1.0, reference, Payload.from_value(top.get("payload", 0.0))),)
+    if "reference" in top or "payload" in top:
+        raise ConfigError("study: give either 'tasks:' or 'reference:' (with 'payload:'), not both")
+    entries = top["tasks"]
+    if not isinstance(entries, list) or not entries:
+        raise ConfigError(f"tasks: expected a non-empty list of tasks, got {entries!r}")
+    tasks = []
+    for i, entry in enumerate(entries):
+        where = f"tasks[{i}]"
+        keys = {"name", "weight", "reference", "payload", "control_points"}
+        d = mapping(entry, where, keys, {"name", "weight", "reference"})
+        points = d.get("control_points")
+        if points is not None and (isinstance(points, bool) or not isinstance(points, int) or points < 7):
+            raise InvalidInputError(f"{where}.control_points", points, "must be an integer >= 7")
+        try:
+            task = Task(
+                name=str(d["name"]),
+                weight=number(d["weight"], f"{where}.weight"),
+                reference=reference_from_mapping(d["reference"], f"{where}.reference", folder, grid_duration),
+                payload=Payload.from_value(d.get("payload", 0.0), f"{where}.payload"),
+                control_points=points,
+            )
+        except InvalidInputError as error:
+            raise InvalidInputError(_prefixed(where, error.field), error.value, error.allowed, error.unit) from None
+        tasks.append(task)
+    names = [t.name for t in tasks]
+    duplicate = next((n for n in names if names.count(n) > 1), None)
+    if duplicate is not None:
+        raise ConfigError(f"tasks: the name {duplicate!r} is used twice; task names must be unique")
+    return tuple(tasks)
+
+
+def check_tasks(tasks: tuple[Task, ...], kin: TcpKinematics, crane: Crane) -> None:
+    """Every task's reference within the crane's reach and joint ranges; the error names the task."""
+    for i, task in enumerate(tasks):
+        try:
+            task.reference.check_reach(kin, crane)
+        except InvalidInputError as error:
+            field = f"tasks[{i}] ({task.name}) {error.field}"
+            raise InvalidInputError(field, error.value, error.allowed, error.unit) from None
+
+
+def _prefixed(where: str, field: str) -> str:
+    return field if field.startswith(where) else f"{where}.{field}"
