@@ -118,12 +118,15 @@ class CoupledWinding:
     fixed_point_change_K: float
     _system: _System = field(repr=False)
 
-    def loss_gradient(self, weights: ArrayLike, rest_weight: float = 0.0) -> tuple[Array, float]:
-        """Gradient of J = sum_k y_k P_k + z E_rest w.r.t. the cold losses (c_k, c_r) [J/W or -].
+    def loss_gradient(
+        self, weights: ArrayLike, rest_weight: float = 0.0, theta_weights: ArrayLike | None = None
+    ) -> tuple[Array, float]:
+        """Gradient of J = sum_k y_k P_k + z E_rest + sum_k x_k T_k w.r.t. the cold losses (c_k, c_r).
 
         Args:
             weights: y_k, shape (K,) (e.g. trapezoid weights [s] for the cycle's copper energy).
             rest_weight: z [-] multiplying the rest's copper energy.
+            theta_weights: x_k, shape (K,), a further linear term in the temperatures (None: 0).
 
         Returns:
             (dJ/dc, shape (K,), dJ/dc_r), with theta's dependence on (c, c_r) through the adjoint.
@@ -135,6 +138,8 @@ class CoupledWinding:
         g = self.resistance_factor
         gamma = y * s.c * alpha
         gamma[-1] += rest_weight * s.c_r * alpha * s.q
+        if theta_weights is not None:
+            gamma = gamma + np.asarray(theta_weights, dtype=float)
         d_c, d_cr = s.adjoint(gamma, g)
         d_c = d_c + y * g
         d_cr = d_cr + rest_weight * s.rest_energy_partial_cr
@@ -181,7 +186,7 @@ def coupled_winding_temperature(
     time: ArrayLike,
     cold_loss: ArrayLike,
     thermal: ThermalParams,
-    winding: WindingResistance,
+    winding: WindingResistance | None,
     duty: Duty,
     rest_cold_loss: float = 0.0,
 ) -> CoupledWinding:
@@ -191,7 +196,8 @@ def coupled_winding_temperature(
         time: Cycle sample times [s], shape (K,), spanning ``duty.cycle_time``.
         cold_loss: c_k, the copper loss at the reference temperature [W], shape (K,), >= 0.
         thermal: The motor's first-order thermal model.
-        winding: R_s(T) data (reference temperature, coefficient, insulation limit).
+        winding: R_s(T) data (reference temperature, coefficient, insulation limit); None keeps R_s at
+            its reference value (alpha = 0, beta = 1: the cold model, never runaway).
         duty: Cycle and rest time.
         rest_cold_loss: c_r [W] >= 0, the rest's copper loss at the reference temperature.
 
@@ -202,8 +208,9 @@ def coupled_winding_temperature(
         raise InvalidInputError("cold_loss", f"shape {c.shape}", f"must be ({t.size},)")
     check_non_negative("rest_cold_loss", rest_cold_loss, "W")
     tau, r = thermal.time_constant, thermal.thermal_resistance
-    alpha = winding.temperature_coefficient
-    beta = 1.0 + alpha * (thermal.ambient_temperature - winding.reference_temperature)
+    alpha = 0.0 if winding is None else winding.temperature_coefficient
+    beta = 1.0 if winding is None else 1.0 + alpha * (thermal.ambient_temperature - winding.reference_temperature)
+    limit = math.inf if winding is None else winding.insulation_limit
     h = np.diff(t)
     e = np.exp(-h / tau)
     a = tau * (-np.expm1(-h / tau)) / h
@@ -257,7 +264,7 @@ def coupled_winding_temperature(
         peak=float(temp[j]),
         peak_index=j,
         poincare_slope=slope,
-        runaway=bool(temp[j] > winding.insulation_limit),
+        runaway=bool(temp[j] > limit),
         fixed_point_change_K=change,
         _system=_System(
             c=c,
