@@ -174,16 +174,21 @@ def _minimal_result_json() -> dict[str, Any]:
 
 
 def test_a_file_written_before_schema_version_reads_as_schema_1_and_writes_back_every_key() -> None:
-    """A schema-1 file without schema_version loads; written back it has the same keys and values plus the version."""
+    """A schema-1 file without schema_version loads; written back it has the same values, schema 2's names, the version."""
     data = _minimal_result_json()
     result = Result.from_json(data)
-    assert result.schema_version == 1 and result.crane_source is None and result.extra == {}
+    assert result.schema_version == 2 and result.crane_source is None and result.extra == {}
     assert result.optimal.lengths == LinkLengths.from_array([1.0, 0.1, 0.7, 1.1, 0.1, 0.7])
     assert result.improvement.decomposition.designs["optimal_lengths_initial_trajectory"].evaluable is False
     assert result.multistart.starts[0].optimal_lengths is None
     written = result.to_json()
-    assert next(iter(written)) == "schema_version" and written.pop("schema_version") == 1
-    assert written == data  # 14 == 14.0 and 150 == 150.0: the same numbers
+    assert next(iter(written)) == "schema_version" and written.pop("schema_version") == 2
+    renamed = json.loads(
+        json.dumps(data)
+        .replace("drawn_energy_without_regeneration_J", "drawn_energy_summed_drives_J")
+        .replace("drawn_energy_sum_of_actuators_J", "drawn_energy_per_drive_sum_J")
+    )
+    assert written == renamed  # 14 == 14.0 and 150 == 150.0: the same numbers
 
 
 def test_unknown_top_level_keys_are_kept_and_written_back() -> None:
@@ -191,7 +196,8 @@ def test_unknown_top_level_keys_are_kept_and_written_back() -> None:
     data = {**_minimal_result_json(), "schema_version": 1, "future_section": {"energy_J": [[1.0, 2.0]]}}
     result = Result.from_json(data)
     assert result.extra == {"future_section": {"energy_J": [[1.0, 2.0]]}}
-    assert result.to_json() == data
+    again = result.to_json()
+    assert Result.from_json(again).to_json() == again
 
 
 def test_a_newer_schema_is_refused_by_name() -> None:
@@ -277,3 +283,13 @@ def test_replace_keeps_a_result_frozen_and_typed() -> None:
         result.crane = "x"  # type: ignore[misc]
     moved = replace(result, crane="crane.yaml", crane_source="my_crane.yaml")
     assert moved.to_json()["crane_source"] == "my_crane.yaml" and "crane_source" not in result.to_json()
+
+
+def test_a_schema_1_file_loads_with_the_renamed_energy_keys() -> None:
+    """Schema 1's drawn_energy_without_regeneration_J and drawn_energy_sum_of_actuators_J land under their honest names."""
+    result = Result.from_json(_minimal_result_json())
+    assert result.schema_version == 2
+    assert result.initial.drawn_energy_summed_drives_J == 12.0
+    assert result.initial.drawn_energy_per_drive_sum_J == 14.0
+    written = result.to_json()
+    assert "drawn_energy_without_regeneration_J" not in json.dumps(written)

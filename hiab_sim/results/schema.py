@@ -27,7 +27,12 @@ from hiab_sim.results.codec import from_json, optional, to_json
 from hiab_sim.results.energy_sections import Codesign, EnergyReport, HydraulicBaseline
 
 #: Version of the result.json layout; files without the key are version 1 (the same keys).
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+#: Keys renamed in schema 2 because their names suggested another boundary (old -> new).
+RENAMED_IN_2: dict[str, str] = {
+    "drawn_energy_without_regeneration_J": "drawn_energy_summed_drives_J",
+    "drawn_energy_sum_of_actuators_J": "drawn_energy_per_drive_sum_J",
+}
 RESULT_FILE = "result.json"
 #: Keys of :class:`EnergyBreakdown`, in the order the figures and tables show them.
 T = TypeVar("T")
@@ -98,8 +103,11 @@ class DesignSummary:
     cost_W2s: float
     cost_note: str
     net_electrical_energy_J: float
-    drawn_energy_without_regeneration_J: float
-    drawn_energy_sum_of_actuators_J: float
+    # int max(sum_i P_i, 0) dt: the drives' powers summed before the positive part is taken, so one drive's
+    # regeneration feeds another (the shared bus seen at the drives' inputs; no inverter or battery)
+    drawn_energy_summed_drives_J: float
+    # sum_i int max(P_i, 0) dt: every drive's own positive power, no credit passed between drives
+    drawn_energy_per_drive_sum_J: float
     energy_breakdown_J: EnergyBreakdown
     actuators: dict[str, ActuatorSummary]
     max_violation: float
@@ -118,7 +126,7 @@ class DecompositionDesign:
     evaluable: bool
     error: str | None = optional()
     net_electrical_energy_J: float | None = optional()
-    drawn_energy_without_regeneration_J: float | None = optional()
+    drawn_energy_summed_drives_J: float | None = optional()
     cost_W2s: float | None = optional()
     collocation_cost_W2s: float | None = optional()
     max_violation: float | None = optional()
@@ -333,8 +341,23 @@ class Result:
 
     @classmethod
     def from_json(cls, data: Any) -> Result:
-        """Build from a parsed result.json (ConfigError names a missing or mistyped key)."""
+        """Build from a parsed result.json (ConfigError names a missing or mistyped key); schema 1 is upgraded."""
+        if isinstance(data, dict):
+            version = data.get("schema_version", 1)
+            if isinstance(version, int) and version > SCHEMA_VERSION:
+                raise ConfigError(f"result.json has schema_version {version}; this hiab-sim reads up to {SCHEMA_VERSION}")
+            if isinstance(version, int) and version < 2:
+                data = {**_renamed(data), "schema_version": SCHEMA_VERSION}
         return from_json(cls, data)
+
+
+def _renamed(data: Any) -> Any:
+    """``data`` with the keys of :data:`RENAMED_IN_2` renamed, at any depth."""
+    if isinstance(data, dict):
+        return {RENAMED_IN_2.get(k, k): _renamed(v) for k, v in data.items()}
+    if isinstance(data, list):
+        return [_renamed(v) for v in data]
+    return data
 
 
 @dataclass(frozen=True)
@@ -370,6 +393,8 @@ def read_json_as(cls: type[T], path: Path) -> T:
     """``cls`` built from the JSON file ``path``; ConfigError names the file and the bad key."""
     data = parse_json(path)
     try:
+        if cls is Result:
+            return cls.from_json(data)  # type: ignore[attr-defined, no-any-return]
         return from_json(cls, data)
     except ConfigError as error:
         raise ConfigError(f"{path}: {error}") from None

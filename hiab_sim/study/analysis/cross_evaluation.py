@@ -88,7 +88,7 @@ def cross_evaluation(mix: MixProblem, z_mix: Array, alone: list[LinkLengths] | N
                 if p.max_violation(z) <= FEASIBLE:
                     values = (
                         summary.net_electrical_energy_J,
-                        summary.drawn_energy_without_regeneration_J,
+                        summary.drawn_energy_summed_drives_J,
                         p.evaluate(z).cost,
                         summary.max_violation,
                     )
