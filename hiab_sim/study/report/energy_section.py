@@ -29,6 +29,8 @@ import numpy as np
 
 from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.emla import battery_energy, operating_point, thermal_check
+from hiab_sim.emla.battery import rest_battery_energy
+from hiab_sim.emla.duty_energy import drive_duty
 from hiab_sim.emla.thermal import Duty
 from hiab_sim.hydraulics import SupplyResult, hydraulic_baseline
 from hiab_sim.quadrature import trapezoid
@@ -44,6 +46,8 @@ from hiab_sim.results.schema import Result
 from hiab_sim.study.nlp.interface import SampleState
 from hiab_sim.study.nlp.objectives import SquaredPowerCost
 from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.thermal_rows import duty_check
+from hiab_sim.study.report.duty_section import duty_energy
 
 #: Drive-loss energies reported per actuator when an option of :mod:`hiab_sim.emla.losses` is on
 #: (electrical = mechanical + copper + rotor friction + screw viscous + inertial + these).
@@ -61,7 +65,7 @@ def study_duty(problem: LinkLengthProblem) -> tuple[Duty, str]:
     settings, cycle = problem.study.energy.duty, problem.task.reference.duration
     if settings is None:
         return Duty(cycle, 0.0), f"none given: back-to-back cycles ({cycle:g} s, no rest)"
-    return settings.duty(cycle), settings.describe(cycle)
+    return settings.duty(cycle), settings.describe(cycle, problem.emlas)
 
 
 def costf2(problem: LinkLengthProblem, state: SampleState) -> float:
@@ -79,7 +83,12 @@ def design_energy(problem: LinkLengthProblem, state: SampleState) -> DesignEnerg
     exact_power = np.column_stack([op.electrical_power for op in ops])
     exact = battery_energy(t, exact_power, battery)
     smooth = battery_energy(t, state.power, battery, smooth=True)
+    smooth_energy = smooth.energy
     duty, _ = study_duty(problem)
+    options = problem.duty_options
+    duty_section = duty_energy(problem.emlas, state, options) if options is not None else None
+    if state.duty is not None:
+        smooth_energy += rest_battery_energy([d.rest_energy for d in state.duty], battery)[0]
     losses = {
         p.name: {key: float(trapezoid(getattr(op, key), t)) for key in DRIVE_LOSS_PARTS}
         for p, op in zip(problem.emlas, ops, strict=True)
@@ -89,7 +98,11 @@ def design_energy(problem: LinkLengthProblem, state: SampleState) -> DesignEnerg
     for i, p in enumerate(problem.emlas):
         if p.thermal is None:
             continue
-        c = thermal_check(p, t, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], duty, exact=True)
+        if options is not None:  # hot windings and the rest's hold
+            d = drive_duty(p, t, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], options, exact=True)
+            c = duty_check(p, d)
+        else:
+            c = thermal_check(p, t, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], duty, exact=True)
         thermal[p.name] = ActuatorThermal(
             c.rms_torque,
             c.continuous_torque,
@@ -99,8 +112,8 @@ def design_energy(problem: LinkLengthProblem, state: SampleState) -> DesignEnerg
             c.temperature_margin,
         )
     return DesignEnergy(
-        battery_energy_J=exact.energy,
-        battery_energy_smooth_J=smooth.energy,
+        battery_energy_J=duty_section.battery_energy_J if duty_section is not None else exact.energy,
+        battery_energy_smooth_J=smooth_energy,
         smoothing_bound_J=battery.smoothing_bound(len(ACTUATOR_NAMES), float(t[-1] - t[0])),
         costf2_W2s=costf2(problem, state),
         drawn_energy_J=dict(zip(ACTUATOR_NAMES, map(float, exact.drawn_energy), strict=True)),
@@ -110,6 +123,7 @@ def design_energy(problem: LinkLengthProblem, state: SampleState) -> DesignEnerg
         drive_loss_smoothing_J=(
             smooth.energy - battery_energy(t, exact_power, battery, smooth=True).energy if losses else None
         ),
+        duty=duty_section,
     )
 
 
@@ -262,6 +276,25 @@ def energy_lines(r: Result) -> list[str]:
         "drawn energy per actuator (no regeneration) at the optimum: "
         + ", ".join(f"{k} {v / 1e3:.3f} kJ" for k, v in e.optimal.drawn_energy_J.items()),
     ]
+    dd = e.optimal.duty
+    if dd is not None:
+        m = dd.battery_energy_by_model_J
+        lines.append(
+            f"duty period at the optimum (hold: {dd.hold}): battery {dd.battery_energy_J / 1e3:.4f} kJ = cycle "
+            f"{dd.cycle_battery_energy_J / 1e3:.4f} + rest {dd.rest_battery_energy_J / 1e3:.4f} kJ; hot windings add "
+            f"{dd.hot_winding_extra_J:.1f} J, the hold {dd.hold_extra_J:.1f} J (cold windings, free rest: "
+            f"{m['cold_windings_free_rest'] / 1e3:.4f} kJ); cycle with no regeneration at all: "
+            f"{dd.no_regeneration_energy_at_battery_J / 1e3:.3f} kJ at the battery"
+        )
+        lines.append(
+            "windings at the optimum: "
+            + "; ".join(
+                f"{k} mean {md.mean_winding_temperature_C:.1f} deg C, R_s x{md.peak_resistance_factor:.3f}"
+                for k, md in dd.motors.items()
+                if md.mean_winding_temperature_C is not None and md.peak_resistance_factor is not None
+            )
+        )
+        lines += [f"INFEASIBLE at the optimum: {line}" for line in dd.infeasible]
     if e.optimal.thermal:
         parts = [
             f"{k} RMS {th.rms_torque_Nm:.2f}/{th.continuous_torque_Nm:.1f} N m, "
