@@ -328,7 +328,7 @@ def test_mjcf_stroke_margin_shortens_the_range_the_lengths_must_serve(
 
 def test_result_sections_round_trip_typed(tmp_path: Path) -> None:
     """buildable, feasibility and sensitivity load back as typed sections from result.json."""
-    from hiab_sim.results.schema import read_result
+    from hiab_sim.results.read import read_result
 
     study = small_study(initial_lengths={"lift": {"L": 1.0071227324212, "Lc0": 0.0865, "Lc": 0.745},
                                          "tilt": {"L": 1.132185817991, "Lc0": 0.085, "Lc": 0.745}})  # fmt: skip

@@ -11,7 +11,7 @@ from test_csv_reference import BAD_FILES
 from test_study_small import small_study, write_study
 
 from hiab_sim.cli import main
-from hiab_sim.results.schema import read_result
+from hiab_sim.results.read import read_result
 from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.spec.study_file import study_from_dict
 

@@ -143,7 +143,7 @@ def solved(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.mark.slow
 def test_two_task_mix_converges_feasible_on_every_task_and_rechecks(solved: Path) -> None:
     """Success, violation <= 1e-6 on every task, re-checked on the fine grid with the other ID path."""
-    from hiab_sim.results.schema import read_result
+    from hiab_sim.results.read import read_result
 
     r = read_result(solved)
     assert r.solver.success and r.tasks is not None and len(r.tasks) == 2
@@ -156,7 +156,7 @@ def test_two_task_mix_converges_feasible_on_every_task_and_rechecks(solved: Path
 @pytest.mark.slow
 def test_cross_evaluation_is_consistent(solved: Path) -> None:
     """The mix optimum costs the mix no more than any task's optimum; each task's optimum is best on its task."""
-    from hiab_sim.results.schema import read_result
+    from hiab_sim.results.read import read_result
 
     pytest.importorskip("casadi")  # the fixed-Xi re-optimisations run on IPOPT
     cross = read_result(solved).cross_evaluation
@@ -174,7 +174,7 @@ def test_cross_evaluation_is_consistent(solved: Path) -> None:
 @pytest.mark.slow
 def test_duty_mix_converges_from_the_built_crane_and_three_starts_agree(tmp_path: Path) -> None:
     """The shipped duty mix: violation <= 1e-6 on every task (fine grid, other ID path); 3 starts agree or listed."""
-    from hiab_sim.results.schema import read_result
+    from hiab_sim.results.read import read_result
     from hiab_sim.study.spec.study_file import load_study
 
     pytest.importorskip("casadi")
@@ -208,7 +208,7 @@ def test_study_file_with_tasks_loads_them_and_one_without_either_form_is_refused
 
 def test_an_infeasible_mix_start_goes_through_the_feasibility_phase_and_converges(tmp_path: Path) -> None:
     """Lift Lc0 + 1.5 mm leaves x < 0 at the low end of the range on both tasks: repaired (IPOPT projection), solved."""
-    from hiab_sim.results.schema import read_result
+    from hiab_sim.results.read import read_result
     from hiab_sim.study.solvers.feasibility import feasible_start
 
     pytest.importorskip("casadi")

@@ -12,7 +12,7 @@ from test_study_small import small_study, write_study
 
 from hiab_sim.cli import main
 from hiab_sim.emla import load_emla_set
-from hiab_sim.results.schema import read_result
+from hiab_sim.results.read import read_result
 from hiab_sim.study.spec.study_file import study_from_dict
 
 FLAGS = ["--no-video", "--quiet", "--no-figures"]

@@ -16,7 +16,8 @@ from hypothesis import strategies as st
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import ConfigError
 from hiab_sim.results.codec import from_json, optional, to_json
-from hiab_sim.results.schema import SCHEMA_VERSION, PlaybackView, Result, read_result
+from hiab_sim.results.read import read_result
+from hiab_sim.results.schema import SCHEMA_VERSION, PlaybackView, Result
 
 # Link lengths inside a crane's range (LinkLengths may validate); every other field from its type hint.
 st.register_type_strategy(

@@ -59,10 +59,10 @@ def test_bad_input_exits_2_with_one_line(
 
 
 def test_a_folder_without_a_result_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """RESULT_DIR without result.json is named in a one-line error, exit 2."""
+    """RESULT_DIR without result.json: a one-line error naming the folder and the missing file, exit 2."""
     assert main(["simulate", str(tmp_path), "--no-video", "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "RESULT_DIR" in err[0]
+    assert len(err) == 1 and str(tmp_path) in err[0] and "result.json" in err[0]
 
 
 @pytest.mark.slow

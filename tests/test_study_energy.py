@@ -15,7 +15,7 @@ from test_study_small import small_study, write_study
 from hiab_sim.cli import main
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.results.energy_sections import TransmissionChoice
-from hiab_sim.results.schema import read_result
+from hiab_sim.results.read import read_result
 from hiab_sim.study.analysis.codesign import combinations, solve_combination, with_transmission
 from hiab_sim.study.nlp.problem import LinkLengthProblem
 from hiab_sim.study.nlp.thermal_rows import ThermalLimits

@@ -14,7 +14,7 @@ import sys
 from collections.abc import Sequence
 
 from hiab_sim import __version__
-from hiab_sim._gl import check_gl_backend
+from hiab_sim._gl import check_gl_backend, select_gl_backend
 from hiab_sim.errors import HiabSimError, InfeasibleStudyError, SolverError
 
 #: Subcommands that import MuJoCo: its OpenGL backend is checked before they run.
@@ -52,6 +52,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; return the process exit status."""
+    select_gl_backend()  # before any subcommand module imports MuJoCo or dm_control
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:

@@ -104,9 +104,9 @@ def _crane_and_lengths(args: argparse.Namespace) -> tuple[Crane, LinkLengths]:
         return crane, parse_lengths(args.lengths) if args.lengths else crane.default_lengths
     if args.lengths:
         raise InvalidInputError("--lengths", args.lengths, "cannot be combined with --from-result")
-    from hiab_sim.results.read import design_lengths, read_run, result_crane
+    from hiab_sim.results.read import design_lengths, read_result, result_crane
 
-    result = read_run(args.from_result)
+    result = read_result(args.from_result)
     return result_crane(args.from_result, result.crane), design_lengths(result, args.design)
 
 

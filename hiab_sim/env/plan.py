@@ -1,10 +1,10 @@
-"""The optimiser's plan for one design, read from a result folder: the one place that reads result files.
+"""The optimiser's plan for one design, read from a result folder.
 
 ``read_plan(result_dir, design)`` returns what the closed-loop validation needs: the crane, the EMLA
 set and the payload of the study, the design's link lengths, its planned joint trajectory
 (positions, rates, accelerations on the fine grid), the study's TCP reference and the optimiser's
-predicted net electrical energy. When the study results become typed (``hiab_sim.results.schema``),
-only this function changes.
+predicted net electrical energy, through the one result-folder reader
+(:func:`hiab_sim.results.read.open_run`).
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ from numpy.typing import NDArray
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.results.read import result_crane
-from hiab_sim.results.schema import read_result
+from hiab_sim.results.read import open_run, result_crane
+from hiab_sim.results.schema import Result
 from hiab_sim.study.spec.study_file import load_study
 
 Array = NDArray[np.float64]
@@ -69,39 +69,29 @@ def read_plan(result_dir: str | Path, design: str) -> DesignPlan:
     """Read ``result.json`` and ``trajectory.npz`` of an ``hiab-sim optimize`` folder for one design.
 
     Raises:
-        InvalidInputError: unknown design, or the folder holds no result.
-        ConfigError: the files are malformed.
+        InvalidInputError: unknown design.
+        ConfigError: the folder holds no result, or its files are malformed (one line naming them).
 
     """
     if design not in DESIGNS:
         raise InvalidInputError("design", design, f"must be one of {', '.join(DESIGNS)}")
-    folder = Path(result_dir)
-    result_file, arrays_file = folder / "result.json", folder / "trajectory.npz"
-    if not (result_file.is_file() and arrays_file.is_file()):
-        raise InvalidInputError(
-            "RESULT_DIR", str(folder), "must hold result.json and trajectory.npz of hiab-sim optimize"
-        )
-    result = read_result(folder)
+    run = open_run(result_dir, Result)
+    result, trajectory = run.result, run.trajectory
     summary = result.optimal if design == "optimal" else result.initial
-    crane = result_crane(folder, result.crane)
-    try:
-        arrays = dict(np.load(arrays_file))
-        return DesignPlan(
-            design=design,
-            crane=crane,
-            emlas=_study_emlas(result.study),
-            lengths=summary.lengths,
-            time=np.asarray(arrays["time"], dtype=float),
-            position=np.asarray(arrays[f"{design}_position"], dtype=float),
-            velocity=np.asarray(arrays[f"{design}_velocity"], dtype=float),
-            acceleration=np.asarray(arrays[f"{design}_acceleration"], dtype=float),
-            reference_tcp=np.asarray(arrays["reference_tcp"], dtype=float),
-            predicted_electrical_power=np.asarray(arrays[f"{design}_electrical_power"], dtype=float),
-            predicted_net_energy=float(summary.net_electrical_energy_J),
-            payload=float(result.settings.payload_kg),
-        )
-    except (KeyError, ValueError, TypeError, OSError) as error:
-        raise ConfigError(f"{folder}: not a readable hiab-sim optimize result ({error})") from None
+    return DesignPlan(
+        design=design,
+        crane=result_crane(run.folder, result.crane),
+        emlas=_study_emlas(result.study),
+        lengths=summary.lengths,
+        time=trajectory.time(),
+        position=trajectory.design(design, "position"),
+        velocity=trajectory.design(design, "velocity"),
+        acceleration=trajectory.design(design, "acceleration"),
+        reference_tcp=trajectory.get("reference_tcp"),
+        predicted_electrical_power=trajectory.design(design, "electrical_power"),
+        predicted_net_energy=float(summary.net_electrical_energy_J),
+        payload=float(result.settings.payload_kg),
+    )
 
 
 def _study_emlas(study: str) -> EmlaSet:

@@ -24,6 +24,8 @@ class Cylinder:
         bore: Piston diameter D [m] > 0.
         rod: Rod diameter d [m], 0 < d < D.
         stroke: Stroke [m] > 0 (reported, not a limit here).
+        pin_to_pin_at_zero: Pin-to-pin length [m] > 0 at zero joint angle, if the crane file gives it
+            (documentation of the source's cylinder; the EMLA chains' own lengths are the model's).
 
     """
 
@@ -31,6 +33,7 @@ class Cylinder:
     bore: float
     rod: float
     stroke: float
+    pin_to_pin_at_zero: float | None = None
 
     def __post_init__(self) -> None:
         check_positive(f"hydraulic_cylinders.{self.name}.bore", self.bore, "m")
@@ -40,6 +43,8 @@ class Cylinder:
                 f"hydraulic_cylinders.{self.name}.rod", self.rod, f"must be < bore = {self.bore:g} m", "m"
             )
         check_positive(f"hydraulic_cylinders.{self.name}.stroke", self.stroke, "m")
+        if self.pin_to_pin_at_zero is not None:
+            check_positive(f"hydraulic_cylinders.{self.name}.pin_to_pin_at_zero", self.pin_to_pin_at_zero, "m")
 
     @property
     def piston_area(self) -> float:
@@ -94,7 +99,15 @@ def hydraulic_cylinders_from_mapping(data: Any, where: str = "hydraulic_cylinder
     for name in CYLINDER_NAMES:
         keys = {"bore", "rod", "stroke"}
         node = mapping(top[name], f"{where}.{name}", keys | {"pin_to_pin_at_zero"}, keys)
-        cylinders[name] = Cylinder(name, *(number(node[k], f"{where}.{name}.{k}") for k in ("bore", "rod", "stroke")))
+        pin = node.get("pin_to_pin_at_zero")
+        bore, rod, stroke = (number(node[k], f"{where}.{name}.{k}") for k in ("bore", "rod", "stroke"))
+        cylinders[name] = Cylinder(
+            name,
+            bore,
+            rod,
+            stroke,
+            pin_to_pin_at_zero=None if pin is None else number(pin, f"{where}.{name}.pin_to_pin_at_zero"),
+        )
     friction = mapping(top.get("friction", {}), f"{where}.friction", {"coulomb", "viscous"}, set())
     return HydraulicCylinders(
         **cylinders,

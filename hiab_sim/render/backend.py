@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim._gl import INSTALL_OSMESA, check_gl_backend
+from hiab_sim._gl import INSTALL_OSMESA, check_gl_backend, select_gl_backend
 from hiab_sim.atomic_io import atomic_path
 from hiab_sim.errors import BackendUnavailableError, HiabSimError, InvalidInputError
 
@@ -43,8 +43,11 @@ def import_mujoco() -> Any:
     """Import ``mujoco`` for rendering, turning a broken OpenGL set-up into a one-line error.
 
     With ``MUJOCO_GL=osmesa`` but no libOSMesa, ``import mujoco`` itself fails deep inside
-    PyOpenGL (``'NoneType' object has no attribute 'glGetError'``); it is checked first.
+    PyOpenGL (``'NoneType' object has no attribute 'glGetError'``); it is checked first. Rendering
+    is where the backend is chosen (:func:`~hiab_sim._gl.select_gl_backend`: OSMesa when unset and
+    installed); it takes effect when this is the first import of ``mujoco`` in the process.
     """
+    select_gl_backend()
     check_gl_backend()
     try:
         import mujoco

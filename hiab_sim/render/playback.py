@@ -19,7 +19,6 @@ Both are resampled to the video's frame rate, in real time.
 
 from __future__ import annotations
 
-import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -30,15 +29,14 @@ from numpy.typing import NDArray
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.results.read import result_crane
-from hiab_sim.results.schema import RESULT_FILE, PlaybackView, read_json_as
+from hiab_sim.results.read import open_run, result_crane
+from hiab_sim.results.schema import PlaybackView
+from hiab_sim.results.trajectory_file import Trajectory
 
 Array = NDArray[np.float64]
 Mode = Literal["kinematic", "simulate"]
 MODES: tuple[str, ...] = ("kinematic", "simulate")
 DESIGNS = ("initial", "optimal")
-TRAJECTORY_FILE = "trajectory.npz"
-_HINT = "write one with 'hiab-sim optimize'"
 #: Spacing of the force samples of a simulated playback [s]: the replay's integrator step.
 SIMULATION_STEP = 1e-3
 
@@ -70,49 +68,28 @@ def load_playback(result_dir: str | Path) -> PlaybackData:
             missing keys, wrong shapes).
 
     """
-    folder = Path(result_dir)
-    if not folder.is_dir():
-        raise ConfigError(f"result folder {folder} does not exist ({_HINT})")
-    for name in (RESULT_FILE, TRAJECTORY_FILE):
-        if not (folder / name).is_file():
-            raise ConfigError(f"result folder {folder} has no {name} ({_HINT})")
-    view = read_json_as(PlaybackView, folder / RESULT_FILE)
-    crane = result_crane(folder, view.crane)
-    arrays = _read_npz(folder / TRAJECTORY_FILE)
-    time = _array(arrays, "time", 1, folder)
-    if len(time) < 2 or not np.all(np.diff(time) > 0):
-        raise ConfigError(f"{folder / TRAJECTORY_FILE}: 'time' must hold at least 2 increasing samples")
-    reference = _array(arrays, "reference_tcp", 2, folder, len(time))
+    run = open_run(result_dir, PlaybackView)
+    view, trajectory = run.result, run.trajectory
+    crane = result_crane(run.folder, view.crane)
+    time = trajectory.time()
+    reference = _columns(trajectory, trajectory.get("reference_tcp"), "reference_tcp")
     designs = []
     for name in DESIGNS:
-        joints = JointSamples(*(_array(arrays, f"{name}_{kind}", 2, folder, len(time)) for kind in _KINDS))
+        joints = JointSamples(
+            *(_columns(trajectory, trajectory.design(name, kind), f"{name}_{kind}") for kind in _KINDS)
+        )
         designs.append(DesignMotion(name, getattr(view, name).lengths, joints))
     return PlaybackData(crane, time, reference, tuple(designs))
 
 
+def _columns(trajectory: Trajectory, value: Array, key: str) -> Array:
+    """The renderer draws the XS 031's three joints and a 3-column TCP: other shapes are refused by name."""
+    if value.ndim != 2 or value.shape[1] != 3:
+        raise ConfigError(f"{trajectory.path}: array '{key}' has shape {value.shape}, expected (K, 3) numbers")
+    return value
+
+
 _KINDS = ("position", "velocity", "acceleration")
-
-
-def _read_npz(path: Path) -> dict[str, Array]:
-    try:
-        with np.load(path, allow_pickle=False) as npz:
-            return {key: np.asarray(npz[key]) for key in npz.files}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as error:
-        raise ConfigError(f"{path}: not a valid .npz archive: {error}") from None
-
-
-def _array(arrays: dict[str, Array], key: str, ndim: int, folder: Path, rows: int | None = None) -> Array:
-    where = folder / TRAJECTORY_FILE
-    if key not in arrays:
-        raise ConfigError(f"{where}: missing array '{key}'")
-    value = arrays[key]
-    shape_ok = value.ndim == ndim and (ndim == 1 or value.shape[1] == 3) and (rows is None or len(value) == rows)
-    if not shape_ok or not np.issubdtype(value.dtype, np.number):
-        expected = "(K,)" if ndim == 1 else "(K, 3)"
-        raise ConfigError(f"{where}: array '{key}' has shape {value.shape}, expected {expected} numbers")
-    if not np.all(np.isfinite(value)):
-        raise ConfigError(f"{where}: array '{key}' holds NaN or inf")
-    return value.astype(float)
 
 
 def frame_times(time: Array, fps: float) -> Array:

@@ -30,6 +30,7 @@ from hiab_sim.render.playback import (
     resample,
     simulated_qpos,
 )
+from hiab_sim.results.trajectory_file import read_trajectory
 
 Array = NDArray[np.float64]
 
@@ -97,19 +98,15 @@ def load_power(result_dir: str | Path, data: PlaybackData) -> dict[str, Array]:
 
     Designs without a ``<design>_electrical_power`` array (K, actuators) are left out.
     """
-    path = Path(result_dir) / "trajectory.npz"
+    trajectory = read_trajectory(result_dir)
     out: dict[str, Array] = {}
-    try:
-        with np.load(path, allow_pickle=False) as npz:
-            for motion in data.designs:
-                key = f"{motion.name}_electrical_power"
-                if key in npz.files:
-                    power = np.asarray(npz[key], dtype=float)
-                    if power.ndim != 2 or len(power) != len(data.time) or not np.all(np.isfinite(power)):
-                        raise ConfigError(f"{path}: array '{key}' must be finite with shape (K, actuators)")
-                    out[motion.name] = power.sum(axis=1)
-    except (OSError, ValueError) as error:
-        raise ConfigError(f"{path}: cannot read electrical power: {error}") from None
+    for motion in data.designs:
+        key = f"{motion.name}_electrical_power"
+        if key in trajectory.arrays:
+            power = trajectory.design(motion.name, "electrical_power")
+            if len(power) != len(data.time):
+                raise ConfigError(f"{trajectory.path}: array '{key}' must have {len(data.time)} rows")
+            out[motion.name] = power.sum(axis=1)
     return out
 
 

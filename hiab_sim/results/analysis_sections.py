@@ -120,3 +120,5 @@ class CrossEvaluation:
     mix_energy_lost_J: tuple[float | None, ...]
     mix_energy_lost_percent: tuple[float | None, ...]
     mix_cost_lost_percent: tuple[float | None, ...]
+    #: Per design and task, why the cell is None ("" where it is computed); absent in older files.
+    unserved: tuple[tuple[str, ...], ...] = ()

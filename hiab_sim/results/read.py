@@ -1,19 +1,27 @@
-"""Reading a result folder's designs for other tools (``mjcf --from-result``, ``compare``).
+"""The one reader of a result folder: ``result.json`` (typed) and ``trajectory.npz`` (checked).
 
-The folder is read once, as a typed :class:`~hiab_sim.results.schema.Result`
-(:func:`read_run`); everything else here works on :class:`RunSummary`.
+Every command that reads a run (``mjcf --from-result``, ``compare``, ``render``, ``simulate``,
+``energy-map --result``, the Python API) opens it with :func:`open_run` or :func:`read_result`: the
+folder's checks and their one-line messages live here. ``result.json`` is read as a typed
+:class:`~hiab_sim.results.schema.Result` (or a smaller view such as the renderer's
+:class:`~hiab_sim.results.schema.PlaybackView`); ``trajectory.npz`` through the declared schema of
+:mod:`hiab_sim.results.trajectory_file`. Tools that need a digest use :class:`RunSummary`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Generic, TypeVar
 
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import Source
-from hiab_sim.results.schema import RESULT_FILE, Result, read_result
+from hiab_sim.results.schema import RESULT_FILE, Result, read_json_as
+from hiab_sim.results.trajectory_file import TRAJECTORY_FILE, Trajectory, read_trajectory
+
+View = TypeVar("View")
 
 #: Designs a result holds, in the order tools show them.
 DESIGNS = ("initial", "optimal")
@@ -48,14 +56,45 @@ class RunSummary:
     recheck_max_violation: float  # fine-grid re-check of the optimum (scaled)
 
 
-def read_run(run_dir: str | Path) -> Result:
-    """The typed result of ``RUN_DIR``; a missing folder or file is a one-line :class:`ConfigError`."""
-    folder = Path(run_dir)
+@dataclass(frozen=True)
+class RunFolder(Generic[View]):
+    """A result folder as read by :func:`open_run`: its ``result.json`` and its ``trajectory.npz``."""
+
+    folder: Path
+    result: View
+    trajectory: Trajectory
+
+
+def _check_folder(folder: Path, files: tuple[str, ...]) -> None:
     if not folder.is_dir():
         raise ConfigError(f"result folder {folder} does not exist ({_HINT})")
-    if not (folder / RESULT_FILE).is_file():
-        raise ConfigError(f"{folder} is not a result folder: it has no {RESULT_FILE} ({_HINT})")
-    return read_result(folder)
+    for name in files:
+        if not (folder / name).is_file():
+            raise ConfigError(f"{folder} is not a result folder: it has no {name} ({_HINT})")
+
+
+def open_run(run_dir: str | Path, view: type[View]) -> RunFolder[View]:
+    """Read a result folder: ``result.json`` as ``view`` (:class:`Result` or a smaller view) and ``trajectory.npz``.
+
+    Raises:
+        ConfigError: the folder or a file is missing or malformed (one line naming it).
+
+    """
+    folder = Path(run_dir)
+    _check_folder(folder, (RESULT_FILE, TRAJECTORY_FILE))
+    return RunFolder(folder, read_json_as(view, folder / RESULT_FILE), read_trajectory(folder))
+
+
+def read_result(run_dir: str | Path) -> Result:
+    """The typed result of a result folder (``result.json`` only; or that file itself).
+
+    A missing folder or file, or a malformed one, is one :class:`ConfigError` line naming it.
+    """
+    path = Path(run_dir)
+    if path.is_file():
+        return read_json_as(Result, path)
+    _check_folder(path, (RESULT_FILE,))
+    return read_json_as(Result, path / RESULT_FILE)
 
 
 def result_crane(run_dir: str | Path, crane: str) -> Crane:
@@ -74,7 +113,7 @@ def design_lengths(result: Result, design: str) -> LinkLengths:
 def summarise(run_dir: str | Path) -> RunSummary:
     """Read a result folder into a :class:`RunSummary`."""
     folder = Path(run_dir)
-    result = read_run(folder)
+    result = read_result(folder)
     designs = {}
     for name in DESIGNS:
         entry = result.optimal if name == "optimal" else result.initial

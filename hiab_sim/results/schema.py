@@ -398,9 +398,3 @@ def read_json_as(cls: type[T], path: Path) -> T:
         return from_json(cls, data)
     except ConfigError as error:
         raise ConfigError(f"{path}: {error}") from None
-
-
-def read_result(folder: str | Path) -> Result:
-    """The :class:`Result` in ``folder/result.json`` (or the file itself); ConfigError names what is wrong."""
-    path = Path(folder)
-    return read_json_as(Result, path / RESULT_FILE if path.is_dir() else path)

@@ -36,8 +36,9 @@ from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.emla import ENVELOPE_LIMIT_NAMES, electrical_power, energy_summary, envelope_margins
 from hiab_sim.emla.battery import battery_power, trapezoid_weights
-from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.results.schema import read_result
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.results.read import open_run, read_result
+from hiab_sim.results.schema import Result
 from hiab_sim.study.analysis.buildable import RobustXi, replace_lengths
 from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.nlp.problem import ACTUATORS, STROKE_SCALE, LinkLengthProblem
@@ -81,22 +82,16 @@ def start_design(problem: LinkLengthProblem) -> BaseDesign:
 def optimum_design(folder: str | Path) -> BaseDesign:
     """The optimum of a result folder: ``result.json``'s optimal lengths and ``trajectory.npz``'s motion.
 
-    The one place the map reads a run's result (switch it here to the typed result).
+    Read through the one result-folder reader (:func:`hiab_sim.results.read.open_run`).
     """
-    folder = Path(folder)
-    result = read_result(folder)
-    try:
-        arrays = np.load(folder / "trajectory.npz")
-    except (OSError, ValueError) as error:
-        raise ConfigError(f"--result {folder}: not a result folder of hiab-sim optimize ({error})") from None
-    xi = result.optimal.lengths.as_array()
+    run = open_run(folder, Result)
     return BaseDesign(
-        xi,
-        arrays["time"],
-        arrays["optimal_position"],
-        arrays["optimal_velocity"],
-        arrays["optimal_acceleration"],
-        f"optimum of {folder} (its lengths and trajectory)",
+        run.result.optimal.lengths.as_array(),
+        run.trajectory.time(),
+        run.trajectory.design("optimal", "position"),
+        run.trajectory.design("optimal", "velocity"),
+        run.trajectory.design("optimal", "acceleration"),
+        f"optimum of {run.folder} (its lengths and trajectory)",
     )
 
 

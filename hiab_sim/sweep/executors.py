@@ -8,7 +8,7 @@ from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import contextmanager
 
-from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.errors import BackendUnavailableError, ConfigError, InvalidInputError
 
 #: Environment of a local worker: one BLAS/OpenMP thread per process, as Dask's nanny sets for its
 #: workers (``distributed.nanny.pre-spawn-environ``); the worker processes are the parallelism, and
@@ -36,7 +36,7 @@ def make_executor(workers: int | None = None, dask: str | None = None) -> Iterat
         try:
             from distributed import Client
         except ImportError:
-            raise ConfigError("--dask needs dask.distributed: pip install 'hiab-sim[dask]'") from None
+            raise BackendUnavailableError("--dask needs dask.distributed: pip install 'hiab-sim[dask]'") from None
         try:
             client = Client(dask, timeout="10s")
         except (OSError, TimeoutError) as error:

@@ -28,7 +28,7 @@ from scipy.optimize import minimize
 
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.emla.drive import drive_state
-from hiab_sim.errors import HiabSimError, InvalidInputError, SolverError
+from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.study.nlp.problem import C_SCALE, XI_SCALE, LinkLengthProblem
 
 Array = NDArray[np.float64]
@@ -133,7 +133,7 @@ class EpsilonProblem:
                 ],
                 options={"maxiter": maxiter, "ftol": p.study.solver.ftol},
             )
-        except HiabSimError as error:  # a trial point left the model's domain
+        except InvalidInputError as error:  # a trial point left the model's domain
             return np.asarray(z0, dtype=float), False, f"a trial point left the model's domain: {error}", 0
         z = np.asarray(res.x, dtype=float)
         accepted = bool(res.success) and self.max_violation(z) <= FEASIBLE

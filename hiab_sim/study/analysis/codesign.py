@@ -28,7 +28,7 @@ from typing import TextIO
 import numpy as np
 
 from hiab_sim.emla import EmlaSet
-from hiab_sim.errors import HiabSimError, InvalidInputError, SolverError
+from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.results.energy_sections import Codesign, CodesignRow, DesignEnergy, TransmissionChoice
 from hiab_sim.study.nlp.problem import LinkLengthProblem
 from hiab_sim.study.report.energy_section import design_energy
@@ -78,7 +78,7 @@ def solve_combination(study: Study, combo: Combination) -> CodesignRow:
         problem = LinkLengthProblem(study, emlas=emlas)
         z0 = problem.initial_point(study.initial_lengths)
         check_start(problem, z0)
-    except HiabSimError as error:
+    except InvalidInputError as error:
         return CodesignRow(combo, "infeasible start", str(error))
     fine = LinkLengthProblem(
         study, emlas=emlas, times=study.grid.fine_times(), cost_scale=problem.cost_scale, tightened=False
@@ -86,7 +86,7 @@ def solve_combination(study: Study, combo: Combination) -> CodesignRow:
     e0 = design_energy(fine, fine.evaluate(z0))
     try:
         result = solve(problem, study.initial_lengths, progress=None)
-    except (SolverError, HiabSimError) as error:
+    except (SolverError, InvalidInputError) as error:
         return CodesignRow(combo, "solver failed", str(error), initial_battery_energy_J=e0.battery_energy_J)
     e1 = design_energy(fine, fine.evaluate(result.z))
     return CodesignRow(

@@ -18,7 +18,7 @@ from __future__ import annotations
 import copy
 
 from hiab_sim.crane.description import LinkLengths
-from hiab_sim.errors import HiabSimError
+from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.results.analysis_sections import CrossEvaluation
 from hiab_sim.study.nlp.interface import N_XI, Array
 from hiab_sim.study.nlp.mix import MixProblem
@@ -77,27 +77,41 @@ def cross_evaluation(mix: MixProblem, z_mix: Array, alone: list[LinkLengths] | N
     lengths = [*alone, mix_lengths]
     fines = [fine_problem(p) for p in mix.problems]
     rows: dict[str, list[list[float | None]]] = {k: [] for k in ("net", "drawn", "cost", "viol")}
+    why: list[tuple[str, ...]] = []
     for d, xi in enumerate(lengths):
         row: dict[str, list[float | None]] = {k: [] for k in rows}
+        row_why: list[str] = []
         for k, (p, fine) in enumerate(zip(mix.problems, fines, strict=True)):
             start = mix_c[k] if d == len(alone) else None
             values: tuple[float | None, ...] = (None, None, None, None)
+            reason = ""
+            # A design outside the model's domain or a failed solve is this cell's answer, said in
+            # words; a missing backend (BackendUnavailableError) is not a cell's answer and propagates.
             try:
-                z, _, _ = fixed_lengths_optimum(p, xi, start)
-                summary = design_summary(fine, z).summary
-                if p.max_violation(z) <= FEASIBLE:
+                z, _, message = fixed_lengths_optimum(p, xi, start)
+            except (InvalidInputError, SolverError) as error:
+                reason = f"cannot be evaluated: {error}"
+            else:
+                violation = p.max_violation(z)
+                if violation <= FEASIBLE:
+                    summary = design_summary(fine, z).summary
                     values = (
                         summary.net_electrical_energy_J,
                         summary.drawn_energy_summed_drives_J,
                         p.evaluate(z).cost,
                         summary.max_violation,
                     )
-            except HiabSimError:
-                pass
+                else:
+                    reason = (
+                        f"no feasible trajectory found: largest scaled violation {violation:.3g} > {FEASIBLE:g} "
+                        f"(solver: {message})"
+                    )
             for key, value in zip(row, values, strict=True):
                 row[key].append(value)
+            row_why.append(reason)
         for key in rows:
             rows[key].append(row[key])
+        why.append(tuple(row_why))
     w = mix.weights
 
     def weighted(values: list[float | None]) -> float | None:
@@ -118,7 +132,7 @@ def cross_evaluation(mix: MixProblem, z_mix: Array, alone: list[LinkLengths] | N
         note=(
             "rows: designs (each task's optimum alone, then the mix optimum); columns: tasks; trajectory "
             "re-optimised at fixed Xi; energies on each task's fine grid, costs on its collocation grid; "
-            "mix = weighted sum over the tasks; None: the design cannot serve the task"
+            "mix = weighted sum over the tasks; None: the design cannot serve the task (why: unserved)"
         ),
         tasks=tuple(task.name for task in mix.tasks),
         weights=tuple(float(v) for v in w),
@@ -133,4 +147,5 @@ def cross_evaluation(mix: MixProblem, z_mix: Array, alone: list[LinkLengths] | N
         mix_energy_lost_J=tuple(lost(mix_net, best_net, False)),
         mix_energy_lost_percent=tuple(lost(mix_net, best_net, True)),
         mix_cost_lost_percent=tuple(lost(mix_cost, best_cost, True)),
+        unserved=tuple(why),
     )

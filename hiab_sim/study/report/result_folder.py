@@ -14,7 +14,6 @@ reported separately, with the loss breakdown of :func:`hiab_sim.emla.operating_p
 
 from __future__ import annotations
 
-import io
 import json
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -48,6 +47,7 @@ from hiab_sim.results.schema import (
     TrackingError,
     WorstConstraint,
 )
+from hiab_sim.results.trajectory_file import write_trajectory
 from hiab_sim.study.nlp.mix import Problem
 from hiab_sim.study.nlp.objectives import SquaredPowerCost
 from hiab_sim.study.nlp.problem import ACTUATORS, Evaluation, LinkLengthProblem
@@ -321,10 +321,8 @@ def energy_decomposition(
 
 
 def write_results(out: Path, result: Result, arrays: dict[str, Array]) -> None:
-    """Write ``result.json`` and ``trajectory.npz`` atomically."""
-    buffer = io.BytesIO()
-    np.savez_compressed(buffer, **arrays)  # type: ignore[arg-type]
-    write_atomic(out / "trajectory.npz", buffer.getvalue())
+    """Write ``result.json`` and ``trajectory.npz`` (its declared schema) atomically."""
+    write_trajectory(out, arrays)
     write_atomic(out / RESULT_FILE, json.dumps(result.to_json(), indent=2) + "\n")
 
 

@@ -25,13 +25,14 @@ stalls on a mix, the least violation it found is reported.
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import numpy as np
 from scipy.optimize import minimize
 
 from hiab_sim.crane.description import LinkLengths
-from hiab_sim.errors import HiabSimError, InfeasibleStudyError, InvalidInputError
+from hiab_sim.errors import InfeasibleStudyError, InvalidInputError
 from hiab_sim.results.analysis_sections import FeasibilityPhase
 from hiab_sim.study.analysis.sensitivity import XI_NAMES
 from hiab_sim.study.nlp.blocks import STROKE_SCALE
@@ -100,7 +101,7 @@ def _phi(problem: Problem, z: Array) -> tuple[float, Array]:
         short = np.minimum(0.0, g - TARGET)
         value = 0.5 * float(short @ short + e @ e)
         grad = problem.constraints_jacobian(z).T @ short + problem.equalities_jacobian(z).T @ e
-    except HiabSimError:
+    except InvalidInputError:
         return 1e10, np.zeros_like(z)
     return value, grad
 
@@ -155,14 +156,14 @@ def _least_max_violation(
     def rows_plus_v(x: Array) -> Array:
         try:
             return problem.constraints(x[:n]) + x[n]
-        except HiabSimError:  # outside the model's domain: a large violation, so the line search steps back
+        except InvalidInputError:  # outside the model's domain: a large violation, so the line search steps back
             return np.full(rows, -OUTSIDE)
 
     def rows_jacobian(x: Array) -> Array:
-        try:
+        # Outside the model's domain the last Jacobian inside it is kept (the point is rejected anyway:
+        # rows_value returns a large violation there).
+        with contextlib.suppress(InvalidInputError):
             last[0] = np.hstack([problem.constraints_jacobian(x[:n]), np.ones((rows, 1))])
-        except HiabSimError:  # keep the last Jacobian inside the domain (the point is rejected anyway)
-            pass
         return last[0]
 
     unit = np.zeros(n + 1)
@@ -188,12 +189,12 @@ def _least_max_violation(
             ],
             options={"maxiter": maxiter, "ftol": 1e-12},
         )
-    except HiabSimError:
+    except InvalidInputError:
         return z
     out = np.asarray(res.x[:n], dtype=float)
     try:
         better = problem.constraints(out).min() > problem.constraints(z).min()
-    except HiabSimError:  # SLSQP may end on a trial point outside the model's domain
+    except InvalidInputError:  # SLSQP may end on a trial point outside the model's domain
         return z
     return out if better else z
 
@@ -223,7 +224,7 @@ def feasible_start(
         worst = int(np.argmin(margins))
         violation0 = max(0.0, -float(margins[worst]), float(np.abs(problem.equalities(z0)).max()))
         worst_name = problem.constraint_names[worst]
-    except HiabSimError as error:
+    except InvalidInputError as error:
         violation0, worst_name = math.inf, f"not an admissible crane: {error}"
     if violation0 <= START_TOLERANCE:
         return z0, None
@@ -251,7 +252,7 @@ def feasible_start(
                 if problem.constraints(candidate).min() >= -START_TOLERANCE:
                     z = candidate
                     break
-            except HiabSimError:
+            except InvalidInputError:
                 continue
         g = problem.constraints(z)
     if g.min() < -START_TOLERANCE or np.abs(problem.equalities(z)).max() > 1e-9:
@@ -296,7 +297,7 @@ def feasible_starts(problem: Problem, count: int, seed: int = 6) -> tuple[list[A
         xi = rng.uniform(low, up)
         try:
             z, phase = feasible_start(problem, problem.initial_point(LinkLengths.from_array(xi)), len(points))
-        except HiabSimError:
+        except InvalidInputError:
             continue
         points.append(z)
         if phase is not None:

@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import sparse
 
-from hiab_sim.errors import ConfigError
+from hiab_sim.errors import BackendUnavailableError
 from hiab_sim.study.nlp.interface import N_XI, Array, PerSampleBlock
 from hiab_sim.study.nlp.mix import Problem
 from hiab_sim.study.nlp.problem import LinkLengthProblem
@@ -190,7 +190,9 @@ def _casadi() -> Any:
     try:
         import casadi
     except ImportError:  # an optional dependency
-        raise ConfigError("solver.method: ipopt needs CasADi (pip install casadi)") from None
+        raise BackendUnavailableError(
+            "IPOPT (solver.method: ipopt, duty-mix cross-evaluation) needs CasADi: pip install 'hiab-sim[ipopt]'"
+        ) from None
     return casadi
 
 

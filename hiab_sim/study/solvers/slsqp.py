@@ -26,7 +26,7 @@ from scipy.optimize import OptimizeResult, minimize
 
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
-from hiab_sim.errors import HiabSimError, InvalidInputError, SolverError
+from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.study.nlp.mix import Problem
 from hiab_sim.study.solvers.ipopt import solve_ipopt
 
@@ -118,7 +118,7 @@ def start_points(problem: Problem, count: int, seed: int = 6) -> list[LinkLength
         try:
             if problem.margins(problem.initial_point(lengths)).min() >= 0.0:
                 starts.append(lengths)
-        except HiabSimError:
+        except InvalidInputError:
             continue
     if len(starts) < count:
         raise InvalidInputError("starts", count, f"only {len(starts)} feasible starts found in the bounds")
@@ -318,7 +318,7 @@ def solve(
                 callback=record,
                 options={"maxiter": limit, "ftol": problem.study.solver.ftol},
             )
-    except HiabSimError as error:
+    except InvalidInputError as error:
         result.message = f"a trial point left the model's domain: {error}"
         if out is not None:
             _save_checkpoint(out, result, result.z, done=False, identity=identity)

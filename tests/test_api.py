@@ -1,0 +1,105 @@
+"""The Python API: the README's example runs as written; evaluate's two meanings; bad input names its field."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_study_small import small_study
+
+import hiab_sim as hs
+from hiab_sim.errors import InvalidInputError
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+
+
+def _readme_api_block() -> str:
+    blocks = re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
+    found = [b for b in blocks if "import hiab_sim as hs" in b]
+    assert found, "the README has no Python example of the API"
+    return found[0]
+
+
+def test_the_readme_python_example_runs_as_written(tmp_path: Path) -> None:
+    """The README's API block runs unchanged in a fresh folder and writes the result folder it names."""
+    code = _readme_api_block()
+    result = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, check=False, timeout=600
+    )
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert (tmp_path / "runs" / "x" / "result.json").is_file()
+    assert "feasible: True" in result.stdout
+
+
+def test_importing_hiab_sim_leaves_the_environment_alone() -> None:
+    """``import hiab_sim`` sets no variable (MUJOCO_GL is chosen when rendering starts)."""
+    env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}
+    code = (
+        "import os; before = dict(os.environ); import hiab_sim; hiab_sim.evaluate; import hiab_sim.study.run; "
+        "print(dict(os.environ) == before)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "True"
+
+
+@pytest.fixture(scope="module")
+def study() -> hs.api.Study:
+    from hiab_sim.study.spec.study_file import study_from_dict
+
+    return study_from_dict(small_study(), "small.yaml")
+
+
+@pytest.fixture(scope="module")
+def optimum(study: hs.api.Study, tmp_path_factory: pytest.TempPathFactory) -> hs.api.Result:
+    return hs.optimize(study, out=tmp_path_factory.mktemp("api") / "run", progress=None, figures=False)
+
+
+def test_fixed_evaluation_of_the_start_reproduces_the_results_initial_design(
+    study: hs.api.Study, optimum: hs.api.Result
+) -> None:
+    """evaluate(..., "fixed") at the built crane's lengths gives result.json's initial design, number for number."""
+    e = hs.evaluate(study, optimum.initial.lengths, trajectory="fixed")
+    assert e.tasks[0].summary.net_electrical_energy_J == pytest.approx(
+        optimum.initial.net_electrical_energy_J, rel=1e-12
+    )
+    assert e.max_violation == pytest.approx(optimum.initial.max_violation, rel=1e-9, abs=1e-12)
+    assert optimum.energy is not None
+    assert e.battery_energy_J == pytest.approx(optimum.energy.initial.battery_energy_J, rel=1e-12)
+
+
+def test_reoptimised_evaluation_of_the_optimum_recovers_its_energy_and_beats_the_fixed_trajectory(
+    study: hs.api.Study, optimum: hs.api.Result
+) -> None:
+    """Re-planning the optimum's trajectory at its lengths lands on the optimum (a local optimum of the same NLP).
+
+    The optimal lengths on the start's inverse-kinematics trajectory ("fixed") cost more than with the
+    trajectory re-optimised for them, and the re-optimised one is feasible.
+    """
+    pytest.importorskip("casadi")
+    lengths = optimum.optimal.lengths.as_array()
+    again = hs.evaluate(study, lengths, trajectory="reoptimize")
+    fixed = hs.evaluate(study, {"lift": lengths[:3], "tilt": lengths[3:]}, trajectory="fixed")
+    assert again.feasible
+    assert again.net_electrical_energy_J == pytest.approx(optimum.optimal.net_electrical_energy_J, rel=1e-3)
+    assert again.tasks[0].summary.cost_W2s <= fixed.tasks[0].summary.cost_W2s
+
+
+@pytest.mark.parametrize(
+    ("lengths", "trajectory", "field"),
+    [
+        (np.ones(5), "fixed", "lengths"),
+        ({"lift": [1.0, 0.3, 0.7]}, "fixed", "lengths"),
+        ({"lift": [1.0, 0.3], "tilt": [1.2, 0.3, 0.6]}, "fixed", "lengths.lift"),
+        (np.ones(6), "replan", "trajectory"),
+    ],
+)
+def test_bad_evaluate_input_names_the_field(study: hs.api.Study, lengths: object, trajectory: str, field: str) -> None:
+    """Wrong-shaped lengths or an unknown trajectory meaning: InvalidInputError naming the field."""
+    with pytest.raises(InvalidInputError) as error:
+        hs.evaluate(study, lengths, trajectory=trajectory)  # type: ignore[arg-type]
+    assert error.value.field == field
