@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from hiab_sim.emla.electrothermal import (
-    COPPER_TEMPERATURE_COEFFICIENT,
     FIXED_POINT_TOLERANCE_K,
     WindingResistance,
     coupled_winding_temperature,
@@ -105,7 +104,7 @@ def test_hot_winding_energy_matches_a_time_stepped_coupled_model(rest_current: f
 
 
 def test_without_temperature_coefficient_the_existing_winding_model_is_reproduced() -> None:
-    """alpha = 0 and T_ref = T_amb: the coupled state equals periodic_winding_temperature of the cold losses."""
+    """Alpha = 0 and T_ref = T_amb: the coupled state equals periodic_winding_temperature of the cold losses."""
     t = np.linspace(0.0, 2.0, 201)
     c = 1.5 * R_REF * _current(t) ** 2
     duty = Duty(2.0, 3.0)
@@ -165,7 +164,7 @@ def test_hot_energy_gradient_matches_finite_differences(rest_current: float) -> 
 
 
 def test_peak_temperature_gradient_matches_finite_differences() -> None:
-    """d T_peak / d(c, c_r) by the adjoint agrees with central differences (peak index held)."""
+    """D T_peak / d(c, c_r) by the adjoint agrees with central differences (peak index held)."""
     t = np.linspace(0.0, 2.0, 21)
     c = 1.5 * R_REF * _current(t) ** 2
     duty = Duty(2.0, 3.0)
@@ -191,7 +190,7 @@ def test_peak_temperature_gradient_matches_finite_differences() -> None:
 
 
 def test_loss_beyond_the_cooling_runs_away() -> None:
-    """alpha R_th c >= 1 on average: the resistance grows faster than the cooling, so no fixed point exists."""
+    """Alpha R_th c >= 1 on average: the resistance grows faster than the cooling, so no fixed point exists."""
     t = np.linspace(0.0, 2.0, 21)
     c = np.full(t.size, 1.2 / (COPPER.temperature_coefficient * THERMAL.thermal_resistance))
     state = coupled_winding_temperature(t, c, THERMAL, COPPER, Duty(2.0, 0.0))

@@ -175,7 +175,7 @@ def _minimal_result_json() -> dict[str, Any]:
 
 
 def test_a_file_written_before_schema_version_reads_as_schema_1_and_writes_back_every_key() -> None:
-    """A schema-1 file without schema_version loads; written back it has the same values, schema 2's names, the version."""
+    """A schema-1 file without schema_version loads; written back: the same values under schema 2's names."""
     data = _minimal_result_json()
     result = Result.from_json(data)
     assert result.schema_version == 2 and result.crane_source is None and result.extra == {}
@@ -287,7 +287,7 @@ def test_replace_keeps_a_result_frozen_and_typed() -> None:
 
 
 def test_a_schema_1_file_loads_with_the_renamed_energy_keys() -> None:
-    """Schema 1's drawn_energy_without_regeneration_J and drawn_energy_sum_of_actuators_J land under their honest names."""
+    """Schema 1's two drawn-energy keys land under names that state their boundaries."""
     result = Result.from_json(_minimal_result_json())
     assert result.schema_version == 2
     assert result.initial.drawn_energy_summed_drives_J == 12.0

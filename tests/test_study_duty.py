@@ -76,8 +76,8 @@ def test_brake_hold_puts_the_brakes_energy_in_the_battery_energy() -> None:
         tau0, tau1 = h.first_pose_torque, h.last_pose_torque
         i0, i1 = tau0 / p.motor.torque_constant, tau1 / p.motor.torque_constant
 
-        def hold_power(i: float) -> float:
-            return 1.5 * p.motor.stator_resistance * i * i + 4.0 * abs(i) + 0.075 * i * i
+        def hold_power(i: float, r_s: float = p.motor.stator_resistance) -> float:
+            return 1.5 * r_s * i * i + 4.0 * abs(i) + 0.075 * i * i
 
         # the cycle's end and start temperatures scale the copper of the engagement and the release
         winding = d.winding

@@ -205,7 +205,8 @@ def battery_energy(time: ArrayLike, power: ArrayLike, params: BatteryParams, smo
         drawn_energy=w @ np.maximum(p, 0.0),
         net_energy=w @ p,
         dc_bus_drawn_energy=float(w @ np.maximum(bus_exact, 0.0)),
-        no_regeneration_energy_at_battery=float(w @ np.maximum(dc_exact, 0.0).sum(axis=1)) / params.discharge_efficiency,
+        no_regeneration_energy_at_battery=float(w @ np.maximum(dc_exact, 0.0).sum(axis=1))
+        / params.discharge_efficiency,
     )
 
 

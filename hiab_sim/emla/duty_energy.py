@@ -128,7 +128,7 @@ class DriveDuty:
         return dp[0], dp[1], dp[2]
 
     def rms_partials(self) -> Array:
-        """d tau_rms / d(f_x, v_x, a_x)_k, shape (3, K)."""
+        """D tau_rms / d(f_x, v_x, a_x)_k, shape (3, K)."""
         p = self._parts
         rms = self.rms_torque
         out = np.zeros((3, p.tau.size))
@@ -142,7 +142,7 @@ class DriveDuty:
         return out
 
     def peak_partials(self) -> Array:
-        """d T_peak / d(f_x, v_x, a_x)_k, shape (3, K) (peak sample held; zeros without thermal data)."""
+        """D T_peak / d(f_x, v_x, a_x)_k, shape (3, K) (peak sample held; zeros without thermal data)."""
         p = self._parts
         out = np.zeros((3, p.tau.size))
         if self.winding is None or not math.isfinite(self.winding.peak):

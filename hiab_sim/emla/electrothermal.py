@@ -240,8 +240,8 @@ def coupled_winding_temperature(
     b = np.empty(K)
     b[0] = sigma
     b[1:] = r * beta * (u * c[:-1] + v * c[1:])
-    theta = np.linalg.solve(lower, b)
-    g = beta + alpha * theta
+    theta: Array = np.asarray(np.linalg.solve(lower, b), dtype=float)
+    g: Array = np.asarray(beta + alpha * theta, dtype=float)
     # one more fixed-point step: losses from this temperature, temperature from those losses
     change = float(np.max(np.abs(_step_once(theta, c, g, e, u, v, r, rho, theta_inf) - theta)))
     theta_end = float(theta[-1])
@@ -254,7 +254,7 @@ def coupled_winding_temperature(
     sigma_p = theta_inf_p * (1.0 - rho) - theta_inf * rho_p
     q_p = 0.0 if lam * t_r < 1e-12 else (-rho_p * lam - (1.0 - rho) * d_lam) / lam**2
     integral_p = theta_inf_p * (t_r - q) + (theta_end - theta_inf) * q_p
-    temp = thermal.ambient_temperature + theta
+    temp: Array = np.asarray(thermal.ambient_temperature + theta, dtype=float)
     j = int(np.argmax(theta))
     return CoupledWinding(
         temperature=temp,

@@ -345,7 +345,9 @@ class Result:
         if isinstance(data, dict):
             version = data.get("schema_version", 1)
             if isinstance(version, int) and version > SCHEMA_VERSION:
-                raise ConfigError(f"result.json has schema_version {version}; this hiab-sim reads up to {SCHEMA_VERSION}")
+                raise ConfigError(
+                    f"result.json has schema_version {version}; this hiab-sim reads up to {SCHEMA_VERSION}"
+                )
             if isinstance(version, int) and version < 2:
                 data = {**_renamed(data), "schema_version": SCHEMA_VERSION}
         return from_json(cls, data)
@@ -394,7 +396,7 @@ def read_json_as(cls: type[T], path: Path) -> T:
     data = parse_json(path)
     try:
         if cls is Result:
-            return cls.from_json(data)  # type: ignore[attr-defined, no-any-return]
+            return cls.from_json(data)  # type: ignore[attr-defined]
         return from_json(cls, data)
     except ConfigError as error:
         raise ConfigError(f"{path}: {error}") from None

@@ -298,7 +298,9 @@ class LinkLengthProblem:
         duty = None
         if self.duty_options is not None:
             duty = tuple(
-                drive_duty(p, self.times, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], self.duty_options)
+                drive_duty(
+                    p, self.times, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], self.duty_options
+                )
                 for i, p in enumerate(self.emlas)
             )
             power = np.column_stack([d.power for d in duty])

@@ -15,9 +15,9 @@ collocation grid is the optimiser's quadrature; the result re-checks on the 10x 
 
 from __future__ import annotations
 
-import numpy as np
-
 import math
+
+import numpy as np
 
 from hiab_sim.emla import EmlaParams, EmlaSet, ThermalCheck, thermal_check
 from hiab_sim.emla.duty_energy import DriveDuty
