@@ -13,6 +13,7 @@ from test_study_small import small_study, write_study
 from hiab_sim.cli import main
 from hiab_sim.emla import load_emla_set
 from hiab_sim.results.read import read_result
+from hiab_sim.results.schema import SCHEMA_VERSION
 from hiab_sim.study.spec.study_file import study_from_dict
 
 FLAGS = ["--no-video", "--quiet", "--no-figures"]
@@ -43,7 +44,7 @@ def _key_paths(data: object, prefix: str = "") -> set[str]:
 def test_optimum_is_feasible_better_and_reported(solved: Path) -> None:
     """Success, max violation <= 1e-6, lower energy, the renderer's keys, and the figures."""
     r = read_result(solved)
-    assert r.crane == "xs031" and r.schema_version == 1
+    assert r.crane == "xs031" and r.schema_version == SCHEMA_VERSION
     assert r.solver.success and r.solver.max_violation_scaled <= 1e-6
     assert r.optimal.net_electrical_energy_J < r.initial.net_electrical_energy_J
     assert r.optimal.collocation_cost_W2s is not None and r.initial.collocation_cost_W2s is not None

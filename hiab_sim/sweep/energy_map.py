@@ -13,7 +13,9 @@ Per design, on the analytic path with all designs stacked into the sample axis
   grid, and f / f_start (the optimiser's scaled objective, ``objective``);
 * the net electrical energy and the energy drawn without regeneration [J], trapezoid on the fine
   grid (as in ``result.json``); ``battery_energy`` is the energy the battery delivers
-  (:func:`hiab_sim.emla.battery.battery_power`, exact kinks, fine grid);
+  (:func:`hiab_sim.emla.battery.battery_power`, exact kinks, fine grid); with the study's duty model
+  (:func:`hiab_sim.study.nlp.problem.duty_options`) every power is the hot windings' and the rest's
+  hold is in the battery energy, as in ``result.json`` (one design at a time, not batched);
 * the scaled margins of every constraint row that depends on Xi, as the optimiser holds them on
   the collocation grid: EMLA envelope (const_e, const_f, >= envelope_margin), strokes (const_j)
   at every sample and at both ends of the working range. Rows that depend on the trajectory only
@@ -35,7 +37,8 @@ from numpy.typing import NDArray
 from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.emla import ENVELOPE_LIMIT_NAMES, electrical_power, energy_summary, envelope_margins
-from hiab_sim.emla.battery import battery_power, trapezoid_weights
+from hiab_sim.emla.battery import battery_power, rest_battery_energy, trapezoid_weights
+from hiab_sim.emla.duty_energy import DutyOptions, drive_duty
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.results.read import open_run, read_result
 from hiab_sim.results.schema import Result
@@ -142,6 +145,26 @@ def _stroke_rows(xi: Array, x: Array, strokes: Array) -> Array:
     return np.stack(cols, axis=-1) / STROKE_SCALE
 
 
+def _every(step: int, *arrays: Array) -> tuple[Array, ...]:
+    """Every ``step``-th sample (axis 1) of each (D, K, 3) array."""
+    return tuple(x[:, ::step] for x in arrays)
+
+
+def _duty_powers(
+    problem: LinkLengthProblem, options: DutyOptions, time: Array, f: Array, v: Array, a: Array, exact: bool = False
+) -> tuple[Array, Array]:
+    """(drive powers (3, D, K) [W], rest energies summed over drives (D,) [J]) of the duty model per design."""
+    D = f.shape[0]
+    power = np.empty((len(problem.emlas.as_tuple()), D, len(time)))
+    rest = np.zeros(D)
+    for i, p in enumerate(problem.emlas):
+        for d in range(D):
+            dd = drive_duty(p, time, f[d, :, i], v[d, :, i], a[d, :, i], options, exact)
+            power[i, d] = dd.power
+            rest[d] += dd.rest_energy
+    return power, rest
+
+
 def evaluate_designs(problem: LinkLengthProblem, base: BaseDesign, xi: Array) -> DesignValues:
     """Objective, energies and Xi-dependent margins of designs xi (D, 6) on the base trajectory."""
     xi = np.atleast_2d(np.asarray(xi, dtype=float))
@@ -160,17 +183,33 @@ def evaluate_designs(problem: LinkLengthProblem, base: BaseDesign, xi: Array) ->
     for lo in range(0, len(xi), CHUNK):
         block = xi[lo : lo + CHUNK]
         f, v, a, x = batched_inverse_dynamics(crane, block, base.position, base.velocity, base.acceleration, tcp)
-        power = np.stack([electrical_power(p, f[..., i], v[..., i], a[..., i]) for i, p in enumerate(problem.emlas)])
+        options = problem.duty_options
+        rest_colloc = rest_exact = np.zeros(len(block))
+        if options is None:
+            power = np.stack(
+                [electrical_power(p, f[..., i], v[..., i], a[..., i]) for i, p in enumerate(problem.emlas)]
+            )
+            colloc_power = power[..., ::ff]
+            exact_power = np.stack(  # exact brake switching and loss kinks, as the report's battery energy
+                [electrical_power(p, f[..., i], v[..., i], a[..., i], exact=True) for i, p in enumerate(problem.emlas)]
+            )
+        else:  # hot windings and the rest's hold, as the problem evaluates them
+            power, _ = _duty_powers(problem, options, base.time, f, v, a, exact=False)
+            colloc_power, rest_colloc = _duty_powers(problem, options, base.time[::ff], *_every(ff, f, v, a))
+            exact_power, rest_exact = _duty_powers(problem, options, base.time, f, v, a, exact=True)
         total = power.sum(axis=0)  # (D, K)
-        colloc = total[:, ::ff]
+        colloc = colloc_power.sum(axis=0)
         cost = 0.5 * problem.dt * np.sum(colloc**2, axis=1)
+        gain = rest_battery_energy([0.0], problem.emlas.battery)[1]
         if problem.objective.name == "battery_energy":  # the optimiser's value: smooth, collocation grid
-            drives = np.moveaxis(power[..., ::ff], 0, -1)
+            drives = np.moveaxis(colloc_power, 0, -1)
             objective = battery_power(drives, problem.emlas.battery, smooth=True)[1] @ colloc_weights
+            objective = objective + gain * rest_colloc
         else:
             objective = cost
         net, drawn = energy_summary(base.time, total)
-        battery = battery_power(np.moveaxis(power, 0, -1), problem.emlas.battery)[1] @ weights  # (D,) exact [J]
+        battery = battery_power(np.moveaxis(exact_power, 0, -1), problem.emlas.battery)[1] @ weights  # (D,) [J]
+        battery = battery + gain * rest_exact
         fc, vc, ac = f[:, ::ff], v[:, ::ff], a[:, ::ff]
         env = np.stack(
             [envelope_margins(p, fc[..., i], vc[..., i], ac[..., i]) for i, p in enumerate(problem.emlas)], axis=1
