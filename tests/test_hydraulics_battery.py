@@ -44,7 +44,7 @@ def test_each_variant_balances_battery_energy_with_work_and_every_loss(index: in
 
 
 def test_lowering_through_a_counterbalance_valve_needs_the_hand_pilot_pressure() -> None:
-    """40 kN lowered on the piston side at 50 mm/s: p_rod = (F_m + p_set A_p) / (A_r + 3 A_p), the valve burns the rest."""
+    """40 kN lowered at 50 mm/s: p_rod = (F_m + p_set A_p) / (A_r + 3 A_p); the valve burns the rest."""
     t = np.linspace(0.0, 1.0, 3)
     f = np.tile([40e3, 0.0, 0.0], (3, 1))
     v = np.tile([-0.05, 0.0, 0.0], (3, 1))

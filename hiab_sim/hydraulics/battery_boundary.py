@@ -8,9 +8,9 @@ the direction of motion (> 0 resistive, < 0 overrunning):
 
 Valve-controlled (``constant_pressure``, ``load_sensing``): one pump, driven by an electric motor
 through an inverter from the battery. The meter-in chamber (area A_in) takes Q = A_in |v_x| at p_in, the
-other (A_out) returns to tank, unless a counterbalance valve (:class:`~hiab_sim.hydraulics.cylinders.CounterbalanceValve`)
-sits in its outlet: it opens when p_out + R p_in = p_set, so with the piston's balance
-p_in A_in - p_out A_out = F_m
+other (A_out) returns to tank, unless a counterbalance valve
+(:class:`~hiab_sim.hydraulics.cylinders.CounterbalanceValve`) sits in its outlet: it opens when
+p_out + R p_in = p_set, so with the piston's balance p_in A_in - p_out A_out = F_m
 
     p_in = (F_m + p_set A_out) / (A_in + R A_out),  p_out = p_set - R p_in
 

@@ -123,7 +123,8 @@ def hydraulic_cylinders_from_mapping(data: Any, where: str = "hydraulic_cylinder
     """Build :class:`HydraulicCylinders` from the crane YAML's ``hydraulic_cylinders`` mapping.
 
     Keys: ``lift``, ``tilt``, ``telescope`` (each ``bore``, ``rod``, ``stroke`` [m], optional
-    ``pin_to_pin_at_zero`` and ``counterbalance: {side, pilot_ratio, setting_pressure [Pa], check_pressure [Pa]}``), ``supply_pressure`` [Pa], optional ``friction: {coulomb, viscous}``.
+    ``pin_to_pin_at_zero`` and ``counterbalance: {side, pilot_ratio, setting_pressure [Pa],
+    check_pressure [Pa]}``), ``supply_pressure`` [Pa], optional ``friction: {coulomb, viscous}``.
     """
     required = {"lift", "tilt", "telescope", "supply_pressure"}
     top = mapping(data, where, required | {"friction"}, required)
