@@ -145,11 +145,6 @@ def _stroke_rows(xi: Array, x: Array, strokes: Array) -> Array:
     return np.stack(cols, axis=-1) / STROKE_SCALE
 
 
-def _every(step: int, *arrays: Array) -> tuple[Array, ...]:
-    """Every ``step``-th sample (axis 1) of each (D, K, 3) array."""
-    return tuple(x[:, ::step] for x in arrays)
-
-
 def _duty_powers(
     problem: LinkLengthProblem, options: DutyOptions, time: Array, f: Array, v: Array, a: Array, exact: bool = False
 ) -> tuple[Array, Array]:
@@ -195,7 +190,8 @@ def evaluate_designs(problem: LinkLengthProblem, base: BaseDesign, xi: Array) ->
             )
         else:  # hot windings and the rest's hold, as the problem evaluates them
             power, _ = _duty_powers(problem, options, base.time, f, v, a, exact=False)
-            colloc_power, rest_colloc = _duty_powers(problem, options, base.time[::ff], *_every(ff, f, v, a))
+            fc_, vc_, ac_ = f[:, ::ff], v[:, ::ff], a[:, ::ff]
+            colloc_power, rest_colloc = _duty_powers(problem, options, base.time[::ff], fc_, vc_, ac_)
             exact_power, rest_exact = _duty_powers(problem, options, base.time, f, v, a, exact=True)
         total = power.sum(axis=0)  # (D, K)
         colloc = colloc_power.sum(axis=0)
