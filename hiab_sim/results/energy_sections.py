@@ -128,14 +128,33 @@ class HydraulicVariant:
 
 
 @dataclass(frozen=True)
+class HydraulicAtBattery:
+    """One hydraulic variant over the cycle at the battery (:mod:`hiab_sim.hydraulics.battery_boundary`)."""
+
+    cycle_battery_energy_J: float  # energy taken from the battery over the cycle
+    terms_J: dict[str, float]  # useful work and every loss, summing to cycle_battery_energy_J
+    max_pilot_pressure_Pa: float  # largest counterbalance pilot pressure the pump supplied
+    pressure_shortfall_samples: int
+    emla_saving_percent: float  # 1 - EMLA cycle battery energy / this, both at the battery, same cycle
+
+
+@dataclass(frozen=True)
 class HydraulicDesign:
-    """Both supply variants for one design, against the EMLAs' battery energy for the same motion."""
+    """Both supply variants for one design, against the EMLAs' battery energy for the same motion.
+
+    ``constant_pressure`` and ``load_sensing`` (and the savings beside them) are drawn at the pump
+    motor's electric input, the EMLA figure at the battery; ``at_battery`` has every variant at the
+    battery over the cycle (with counterbalance valves, leakage and the pump's motor and inverter),
+    compared with the EMLAs' battery energy of the same cycle (``emla_cycle_battery_energy_J``).
+    """
 
     constant_pressure: HydraulicVariant
     load_sensing: HydraulicVariant
     emla_battery_energy_J: float
     emla_saving_vs_load_sensing_percent: float
     emla_saving_vs_constant_pressure_percent: float
+    at_battery: dict[str, HydraulicAtBattery] | None = optional()
+    emla_cycle_battery_energy_J: float | None = optional()
 
 
 @dataclass(frozen=True)

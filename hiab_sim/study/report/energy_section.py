@@ -33,11 +33,13 @@ from hiab_sim.emla.battery import rest_battery_energy
 from hiab_sim.emla.duty_energy import drive_duty
 from hiab_sim.emla.thermal import Duty
 from hiab_sim.hydraulics import SupplyResult, hydraulic_baseline
+from hiab_sim.hydraulics.battery_boundary import battery_boundary_baselines
 from hiab_sim.quadrature import trapezoid
 from hiab_sim.results.energy_sections import (
     ActuatorThermal,
     DesignEnergy,
     EnergyReport,
+    HydraulicAtBattery,
     HydraulicBaseline,
     HydraulicDesign,
     HydraulicVariant,
@@ -244,17 +246,34 @@ def hydraulic_report(
         if supplies is None or cylinders is None:
             return None
         cp, ls = supplies
+        emla_cycle = e.duty.cycle_battery_energy_J if e.duty is not None else e.battery_energy_J
+        act = state.actuators
+        at_battery = {
+            b.variant: HydraulicAtBattery(
+                cycle_battery_energy_J=b.battery_energy,
+                terms_J=b.terms,
+                max_pilot_pressure_Pa=b.max_pilot_pressure,
+                pressure_shortfall_samples=b.pressure_shortfall_samples,
+                emla_saving_percent=100.0 * (1.0 - emla_cycle / b.battery_energy),
+            )
+            for b in battery_boundary_baselines(
+                state.joints.time, act.force, act.velocity, cylinders, fine.emlas.battery
+            )
+        }
         designs[name] = HydraulicDesign(
             constant_pressure=_variant(cp),
             load_sensing=_variant(ls),
             emla_battery_energy_J=e.battery_energy_J,
             emla_saving_vs_load_sensing_percent=100.0 * (1.0 - e.battery_energy_J / ls.input_energy),
             emla_saving_vs_constant_pressure_percent=100.0 * (1.0 - e.battery_energy_J / cp.input_energy),
+            at_battery=at_battery,
+            emla_cycle_battery_energy_J=emla_cycle,
         )
     return HydraulicBaseline(
         note=(
             "valve-controlled cylinders of the crane file for the same rod forces and velocities (fine grid): "
-            "electric energy into the pump motor; EMLA: battery energy"
+            "constant_pressure and load_sensing at the pump motor's electric input, EMLA at the battery; at_battery: "
+            "every variant (also pump-controlled EHAs) at the battery over the cycle, against the EMLAs' cycle"
         ),
         supply_pressure_Pa=cylinders.supply_pressure if cylinders is not None else float("nan"),
         initial=designs["initial"],
@@ -319,6 +338,14 @@ def energy_lines(r: Result) -> list[str]:
                 f"{th.peak_winding_temperature_C:.1f}/{th.max_winding_temperature_C:.0f} deg C"
             )
     h = r.hydraulic_baseline
+    if h is not None and h.optimal.at_battery is not None:
+        lines.append(
+            "hydraulic baselines at the battery, same cycle: "
+            + ", ".join(
+                f"{k} {v.cycle_battery_energy_J / 1e3:.2f} kJ (EMLA -{v.emla_saving_percent:.1f} %)"
+                for k, v in h.optimal.at_battery.items()
+            )
+        )
     if h is not None:
         o = h.optimal
         lines.append(
