@@ -14,9 +14,13 @@ from hiab_sim.study.run import run_study
 
 @pytest.fixture(scope="module")
 def small_result(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The small study optimised once (analytic ID path, no figures)."""
+    """The small study optimised once (analytic ID path, no figures), on the paper's EMLA model.
+
+    The closed loop's time-domain drives model the paper's drive (no transmission or inverter loss),
+    so its energy is compared with a prediction of the same model.
+    """
     folder = tmp_path_factory.mktemp("small_closed_loop")
-    study = write_study(folder, small_study())
+    study = write_study(folder, small_study(emla="paper"))
     return run_study(study, folder / "out", progress=None, figures=False).folder
 
 
