@@ -55,6 +55,7 @@ class RestHold:
         rest_copper_loss_ref: c_r, the rest's copper loss at R_s,ref [W].
         rest_other_power: Inverter standby, inverter current and coil power during the rest [W]
             (not temperature dependent).
+        standby_power: The part of ``rest_other_power`` that is the powered inverter's standby c_0 [W].
         transition_copper_ref: Copper energy of the release (first pose) and of the engagement (last
             pose) at R_s,ref [J], each to be scaled by R_s(T)/R_s,ref of its sample.
         transition_other_energy: Coil and inverter energy of the release and engagement beyond the
@@ -74,6 +75,7 @@ class RestHold:
     rest_torque: float
     rest_copper_loss_ref: float
     rest_other_power: float
+    standby_power: float
     transition_copper_ref: tuple[float, float]
     transition_other_energy: float
     cycle_coil_energy: float
@@ -127,6 +129,7 @@ def rest_hold(params: EmlaParams, mode: str, first_force: float, last_force: flo
     cu_last, d_cu_last = _copper(params, tau_last)
     inv_first, d_inv_first = _inverter(params, tau_first)
     inv_last, d_inv_last = _inverter(params, tau_last)
+    standby = losses.inverter_constant_loss if losses.inverter_on else 0.0
     if mode == "motor":
         coil = brake.coil_power if brake is not None else (losses.brake_coil_power if losses.brake_on else 0.0)
         return RestHold(
@@ -136,6 +139,7 @@ def rest_hold(params: EmlaParams, mode: str, first_force: float, last_force: flo
             rest_torque=tau_last,
             rest_copper_loss_ref=cu_last,
             rest_other_power=inv_last + coil,
+            standby_power=standby,
             transition_copper_ref=(0.0, 0.0),
             transition_other_energy=0.0,
             cycle_coil_energy=0.0,
@@ -147,7 +151,6 @@ def rest_hold(params: EmlaParams, mode: str, first_force: float, last_force: flo
         )
     if brake is None:
         raise InvalidInputError(f"{params.name}.holding_brake", None, "must be given in the EMLA file for hold: brake")
-    standby = losses.inverter_constant_loss if losses.inverter_on else 0.0
     t_rel, t_eng = brake.release_time, brake.engage_time
     return RestHold(
         mode=mode,
@@ -156,6 +159,7 @@ def rest_hold(params: EmlaParams, mode: str, first_force: float, last_force: flo
         rest_torque=0.0,
         rest_copper_loss_ref=0.0,
         rest_other_power=standby,
+        standby_power=standby,
         transition_copper_ref=(cu_first * t_rel, cu_last * t_eng),
         transition_other_energy=(brake.coil_power + inv_first - standby) * t_rel + (inv_last - standby) * t_eng,
         cycle_coil_energy=0.0 if losses.brake_on else brake.coil_power * cycle_time,

@@ -49,6 +49,7 @@ class MotorDuty:
     mean_winding_temperature_C: float | None = optional()  # over the cycle's samples
     peak_winding_temperature_C: float | None = optional()
     peak_resistance_factor: float | None = optional()  # R_s(T_peak) / R_s,ref
+    rest_standby_energy_J: float | None = optional()  # the part of rest_energy_J that is the inverter's standby
 
 
 @dataclass(frozen=True)

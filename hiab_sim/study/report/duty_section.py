@@ -75,6 +75,7 @@ def duty_energy(emlas: EmlaSet, state: SampleState, options: DutyOptions) -> Dut
             brake_margin=margin,
             mean_winding_temperature_C=float(np.mean(w.temperature)) if w is not None else None,
             peak_winding_temperature_C=peak,
+            rest_standby_energy_J=h.standby_power * options.duty.rest_time if h is not None else None,
             peak_resistance_factor=(
                 float(p.winding.factor(peak)) if p.winding is not None and peak is not None and options.hot else None
             ),
