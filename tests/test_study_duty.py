@@ -152,3 +152,23 @@ def test_seed_faithful_reproduces_the_paper_model_optimum(tmp_path: Path) -> Non
     assert r.energy.optimal.costf2_W2s == pytest.approx(PAPER_OPTIMUM_COSTF2_W2S, rel=1e-9)
     assert r.optimal.net_electrical_energy_J == pytest.approx(PAPER_OPTIMUM_NET_J, rel=1e-9)
     assert r.energy.optimal.duty is None and not math.isnan(r.energy.optimal.battery_energy_J)
+
+
+def test_the_hydraulic_section_compares_every_variant_with_the_emla_cycle_at_the_battery() -> None:
+    """at_battery has the three variants; each saving is 1 - EMLA cycle battery energy / the variant's."""
+    from hiab_sim.study.report.energy_section import energy_report, hydraulic_report
+
+    study = load_study("xs031_spiral")
+    fine = LinkLengthProblem(study, times=study.grid.fine_times(), tightened=False, cost_scale=1.0)
+    ev = fine.evaluate(fine.initial_point(study.initial_lengths))
+    energy = energy_report(fine, ev, ev)
+    section = hydraulic_report(fine, ev, ev, energy)
+    assert section is not None and section.optimal.at_battery is not None
+    assert set(section.optimal.at_battery) == {"constant_pressure", "load_sensing", "pump_controlled"}
+    assert energy.optimal.duty is not None
+    cycle = energy.optimal.duty.cycle_battery_energy_J
+    assert section.optimal.emla_cycle_battery_energy_J == cycle
+    for variant in section.optimal.at_battery.values():
+        assert variant.emla_saving_percent == pytest.approx(100 * (1 - cycle / variant.cycle_battery_energy_J))
+        assert sum(variant.terms_J.values()) == pytest.approx(variant.cycle_battery_energy_J, rel=1e-9)
+    assert section.optimal.at_battery["load_sensing"].max_pilot_pressure_Pa > 0.0  # the counterbalance valves act
