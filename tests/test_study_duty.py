@@ -172,3 +172,26 @@ def test_the_hydraulic_section_compares_every_variant_with_the_emla_cycle_at_the
         assert variant.emla_saving_percent == pytest.approx(100 * (1 - cycle / variant.cycle_battery_energy_J))
         assert sum(variant.terms_J.values()) == pytest.approx(variant.cycle_battery_energy_J, rel=1e-9)
     assert section.optimal.at_battery["load_sensing"].max_pilot_pressure_Pa > 0.0  # the counterbalance valves act
+
+
+def test_brake_rows_hold_the_pose_and_their_partials_match_finite_differences() -> None:
+    """brake.<name> holding torque = 1 - max |f_x / k| / M_4 at the start, its derivative by central differences."""
+    study = load_study("xs031_spiral")
+    problem = LinkLengthProblem(study)
+    z = problem.initial_point(study.initial_lengths)
+    names = problem.constraint_names
+    rows = [i for i, n in enumerate(names) if n.startswith("brake.")]
+    assert [names[i] for i in rows] == [f"brake.{a} holding torque" for a in ("lift", "tilt", "telescope")]
+    ev = problem.evaluate(z)
+    lift = problem.emlas["lift"]
+    f = ev.actuators.force[:, 0]
+    expected = 1 - max(abs(f[0]), abs(f[-1])) / lift.transmission_ratio / 28.0
+    assert problem.constraints(z)[rows[0]] == pytest.approx(expected, rel=1e-12)
+    jac = problem.constraints_jacobian(z)
+    h = 1e-6
+    for j in (0, 1, 3, 8, 20, 40):
+        zp, zm = z.copy(), z.copy()
+        zp[j] += h
+        zm[j] -= h
+        fd = (problem.constraints(zp)[rows] - problem.constraints(zm)[rows]) / (2 * h)
+        assert jac[rows, j] == pytest.approx(fd, rel=1e-5, abs=1e-8)

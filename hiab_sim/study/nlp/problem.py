@@ -63,6 +63,7 @@ from hiab_sim.study.nlp.interface import (
     SampleState,
 )
 from hiab_sim.study.nlp.objectives import make_objective
+from hiab_sim.study.nlp.brake_rows import brake_blocks
 from hiab_sim.study.nlp.thermal_rows import thermal_blocks
 from hiab_sim.study.references.kinds import ik_start
 from hiab_sim.study.spec.study_file import Study
@@ -251,6 +252,7 @@ class LinkLengthProblem:
             bl.JointVelocityLimits(t, np.asarray(self.study.bounds.joint_velocity)),
             bl.WorkingRange(self.crane.chains, self.working, self.working_clearance),
             *thermal_blocks(self.emlas, self.study.energy.duty, self.task.reference.duration),
+            *brake_blocks(self.emlas, self.study.energy.duty),
             *buildable_blocks(self.study, self.working, self.tightened),
         ]
 
