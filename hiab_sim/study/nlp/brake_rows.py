@@ -42,7 +42,7 @@ class BrakeHolding(ConstraintBlock):
         return np.asarray(out, dtype=float)
 
     def jacobian(self, state: SampleState, partials: SamplePartials) -> DenseRows:
-        """d row / d f_x at the larger of the first and last samples, through the ID partials."""
+        """D row / d f_x at the larger of the first and last samples, through the ID partials."""
         assert state.duty is not None
         K = len(state.joints.time)
         rows = np.zeros((len(self.indices), K, 9))

@@ -51,6 +51,7 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.analysis.buildable import buildable_blocks
 from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.nlp import blocks as bl
+from hiab_sim.study.nlp.brake_rows import brake_blocks
 from hiab_sim.study.nlp.id_partials import id_joint_partials, id_length_partials
 from hiab_sim.study.nlp.interface import (
     N_XI,
@@ -63,7 +64,6 @@ from hiab_sim.study.nlp.interface import (
     SampleState,
 )
 from hiab_sim.study.nlp.objectives import make_objective
-from hiab_sim.study.nlp.brake_rows import brake_blocks
 from hiab_sim.study.nlp.thermal_rows import thermal_blocks
 from hiab_sim.study.references.kinds import ik_start
 from hiab_sim.study.spec.study_file import Study
