@@ -40,8 +40,8 @@ class DutySettings:
     """Rest between cycles: exactly one of ``rest_time`` [s] >= 0 or ``cycles_per_hour`` [1/h] > 0.
 
     ``hold`` says what carries the machine during the rest (:mod:`hiab_sim.emla.hold`): ``brake``
-    (the EMLAs' holding brakes) or ``motor`` (the motors hold the last pose); None (the key
-    omitted) is ``brake`` when every EMLA of the set has ``holding_brake`` data and otherwise the
+    (the EMLAs' holding brakes), ``motor`` (the motors hold the last pose) or ``none`` (the
+    seed paper's free rest, stated as a choice); None (the key omitted) is ``brake`` when every EMLA of the set has ``holding_brake`` data and otherwise the
     seed paper's free rest (zero torque, zero power), see :meth:`hold_mode`.
     """
 
@@ -51,7 +51,7 @@ class DutySettings:
 
     def __post_init__(self) -> None:
         if self.hold is not None:
-            check_choice("duty.hold", self.hold, HOLD_MODES)
+            check_choice("duty.hold", self.hold, (*HOLD_MODES, "none"))
         if (self.rest_time is None) == (self.cycles_per_hour is None):
             raise InvalidInputError(
                 "duty",
@@ -73,7 +73,7 @@ class DutySettings:
     def hold_mode(self, emlas: EmlaSet) -> str | None:
         """The hold of the rest for ``emlas``: the given one, else ``brake`` if every EMLA has brake data, else None."""
         if self.hold is not None:
-            return self.hold
+            return None if self.hold == "none" else self.hold
         return "brake" if all(p.brake is not None for p in emlas) else None
 
     def options(self, cycle_time: float, emlas: EmlaSet) -> DutyOptions:
@@ -158,7 +158,7 @@ def energy_settings(top: Any) -> EnergySettings:
         d = dict(mapping(top["duty"], "duty", {"rest_time", "cycles_per_hour", "hold"}, set()))
         hold = d.pop("hold", None)
         if hold is not None and not isinstance(hold, str):
-            raise InvalidInputError("duty.hold", hold, f"must be one of {', '.join(HOLD_MODES)}")
+            raise InvalidInputError("duty.hold", hold, f"must be one of {', '.join((*HOLD_MODES, 'none'))}")
         duty = DutySettings(**{k: number(v, f"duty.{k}") for k, v in d.items()}, hold=hold)
     elif "duty" in top:
         raise InvalidInputError("duty", None, "give exactly one of rest_time [s] or cycles_per_hour")
