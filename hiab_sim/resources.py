@@ -8,6 +8,7 @@ kind          folder in the source tree   shipped names
 ============  ==========================  ===================================================
 ``crane``     ``hiab_sim/presets/``       ``xs031``
 ``emla``      ``hiab_sim/presets/``       ``default``, ``xs031``, ``paper`` (the seed's lossless model)
+``plant``     ``hiab_sim/presets/``       ``realistic`` (the closed loop's plant effects)
 ``study``     ``optimize/``               every ``*.yaml`` by its path without the suffix,
                                           e.g. ``xs031_spiral``, ``sweeps/<name>``
 ``cases``     ``validate/``               ``cases``
@@ -22,6 +23,7 @@ study), else against the working folder.
 
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass
 from importlib import resources
 from importlib.resources.abc import Traversable
@@ -30,12 +32,13 @@ from typing import Literal
 
 from hiab_sim.errors import ConfigError
 
-Kind = Literal["crane", "emla", "study", "cases", "mjcf"]
+Kind = Literal["crane", "emla", "study", "cases", "mjcf", "plant"]
 
 #: Package (anchor) and sub-folder of each kind's shipped files.
 _FOLDERS: dict[str, tuple[str, str]] = {
     "crane": ("hiab_sim", "presets"),
     "emla": ("hiab_sim", "presets"),
+    "plant": ("hiab_sim", "presets"),
     "study": ("hiab_sim._data.studies", ""),
     "cases": ("hiab_sim._data.validate", ""),
     "mjcf": ("hiab_sim._data.mjcf", ""),
@@ -44,11 +47,19 @@ _FOLDERS: dict[str, tuple[str, str]] = {
 _NAMED: dict[str, dict[str, str]] = {
     "crane": {"xs031": "hiab_xs031.yaml"},
     "emla": {"default": "emla_xs031.yaml", "xs031": "emla_xs031.yaml", "paper": "emla_paper.yaml"},
+    "plant": {"realistic": "plant_realistic.yaml"},
 }
 _SUFFIX = {"mjcf": ".xml"}
 
 #: What each kind is called in messages.
-_WHAT = {"crane": "crane", "emla": "EMLA set", "study": "study", "cases": "case file", "mjcf": "MJCF file"}
+_WHAT = {
+    "crane": "crane",
+    "emla": "EMLA set",
+    "study": "study",
+    "cases": "case file",
+    "mjcf": "MJCF file",
+    "plant": "plant",
+}
 
 DEFAULT_STUDY = "xs031_spiral"
 DEFAULT_CASES = "cases"
@@ -156,12 +167,36 @@ def locate(source: str | Path, kind: Kind, relative_to: Source | None = None) ->
     else:
         candidate = relative_to.sibling(str(path))
     if not candidate.file.is_file():
-        known = ", ".join(shipped_names(kind))
+        offered = listed_names(kind)
+        close = difflib.get_close_matches(str(source), offered, n=1)
+        hint = f"; did you mean '{close[0]}'?" if close else ""
         where = f" (looked for {candidate.label})" if str(candidate.label) != str(source) else ""
         raise ConfigError(
-            f"cannot read {_WHAT[kind]} '{source}': neither a shipped name ({known}) nor a readable file{where}"
+            f"cannot read {_WHAT[kind]} '{source}': neither a shipped name ({', '.join(offered)}) "
+            f"nor a readable file{where}{hint}"
         )
     return candidate
+
+
+#: Top-level keys that make a shipped YAML file of the study folder a study (a reference or tasks, and bands).
+_STUDY_KEYS = (("tracking",), ("reference", "tasks"))
+
+
+def listed_names(kind: Kind) -> list[str]:
+    """The shipped names offered in messages: for studies only the files that are studies.
+
+    The study folder also ships the EMLA set, crane file and sweep specifications the studies
+    name; they resolve as shipped names but are not offered where a study is asked for.
+    """
+    names = shipped_names(kind)
+    if kind != "study":
+        return list(names)
+    kept = []
+    for name, file in names.items():
+        keys = {line.split(":", 1)[0] for line in file.read_text(encoding="utf-8").splitlines() if ":" in line}
+        if all(any(k in keys for k in group) for group in _STUDY_KEYS):
+            kept.append(name)
+    return kept
 
 
 def mjcf_template() -> str:

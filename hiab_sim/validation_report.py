@@ -1,4 +1,4 @@
-"""Reports of the cross-validation (``hiab-sim validate``): JSON, the README's markdown table, force plots.
+"""Reports of the cross-validation (``hiab-sim validate``): JSON, the markdown table of docs/validation.md, force plots.
 
 Every file is written atomically (:mod:`hiab_sim.atomic_io`); the computations are in
 :mod:`hiab_sim.validation`.
@@ -11,14 +11,15 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
-from hiab_sim.atomic_io import atomic_path, write_atomic
+from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import Crane
 from hiab_sim.dynamics.samples import ACTUATOR_NAMES
+from hiab_sim.figure_io import new_figure, save_png
 from hiab_sim.validation import CaseResult, Tolerances
 
 
 def markdown_table(results: list[CaseResult], tolerances: Tolerances) -> str:
-    """The validation table (markdown), as inserted in the README."""
+    """The validation table (markdown), as inserted in docs/validation.md."""
     lines = [
         "| case | samples | length sets | max abs force error [N] | max rel force error | "
         "max abs velocity error [m/s] | 6D form: max rel force error | balance (analytic) | balance (MuJoCo) | pass |",
@@ -59,10 +60,8 @@ def report_dict(crane: Crane, results: list[CaseResult], tolerances: Tolerances)
 
 def plot_case(result: CaseResult) -> Any:
     """Figure: both force traces (top) and their difference (bottom) for each actuator."""
-    from matplotlib.figure import Figure
-
     traces = result.traces
-    fig = Figure(figsize=(12, 6), layout="constrained")
+    fig = new_figure((12, 6))
     axes = fig.subplots(2, 3, sharex=True)
     style = {"linestyle": "-"} if traces["time"] else {"linestyle": "none", "marker": "."}
     for j, name in enumerate(ACTUATOR_NAMES):
@@ -92,7 +91,6 @@ def write_report(out_dir: Path, crane: Crane, results: list[CaseResult], toleran
     for result in results:
         path = out_dir / f"forces_{result.name.replace('+', '_')}.png"
         fig = plot_case(result)
-        with atomic_path(path) as temporary:
-            fig.savefig(temporary, dpi=110, format="png")
+        save_png(fig, path, dpi=110)
         written.append(path)
     return written

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Idempotent set-up on a fresh Debian machine: system libraries (OSMesa for off-screen
-# rendering, ffmpeg for videos), a virtual environment in .venv and hiab-sim with its extras.
+# rendering, ffmpeg for videos, Chromium for the report's PDF and the browser tests), a virtual
+# environment in .venv and hiab-sim with its extras (docs: the documentation site).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SUDO=""
@@ -8,6 +9,7 @@ if [ "$(id -u)" != "0" ]; then SUDO="sudo"; fi
 need=""
 dpkg -s libosmesa6 >/dev/null 2>&1 || need="$need libosmesa6"
 command -v ffmpeg >/dev/null 2>&1 || need="$need ffmpeg"
+command -v chromium >/dev/null 2>&1 || need="$need chromium"   # the report's --pdf and the browser tests
 python3 -c "import ensurepip, venv" >/dev/null 2>&1 || need="$need python3-venv"   # Debian splits venv out
 if [ -n "$need" ]; then
   echo "[setup] apt-get install$need"
@@ -24,4 +26,4 @@ if [ ! -x .venv/bin/python ]; then
   python3 -m venv .venv
 fi
 .venv/bin/python -m pip install -q --upgrade pip >/dev/null
-.venv/bin/python -m pip install -q -e ".[test,dev,dask,ipopt]"
+.venv/bin/python -m pip install -q -e ".[test,dev,dask,ipopt,docs]"

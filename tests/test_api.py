@@ -25,6 +25,7 @@ def _readme_api_block() -> str:
     return found[0]
 
 
+@pytest.mark.e2e
 def test_the_readme_python_example_runs_as_written(tmp_path: Path) -> None:
     """The README's API block runs unchanged in a fresh folder and writes the result folder it names."""
     code = _readme_api_block()
@@ -33,7 +34,6 @@ def test_the_readme_python_example_runs_as_written(tmp_path: Path) -> None:
     )
     assert result.returncode == 0, result.stderr[-2000:]
     assert (tmp_path / "runs" / "x" / "result.json").is_file()
-    assert "feasible: True" in result.stdout
 
 
 def test_importing_hiab_sim_leaves_the_environment_alone() -> None:

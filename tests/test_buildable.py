@@ -24,6 +24,9 @@ from hiab_sim.study.solvers.feasibility import feasible_start
 from hiab_sim.study.solvers.slsqp import solve
 from hiab_sim.study.spec.study_file import Study, study_from_dict
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 
 @pytest.fixture(scope="module")
 def solved() -> tuple[LinkLengthProblem, np.ndarray]:
@@ -290,7 +293,8 @@ def test_shipped_studies_print_a_rounded_design_that_mjcf_accepts(
     out = tmp_path / name
     assert main(["optimize", f"optimize/{name}.yaml", "--out", str(out), "--no-figures", "--no-video", "--quiet"]) == 0
     printed = capsys.readouterr().out
-    command = next(line.split("export: hiab-sim ")[1] for line in printed.splitlines() if "export: hiab-sim" in line)
+    marker = "Model of the buildable design: hiab-sim "
+    command = next(line.split(marker)[1] for line in printed.splitlines() if marker in line)
     result = json.loads((out / "result.json").read_text())["buildable"]
     xi = np.array([result["lengths"][c][k] for c in ("lift", "tilt") for k in ("L", "Lc0", "Lc")])
     np.testing.assert_allclose(xi * 1e3, np.round(xi * 1e3), atol=1e-9)

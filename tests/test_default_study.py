@@ -15,6 +15,9 @@ from hiab_sim.study.nlp.problem import duty_options
 from hiab_sim.study.run import RunOutput, run_study
 from hiab_sim.study.spec.study_file import load_study
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> RunOutput:
@@ -81,4 +84,29 @@ def test_saving_decomposes_into_lengths_and_trajectory(run: RunOutput, result: R
     assert d.from_lengths_J is not None and d.from_lengths_J > 0.0
     assert d.from_lengths_J == pytest.approx(e00 - e10, abs=1e-6)
     assert d.from_trajectory_J == pytest.approx(e00 - e01, abs=1e-6)
-    assert d.interaction_J == pytest.approx(e10 + e01 - e00 - e11, abs=1e-6)
+
+
+def test_default_study_results_page_is_current(result: Result) -> None:
+    """docs/results/default-study.md's generated table matches this fresh run within the stated tolerance."""
+    from hiab_sim.docs_site.results_page import current_block, differences, results_block
+
+    page = (Path(__file__).resolve().parents[1] / "docs" / "results" / "default-study.md").read_text()
+    assert differences(current_block(page), results_block(result)) == []
+
+
+def test_default_run_report_is_self_contained_and_states_the_design(run: RunOutput, result: Result) -> None:
+    """hiab-sim report on the default run: one HTML file, nothing external, the design to build and battery energy."""
+    from browser_helper import References
+
+    from hiab_sim.design_report import write_report
+
+    (path,) = write_report(run.folder)
+    html = path.read_text()
+    parser = References()
+    parser.feed(html)
+    assert parser.tags == [] and all(url.startswith("data:") for url in parser.urls)
+    assert result.buildable is not None and result.energy is not None
+    lift, tilt = result.buildable.lengths.lift, result.buildable.lengths.tilt
+    assert f"lift L / Lc0 / Lc = {lift.L:.3f} / {lift.Lc0:.3f} / {lift.Lc:.3f} m" in html
+    assert f"tilt L / Lc0 / Lc = {tilt.L:.3f} / {tilt.Lc0:.3f} / {tilt.Lc:.3f} m" in html
+    assert f"{result.energy.optimal.battery_energy_J:.1f} J" in html

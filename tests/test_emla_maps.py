@@ -80,21 +80,24 @@ def test_emla_map_command_rejects_a_missing_output_folder(tmp_path: Path, capsys
     assert "folder must exist" in capsys.readouterr().err
 
 
-def test_design_overlays_use_one_colour_and_marker_per_design_apart_from_the_hydraulic_lines() -> None:
-    """Each design's points carry its style colour and its own marker; no design shares the hydraulic colour."""
+def test_design_overlays_use_one_colour_and_line_style_per_design_apart_from_the_hydraulic_lines() -> None:
+    """Each design's path carries its style colour and its own line style; no design shares the hydraulic colour."""
     from matplotlib.colors import to_hex
 
-    from hiab_sim.style import COLOURS, MARKERS
+    from hiab_sim.style import COLOURS
 
     emap = efficiency_map(EMLAS.lift, n_force=21, n_velocity=21)
     t = np.linspace(0, 6, 40)
     designs = {"initial": (30e3 * np.sin(t), 0.1 * np.cos(t)), "optimal": (25e3 * np.sin(t), 0.08 * np.cos(t))}
     fig = plot_efficiency_map(emap, designs=designs)
     lines = {ln.get_label(): ln for ln in fig.axes[0].get_lines()}
+    styles = set()
     for name, (force, _) in designs.items():
-        line = lines[f"{name} design"]
-        assert to_hex(line.get_color()) == COLOURS[name].lower() and line.get_marker() == MARKERS[name]
+        line = lines[f"{name} design: operating points over the motion"]
+        assert to_hex(line.get_color()) == COLOURS[name].lower()
+        styles.add(line.get_linestyle())
         np.testing.assert_allclose(line.get_ydata(), force / 1e3)
+    assert len(styles) == 2 and "--" not in styles  # dashed is the hydraulic lines' style
     hydraulic = {to_hex(ln.get_color()) for ln in fig.axes[0].get_lines() if ln.get_linestyle() == "--"}
     assert hydraulic == {COLOURS["hydraulic"].lower()}
     assert len({COLOURS[n] for n in ("initial", "optimal", "rounded", "hydraulic")}) == 4

@@ -148,15 +148,16 @@ def test_unknown_key_in_the_cylinder_section_is_a_config_error() -> None:
 
 
 def test_comparison_figure_shows_the_energies_it_was_given() -> None:
-    """Bar heights are the EMLA drawn/battery energies and both baselines' per-actuator and total inputs, in kJ."""
+    """Left chart: battery and both pump inputs; right chart: per actuator drive and pump inputs, in kJ."""
     from hiab_sim.hydraulics.figure import plot_energy_comparison
 
     t, f, v = _hand_case()
     cp, ls = hydraulic_baseline(t, f, v, FRICTIONLESS, IDEAL)
     fig = plot_energy_comparison(("lift", "tilt", "telescope"), [1.0e3, 2.0e3, 0.5e3], 2.5e3, cp, ls)
-    heights = [p.get_height() for p in fig.axes[0].patches]
-    expected = np.r_[[1.0, 2.0, 0.5, 2.5], np.r_[ls.input_energy_per_actuator, ls.input_energy] / 1e3,
-                     np.r_[cp.input_energy_per_actuator, cp.input_energy] / 1e3]  # fmt: skip
-    assert heights == pytest.approx(expected, rel=1e-12)
+    whole = [p.get_height() for p in fig.axes[0].patches]
+    assert whole == pytest.approx(np.r_[2.5, ls.input_energy / 1e3, cp.input_energy / 1e3], rel=1e-12)
+    each = [p.get_height() for p in fig.axes[1].patches]
+    expected = np.r_[[1.0, 2.0, 0.5], ls.input_energy_per_actuator / 1e3, cp.input_energy_per_actuator / 1e3]
+    assert each == pytest.approx(expected, rel=1e-12)
     with pytest.raises(InvalidInputError, match="emla_drawn"):
         plot_energy_comparison(("lift", "tilt"), [1.0, 2.0], 1.0, cp, ls)

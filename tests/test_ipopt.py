@@ -97,6 +97,7 @@ def test_length_partials_on_the_stacked_analytic_path_equal_mujocos_per_design_m
     np.testing.assert_allclose(analytic, mujoco, atol=1e-6 * np.abs(mujoco).max())
 
 
+@pytest.mark.e2e
 def test_ipopt_and_dense_slsqp_reach_the_same_design_of_the_two_task_mix() -> None:
     """Two solvers, two Jacobian assemblies (sparse two-sided rows vs dense one-sided): same Xi, feasible, same cost."""
     pytest.importorskip("casadi")

@@ -206,6 +206,7 @@ def test_study_file_with_tasks_loads_them_and_one_without_either_form_is_refused
         study_from_dict(data, "none.yaml")
 
 
+@pytest.mark.e2e
 def test_an_infeasible_mix_start_goes_through_the_feasibility_phase_and_converges(tmp_path: Path) -> None:
     """Lift Lc0 + 1.5 mm leaves x < 0 at the low end of the range on both tasks: repaired (IPOPT projection), solved."""
     from hiab_sim.results.read import read_result

@@ -45,6 +45,7 @@ def test_inactive_epsilon_reproduces_the_plain_optimum(plain: tuple[LinkLengthPr
     np.testing.assert_allclose(z[: problem.n_xi], result.z[: problem.n_xi], atol=1e-8)
 
 
+@pytest.mark.e2e
 def test_front_is_monotone_from_the_plain_optimum(plain: tuple[LinkLengthProblem, SolveResult]) -> None:
     """A lower peak force never comes with a lower objective; each point holds its epsilon; it starts at the optimum."""
     problem, result = plain

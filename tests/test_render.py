@@ -154,13 +154,63 @@ def test_stacked_layout_puts_one_design_above_the_other(result_dir: Path) -> Non
         assert _saturated(panel[25:]).sum() > 200
 
 
+def _project(camera: object, point: np.ndarray, size: tuple[int, int], fovy: float) -> tuple[float, float]:
+    """Pixel (column, row) of a world point through a free camera: an independent pinhole model."""
+    from hiab_sim.render.camera import camera_axes
+
+    forward, right, up = camera_axes(float(camera.azimuth), float(camera.elevation))  # type: ignore[attr-defined]
+    eye = np.asarray(camera.lookat) - forward * float(camera.distance)  # type: ignore[attr-defined]
+    v = point - eye
+    tan_y = np.tan(np.radians(fovy) / 2.0)
+    width, height = size
+    x, y, z = v @ right / (v @ forward), v @ up / (v @ forward), 1.0
+    return width / 2 * (1 + x / (tan_y * width / height) / z), height / 2 * (1 - y / tan_y / z)
+
+
+def _luminance(rgb: np.ndarray) -> np.ndarray:
+    """Relative luminance (sRGB, WCAG) of pixels (..., 3) uint8."""
+    c = rgb.astype(float) / 255.0
+    linear = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return linear @ np.array([0.2126, 0.7152, 0.0722])
+
+
+def test_dressed_frame_spans_the_machine_and_its_captions_read(result_dir: Path) -> None:
+    """A 640x480 overlay frame shows the whole machine and readable captions.
+
+    The design-coloured pixels reach from the column to the tool point as an independent pinhole
+    model projects them, and the caption text has a contrast ratio above 4.5 (WCAG AA) on its box.
+    """
+    size = (640, 480)
+    data = load_playback(result_dir)
+    with playback_renderer(data, fps=FPS, size=size, layout="overlay") as renderer:
+        index = len(renderer) // 2
+        image = renderer.frame(index)
+        optimal = renderer.designs[0]
+        fovy = float(optimal.model.vis.global_.fovy)
+        tool = _project(renderer.camera, optimal.tcp[index], size, fovy)
+        column = _project(renderer.camera, np.zeros(3), size, fovy)
+        caption_rows = renderer._captions[0].shape[0] + 8
+    machine = _saturated(image)
+    machine[:caption_rows] = False  # the captions are coloured too
+    rows, cols = np.nonzero(machine)
+    assert cols.max() - cols.min() > 0.4 * size[0] and rows.max() - rows.min() > 0.3 * size[1]
+    margin = 30  # px: box sections and the tool block reach past the points projected
+    assert cols.min() - margin <= min(tool[0], column[0]) and max(tool[0], column[0]) <= cols.max() + margin
+    assert rows.min() - margin <= min(tool[1], column[1]) and max(tool[1], column[1]) <= rows.max() + margin
+    assert 0 <= tool[0] < size[0] and 0 <= tool[1] < size[1] and 0 <= column[0] < size[0]
+    band = image[4:caption_rows, : size[0] // 2]
+    lum = _luminance(band)
+    text, box = np.percentile(lum, 2), np.percentile(lum, 90)
+    assert (box + 0.05) / (text + 0.05) > 4.5
+
+
 def test_energy_notes_integrate_the_power_in_time() -> None:
     """Constant 1 kW for 2 s: the notes read 0, 1 and 2 kJ of 2 kJ at 0, 1 and 2 s; without power only the time."""
     from hiab_sim.render.video import energy_notes
 
     time = np.linspace(0.0, 2.0, 9)
     notes = energy_notes(time, np.array([0.0, 1.0, 2.0]), np.full(9, 1000.0))
-    assert [n.split("E =")[1].split()[0] for n in notes] == ["0.000", "1.000", "2.000"]
+    assert [n.split("net energy")[1].split()[0] for n in notes] == ["0.000", "1.000", "2.000"]
     assert all(n.endswith("of 2.000 kJ") for n in notes)
     assert energy_notes(time, np.array([0.5]), None) == ("t =  0.50 s",)
 
@@ -208,6 +258,7 @@ def _count_frames(path: Path) -> int:
     return len(mediapy.read_video(path))
 
 
+@pytest.mark.e2e
 @pytest.mark.skipif(shutil.which("ffmpeg") is None, reason="needs Debian ffmpeg (scripts/setup.sh installs it)")
 def test_mp4_holds_every_frame_and_no_temporary_file(result_dir: Path, tmp_path: Path) -> None:
     """render_result writes an H.264 mp4 with one frame per tick and leaves nothing else behind."""
@@ -306,6 +357,7 @@ def test_missing_ffmpeg_is_one_line(
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.e2e
 def test_cli_prints_nothing_at_exit(result_dir: Path, tmp_path: Path) -> None:
     """The GL contexts are freed before exit: the process's stderr stays empty (CI: MUJOCO_GL=osmesa)."""
     output = tmp_path / "still.png"

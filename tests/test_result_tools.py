@@ -15,6 +15,9 @@ from test_study_small import small_study, write_study
 from hiab_sim.cli import main
 from hiab_sim.crane.loader import load_crane
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 CRANE = load_crane("xs031")
 
 
@@ -70,7 +73,8 @@ def test_compare_table_matches_each_result(solved: Path, tmp_path: Path, capsys)
     out = tmp_path / "cmp"
     assert main(["compare", str(solved), str(second), "--out", str(out)]) == 0
     printed = capsys.readouterr().out
-    assert "saving vs initial" in printed and "copy" in printed
+    assert "saving [%]" in printed and "copy" in printed
+    assert max(len(line) for line in printed.splitlines() if not line.startswith("wrote")) <= 100
     with (out / "comparison.csv").open() as handle:
         table = list(csv.DictReader(handle))
     assert [(r["run"], r["design"]) for r in table] == [
@@ -85,6 +89,25 @@ def test_compare_table_matches_each_result(solved: Path, tmp_path: Path, capsys)
     saved = float(table[1]["saving vs initial [%]"])
     assert saved == pytest.approx(result["improvement"]["net_energy_saved_percent"], rel=1e-9)
     assert (out / "comparison.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_compare_without_out_writes_nothing_and_fits_100_columns(
+    solved: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Without --out, compare only prints (no ./comparison/), every line within 100 columns even for long names."""
+    second = tmp_path / ("a_rather_long_run_folder_name_" * 4)
+    shutil.copytree(solved, second)
+    data = json.loads((second / "result.json").read_text())
+    data["name"] = second.name
+    (second / "result.json").write_text(json.dumps(data))
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    assert main(["compare", str(solved), str(second)]) == 0
+    printed = capsys.readouterr().out
+    assert max(len(line) for line in printed.splitlines()) <= 100
+    assert "..." in printed  # the long name is shortened, not wrapped
+    assert list(work.iterdir()) == []
 
 
 def test_compare_rejects_bad_folders_with_one_line(solved: Path, tmp_path: Path, capsys) -> None:

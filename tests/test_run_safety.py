@@ -10,7 +10,7 @@ import pytest
 from test_study_small import small_study, write_study
 
 from hiab_sim.cli import main
-from hiab_sim.errors import InvalidInputError
+from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study.run_safety import (
     OWNER_FILE,
     check_folder,
@@ -20,8 +20,20 @@ from hiab_sim.study.run_safety import (
     resolve_starts,
 )
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 FLAGS = ["--no-video", "--quiet", "--no-figures"]
-OUTPUTS = ("result.json", "trajectory.npz", "checkpoint_0.json", "checkpoint_3.json", "objective.png", "playback.mp4")
+OUTPUTS = (
+    "result.json",
+    "trajectory.npz",
+    "checkpoint_0.json",
+    "checkpoint_3.json",
+    "objective.png",
+    "playback.mp4",
+    "simulation.json",
+    "summary.md",
+)
 
 
 def _fill(folder: Path, names: tuple[str, ...] = OUTPUTS) -> None:
@@ -37,7 +49,7 @@ def _claim(folder: Path, digest: str, starts: int = 1) -> None:
 def test_a_folder_of_another_study_is_refused_unless_forced(tmp_path: Path) -> None:
     """A marker with another study hash refuses the run (field --out); the same hash and --force pass."""
     _claim(tmp_path, "a" * 64)
-    with pytest.raises(InvalidInputError, match=r"--out .* belongs to study 's'.*--force"):
+    with pytest.raises(ConfigError, match=r"belongs to the study named 's'.*name: field.*--force"):
         check_folder(tmp_path, "b" * 64, resume=False, force=False)
     check_folder(tmp_path, "a" * 64, resume=False, force=False)
     check_folder(tmp_path, "b" * 64, resume=False, force=True)
@@ -46,7 +58,7 @@ def test_a_folder_of_another_study_is_refused_unless_forced(tmp_path: Path) -> N
 def test_a_legacy_folder_is_owned_by_its_checkpoints_study(tmp_path: Path) -> None:
     """Without a marker, a checkpoint's study hash decides; a folder with nothing of hiab-sim's is refused."""
     (tmp_path / "checkpoint_0.json").write_text(json.dumps({"study_sha256": "a" * 64, "study": "x.yaml"}))
-    with pytest.raises(InvalidInputError, match=r"belongs to study x\.yaml"):
+    with pytest.raises(ConfigError, match=r"belongs to study x\.yaml"):
         check_folder(tmp_path, "b" * 64, resume=False, force=False)
     check_folder(tmp_path, "a" * 64, resume=False, force=False)
     other = tmp_path / "holiday"
@@ -121,17 +133,19 @@ def test_cli_another_study_is_refused_then_forced(two_start_run: Path, tmp_path:
     """Another study exits 2 leaving the folder as it was; with --force it runs and no stale output survives."""
     out = tmp_path / "out"
     shutil.copytree(two_start_run, out)
-    _fill(out, ("objective.png", "playback.mp4"))
+    _fill(out, ("objective.png", "playback.mp4", "simulation.json"))
     before = {p.name: p.read_bytes() for p in out.iterdir()}
     other = write_study(tmp_path, small_study(name="other", tracking={**small_study()["tracking"], "position": 3e-3}))
     capsys.readouterr()
     assert main(["optimize", str(other), "--out", str(out), *FLAGS]) == 2
     err = capsys.readouterr().err
-    assert "belongs to study 'small'" in err and len(err.strip().splitlines()) == 1
+    assert "belongs to the study named 'small'" in err and "out of range" not in err
+    assert len(err.strip().splitlines()) == 1
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
     assert main(["optimize", str(other), "--out", str(out), "--force", *FLAGS]) == 0
     names = sorted(p.name for p in out.iterdir())
-    assert names == sorted([OWNER_FILE, "checkpoint_0.json", "result.json", "trajectory.npz"])
+    expected = [OWNER_FILE, "checkpoint_0.json", "report.html", "result.json", "summary.md", "trajectory.npz"]
+    assert names == sorted(expected)
     assert read_owner(out)["name"] == "other"  # type: ignore[index]
 
 

@@ -11,6 +11,9 @@ from test_study_small import small_study, write_study
 from hiab_sim.cli import main
 from hiab_sim.study.run import run_study
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 
 @pytest.fixture(scope="module")
 def small_result(tmp_path_factory: pytest.TempPathFactory) -> Path:
@@ -93,3 +96,51 @@ def test_default_study_validates_in_closed_loop(tmp_path: Path) -> None:
         designs["optimal"]["nominal"]["net_electrical_energy_J"]
         < designs["initial"]["nominal"]["net_electrical_energy_J"]
     )
+
+
+def test_simulate_on_the_realistic_plant_reports_every_effect(small_result: Path, tmp_path: Path) -> None:
+    """--plant realistic: plant_effects holds ideal, each effect alone and all, both designs, shares, the mass split."""
+    out = tmp_path / "sim"
+    args = ["simulate", str(small_result), "--plant", "realistic", "--no-video", "--quiet", "--out", str(out)]
+    assert main(args) == 0
+    report = json.loads((out / "simulation.json").read_text())
+    effects = report["plant_effects"]
+    assert list(effects["variants"]) == ["ideal", *effects["effects_on"], "all"]
+    for entry in effects["variants"].values():
+        for design in ("initial", "optimal"):
+            assert entry[design]["tcp_error_mm"]["max"] <= 10.0
+        assert isinstance(entry["optimal_below_initial"], bool)
+    ideal = effects["variants"]["ideal"]["optimal"]
+    assert ideal["dc_bus_energy_J"] == pytest.approx(ideal["predicted_net_electrical_energy_J"], rel=0.02)
+    split = effects["mismatch_split"]["optimal"]
+    assert split["predicted_at_true_masses_J"] > split["predicted_J"]
+    # No worse than the nominal optimum at the true masses, within the small study's solver and ID tolerances.
+    assert split["replanned_optimum_predicted_J"] <= split["predicted_at_true_masses_J"] * (1 + 1e-3)
+    assert (out / "closed_loop_plant_effects.png").is_file()
+
+
+def test_a_bad_plant_exits_2_naming_it(small_result: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """An unknown plant name or a zero cycle count exits 2 with one line, nothing written."""
+    out = tmp_path / "sim"
+    for extra, word in ((["--plant", "windy"], "windy"), (["--cycles", "0"], "--cycles")):
+        assert main(["simulate", str(small_result), "--no-video", "--quiet", "--out", str(out), *extra]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and word in err[0]
+        assert not out.exists()
+
+
+@pytest.mark.slow
+def test_default_study_on_the_realistic_plant(tmp_path: Path) -> None:
+    """The default study's both designs complete on the realistic plant within 10 mm, over two cycles; ideal = today."""
+    result = run_study(None, tmp_path / "run", progress=None, figures=False).folder
+    args = ["simulate", str(result), "--plant", "realistic", "--cycles", "2", "--no-video", "--no-figures", "--quiet"]
+    assert main(args) == 0
+    effects = json.loads((result / "simulation.json").read_text())["plant_effects"]
+    for design in ("initial", "optimal"):
+        ideal = effects["variants"]["ideal"][design]
+        assert ideal["dc_bus_energy_J"] == pytest.approx(ideal["predicted_net_electrical_energy_J"], rel=6e-4)
+        every = effects["variants"]["all"][design]
+        assert every["tcp_error_mm"]["max"] <= 10.0
+        temperatures = [c["winding_temperature_C"][0] for c in every["cycles"]]
+        assert temperatures[1] > temperatures[0]
+    assert "optimal_below_initial" in effects["variants"]["all"]

@@ -115,6 +115,7 @@ def test_thermal_rows_exist_only_with_a_duty_and_hold_at_60_cycles_per_hour_not_
     assert values[0] < 0.0  # lift rms torque above the continuous torque
 
 
+@pytest.mark.e2e
 def test_every_result_reports_both_objectives_battery_thermal_and_hydraulics(tmp_path: Path) -> None:
     """result.json has the energy and hydraulic sections; costf2 and the battery energy match independent sums."""
     study = write_study(tmp_path, small_study(duty={"cycles_per_hour": 60}, emla="paper"))

@@ -19,6 +19,9 @@ from hiab_sim.sweep.runner import run_sweep
 from hiab_sim.sweep.spec import load_sweep
 from hiab_sim.sweep.table import read_table
 
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
+
 #: A smaller spiral on a coarse grid: each point optimises in a few seconds.
 TINY = {
     "spline": {"control_points": 16, "degree": 5},

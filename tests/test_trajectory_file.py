@@ -87,6 +87,7 @@ def test_not_an_npz_is_one_line(tmp_path: Path) -> None:
         read_trajectory(tmp_path)
 
 
+@pytest.mark.e2e
 def test_a_run_writes_exactly_the_declared_arrays(tmp_path: Path) -> None:
     """A single-task optimisation's trajectory.npz holds the declared keys, its version, and nothing else."""
     from test_study_small import small_study

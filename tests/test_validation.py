@@ -57,6 +57,7 @@ def test_random_link_lengths_are_feasible_and_distinct(crane: Crane) -> None:
     assert np.all(np.ptp(values, axis=0) > 1e-3)
 
 
+@pytest.mark.e2e
 def test_validate_command_writes_report_table_and_plots(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """`hiab-sim validate --samples small` exits 0 and writes report.json, table.md and one plot per case."""
     assert main(["validate", "--samples", "small", "--out", str(tmp_path)]) == 0

@@ -13,6 +13,10 @@ from pathlib import Path
 
 import mujoco
 import numpy
+import pytest
+
+#: End-to-end runs of whole studies and commands: the full suite, not the fast tier.
+pytestmark = pytest.mark.e2e
 
 REPO = Path(__file__).resolve().parents[1]
 #: What the wheel is built from (the tracked sources; no .venv, runs/ or build/ from this checkout).

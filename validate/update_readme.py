@@ -1,10 +1,10 @@
-"""Replace the validation table in README.md with the one ``hiab-sim validate`` wrote.
+"""Replace the validation table of the documentation (docs/validation.md) with the one ``hiab-sim validate`` wrote.
 
-Usage: ``python validate/update_readme.py [--table runs/validate/table.md] [--readme README.md] [--check]``,
+Usage: ``python validate/update_readme.py [--table runs/validate/table.md] [--readme docs/validation.md] [--check]``,
 from the repository root (the defaults are relative to the working folder, like ``hiab-sim validate --out``).
 The table goes between the markers ``<!-- validation-table:start -->`` and
 ``<!-- validation-table:end -->``. With ``--check`` nothing is written and the exit status is 1
-when the README is out of date (CI runs ``hiab-sim validate`` and then this check, see
+when the page is out of date (CI runs ``hiab-sim validate`` and then this check, see
 scripts/test.sh): its text must equal the fresh table's except for the numbers written in
 e-notation, which are round-off-level errors that change with the CPU and the BLAS build and
 may differ by up to ``--round-off-factor`` (default 10; 0 on one side needs 0 on the other).
@@ -29,7 +29,7 @@ def current_block(readme: str) -> str:
     """The text between the markers (without the surrounding newlines)."""
     start, end = readme.find(START), readme.find(END)
     if start < 0 or end < 0 or end < start:
-        raise ValueError(f"README must contain {START} followed by {END}")
+        raise ValueError(f"the page must contain {START} followed by {END}")
     return readme[start + len(START) : end].strip()
 
 
@@ -42,26 +42,26 @@ def _same_number(a: float, b: float, factor: float) -> bool:
 
 
 def differences(written: str, fresh: str, factor: float) -> list[str]:
-    """Where the README's table differs from a fresh one beyond round-off: one message per line that differs."""
+    """Where the page's table differs from a fresh one beyond round-off: one message per line that differs."""
     old_lines, new_lines = written.strip().splitlines(), fresh.strip().splitlines()
     if len(old_lines) != len(new_lines):
-        return [f"the README's table has {len(old_lines)} lines, the fresh table {len(new_lines)}"]
+        return [f"the page's table has {len(old_lines)} lines, the fresh table {len(new_lines)}"]
     out = []
     for row, (old, new) in enumerate(zip(old_lines, new_lines, strict=True), start=1):
         old_numbers = [float(x) for x in NUMBER.findall(old)]
         new_numbers = [float(x) for x in NUMBER.findall(new)]
         same_text = NUMBER.sub("#", old) == NUMBER.sub("#", new)
         if not same_text or len(old_numbers) != len(new_numbers):
-            out.append(f"line {row}: README {old!r} != fresh {new!r}")
+            out.append(f"line {row}: page {old!r} != fresh {new!r}")
             continue
         for a, b in zip(old_numbers, new_numbers, strict=True):
             if not _same_number(a, b, factor):
-                out.append(f"line {row}: README {a:.2e} vs fresh {b:.2e} (more than x{factor:g} apart)")
+                out.append(f"line {row}: page {a:.2e} vs fresh {b:.2e} (more than x{factor:g} apart)")
     return out
 
 
 def replace_block(readme: str, table: str) -> str:
-    """README text with the block between the markers replaced by ``table``."""
+    """The page's text with the block between the markers replaced by ``table``."""
     current_block(readme)  # the markers are there, in order
     start, end = readme.find(START), readme.find(END)
     return readme[: start + len(START)] + "\n" + table.strip() + "\n" + readme[end:]
@@ -70,8 +70,15 @@ def replace_block(readme: str, table: str) -> str:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--table", type=Path, default=Path("runs/validate/table.md"))
-    parser.add_argument("--readme", type=Path, default=Path("README.md"))
-    parser.add_argument("--check", action="store_true", help="only check that the README is up to date")
+    parser.add_argument(
+        "--readme",
+        "--page",
+        dest="readme",
+        type=Path,
+        default=Path("docs/validation.md"),
+        help="the page with the table",
+    )
+    parser.add_argument("--check", action="store_true", help="only check that the page is up to date")
     parser.add_argument(
         "--round-off-factor",
         type=float,

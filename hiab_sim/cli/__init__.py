@@ -3,13 +3,15 @@
 Every subcommand module in :data:`SUBCOMMANDS` exposes ``add_parser(subparsers)`` and
 ``run(args) -> int``. A :class:`~hiab_sim.errors.HiabSimError` (bad input) is printed on one
 line and the process exits with status 2, without a traceback; a solver failure exits 1, a study with no
-feasible point within its bounds exits 3 (the message names the binding limit).
+feasible point within its bounds exits 3 (the message names the binding limit). Output into a closed
+pipe (``hiab-sim crane | head -1``) ends the command quietly with the shell's status for SIGPIPE (141).
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 from collections.abc import Sequence
 
@@ -20,13 +22,18 @@ from hiab_sim.errors import HiabSimError, InfeasibleStudyError, SolverError
 #: Subcommands that import MuJoCo: its OpenGL backend is checked before they run.
 USES_MUJOCO = {"mjcf", "validate", "optimize", "render", "simulate", "sweep", "pareto"}
 
+#: Exit status of a command whose output pipe was closed by its reader (128 + SIGPIPE, as a shell reports it).
+BROKEN_PIPE_STATUS = 141
+
 #: Subcommand name -> module under ``hiab_sim.cli`` that implements it.
 SUBCOMMANDS: dict[str, str] = {
     "crane": "crane_info",
+    "machine": "machine",
     "mjcf": "mjcf",
     "validate": "validate",
     "emla-map": "emla_map",
     "optimize": "optimize",
+    "report": "report",
     "render": "render",
     "compare": "compare",
     "simulate": "simulate",
@@ -51,7 +58,22 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI; return the process exit status."""
+    """Run the CLI; return the process exit status (141 when the reader of stdout closed the pipe)."""
+    try:
+        try:
+            status = _main(argv)
+        finally:  # also after --help's SystemExit: a closed pipe shows on this flush when the output was buffered
+            sys.stdout.flush()
+    except BrokenPipeError:
+        # The reader is gone: point stdout at /dev/null so the interpreter's final flush cannot fail again.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+        return BROKEN_PIPE_STATUS
+    return status
+
+
+def _main(argv: Sequence[str] | None) -> int:
     select_gl_backend()  # before any subcommand module imports MuJoCo or dm_control
     parser = build_parser()
     args = parser.parse_args(argv)

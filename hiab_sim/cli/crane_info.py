@@ -12,7 +12,15 @@ from hiab_sim.crane.loader import load_crane
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register the subcommand."""
-    parser = subparsers.add_parser("crane", help="print a summary of a crane description")
+    parser = subparsers.add_parser(
+        "crane",
+        help="print a summary of a crane description",
+        description=(
+            "Print a crane description: for each closed chain (cylinder base pivot, boom hinge, rod-end pivot) its "
+            "link lengths, the cylinder's stroke and usable stroke, the joint range the chain can reach and the "
+            "working range the study uses; the telescope; every body with its mass."
+        ),
+    )
     parser.add_argument("--crane", default="xs031", help="preset name or YAML file (default: xs031)")
     parser.set_defaults(run=run)
 

@@ -31,6 +31,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Compute the map, write the requested files and print a one-line summary per file."""
     from hiab_sim.emla.maps import efficiency_map, plot_efficiency_map, save_csv, save_npz
+    from hiab_sim.figure_io import save_png
 
     params = load_emla_set(args.config)[args.actuator]
     emap = efficiency_map(params, n_force=args.resolution, n_velocity=args.resolution)
@@ -41,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
         if not path.parent.is_dir():
             raise InvalidInputError(f"{kind} path", str(path), "its folder must exist")
     fig = plot_efficiency_map(emap)
-    fig.savefig(output, dpi=150)
+    save_png(fig, output, dpi=150)
     if args.csv:
         save_csv(emap, args.csv)
     if args.npz:

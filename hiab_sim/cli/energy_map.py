@@ -12,7 +12,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "energy-map",
         help="Map the objective and net energy over two link lengths (the rest and the trajectory fixed).",
         description=(
-            "Evaluate the study's objective (eq. costf2), net electrical energy and Xi-dependent constraints on an "
+            "Evaluate the study's objective (by default the seed paper's squared-power cost costf2 in W^2 s), "
+            "the net electrical energy and the constraints that depend on the link lengths only on an "
             "N x N grid of two link lengths over their bounds, the other four and the joint trajectory fixed at "
             "the optimum of --result (or the study's start), on the analytic ID path, vectorised over designs. "
             "Infeasible cells are coloured by their binding constraint."
@@ -39,9 +40,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Compute and write the map; return the exit status."""
     from hiab_sim.study.nlp.problem import LinkLengthProblem
+    from hiab_sim.study.report.summary import limit_in_words
     from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
     from hiab_sim.sweep.energy_map import energy_map, optimum_design, parse_variables, result_study, start_design
-    from hiab_sim.sweep.map_output import TRAJECTORY_NOTE, summary, write_map
+    from hiab_sim.sweep.map_output import TRAJECTORY_NOTE, infeasible_note, summary, write_map
 
     variables = parse_variables(args.vars)
     study = load_study(args.study or (result_study(args.result) if args.result else DEFAULT_STUDY))
@@ -56,12 +58,13 @@ def run(args: argparse.Namespace) -> int:
     at = s["at_base"]
     print(
         f"at the base: objective {at['objective']:.6f}, net energy {at['net_electrical_energy_J'] / 1e3:.3f} kJ, "
-        f"binding {at['binding_constraint']} (margin {at['smallest_margin']:.2e})"
+        f"binding: {limit_in_words(at['binding_constraint'])} (margin {at['smallest_margin']:.2e})"
     )
     best = s["best_feasible_cell"]
-    if best is None:
-        print(f"no feasible cell (of {s['cells']})")
-    else:
+    note = infeasible_note(m)
+    if best is None or note is not None:
+        print(note.replace("\n", " ") if note is not None else f"no feasible cell (of {s['cells']})")
+    if best is not None:
         xi = best["xi_m"]
         i0, i1 = variables
         print(

@@ -26,7 +26,7 @@ import numpy as np
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
-from hiab_sim.errors import InvalidInputError
+from hiab_sim.errors import ConfigError, HiabSimError, InvalidInputError
 
 #: Natural frequency of the viewer file's stroke servos [Hz].
 SERVO_FREQUENCY_HZ = 1.0
@@ -37,7 +37,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "mjcf",
         help="write the MJCF crane model for a link-length set",
-        description="Write the MuJoCo MJCF model of the crane (closed chains as connect equalities).",
+        description=(
+            "Write the MuJoCo MJCF model of the crane for one set of link lengths: the closed chains as connect "
+            "equalities, the EMLAs as stroke servos around the home pose, and cameras that frame the machine. "
+            "Opens in 'python -m mujoco.viewer --mjcf=FILE'."
+        ),
     )
     parser.add_argument("--crane", default="xs031", help="preset name or YAML file (default: xs031)")
     parser.add_argument(
@@ -85,6 +89,77 @@ def parse_lengths(text: str) -> LinkLengths:
     return LinkLengths.from_array(values)
 
 
+#: Poses per joint over its working range that the cameras are fitted to (every combination).
+CAMERA_POSES_PER_JOINT = 4
+#: Aspect ratio (width / height) the cameras are fitted for: the template's off-screen buffer, 1280 x 720.
+CAMERA_ASPECT = 16.0 / 9.0
+
+
+def workspace_qpos(crane: Crane, lengths: LinkLengths) -> np.ndarray:
+    """Loop-consistent qpos (P, nq) at every combination of poses over each joint's working range."""
+    from hiab_sim.crane.mechanism import reachable_joint_range
+    from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
+    from hiab_sim.dynamics.samples import JointSamples
+
+    ranges = []
+    for chain in crane.chains:  # the working range, within what these lengths reach (1e-9 rad inside)
+        reach = reachable_joint_range(chain, getattr(lengths, chain.name))
+        ranges.append((max(chain.joint_range[0], reach[0]) + 1e-9, min(chain.joint_range[1], reach[1]) - 1e-9))
+    ranges.append(crane.telescope.joint_range)
+    axes = [np.linspace(low, high, CAMERA_POSES_PER_JOINT) for low, high in ranges]
+    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(ranges))
+    qpos, _, _ = MujocoInverseDynamics(crane, lengths).state(JointSamples.at_rest(grid))
+    return np.asarray(qpos)
+
+
+def frame_cameras(text: str, model: object, crane: Crane, lengths: LinkLengths, names: list[str]) -> str:
+    """The MJCF with its cameras (``side``, ``perspective``) placed to frame the machine at every pose.
+
+    The poses are :func:`workspace_qpos`; the cameras hold the visible geoms' bounding boxes at all
+    of them (:func:`hiab_sim.render.camera.framed_cameras`), whatever the link lengths.
+    """
+    from xml.etree import ElementTree
+
+    import mujoco
+
+    from hiab_sim.render.camera import MODEL_CAMERAS, framed_cameras, geom_corners
+
+    assert isinstance(model, mujoco.MjModel)
+    data = mujoco.MjData(model)
+    address = [int(model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n)]) for n in names]
+    corners = []
+    for q in workspace_qpos(crane, lengths):
+        data.qpos[address] = q
+        mujoco.mj_kinematics(model, data)
+        corners.append(geom_corners(model, data))
+    root = ElementTree.fromstring(text)
+    world = root.find("worldbody")
+    assert world is not None
+    cameras = {c.get("name"): c for c in world.findall("camera")}
+    fovy = float(next(iter(cameras.values())).get("fovy", "45")) if cameras else 45.0
+    for name, (position, xyaxes) in framed_cameras(np.concatenate(corners), CAMERA_ASPECT, fovy).items():
+        camera = cameras.get(name)
+        if camera is None:
+            camera = ElementTree.SubElement(world, "camera", name=name, fovy=f"{fovy:g}")
+        camera.set("pos", " ".join(f"{v:.4f}" for v in position))
+        camera.set("xyaxes", " ".join(f"{v:.4f}" for v in xyaxes))
+        camera.attrib.pop("quat", None)
+        camera.attrib.pop("euler", None)
+    assert set(MODEL_CAMERAS) <= {c.get("name") for c in world.findall("camera")}
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+def given_chain(lengths: LinkLengths, message: str) -> str:
+    """The lengths the user gave for the chain a message names (``lift.joint_range ...``), else all of them."""
+    from dataclasses import fields
+
+    for chain in (f.name for f in fields(LinkLengths)):
+        if message.startswith(f"{chain}."):
+            xi = getattr(lengths, chain)
+            return f"the {chain} chain given as L = {xi.L:g} m, Lc0 = {xi.Lc0:g} m, Lc = {xi.Lc:g} m"
+    return "the lengths given [" + ", ".join(f"{v:g}" for v in lengths.as_array()) + "] m"
+
+
 def home_keyframe(crane: Crane, lengths: LinkLengths) -> tuple[np.ndarray, np.ndarray]:
     """Loop-consistent qpos at the middle of the working ranges and the forces that hold it [N]."""
     from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
@@ -123,7 +198,12 @@ def run(args: argparse.Namespace) -> int:
     from hiab_sim.model.drives import HomePose, SlideDrives, servo_gains
     from hiab_sim.model.mjcf import build_model
 
-    qpos, force = home_keyframe(crane, lengths)
+    try:
+        qpos, force = home_keyframe(crane, lengths)
+    except HiabSimError as error:
+        if not args.lengths:
+            raise
+        raise ConfigError(f"--lengths {args.lengths}: {given_chain(lengths, str(error))}: {error}") from None
     names = [build_model(crane, lengths).joint(j).name for j in range(len(qpos))]
     drives = SlideDrives.from_emla(load_emla_set())
     home = HomePose(
@@ -133,6 +213,8 @@ def run(args: argparse.Namespace) -> int:
     )
     text = to_xml(crane, lengths, keyframes={"home": (qpos, np.zeros(3))}, drives=drives, home=home)
     model = mujoco.MjModel.from_xml_string(text)  # what the file will load as
+    text = frame_cameras(text, model, crane, lengths, names)
+    model = mujoco.MjModel.from_xml_string(text)
     output = Path(args.output)
     if not output.parent.is_dir():
         raise InvalidInputError("--output", str(output), "its folder must exist")

@@ -1,13 +1,15 @@
 """``hiab-sim optimize``: energy-optimal link lengths of both closed chains.
 
 Runs a study (default ``optimize/xs031_spiral.yaml``) with SQP, prints one line per iteration to
-stderr, and writes ``result.json``, ``trajectory.npz``, the figures and the playback video into
-the output folder. Bad input exits 2 before anything is written; a solver failure exits 1 and
+stderr with ``--verbose``, and writes ``result.json``, ``trajectory.npz``, the figures, the playback
+video and ``summary.md`` into the output folder; the console ends with that summary
+(:mod:`hiab_sim.study.report.summary`). Bad input exits 2 before anything is written; a solver failure exits 1 and
 keeps the partial history (``checkpoint_<k>.json``) for ``--resume``. A start that violates
 constraints goes through the feasibility phase (:mod:`hiab_sim.study.solvers.feasibility`); when no point
-within the bounds is feasible the run exits 3 and names the binding limit. stdout also prints the
-design rounded to the study's ``build.tolerance`` with its re-checks and export command, and the
-largest KKT multipliers (``result.json`` -> ``buildable``, ``feasibility``, ``sensitivity``).
+within the bounds is feasible the run exits 3 and names the binding limit. With ``--verbose`` stdout
+also prints the full report before the summary: the design rounded to the study's ``build.tolerance``
+with its re-checks and export command, and the largest multipliers of the optimality conditions
+(``result.json`` -> ``buildable``, ``feasibility``, ``sensitivity``).
 """
 
 from __future__ import annotations
@@ -17,7 +19,9 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from hiab_sim.atomic_io import write_atomic
 from hiab_sim.errors import BackendUnavailableError
+from hiab_sim.study.report.summary import SUMMARY_FILE, summary_text
 
 if TYPE_CHECKING:
     from hiab_sim.results.schema import Decomposition, Result
@@ -29,7 +33,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "optimize",
         help="Optimise the link lengths of both closed chains for least EMLA energy.",
         description=(
-            "Minimise the seed's cost (eq. costf2: 1/2 Dt sum (sum_i P_i)^2 with EMLA electrical power) over "
+            "Minimise the seed paper's squared-power cost (costf2 = 1/2 Dt sum over samples of the squared total "
+            "EMLA electrical power, in W^2 s; a smooth stand-in for energy, not an energy) over "
             "both chains' link lengths and the B-spline joint trajectory, subject to inverse dynamics, TCP "
             "tracking of a spiral, the EMLA envelope, stroke, triangle and joint limits (SLSQP). A study may "
             "instead minimise the battery's energy (objective: battery_energy), add the motors' thermal limits "
@@ -53,7 +58,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--id", choices=("mujoco", "analytic"), help="inverse-dynamics path (default: the study's)")
     parser.add_argument("--no-video", action="store_true", help="do not render the playback video")
     parser.add_argument("--no-figures", action="store_true", help="do not draw the figures (quick runs)")
-    parser.add_argument("--quiet", action="store_true", help="no per-iteration progress lines")
+    parser.add_argument("--no-report", action="store_true", help="do not write the design report (report.html)")
+    parser.add_argument(
+        "--verbose",
+        action="store_true",
+        help="also print each iteration and the full report (solver, re-check, decomposition, sensitivities)",
+    )
+    parser.add_argument("--quiet", action="store_true", help="only the summary (the default; kept for scripts)")
     parser.set_defaults(run=run)
 
 
@@ -137,22 +148,36 @@ def run(args: argparse.Namespace) -> int:
         resume=args.resume,
         force=args.force,
         id_path=args.id,
-        progress=None if args.quiet else sys.stderr,
+        progress=sys.stderr if args.verbose else None,
         figures=not args.no_figures,
     )
-    from hiab_sim.study.analysis.codesign import codesign_lines
-    from hiab_sim.study.report.energy_section import energy_lines
+    if output.removed:
+        names = ", ".join(sorted(p.name for p in output.removed))
+        print(f"removed all {len(output.removed)} output file(s) of the earlier run in {output.folder}: {names}")
+    if args.verbose:
+        from hiab_sim.study.analysis.codesign import codesign_lines
+        from hiab_sim.study.report.energy_section import energy_lines
 
-    codesign = [] if output.result.codesign is None else codesign_lines(output.result.codesign)
-    for line in [*summary_lines(output.result), *energy_lines(output.result), *codesign]:
-        print(line)
-    print(f"wrote {output.folder}/result.json, trajectory.npz and {len(output.figures)} figures")
+        codesign = [] if output.result.codesign is None else codesign_lines(output.result.codesign)
+        for line in [*summary_lines(output.result), *energy_lines(output.result), *codesign]:
+            print(line)
+    files = ["result.json", "trajectory.npz", SUMMARY_FILE]
+    if output.figures:
+        files.append(f"{len(output.figures)} figures (*.png)")
     if not args.no_video:
         try:
             from hiab_sim.render import render_result
 
             video = render_result(output.folder, output.folder / "playback.mp4")
-            print(f"wrote video: {video}")
+            files.append(video.name)
         except BackendUnavailableError as error:
             print(f"hiab-sim optimize: no video: {error}", file=sys.stderr)
+    if not args.no_report:
+        from hiab_sim.design_report import write_report
+
+        files.extend(path.name for path in write_report(output.folder))
+    text = summary_text(output.result, output.folder, files)
+    write_atomic(output.folder / SUMMARY_FILE, text)
+    print()
+    print(text, end="")
     return 0

@@ -15,7 +15,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="Pareto front of the energy objective against peak actuator force or rms motor torque.",
         description=(
             "Optimise the study, find the least criterion its constraints allow, and minimise the objective "
-            "(eq. costf2) with criterion <= epsilon for epsilon from the optimum's criterion down to that least "
+            "(the seed paper's squared-power cost costf2, W^2 s) with criterion <= epsilon for epsilon from the "
+            "optimum's criterion down to that least "
             "value, each a full SQP optimisation. Writes pareto.csv, pareto.json and pareto.png."
         ),
     )

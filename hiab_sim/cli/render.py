@@ -29,8 +29,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="Render a playback video of an optimisation result off-screen (initial vs optimal design).",
         description=(
             "Render the crane following the study's trajectory with the initial and the optimal link "
-            "lengths, the reference TCP curve (grey) and each design's TCP trail, off-screen through "
-            "OSMesa (MUJOCO_GL=osmesa, selected automatically; MUJOCO_GL=egl is honoured)."
+            "lengths: the machine drawn from its description (box-section booms, the cylinders' bores and "
+            "rods, pins, column, truck bed, end mass, hook), the reference path of the tool (grey), each "
+            "design's tool trail, the time and each design's cumulative drive energy. By default the "
+            "optimal design is drawn over a ghost of the initial one, the cylinder pivots the lengths move "
+            "marked. Off-screen through OSMesa (MUJOCO_GL=osmesa, selected automatically; MUJOCO_GL=egl is "
+            "honoured)."
         ),
     )
     parser.add_argument("result_dir", metavar="RESULT_DIR", help="folder written by 'hiab-sim optimize'")
@@ -49,9 +53,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--layout",
         choices=("stacked", "side-by-side", "overlay"),
-        default="stacked",
-        help="designs in two viewports, one above the other or side by side, or overlaid (initial translucent) "
-        "(default: stacked)",
+        default="overlay",
+        help="overlay: the optimal design over a ghost of the initial one, moved pivots marked; stacked or "
+        "side-by-side: one viewport per design (default: overlay)",
     )
     parser.add_argument(
         "--still",

@@ -141,6 +141,7 @@ class DriveStep:
         rod_force: k (torque - friction_torque) [N], the force handed to the slide.
         current_limited: The reference was clipped to the current limit.
         voltage_limited: The voltage command left the inverter's circle during the step.
+        inverter_energy: The inverter's loss over the step [J] (0: a lossless inverter, as here).
 
     """
 
@@ -155,6 +156,7 @@ class DriveStep:
     rod_force: Array
     current_limited: NDArray[np.bool_]
     voltage_limited: NDArray[np.bool_]
+    inverter_energy: Array | float = 0.0
 
 
 class DriveSimulator:

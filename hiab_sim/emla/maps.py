@@ -23,14 +23,15 @@ from hiab_sim.emla.config import EmlaParams
 from hiab_sim.emla.envelope import ENVELOPE_LIMIT_NAMES
 from hiab_sim.emla.model import operating_point, peak_force, top_speed
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.style import MARKERS, colour
+from hiab_sim.style import colour
 
 #: Filled efficiency levels of the map; the labelled contour lines are a subset.
 EFFICIENCY_LEVELS: tuple[float, ...] = (0.0, 0.3, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.92, 0.94, 0.96, 1.0)
 LABELLED_LEVELS: tuple[float, ...] = (0.5, 0.7, 0.8, 0.85, 0.9, 0.92, 0.94)
 #: Efficiency field under design overlays: light greys (darker = more efficient), so that the
 #: designs' colours (:mod:`hiab_sim.style`) are the only colours on the map.
-DESIGN_BACKGROUND = ListedColormap(colormaps["Greys"](np.linspace(0.04, 0.5, 256)), name="light_greys")
+# Warm light field (cream to sand) under the designs' blue and green lines: no grey-on-grey, no clash with them.
+DESIGN_BACKGROUND = ListedColormap(colormaps["YlOrBr"](np.linspace(0.0, 0.35, 256)), name="light_sand")
 
 
 @dataclass(frozen=True)
@@ -161,11 +162,11 @@ def plot_efficiency_map(
     if operating_points is not None:
         f_op, v_op = _points(operating_points, "operating_points")
         ax.plot(v_op, f_op / 1e3, ".", color="tab:orange", markersize=3, label="operating points")
-    for name, points in (designs or {}).items():
+    for name, points in (designs or {}).items():  # the motion's path through the map: a line per design
         f_op, v_op = _points(points, f"designs[{name!r}]")
         ax.plot(
-            v_op, f_op / 1e3, MARKERS.get(name, "o"), color=colour(name), markersize=3.5,
-            markeredgecolor="black", markeredgewidth=0.3, label=f"{name} design", linestyle="none",
+            v_op, f_op / 1e3, color=colour(name), linewidth=2.4 if name == "optimal" else 1.6,
+            linestyle="-" if name == "optimal" else "-.", label=f"{name} design: operating points over the motion",
         )  # fmt: skip
     ax.axhline(0.0, color="0.3", linewidth=0.5)
     ax.axvline(0.0, color="0.3", linewidth=0.5)

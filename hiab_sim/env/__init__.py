@@ -15,6 +15,7 @@ from dm_control.rl import control
 
 from hiab_sim.env.physics import CranePhysics, crane_physics
 from hiab_sim.env.plan import DESIGNS, DesignPlan, read_plan
+from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.reference import PlannedMotion, planned_motion
 from hiab_sim.env.task import CraneTrackingTask
 from hiab_sim.errors import InvalidInputError
@@ -46,6 +47,7 @@ def load(
     control_timestep: float = 2 * PHYSICS_TIMESTEP,
     physics_timestep: float = PHYSICS_TIMESTEP,
     current_bandwidth_hz: float = CURRENT_BANDWIDTH_HZ,
+    plant: Plant | None = None,
 ) -> control.Environment:
     """Closed-loop environment of one design of an ``hiab-sim optimize`` result.
 
@@ -55,7 +57,8 @@ def load(
         payload_error: Relative end-mass error of the simulated crane (0.2: 20 % heavier than planned).
         control_timestep: Agent step [s], a multiple of the physics step.
         physics_timestep: MuJoCo step [s].
-        current_bandwidth_hz: Current-loop bandwidth of the drives [Hz].
+        current_bandwidth_hz: Current-loop bandwidth of the drives [Hz] (of the continuous loop).
+        plant: The plant's effects (:mod:`hiab_sim.env.plant`); None or every effect off: the planner's model.
 
     Raises:
         InvalidInputError: a value out of range (the field is named).
@@ -68,6 +71,7 @@ def load(
         control_timestep=control_timestep,
         physics_timestep=physics_timestep,
         current_bandwidth_hz=current_bandwidth_hz,
+        plant=plant,
     )
 
 
@@ -78,6 +82,7 @@ def make_environment(
     control_timestep: float = 2 * PHYSICS_TIMESTEP,
     physics_timestep: float = PHYSICS_TIMESTEP,
     current_bandwidth_hz: float = CURRENT_BANDWIDTH_HZ,
+    plant: Plant | None = None,
 ) -> control.Environment:
     """Closed-loop environment of a plan (see :func:`load` for the arguments)."""
     if not (0.0 < physics_timestep <= 0.01):
@@ -86,7 +91,7 @@ def make_environment(
     if n_sub < 1 or abs(n_sub * physics_timestep - control_timestep) > 1e-9:
         raise InvalidInputError("control_timestep", control_timestep, "must be a multiple of the physics step", "s")
     motion = planned_motion(plan, physics_timestep)
-    physics = crane_physics(plan, motion, physics_timestep, payload_error, current_bandwidth_hz)
+    physics = crane_physics(plan, motion, physics_timestep, payload_error, current_bandwidth_hz, plant)
     task = CraneTrackingTask(plan, motion, physics.drives.drives.current_limit)
     steps = round(plan.duration / control_timestep)
     return control.Environment(
@@ -100,6 +105,7 @@ __all__ = [
     "CraneTrackingTask",
     "DesignPlan",
     "PlannedMotion",
+    "Plant",
     "load",
     "make_environment",
     "planned_motion",

@@ -7,6 +7,13 @@ extra body with the end mass's centre of mass and scaled inertia) and the study'
 mass at the TCP, also scaled. :class:`CranePhysics` steps the drives of
 :mod:`hiab_sim.emla.drive_sim` once per physics step, at the speeds of the slides
 (omega_m = k v_x), and applies their rod forces as the actuators' ``ctrl`` before ``mj_step``.
+
+A :class:`~hiab_sim.env.plant.config.Plant` adds what the planner leaves out (:mod:`hiab_sim.env.plant`):
+the crane and friction of the mismatch, the hinge and pin friction, a two-mass drive train per EMLA
+(the rotor's reflected inertia and the screw friction then move from the slide to the motor side,
+which the drive turns and the spring joins to the rod), the discrete current loop with its inverter
+losses, the sensors the controller reads, and the winding temperature that sets R_s. With every
+effect off (or no plant) the model is the one above, step for step.
 """
 
 from __future__ import annotations
@@ -14,6 +21,7 @@ from __future__ import annotations
 import concurrent.futures.thread  # noqa: F401  (registers its exit hook first; see _free_live_physics)
 import threading
 import weakref
+from dataclasses import replace
 
 import mujoco
 import numpy as np
@@ -22,10 +30,17 @@ from numpy.typing import NDArray
 
 from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator, DriveStep
 from hiab_sim.env.plan import DesignPlan
+from hiab_sim.env.plant.config import Plant
+from hiab_sim.env.plant.current_loop import DiscreteCurrentLoop
+from hiab_sim.env.plant.drivetrain import TwoMassDriveTrain, coupled_step
+from hiab_sim.env.plant.friction import FrictionMeter, add_joint_friction
+from hiab_sim.env.plant.mismatch import true_crane, true_drives
+from hiab_sim.env.plant.sensors import CurrentSensorError, MotionSensor
+from hiab_sim.env.plant.thermal import WindingTemperature
 from hiab_sim.env.reference import PlannedMotion
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.model.drives import HomePose, SlideDrives
-from hiab_sim.model.mjcf import JOINTS, SLIDES, build_spec
+from hiab_sim.model.mjcf import ACTUATORS, JOINTS, SLIDES, build_spec
 
 Array = NDArray[np.float64]
 
@@ -60,15 +75,46 @@ class CranePhysics(dm_mujoco.Physics):
     last: DriveStep | None
     energy: Array
     copper: Array
+    plant: Plant | None
+    drive_train: TwoMassDriveTrain | None
+    sensor: MotionSensor
+    current_error: CurrentSensorError
+    thermal: WindingTemperature | None
+    friction: FrictionMeter | None
 
-    def attach_drives(self, drives: DriveSimulator) -> None:
-        """Attach the drives (order lift, tilt, telescope) and clear the energy counters."""
+    def attach_drives(
+        self,
+        drives: DriveSimulator,
+        plant: Plant | None = None,
+        drive_train: TwoMassDriveTrain | None = None,
+        thermal: WindingTemperature | None = None,
+        friction: FrictionMeter | None = None,
+    ) -> None:
+        """Attach the drives (order lift, tilt, telescope) and the plant's parts; clear the energy counters."""
         _LIVE.add(self)
         self.drives = drives
+        self.plant = plant
+        self.drive_train = drive_train
+        self.thermal = thermal
+        self.friction = friction
         self.slide_dofs = np.array([self.model.jnt_dofadr[self.model.name2id(s, "joint")] for s in SLIDES])
         self.tcp_site = int(self.model.name2id("tcp", "site"))
+        self.actuator_ids = np.array([self.model.name2id(name, "actuator") for name in ACTUATORS])
         self.current_reference = np.zeros(len(SLIDES))
+        h = float(self.model.opt.timestep)
+        sensors = plant.sensors if plant is not None else None
+        self.sensor = MotionSensor(sensors, drives.drives.ratio, h)
+        rate = plant.current_loop.rate_Hz if plant is not None else 1.0 / h
+        self.current_error = CurrentSensorError(sensors, len(SLIDES), rate * h)
+        if isinstance(drives, DiscreteCurrentLoop):
+            drives.sensor = self.current_error
         self.reset_counters()
+
+    def motor_state(self) -> tuple[Array, Array]:
+        """Motor-side stroke [m] and rate [m/s] at the rod (the rod's own when the drive train is rigid)."""
+        if self.drive_train is None:
+            return self.stroke().copy(), self.rod_velocity().copy()
+        return self.drive_train.position.copy(), self.drive_train.velocity.copy()
 
     def reset_counters(self) -> None:
         """Zero the accumulated electrical and copper energy and the limit counters."""
@@ -78,6 +124,9 @@ class CranePhysics(dm_mujoco.Physics):
         self.steps = 0
         self.current_limited_steps = np.zeros(len(SLIDES))
         self.voltage_limited_steps = np.zeros(len(SLIDES))
+        self.inverter = np.zeros(len(SLIDES))
+        self.drive_train_loss = np.zeros(len(SLIDES))
+        self.friction_loss = 0.0
 
     def rod_velocity(self) -> Array:
         """v_x of the slides x1, x2, xt2 [m/s]."""
@@ -89,6 +138,9 @@ class CranePhysics(dm_mujoco.Physics):
 
     def step(self, nstep: int = 1) -> None:
         """Advance nstep physics steps, each: drives over the step, then ``mj_step`` with their rod forces."""
+        if self.plant is not None and self.plant.enabled:
+            self._plant_step(nstep)
+            return
         model, data = self.model.ptr, self.data.ptr
         h = float(model.opt.timestep)
         ratio = self.drives.drives.ratio
@@ -103,31 +155,120 @@ class CranePhysics(dm_mujoco.Physics):
                 self.voltage_limited_steps += result.voltage_limited
                 self.steps += 1
                 self.last = result
+                self.sensor.push(data.qpos[self.slide_dofs], data.qvel[self.slide_dofs])
+            mujoco.mj_kinematics(model, data)  # site positions of the new state, for observations
+
+    def _plant_step(self, nstep: int) -> None:
+        """:meth:`step` with the plant's effects (module docstring)."""
+        model, data = self.model.ptr, self.data.ptr
+        h = float(model.opt.timestep)
+        ratio = self.drives.drives.ratio
+        train, thermal, friction = self.drive_train, self.thermal, self.friction
+        discrete = isinstance(self.drives, DiscreteCurrentLoop)
+        with self.check_invalid_state():
+            for _ in range(nstep):
+                v = data.qvel[self.slide_dofs]
+                omega = ratio * (v if train is None else train.velocity)
+                reference = self.current_reference if discrete else self.current_reference - self.current_error.sample()
+                result = self.drives.step(reference, omega, h)
+                if train is None:
+                    data.ctrl[:] = result.rod_force
+                    mujoco.mj_step(model, data)
+                else:
+                    loss = coupled_step(train, model, data, self.actuator_ids, self.slide_dofs, result.rod_force, h)
+                    self.drive_train_loss += loss
+                if friction is not None:
+                    self.friction_loss += h * friction.power(model, data)
+                if thermal is not None:
+                    thermal.advance(result.copper_energy, h)
+                    self.drives.drives = replace(self.drives.drives, resistance=thermal.resistance())
+                self.energy += result.electrical_energy
+                self.copper += result.copper_energy
+                self.inverter += result.inverter_energy
+                self.current_limited_steps += result.current_limited
+                self.voltage_limited_steps += result.voltage_limited
+                self.steps += 1
+                self.last = result
+                self.sensor.push(*self.motor_state())
             mujoco.mj_kinematics(model, data)  # site positions of the new state, for observations
 
 
 def crane_physics(
-    plan: DesignPlan, motion: PlannedMotion, timestep: float, payload_error: float, bandwidth_hz: float
+    plan: DesignPlan,
+    motion: PlannedMotion,
+    timestep: float,
+    payload_error: float,
+    bandwidth_hz: float,
+    plant: Plant | None = None,
 ) -> CranePhysics:
     """Build the simulation Physics of a design at its plan's start (module docstring)."""
     if not (np.isfinite(payload_error) and 0.0 <= payload_error <= 2.0):
         raise InvalidInputError("payload_error", payload_error, "must lie in [0, 2] (end mass heavier than planned)")
-    drives = SlideDrives.from_emla(plan.emlas)
-    spec = build_spec(plan.crane, plan.lengths, drives)
+    active = plant if plant is not None and plant.enabled else None
+    slides = SlideDrives.from_emla(plan.emlas)
+    arrays = DriveArrays.from_params(plan.emlas)
+    crane = plan.crane
+    if active is not None:
+        crane = true_crane(crane, active.mismatch)
+        arrays, slides = true_drives(arrays, slides, active.mismatch)
+    train_data = active.drive_train if active is not None and active.drive_train.enabled else None
+    compliant = train_data is not None
+    if train_data is not None:  # the rotor and the screw friction move to the motor side of the spring
+        train_data.check_step(timestep)
+        rod_side = train_data.rod_side_mass_kg
+        slides = replace(slides, armature=(rod_side, rod_side, rod_side), damping=(0.0, 0.0, 0.0))
+    spec = build_spec(crane, plan.lengths, slides)
     names = [spec.joints[i].name for i in range(len(spec.joints))]
     home = HomePose(
         qpos={name: float(motion.qpos[0, i]) for i, name in enumerate(names)},
         force=(float(motion.force[0, 0]), float(motion.force[0, 1]), float(motion.force[0, 2])),
     )
-    spec = build_spec(plan.crane, plan.lengths, drives, home)
+    spec = build_spec(crane, plan.lengths, slides, home)
     spec.option.timestep = timestep
     # Implicit in the velocity-dependent forces (the slides' damping); 3x cheaper than the template's RK4.
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    if compliant:
+        _spring_actuators(spec)
+    joints: tuple[str, ...] = ()
+    tendons: tuple[str, ...] = ()
+    if active is not None and active.joint_friction.enabled:
+        joints, tendons = add_joint_friction(spec, active.joint_friction)
     _add_payload(spec, plan, payload_error)
     _add_view(spec, motion)
     physics = CranePhysics.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
-    physics.attach_drives(DriveSimulator(DriveArrays.from_params(plan.emlas), bandwidth_hz=bandwidth_hz))
+    drives: DriveSimulator
+    if active is not None and active.current_loop.enabled:
+        drives = DiscreteCurrentLoop(arrays, active.current_loop, CurrentSensorError(None, len(SLIDES), 1.0), timestep)
+    else:
+        drives = DriveSimulator(arrays, bandwidth_hz=bandwidth_hz)
+    physics.attach_drives(
+        drives,
+        plant,
+        drive_train=None
+        if train_data is None
+        else TwoMassDriveTrain(train_data, arrays.reflected_inertia, arrays.viscous),
+        thermal=WindingTemperature(active.thermal, plan.emlas.as_tuple())
+        if active and active.thermal.enabled
+        else None,
+        friction=FrictionMeter(physics.model.ptr, joints, tendons) if joints else None,
+    )
     return physics
+
+
+def _spring_actuators(spec: mujoco.MjSpec) -> None:
+    """Make the slides' actuators the drive train's springs: f = ctrl - k_c x - c_c v, unlimited.
+
+    The limits of the EMLA are the motor's (its current limit); the spring carries what the motor
+    side and the load make of it. (k_c, c_c) are set every step (:mod:`hiab_sim.env.plant.drivetrain`).
+    """
+    for name in ACTUATORS:
+        actuator = spec.actuator(name)
+        actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+        actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_FALSE
+        actuator.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+        actuator.gainprm[0] = 1.0
+        actuator.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+        actuator.biasprm[:3] = [0.0, 0.0, 0.0]
 
 
 def _add_view(spec: mujoco.MjSpec, motion: PlannedMotion) -> None:

@@ -4,22 +4,33 @@ Energies come from the drives' exact per-step integrals (:mod:`hiab_sim.emla.dri
 electrical energy is int 3/2 (v_d i_d + v_q i_q) dt over the cycle, summed over the drives (the DC
 bus credits regeneration of one drive to the others). The predicted energy is the optimiser's number
 for the design (``result.json``); the predicted power is the plan's P_elec on its fine grid.
+
+With a plant (:mod:`hiab_sim.env.plant`) the DC bus also pays the inverters' losses (the DC-bus
+energy is the electrical energy plus them), the gains follow the design rules of
+:mod:`hiab_sim.control.cascade` for the plant's lowest drive-train resonance, and ``cycles`` > 1
+runs the cycle repeatedly with the winding temperature carried over (cooling over the plant's rest
+between cycles); the log is the last cycle's, the per-cycle energies and temperatures are kept.
 """
 
 from __future__ import annotations
 
 import time as _time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
+from dm_control.rl import control
 from numpy.typing import NDArray
 
 from hiab_sim.control.cascade import CascadeController, CascadeGains
 from hiab_sim.emla.config import ACTUATOR_NAMES
+from hiab_sim.emla.drive_sim import DriveArrays
 from hiab_sim.env import make_environment
 from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.plan import DesignPlan
+from hiab_sim.env.plant.config import Plant
+from hiab_sim.env.plant.drivetrain import locked_rod_frequency_Hz
+from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
 
@@ -44,6 +55,14 @@ class ClosedLoopRun:
         copper_energy: int 3/2 R_s |i|^2 dt per drive [J].
         qpos: Joint positions at every control step, for rendering (N, nq).
         wall_time: Wall-clock seconds of the simulation loop.
+        plant: Name of the plant (``ideal``: the planner's model).
+        inverter_energy: The inverters' loss per drive over the cycle [J].
+        drive_train_loss: Screw friction and spring damping of the two-mass drive train per drive [J].
+        friction_loss: Dissipated in the hinges and pins over the cycle [J].
+        winding_temperature: Winding temperature per drive at the end of the cycle [deg C], or None.
+        cycles: Per cycle: DC-bus energy [J] and end winding temperatures [deg C].
+        gains: The controller's loop bandwidths.
+        lowest_resonance_hz: The lowest drive-train resonance the gains were designed against [Hz], or None.
 
     """
 
@@ -66,11 +85,24 @@ class ClosedLoopRun:
     copper_energy: Array
     qpos: Array
     wall_time: float
+    plant: str = "ideal"
+    inverter_energy: Array | None = None
+    drive_train_loss: Array | None = None
+    friction_loss: float = 0.0
+    winding_temperature: Array | None = None
+    cycles: tuple[dict[str, object], ...] = ()
+    gains: CascadeGains = field(default_factory=CascadeGains)
+    lowest_resonance_hz: float | None = None
 
     @property
     def net_energy(self) -> float:
-        """Closed-loop net electrical energy of all drives [J]."""
+        """Closed-loop net electrical energy of all drives at the motor terminals [J]."""
         return float(self.cumulative_energy[-1].sum())
+
+    @property
+    def bus_energy(self) -> float:
+        """Closed-loop energy drawn from the DC bus: electrical energy plus the inverters' losses [J]."""
+        return self.net_energy + (0.0 if self.inverter_energy is None else float(self.inverter_energy.sum()))
 
     def summary(self) -> dict[str, object]:
         """The numbers of ``simulation.json`` for this run."""
@@ -103,6 +135,16 @@ class ClosedLoopRun:
             },
             "simulated_time_s": float(self.time[-1]),
             "wall_time_s": self.wall_time,
+            "plant": self.plant,
+            "dc_bus_energy_J": self.bus_energy,
+            "dc_bus_energy_difference_percent": 100.0 * (self.bus_energy / self.predicted_net_energy - 1.0),
+            "inverter_loss_J": 0.0 if self.inverter_energy is None else float(self.inverter_energy.sum()),
+            "drive_train_loss_J": 0.0 if self.drive_train_loss is None else float(self.drive_train_loss.sum()),
+            "joint_friction_loss_J": self.friction_loss,
+            "winding_temperature_C": None
+            if self.winding_temperature is None
+            else {name: float(t) for name, t in zip(ACTUATOR_NAMES, self.winding_temperature, strict=True)},
+            "cycles": list(self.cycles),
         }
 
 
@@ -110,22 +152,101 @@ def _trapezoid(y: Array, t: Array) -> float:
     return float(0.5 * np.sum((y[1:] + y[:-1]) * np.diff(t)))
 
 
+def design_gains(plan: DesignPlan, plant: Plant | None) -> tuple[CascadeGains, float | None]:
+    """The design-rule gains for the plant's lowest drive-train resonance [Hz] (None when rigid)."""
+    if plant is None or not plant.drive_train.enabled:
+        return CascadeGains.design(None), None
+    masses = np.array([p.motor.rotor_inertia * p.transmission_ratio**2 + p.screw_moving_mass for p in plan.emlas])
+    lowest = float(locked_rod_frequency_Hz(plant.drive_train, masses).min())
+    return CascadeGains.design(lowest), lowest
+
+
 def run_closed_loop(
     plan: DesignPlan,
     payload_error: float = 0.0,
     gains: CascadeGains | None = None,
     progress: Callable[[int, int], None] | None = None,
+    plant: Plant | None = None,
+    cycles: int = 1,
 ) -> tuple[ClosedLoopRun, CranePhysics]:
-    """Simulate one cycle of a design's plan under the cascade controller; return the log and the Physics.
+    """Simulate ``cycles`` cycles of a design's plan under the cascade controller; return the last log and the Physics.
 
     The Physics is returned at the end of the cycle (for rendering the logged ``qpos``); call its
-    ``free()`` when done with it.
+    ``free()`` when done with it. ``gains`` None: the design rules for the plant (module docstring).
     """
-    env = make_environment(plan, payload_error=payload_error)
+    if isinstance(cycles, bool) or not isinstance(cycles, int) or cycles < 1:
+        raise InvalidInputError("cycles", cycles, "must be an integer >= 1")
+    designed, lowest = design_gains(plan, plant)
+    gains = gains or designed
+    env = make_environment(plan, payload_error=payload_error, plant=plant)
     physics: CranePhysics = env.physics
     task = env.task
-    controller = CascadeController(task.motion, physics.drives.drives, gains)
+    compliant = plant is not None and plant.drive_train.enabled
+    stiffness = plant.drive_train.axial_stiffness_N_per_m if plant is not None and compliant else None
+    controller = CascadeController(task.motion, DriveArrays.from_params(plan.emlas), gains, stiffness)
     steps = round(task.motion.time[-1] / env.control_timestep())
+    history: list[dict[str, object]] = []
+    for cycle in range(cycles):
+        if cycle > 0 and physics.thermal is not None:
+            physics.thermal.rest()
+            physics.drives.drives = replace(physics.drives.drives, resistance=physics.thermal.resistance())
+        log = _one_cycle(env, physics, controller, steps, progress)
+        bus = float(physics.energy.sum() + physics.inverter.sum())
+        temperature = None if physics.thermal is None else physics.thermal.temperature.copy()
+        history.append(
+            {
+                "cycle": cycle + 1,
+                "dc_bus_energy_J": bus,
+                "winding_temperature_C": None if temperature is None else [float(t) for t in temperature],
+            }
+        )
+    time, error, plan_error, current, voltage, energy, qpos, wall = log
+    n = len(time)
+    dt = np.diff(time)
+    power = np.vstack([np.diff(energy, axis=0) / dt[:, None], np.zeros((1, 3))])
+    power[-1] = power[-2]
+    plan = task.plan
+    run = ClosedLoopRun(
+        design=plan.design,
+        payload_error=payload_error,
+        time=time,
+        tcp_error=error,
+        plan_error=plan_error,
+        current_dq=current,
+        voltage_dq=voltage,
+        electrical_power=power,
+        cumulative_energy=energy,
+        plan_time=plan.time - plan.time[0],
+        predicted_power=plan.predicted_electrical_power,
+        predicted_net_energy=plan.predicted_net_energy,
+        current_limit=physics.drives.drives.current_limit,
+        voltage_limit=physics.drives.drives.voltage_limit,
+        current_limit_fraction=physics.current_limited_steps / max(physics.steps, 1),
+        voltage_limit_fraction=physics.voltage_limited_steps / max(physics.steps, 1),
+        copper_energy=physics.copper.copy(),
+        qpos=qpos[:n],
+        wall_time=wall,
+        plant="ideal" if plant is None else plant.name,
+        inverter_energy=physics.inverter.copy(),
+        drive_train_loss=physics.drive_train_loss.copy(),
+        friction_loss=float(physics.friction_loss),
+        winding_temperature=None if physics.thermal is None else physics.thermal.temperature.copy(),
+        cycles=tuple(history),
+        gains=gains,
+        lowest_resonance_hz=lowest,
+    )
+    return run, physics
+
+
+def _one_cycle(
+    env: control.Environment,
+    physics: CranePhysics,
+    controller: CascadeController,
+    steps: int,
+    progress: Callable[[int, int], None] | None,
+) -> tuple[Array, Array, Array, Array, Array, Array, Array, float]:
+    """One episode: (time, TCP error, error to the plan, currents, voltages, cumulative energy, qpos, wall time)."""
+    task = env.task
     nq = physics.model.nq
     time = np.empty(steps + 1)
     error = np.empty(steps + 1)
@@ -153,29 +274,4 @@ def run_closed_loop(
             progress(k, steps)
     wall = _time.perf_counter() - start
     n = k + 1
-    dt = np.diff(time[:n])
-    power = np.vstack([np.diff(energy[:n], axis=0) / dt[:, None], np.zeros((1, 3))])
-    power[-1] = power[-2]
-    plan = task.plan
-    run = ClosedLoopRun(
-        design=plan.design,
-        payload_error=payload_error,
-        time=time[:n],
-        tcp_error=error[:n],
-        plan_error=plan_error[:n],
-        current_dq=current[:n],
-        voltage_dq=voltage[:n],
-        electrical_power=power,
-        cumulative_energy=energy[:n],
-        plan_time=plan.time - plan.time[0],
-        predicted_power=plan.predicted_electrical_power,
-        predicted_net_energy=plan.predicted_net_energy,
-        current_limit=physics.drives.drives.current_limit,
-        voltage_limit=physics.drives.drives.voltage_limit,
-        current_limit_fraction=physics.current_limited_steps / max(physics.steps, 1),
-        voltage_limit_fraction=physics.voltage_limited_steps / max(physics.steps, 1),
-        copper_energy=physics.copper.copy(),
-        qpos=qpos[:n],
-        wall_time=wall,
-    )
-    return run, physics
+    return time[:n], error[:n], plan_error[:n], current[:n], voltage[:n], energy[:n], qpos[:n], wall

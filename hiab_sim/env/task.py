@@ -7,6 +7,9 @@ Observations (``OrderedDict`` of float arrays):
 
 * ``time`` (1,) [s]; ``joint_position`` (nq,) and ``joint_velocity`` (nv,) of every MuJoCo joint;
 * ``stroke`` (3,) [m] and ``rod_velocity`` (3,) [m/s] of x1, x2, xt2;
+* ``measured_stroke`` (3,) [m] and ``measured_velocity`` (3,) [m/s]: what the controller reads, the
+  motor-side stroke and rate from the encoder (:mod:`hiab_sim.env.plant.sensors`; exact, and the
+  rod's own, when the plant has no sensors and a rigid drive train);
 * ``tcp`` and ``reference_tcp`` (3,) [m], MuJoCo world, the reference at this time;
 * ``current_dq`` and ``voltage_dq`` (3, 2) [A, V]: (d, q) of each drive at the end of the last step;
 * ``electrical_power`` (3,) [W]: mean 3/2 (v_d i_d + v_q i_q) of each drive over the last physics
@@ -44,7 +47,10 @@ class CraneTrackingTask(base.Task):
         physics.drives.reset(0.0, self.motion.current[0])
         physics.current_reference = self.motion.current[0].copy()
         physics.reset_counters()
+        if physics.drive_train is not None:
+            physics.drive_train.reset(self.motion.stroke[0], self.motion.rod_velocity[0], self.motion.force[0])
         physics.forward()
+        physics.sensor.reset(*physics.motor_state())
 
     def action_spec(self, physics: CranePhysics) -> specs.BoundedArray:
         """q-current references [A] within the drives' current limit."""
@@ -78,6 +84,9 @@ class CraneTrackingTask(base.Task):
         obs["joint_velocity"] = data.qvel.copy()
         obs["stroke"] = physics.stroke().copy()
         obs["rod_velocity"] = physics.rod_velocity().copy()
+        measured_stroke, measured_velocity = physics.sensor.measured()
+        obs["measured_stroke"] = np.array(measured_stroke, dtype=float)
+        obs["measured_velocity"] = np.array(measured_velocity, dtype=float)
         obs["tcp"] = data.site_xpos[physics.tcp_site].copy()
         obs["reference_tcp"] = self.motion.reference_tcp[self.motion.index(time)].copy()
         obs["current_dq"] = current

@@ -13,9 +13,11 @@ import numpy as np
 from tqdm import tqdm
 
 from hiab_sim.control.cascade import CascadeGains
+from hiab_sim.crane.description import Crane
 from hiab_sim.env import CURRENT_BANDWIDTH_HZ, PHYSICS_TIMESTEP
 from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.plan import read_plan
+from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.rollout import ClosedLoopRun, run_closed_loop
 
 #: Video frame rate [1/s] and the size of one design's viewport (width, height) [px].
@@ -24,9 +26,14 @@ VIEWPORT = (480, 480)
 
 
 def simulate_designs(
-    result_dir: str | Path, designs: Sequence[str], payload_error: float, quiet: bool = False
+    result_dir: str | Path,
+    designs: Sequence[str],
+    payload_error: float,
+    quiet: bool = False,
+    plant: Plant | None = None,
+    cycles: int = 1,
 ) -> tuple[list[ClosedLoopRun], list[ClosedLoopRun], list[CranePhysics]]:
-    """Run every design at ``payload_error`` (and, when it is not 0, nominally too).
+    """Run every design at ``payload_error`` (and, when it is not 0, nominally too) on ``plant`` for ``cycles``.
 
     Returns:
         The runs at ``payload_error``, the nominal runs (empty when payload_error is 0) and the
@@ -39,7 +46,9 @@ def simulate_designs(
         conditions = [payload_error] if payload_error == 0.0 else [0.0, payload_error]
         for error in conditions:
             label = design if error == 0.0 else f"{design} end mass +{100 * error:g} %"
-            with tqdm(total=1, desc=label, unit="step", disable=quiet, file=sys.stderr, leave=False) as bar:
+            with tqdm(
+                total=1, desc=label, unit="step", disable=quiet or not sys.stderr.isatty(), file=sys.stderr, leave=False
+            ) as bar:
 
                 def progress(done: int, total: int, bar: tqdm = bar) -> None:
                     if bar.total != total:
@@ -48,7 +57,7 @@ def simulate_designs(
                         bar.n = done
                         bar.refresh()
 
-                run, item = run_closed_loop(plan, error, progress=progress)
+                run, item = run_closed_loop(plan, error, progress=progress, plant=plant, cycles=cycles)
             if error == payload_error:
                 runs.append(run)
                 physics.append(item)
@@ -71,7 +80,7 @@ def simulation_report(
             entry["extra_energy_J"] = run.net_energy - match.net_energy
             entry["extra_energy_vs_predicted_J"] = run.net_energy - run.predicted_net_energy
         designs[run.design] = entry
-    gains = CascadeGains()
+    gains = runs[0].gains if runs else CascadeGains()
     report: dict[str, object] = {
         "result_dir": str(Path(result_dir).resolve()),
         "designs": designs,
@@ -86,6 +95,7 @@ def simulation_report(
             },
             "energy": "closed loop: int 3/2 (v_d i_d + v_q i_q) dt over the cycle, summed over the drives",
             "tcp_error": "distance of the simulated TCP to the study's TCP reference at the same time",
+            "plant": runs[0].plant if runs else "ideal",
         },
     }
     by_design = {run.design: run for run in runs}
@@ -95,7 +105,7 @@ def simulation_report(
 
 
 def table(report: dict[str, object]) -> str:
-    """Markdown table of predicted vs closed-loop energy and tracking errors (the README's table)."""
+    """Markdown table of predicted vs closed-loop energy and tracking errors (docs/results/closed-loop.md)."""
     lines = [
         "| design | end mass | predicted energy [J] | closed-loop energy [J] | difference | TCP error rms / max [mm]"
         " | at current limit | at voltage limit | extra energy [J] |",
@@ -118,33 +128,68 @@ def table(report: dict[str, object]) -> str:
     return "\n".join(lines)
 
 
-def render_video(path: Path, runs: list[ClosedLoopRun], physics: list[CranePhysics], quiet: bool = False) -> Path:
-    """Render the logged runs side by side at :data:`FPS` through ``Physics.render`` (camera ``closed_loop``)."""
+def render_video(
+    path: Path,
+    runs: list[ClosedLoopRun],
+    physics: list[CranePhysics],
+    crane: Crane,
+    nominal: list[ClosedLoopRun] | None = None,
+    quiet: bool = False,
+) -> Path:
+    """Render the closed-loop runs in the playback's visual language (:mod:`hiab_sim.render`).
+
+    One panel per end-mass condition (the planned mass when ``nominal`` runs are given, then the
+    runs' own), each overlaying the optimal design (opaque) on the initial one (ghost), the
+    machine dressed from ``crane``, with the time and each design's cumulative drive energy
+    int sum_i P_elec,i dt [kJ] of the closed loop. A nominal run is drawn with its design's
+    model of ``physics`` (the end-mass error changes inertia, not geometry).
+    """
     from hiab_sim.render.backend import video_sink
-    from hiab_sim.render.labels import caption_bitmap, stamp
+    from hiab_sim.render.decor import INITIAL_RGBA, OPTIMAL_RGBA
+    from hiab_sim.render.dress import machine_dress
+    from hiab_sim.render.frames import Design, PlaybackRenderer
 
     width, height = VIEWPORT
-    captions = [
-        caption_bitmap(
-            f"{run.design}: closed loop" + (f", end mass +{100 * run.payload_error:g} %" if run.payload_error else ""),
-            (0.1, 0.1, 0.1),
-        )
-        for run in runs
-    ]
-    for item in physics:
-        item.model.light_castshadow[:] = 0  # software (OSMesa) shadows cost 3x the frame time
+    colours = {"initial": INITIAL_RGBA, "optimal": OPTIMAL_RGBA}
     duration = min(run.time[-1] for run in runs)
     frames = int(np.floor(duration * FPS)) + 1
-    with video_sink(path, (width * len(runs), height), FPS) as sink:
-        for frame in tqdm(range(frames), desc="video", unit="frame", disable=quiet, file=sys.stderr, leave=False):
-            images: list[np.ndarray] = []
-            for run, item in zip(runs, physics, strict=True):
-                index = int(np.clip(np.searchsorted(run.time, frame / FPS), 0, len(run.time) - 1))
-                item.data.qpos[:] = run.qpos[index]
-                item.data.qvel[:] = 0.0
-                item.forward()
-                image = np.array(item.render(height, width, camera_id="closed_loop"))
-                stamp(image, captions[len(images)])
-                images.append(image)
-            sink.add(np.hstack(images))
+    at = np.arange(frames) / FPS
+    models = {run.design: item.model.ptr for run, item in zip(runs, physics, strict=True)}
+    marks = tuple(f"{chain.name}_base_pivot" for chain in crane.chains)
+    panels = [nominal, runs] if nominal else [runs]
+
+    def design(run: ClosedLoopRun) -> Design:
+        index = np.clip(np.searchsorted(run.time, at), 0, len(run.time) - 1)
+        energy = run.cumulative_energy.sum(axis=1) if run.cumulative_energy.ndim == 2 else run.cumulative_energy
+        total = float(energy[-1]) / 1e3
+        notes = tuple(
+            f"t = {t:5.2f} s   drive energy {energy[k] / 1e3:.3f} of {total:.3f} kJ"
+            for t, k in zip(at, index, strict=True)
+        )
+        mass = "planned end mass" if run.payload_error == 0 else f"end mass +{100 * run.payload_error:g} %"
+        caption = f"{run.design}, {mass}" if run.design != "initial" else "initial (ghost)"
+        model = models[run.design]
+        return Design(
+            run.design, model, run.qpos[index], colours.get(run.design, OPTIMAL_RGBA), caption, notes,
+            dress=machine_dress(model, crane), marks=marks,
+        )  # fmt: skip
+
+    renderers = []
+    try:
+        for panel in panels:
+            ordered = sorted(panel, key=lambda run: run.design != "optimal")  # the optimal design opaque
+            renderers.append(PlaybackRenderer([design(run) for run in ordered], None, (width, height), "overlay"))
+        with video_sink(path, (width * len(renderers), height), FPS) as sink:
+            for frame in tqdm(
+                range(frames),
+                desc="video",
+                unit="frame",
+                disable=quiet or not sys.stderr.isatty(),
+                file=sys.stderr,
+                leave=False,
+            ):
+                sink.add(np.hstack([renderer.frame(frame) for renderer in renderers]))
+    finally:
+        for renderer in renderers:
+            renderer.close()
     return path

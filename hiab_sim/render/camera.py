@@ -70,3 +70,22 @@ def fit_camera(
     camera.azimuth = azimuth
     camera.elevation = elevation
     return camera
+
+
+def fixed_pose(camera: mujoco.MjvCamera) -> tuple[Array, Array]:
+    """Position [m] and ``xyaxes`` (right, up) of a fixed MJCF camera that sees what ``camera`` sees."""
+    forward, right, up = camera_axes(float(camera.azimuth), float(camera.elevation))
+    position = np.asarray(camera.lookat, dtype=float) - forward * float(camera.distance)
+    return position, np.concatenate([right, up])
+
+
+#: The exported model's cameras: name -> (azimuth, elevation) [deg] (side view, three-quarter view).
+MODEL_CAMERAS = {"side": (90.0, -12.0), "perspective": (135.0, -22.0)}
+
+
+def framed_cameras(points: Array, aspect: float, fovy: float) -> dict[str, tuple[Array, Array]]:
+    """Fixed poses of :data:`MODEL_CAMERAS` that each hold every point of ``points`` (P, 3) [m] in view."""
+    return {
+        name: fixed_pose(fit_camera(points, aspect, fovy, azimuth, elevation, margin=1.1))
+        for name, (azimuth, elevation) in MODEL_CAMERAS.items()
+    }

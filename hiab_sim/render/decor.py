@@ -51,6 +51,19 @@ def add_polyline(scene: mujoco.MjvScene, points: Array, rgba: Sequence[float], w
         scene.ngeom += 1
 
 
+def add_ball(scene: mujoco.MjvScene, centre: Array, radius: float, rgba: Sequence[float]) -> None:
+    """Append a self-lit ball of ``radius`` [m] at ``centre`` (a marker: a moved pivot)."""
+    geom = _next_geom(scene)
+    if geom is None:
+        return
+    colour = np.asarray((*rgba[:3], 1.0), dtype=np.float32)
+    size = np.array([radius, radius, radius])
+    mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_SPHERE, size, np.asarray(centre, float), np.eye(3).ravel(), colour)
+    geom.emission = 0.6
+    geom.category = mujoco.mjtCatBit.mjCAT_DECOR
+    scene.ngeom += 1
+
+
 def add_backdrop(scene: mujoco.MjvScene, camera: mujoco.MjvCamera, depth: float, half_size: float) -> None:
     """Append a self-lit square backdrop facing the camera, ``depth`` [m] behind its look-at point.
 

@@ -14,6 +14,7 @@ no shadows, reflections, skybox or multisampling; a self-lit backdrop instead of
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
@@ -26,13 +27,23 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.render import decor
 from hiab_sim.render.backend import open_renderer
 from hiab_sim.render.camera import camera_axes, fit_camera, geom_corners
+from hiab_sim.render.dress import MachineDress, dress_points, dress_scene
 from hiab_sim.render.labels import caption_bitmap, stamp
 
 Array = NDArray[np.float64]
 Image = NDArray[np.uint8]
 Layout = Literal["side-by-side", "stacked", "overlay"]
 LAYOUTS: tuple[str, ...] = ("side-by-side", "stacked", "overlay")
-GHOST_ALPHA = 0.5
+GHOST_ALPHA = 0.4
+#: Radius of the balls that mark moved pivots [m].
+MARK_RADIUS_M = 0.07
+#: Room kept free above the machine for the captions, as a fraction of the motion's height.
+CAPTION_ROOM = 0.35
+
+
+def text_colour(rgba: Sequence[float]) -> tuple[float, float, float]:
+    """A design's colour darkened for text on the light caption box (contrast ratio above 4.5)."""
+    return (0.55 * rgba[0], 0.55 * rgba[1], 0.55 * rgba[2])
 
 
 @dataclass(frozen=True)
@@ -50,6 +61,10 @@ class Design:
     caption: str | None = None  # top-left of the design's viewport; default: the name
     notes: tuple[str, ...] = ()  # one text per frame under the caption (time, energy); () for none
     tcp_site: str = "tcp"
+    #: The machine's dressing (box booms, cylinders of the data, pins, blocks, hook, bed); None: the bare model.
+    dress: MachineDress | None = None
+    #: Sites marked with a ball of the design's colour (pivots that move between designs).
+    marks: tuple[str, ...] = ()
     #: TCP position per frame (N, 3) in the MuJoCo world [m], computed from ``qpos``.
     tcp: Array = field(init=False, repr=False)
 
@@ -121,7 +136,8 @@ class PlaybackRenderer:
         self._perturb = mujoco.MjvPerturb()
         panel_width = width // panels if layout == "side-by-side" else width
         panel_height = height // panels if layout == "stacked" else height
-        max_geom = sum(d.model.ngeom for d in self.designs) + decor.MAX_SEGMENTS * (len(self.designs) + 1) + 16
+        extra = sum(d.model.njnt + 8 + len(d.marks) for d in self.designs)  # pins, blocks, hook, bed, marks
+        max_geom = sum(d.model.ngeom for d in self.designs) + decor.MAX_SEGMENTS * (len(self.designs) + 1) + 16 + extra
         self._renderers: list[mujoco.Renderer] = []
         try:
             for design in self.designs if layout != "overlay" else self.designs[:1]:
@@ -133,14 +149,17 @@ class PlaybackRenderer:
             self.close()
             raise
         points = self._motion_points()
+        low, high = points.min(axis=0), points.max(axis=0)
+        room = 0.5 * (low + high) + [0.0, 0.0, 0.5 * (high[2] - low[2]) * (1.0 + 2.0 * CAPTION_ROOM)]
+        points = np.vstack([points, room])  # the captions' band stays clear of the machine
         fovy = float(self.designs[0].model.vis.global_.fovy)
         self.camera = fit_camera(points, aspect=panel_width / panel_height, fovy=fovy)
         forward, _, _ = camera_axes(float(self.camera.azimuth), float(self.camera.elevation))
         depth = float(np.max((points - self.camera.lookat) @ forward)) + 1.0
         aspect = panel_width / panel_height
         self._backdrop = (depth, 4.0 * (self.camera.distance + depth) * np.tan(np.radians(fovy)) * max(aspect, 1.0))
-        self._line = max(12, panel_height // 16 if layout == "stacked" else height // 26)
-        self._captions = [caption_bitmap(d.caption or d.name, d.rgba[:3], self._line) for d in self.designs]
+        self._line = max(16, min(panel_height // 14 if layout == "stacked" else height // 20, panel_width // 28))
+        self._captions = [caption_bitmap(d.caption or d.name, text_colour(d.rgba), self._line) for d in self.designs]
 
     def __len__(self) -> int:
         return len(self.designs[0])
@@ -153,6 +172,8 @@ class PlaybackRenderer:
                 data.qpos[:] = design.qpos[k]
                 mujoco.mj_kinematics(design.model, data)
                 points.append(geom_corners(design.model, data))
+                if design.dress is not None:
+                    points.append(dress_points(design.model, data, design.dress))
             points.append(design.tcp)
         return np.concatenate(points)
 
@@ -162,6 +183,23 @@ class PlaybackRenderer:
             decor.add_polyline(scene, self.reference, decor.REFERENCE_RGBA, width=decor.LINE_WIDTH - 1.0)
         for design in designs:
             decor.add_polyline(scene, design.tcp[: index + 1], design.rgba)
+        self._marks(scene, designs)
+
+    def _marks(self, scene: mujoco.MjvScene, designs: Sequence[Design]) -> None:
+        """A ball of each design's colour at its marked sites; overlaid, a line from each to the next design's."""
+        where: list[dict[str, Array]] = []
+        for design in designs:
+            data = self._data[self.designs.index(design)]
+            found = {}
+            for name in design.marks:
+                site = mujoco.mj_name2id(design.model, mujoco.mjtObj.mjOBJ_SITE, name)
+                if site >= 0:
+                    found[name] = np.array(data.site_xpos[site])
+                    decor.add_ball(scene, found[name], MARK_RADIUS_M, design.rgba)
+            where.append(found)
+        for first, second in itertools.pairwise(where):
+            for name in first.keys() & second.keys():
+                decor.add_polyline(scene, np.stack([first[name], second[name]]), (0.1, 0.1, 0.1, 1.0), width=2.0)
 
     def frame(self, index: int) -> Image:
         """The RGB image (height, width, 3) uint8 of frame ``index``."""
@@ -177,7 +215,10 @@ class PlaybackRenderer:
             self._renderers, self.designs, self._data, self._captions, strict=True
         ):
             renderer.update_scene(data, camera=self.camera, scene_option=self._option)
-            decor.tint_geoms(renderer.scene, 0, design.rgba)
+            if design.dress is not None:
+                dress_scene(renderer.scene, (0, renderer.scene.ngeom), design.model, data, design.dress, design.rgba)
+            else:
+                decor.tint_geoms(renderer.scene, 0, design.rgba)
             self._decorate(renderer.scene, [design], index)
             image = renderer.render()
             self._label(image, design, caption, index, top=8)
@@ -189,7 +230,7 @@ class PlaybackRenderer:
         stamp(image, caption, top=top)
         top += caption.shape[0] + 6
         if design.notes:
-            note = caption_bitmap(design.notes[index], design.rgba[:3], max(10, int(0.8 * self._line)))
+            note = caption_bitmap(design.notes[index], text_colour(design.rgba), max(14, int(0.8 * self._line)))
             stamp(image, note, top=top)
             top += note.shape[0] + 6
         return top
@@ -198,12 +239,20 @@ class PlaybackRenderer:
         renderer = self._renderers[0]
         renderer.update_scene(self._data[0], camera=self.camera, scene_option=self._option)
         scene = renderer.scene
-        decor.tint_geoms(scene, 0, self.designs[0].rgba)
+        if self.designs[0].dress is None:
+            decor.tint_geoms(scene, 0, self.designs[0].rgba)
+        spans = [(0, scene.ngeom)]
         for design, data in zip(self.designs[1:], self._data[1:], strict=True):
             start = scene.ngeom
             mujoco.mjv_addGeoms(design.model, data, self._option, self._perturb, mujoco.mjtCatBit.mjCAT_DYNAMIC, scene)
             decor.drop_coincident(scene, start)
-            decor.tint_geoms(scene, start, (*design.rgba[:3], GHOST_ALPHA), weight=0.8)
+            spans.append((start, scene.ngeom))
+        for k, (design, data, span) in enumerate(zip(self.designs, self._data, spans, strict=True)):
+            if design.dress is not None:
+                alpha = 1.0 if k == 0 else GHOST_ALPHA
+                dress_scene(scene, span, design.model, data, design.dress, design.rgba, alpha, ground=k == 0)
+            elif k > 0:
+                decor.tint_geoms(scene, span[0], (*design.rgba[:3], GHOST_ALPHA), weight=0.8)
         self._decorate(scene, self.designs, index)
         image = renderer.render()
         top = 8

@@ -33,12 +33,26 @@ def caption_bitmap(text: str, rgb: Sequence[float], height: int = 18) -> NDArray
     return np.ascontiguousarray(rgba[rows.min() : rows.max() + 1, cols.min() : cols.max() + 1])
 
 
-def stamp(image: Image, bitmap: NDArray[np.float32], top: int = 8, left: int = 8) -> None:
-    """Alpha-blend ``bitmap`` onto ``image`` (H, W, 3) in place, clipped to the image."""
+#: Caption box: padding [px] and how much of the scene shows through its white [0, 1].
+BOX_PAD = 4
+BOX_SHOW_THROUGH = 0.15
+
+
+def stamp(image: Image, bitmap: NDArray[np.float32], top: int = 8, left: int = 8, box: bool = True) -> None:
+    """Alpha-blend ``bitmap`` onto ``image`` (H, W, 3) in place, clipped to the image.
+
+    With ``box`` the text sits on a nearly white box (:data:`BOX_SHOW_THROUGH`), so it stays
+    readable over any part of the scene.
+    """
     height = min(bitmap.shape[0], image.shape[0] - top)
     width = min(bitmap.shape[1], image.shape[1] - left)
     if height <= 0 or width <= 0:
         return
+    if box:
+        r0, c0 = max(top - BOX_PAD, 0), max(left - BOX_PAD, 0)
+        r1, c1 = min(top + height + BOX_PAD, image.shape[0]), min(left + width + BOX_PAD, image.shape[1])
+        region = image[r0:r1, c0:c1].astype(np.float32)
+        image[r0:r1, c0:c1] = (BOX_SHOW_THROUGH * region + (1.0 - BOX_SHOW_THROUGH) * 255.0 + 0.5).astype(np.uint8)
     patch = image[top : top + height, left : left + width].astype(np.float32)
     source = bitmap[:height, :width]
     alpha = source[..., 3:4]

@@ -1,10 +1,12 @@
 """``render_result``: a playback video (or a still frame) of an optimisation result folder.
 
-Each design's viewport names it and shows, per frame, the time and the design's cumulative net
-electrical energy E(t) = integral of sum_i P_elec,i dt [kJ] (trapezoidal on the result's fine
-grid, whose total is the result's ``net_electrical_energy_J``) next to its total. Colours are
-those of :mod:`hiab_sim.style`. The default layout stacks the designs, so that each viewport is
-wider than tall like the crane's motion.
+Each design is named and shows, per frame, the time and its cumulative net electrical energy
+of the drives E(t) = integral of sum_i P_elec,i dt [kJ] (trapezoidal on the result's fine grid,
+whose total is the result's ``net_electrical_energy_J``; the battery's own number is in
+``summary.md``) next to its total. The machine is dressed from its description
+(:mod:`hiab_sim.render.dress`) in the colours of :mod:`hiab_sim.style`. The default layout overlays
+the initial design as a ghost on the optimal one, with the cylinder base pivots that the link
+lengths move marked by balls of each design's colour and joined by a line.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.model.mjcf import build_model, source_to_world
 from hiab_sim.render.backend import check_gl_backend, check_output_path, ffmpeg_path, video_sink, write_image
 from hiab_sim.render.decor import INITIAL_RGBA, OPTIMAL_RGBA
+from hiab_sim.render.dress import machine_dress
 from hiab_sim.render.frames import LAYOUTS, Design, Layout, PlaybackRenderer
 from hiab_sim.render.playback import (
     MODES,
@@ -37,7 +40,7 @@ Array = NDArray[np.float64]
 #: Default file name of the playback video inside a result folder.
 VIDEO_NAME = "playback.mp4"
 #: Default arrangement of the designs.
-DEFAULT_LAYOUT: Layout = "stacked"
+DEFAULT_LAYOUT: Layout = "overlay"  # the optimal design opaque, the initial one as a ghost: the difference shows
 _COLOURS = {"initial": INITIAL_RGBA, "optimal": OPTIMAL_RGBA}
 
 
@@ -62,6 +65,7 @@ def playback_renderer(
     if layout not in LAYOUTS:
         raise InvalidInputError("layout", layout, f"must be one of {', '.join(LAYOUTS)}")
     at = frame_times(data.time, fps)
+    marks = tuple(f"{chain.name}_base_pivot" for chain in data.crane.chains)  # the pivots the lengths move
     designs = []
     for motion in data.designs:
         model = build_model(data.crane, motion.lengths)
@@ -69,12 +73,17 @@ def playback_renderer(
             qpos = planned_qpos(data.crane, motion.lengths, resample(data.time, motion.joints.position, at))
         else:
             qpos = resample(*simulated_qpos(data.crane, motion.lengths, data.time, motion.joints), at)
-        caption = f"{motion.name} ({mode})"
+        caption = f"{motion.name} design" + (" (simulated)" if mode != "kinematic" else "")
         if layout == "overlay" and motion.name == "initial":
-            caption = f"{motion.name} (translucent, {mode})"
+            caption += ", ghost"
         power = None if energy is None else energy.get(motion.name)
         notes = energy_notes(data.time, at, power)
-        designs.append(Design(motion.name, model, qpos, _COLOURS.get(motion.name, OPTIMAL_RGBA), caption, notes))
+        designs.append(
+            Design(
+                motion.name, model, qpos, _COLOURS.get(motion.name, OPTIMAL_RGBA), caption, notes,
+                dress=machine_dress(model, data.crane), marks=marks,
+            )
+        )  # fmt: skip
     if layout == "overlay":
         designs.reverse()  # the optimal design opaque, the initial one as a translucent ghost
     return PlaybackRenderer(designs, source_to_world(data.reference_tcp), size, layout=layout, shadows=shadows)
@@ -88,7 +97,7 @@ def energy_notes(time: Array, at: Array, power: Array | None) -> tuple[str, ...]
     cumulative = np.concatenate([[0.0], np.cumsum(steps)])
     total = cumulative[-1] / 1e3
     return tuple(
-        f"t = {t:5.2f} s   E = {e / 1e3:6.3f} of {total:.3f} kJ"
+        f"t = {t:5.2f} s   drives' net energy {e / 1e3:.3f} of {total:.3f} kJ"
         for t, e in zip(at, np.interp(at, time, cumulative), strict=True)
     )
 

@@ -31,11 +31,12 @@ from hiab_sim.study.spec.study_file import Study, load_study
 
 @dataclass(frozen=True)
 class RunOutput:
-    """What a run wrote: the folder, the result (as in its result.json) and the figure paths."""
+    """What a run wrote: the folder, the result (as in its result.json), the figure paths, earlier outputs removed."""
 
     folder: Path
     result: Result
     figures: list[Path]
+    removed: tuple[Path, ...] = ()
 
 
 def run_study(
@@ -130,4 +131,4 @@ def run_study(
         if result.cross_evaluation is not None:
             paths.append(folder / "cross_evaluation.png")
             cross_figure(result.cross_evaluation, paths[-1])
-    return RunOutput(folder, result, paths)
+    return RunOutput(folder, result, paths, tuple(removed))

@@ -7,8 +7,9 @@ hash :func:`hiab_sim.study.solvers.slsqp.study_digest`, number of starts). Rules
   non-empty folder that is not a result folder (nothing in it is hiab-sim's), so that ``--out``
   pointing at the wrong place deletes nothing;
 - a fresh run (not ``resume``) deletes every output of earlier runs (:data:`OUTPUT_PATTERNS`:
-  result, trajectory, checkpoints, figures, video, copied crane) before it writes, so a
-  ``--no-figures`` re-run leaves no old figure beside a new result;
+  result, trajectory, checkpoints, summary, figures, videos, the closed-loop simulation's report, copied
+  crane) before it writes, so a ``--no-figures`` re-run leaves no old figure beside a new result and no
+  simulation of the old design beside the new one; the caller tells the user what was removed;
 - ``resume`` needs the folder's checkpoints (a typo in ``--out`` is an error, not a fresh run),
   and restores the run's own number of starts unless it is given; whether the checkpoints are
   this run's is checked per start by :func:`hiab_sim.study.solvers.slsqp.check_checkpoint`.
@@ -24,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.errors import InvalidInputError
+from hiab_sim.errors import ConfigError, InvalidInputError
 
 OWNER_FILE = "owner.json"
 #: Files a run writes into its folder (glob patterns); a fresh run deletes these and nothing else.
@@ -32,9 +33,13 @@ OUTPUT_PATTERNS = (
     "result.json",
     "trajectory.npz",
     "checkpoint_*.json",
+    "summary.md",
     "*.png",
     "*.mp4",
     "crane.yaml",
+    "simulation.json",  # hiab-sim simulate's, of the run it validated
+    "report.html",
+    "report.pdf",
     OWNER_FILE,
 )
 NO_CHECKPOINTS = "has no checkpoint_<k>.json to resume from (run without --resume to start afresh)"
@@ -72,7 +77,7 @@ def _recorded_digest(folder: Path) -> tuple[str | None, str]:
     """The study hash the folder's outputs belong to, and a label of that study (marker, else a checkpoint)."""
     owner = read_owner(folder)
     if owner is not None:
-        return owner.get("study_sha256"), f"study '{owner.get('name')}' ({owner.get('study')})"
+        return owner.get("study_sha256"), f"the study named '{owner.get('name')}' ({owner.get('study')})"
     for path in checkpoints(folder):  # a folder written before the marker existed
         try:
             data = json.loads(path.read_text(encoding="utf-8"))
@@ -84,9 +89,10 @@ def _recorded_digest(folder: Path) -> tuple[str | None, str]:
 
 
 def check_folder(folder: Path, digest: str, resume: bool, force: bool) -> None:
-    """Raise :class:`InvalidInputError` (field ``--out`` or ``--resume``) unless this study may use ``folder``.
+    """Raise unless this study may use ``folder``; writes nothing.
 
-    Writes nothing. See the module docstring for the rules.
+    A folder of another study raises :class:`ConfigError` naming that study, a bad ``--out`` or
+    ``--resume`` :class:`InvalidInputError`. See the module docstring for the rules.
     """
     if folder.exists() and not folder.is_dir():
         raise InvalidInputError("--out", str(folder), "must be a folder (it is a file)")
@@ -98,10 +104,10 @@ def check_folder(folder: Path, digest: str, resume: bool, force: bool) -> None:
         return
     recorded, owner = _recorded_digest(folder)
     if recorded is not None and recorded != digest:
-        raise InvalidInputError(
-            "--out",
-            str(folder),
-            f"belongs to {owner} (sha256 {str(recorded)[:12]}); use another --out, or --force to replace its results",
+        raise ConfigError(
+            f"output folder {folder} belongs to {owner}, not to this study (another file or another version of "
+            f"it; sha256 {str(recorded)[:12]}); the default folder runs/<name> comes from the study's name: field, "
+            "so give this study its own name:, pass --out, or use --force to replace the results there"
         )
     if recorded is None and not outputs(folder):
         raise InvalidInputError(

@@ -90,30 +90,70 @@ def write_map(m: EnergyMap, out: Path) -> list[Path]:
     return paths
 
 
-def figure_png(m: EnergyMap) -> bytes:
-    """PNG of two panels (objective, net energy) with infeasible cells coloured by binding constraint."""
-    import matplotlib
+def infeasible_note(m: EnergyMap) -> str | None:
+    """Why cells are infeasible, in words: the most frequent binding limit and which variables to map instead.
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    None when most cells are feasible. The hint names the other lengths of the chain the binding
+    limit belongs to (they move that limit), else the two variables of the map with wider bounds.
+    """
+    from hiab_sim.study.report.summary import limit_in_words
+
+    v = m.values
+    feasible = np.asarray(v.feasible, dtype=bool)
+    if feasible.mean() >= 0.5:
+        return None
+    binding = np.asarray(v.binding)[~feasible]
+    names, counts = np.unique(binding, return_counts=True)
+    top = v.names[int(names[np.argmax(counts)])]
+    share = int(counts.max())
+    chain = top.split(".")[1] if top.count(".") >= 2 else ""
+    others = [x for x in VARIABLES if x.startswith(f"{chain}.") and x not in m.variables] if chain else []
+    hint = (
+        f"map {' and '.join(others[:2])} instead (they move this limit)"
+        if others
+        else "widen the bounds of the mapped variables, or map the lengths of the chain that binds"
+    )
+    head = "no feasible cell" if not feasible.any() else f"only {int(feasible.sum())} feasible cells"
+    return (
+        f"{head} of {feasible.size}: {share} cells break {limit_in_words(top)} "
+        f"with the other lengths fixed at the {m.base.source.split(' (')[0]};\n{hint}"
+    )
+
+
+def figure_png(m: EnergyMap) -> bytes:
+    """PNG of two panels (objective, net energy) with infeasible cells coloured by binding constraint.
+
+    Where most cells are infeasible, a note in the figure says which limit binds and which
+    variables to map instead (:func:`infeasible_note`); without a feasible cell the value panels
+    get no colour bar (it would have no values to show).
+    """
+    from matplotlib import colormaps
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
+
+    from hiab_sim.figure_io import new_figure, png_bytes
+    from hiab_sim.study.report.summary import limit_in_words
 
     v = m.values
     i, j = VARIABLES.index(m.variables[0]), VARIABLES.index(m.variables[1])
     feasible = m.grid(v.feasible)
     binding = m.grid(v.binding)
     labels = sorted({v.names[int(k)] for k in binding[~feasible]})
-    palette = plt.get_cmap("tab10")
+    palette = colormaps["tab10"]
     category = np.full(feasible.shape, np.nan)
     for n, name in enumerate(labels):
         category[(~feasible) & (binding == v.names.index(name))] = n
-    fig, axes = plt.subplots(1, 2, figsize=(13, 5.2), constrained_layout=True)
-    panels = ((v.objective, "objective f / f_start (eq. costf2)"), (v.net_energy / 1e3, "net electrical energy [kJ]"))
+    fig = new_figure((13, 5.6))
+    axes = fig.subplots(1, 2)
+    panels = (
+        (v.objective, "objective / its value at the base design"),
+        (v.net_energy / 1e3, "net electrical energy per cycle [kJ]"),
+    )
     for ax, (values, title) in zip(axes, panels, strict=True):
         grid = np.ma.masked_where(~feasible, m.grid(values))
         mesh = ax.pcolormesh(m.axes[0], m.axes[1], grid.T, shading="nearest", cmap="viridis")
-        fig.colorbar(mesh, ax=ax, label=title)
+        if feasible.any():
+            fig.colorbar(mesh, ax=ax, label=title)
         if labels:
             cmap = ListedColormap([palette(n % 10) for n in range(len(labels))])
             ax.pcolormesh(
@@ -126,19 +166,31 @@ def figure_png(m: EnergyMap) -> bytes:
                 vmin=-0.5,
                 vmax=len(labels) - 0.5,
             )
-        ax.plot(m.base.xi[i], m.base.xi[j], "r*", mec="k", ms=14, label="base (" + m.base.source.split(" (")[0] + ")")
+        ax.plot(m.base.xi[i], m.base.xi[j], "*", color="red", mec="k", ms=14,
+                label="base (" + m.base.source.split(" (")[0] + ")")  # fmt: skip
         ax.plot(m.start_xi[i], m.start_xi[j], "wo", mec="k", ms=5, label="start")
         lo, hi = m.low[[i, j]], m.up[[i, j]]
         ax.plot([lo[0], hi[0], hi[0], lo[0], lo[0]], [lo[1], lo[1], hi[1], hi[1], lo[1]], "k--", lw=1, label="bounds")
         ax.set_xlabel(f"{m.variables[0]} [m]")
         ax.set_ylabel(f"{m.variables[1]} [m]")
-        ax.set_title(title)
+        ax.set_title(title if feasible.any() else f"{title}: no feasible cell to colour", fontsize=10)
+    note = infeasible_note(m)
+    if note is not None:
+        import textwrap
+
+        wrapped = "\n".join(textwrap.fill(part, 58) for part in note.split("\n"))
+        for ax in axes:
+            ax.text(
+                0.5, 0.5, wrapped, transform=ax.transAxes, ha="center", va="center", fontsize=8.5,
+                bbox={"boxstyle": "round", "fc": "white", "ec": "0.3", "alpha": 0.92},
+            )  # fmt: skip
     handles, names = axes[0].get_legend_handles_labels()
     handles += [Patch(color=palette(n % 10), alpha=0.35) for n in range(len(labels))]
-    names += [f"infeasible: {name}" for name in labels]
-    fig.legend(handles, names, loc="outside lower center", ncol=3, fontsize=8)
-    fig.suptitle(f"Energy map over {m.variables[0]} x {m.variables[1]}; others and trajectory at the {m.base.source}")
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=110)
-    plt.close(fig)
-    return buffer.getvalue()
+    names += [f"infeasible: {limit_in_words(name)}" for name in labels]
+    fig.legend(handles, names, loc="outside lower center", ncol=2, fontsize=8)
+    fig.suptitle(
+        f"Energy map over {m.variables[0]} x {m.variables[1]}; the other lengths and the trajectory at the "
+        f"{m.base.source}",
+        fontsize=10,
+    )
+    return png_bytes(fig)

@@ -23,13 +23,14 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize
 
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.emla.drive import drive_state
 from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.study.nlp.problem import C_SCALE, XI_SCALE, LinkLengthProblem
+from hiab_sim.style import colour
 
 Array = NDArray[np.float64]
 CRITERIA = {"peak_force": "N", "rms_torque": "N m"}
@@ -258,27 +259,41 @@ def _point(
 
 
 def front_figure_png(front: list[FrontPoint], name: str, title: str) -> bytes:
-    """PNG of the front: objective against the criterion, the plain optimum marked."""
-    import io
+    """PNG of the front: the objective against the criterion, the plain optimum marked.
 
-    import matplotlib
+    The criterion axis also shows the change from the plain optimum in %, so a narrow span
+    (a front over a few tenths of a percent) reads as what it is.
+    """
+    from hiab_sim.figure_io import new_figure, png_bytes
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    words = name.replace("_", " ")
+    unit = CRITERIA[name]
+    k = 1e-3 if unit == "N" else 1.0  # forces in kN
+    unit = "kN" if unit == "N" else unit
     ok = [p for p in front if p.accepted]
-    fig, ax = plt.subplots(figsize=(6.4, 4.6), constrained_layout=True)
-    ax.plot([p.criterion for p in ok], [p.objective for p in ok], "o-", label="front (epsilon-constraint)")
-    ax.plot(front[0].criterion, front[0].objective, "r*", ms=14, label="plain optimum (epsilon inactive)")
+    fig = new_figure((6.6, 4.8))
+    ax = fig.add_subplot()
+    ax.plot([k * p.criterion for p in ok], [p.objective for p in ok], "o-", color=colour("optimal"),
+            label="least objective for each limit on the criterion")  # fmt: skip
+    ax.plot(k * front[0].criterion, front[0].objective, "*", color=colour("initial"), mec="k", ms=14,
+            label="plain optimum (no limit on the criterion)")  # fmt: skip
     bad = [p for p in front if not p.accepted]
     if bad:
-        ax.plot([p.epsilon for p in bad], [p.objective for p in bad], "kx", label="not converged")
-    ax.set_xlabel(f"{name} [{CRITERIA[name]}]")
-    ax.set_ylabel("objective f / f_start (eq. costf2)")
-    ax.set_title(f"{title}: objective against {name}")
+        ax.plot([k * p.epsilon for p in bad], [p.objective for p in bad], "x", color="red", label="not converged")
+    base = k * front[0].criterion
+    if base != 0.0:
+
+        def to_percent(c: ArrayLike) -> ArrayLike:
+            return 100.0 * (np.asarray(c, dtype=float) / base - 1.0)
+
+        def from_percent(d: ArrayLike) -> ArrayLike:
+            return base * (1.0 + np.asarray(d, dtype=float) / 100.0)
+
+        top = ax.secondary_xaxis("top", functions=(to_percent, from_percent))
+        top.set_xlabel(f"{words}: change from the plain optimum [%]")
+    ax.set_xlabel(f"{words} [{unit}]")
+    ax.set_ylabel("objective / its value at the start")
+    ax.set_title(f"{title}: what limiting the {words} costs", fontsize=10)
     ax.grid(alpha=0.3)
-    ax.legend()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=110)
-    plt.close(fig)
-    return buffer.getvalue()
+    ax.legend(fontsize=8)
+    return png_bytes(fig)

@@ -105,7 +105,7 @@ def _ordered(rows: dict[str, dict[str, Any]], order: dict[str, int]) -> list[dic
 
 
 def _bar(total: int, initial: int, enabled: bool) -> Any:
-    if not enabled:
+    if not enabled or not sys.stderr.isatty():  # redirected to a file, a bar would dump every update
         return None
     from tqdm import tqdm
 

@@ -38,7 +38,7 @@ from hiab_sim.errors import ConfigError, HiabSimError
 from hiab_sim.resources import Source, locate
 from hiab_sim.study.spec.study_file import study_from_dict
 from hiab_sim.sweep.paths import parse_path, set_path
-from hiab_sim.yaml_fields import read_yaml
+from hiab_sim.yaml_fields import mapping, read_yaml
 
 _TOP = {"name", "study", "set", "grid", "sample"}
 
@@ -133,8 +133,7 @@ def _grid_points(grid: Any) -> tuple[list[str], list[dict[str, Any]], list[str]]
 def _sample_points(sample: Any) -> tuple[list[str], list[dict[str, Any]], list[str]]:
     from scipy.stats import qmc
 
-    if not isinstance(sample, dict) or set(sample) - {"points", "seed", "ranges"} or "ranges" not in sample:
-        raise ConfigError("sample: expected a mapping with points, seed and ranges {path: [low, high]}")
+    mapping(sample, "sample", {"points", "seed", "ranges"}, {"points", "ranges"})
     n, seed, ranges = sample.get("points"), sample.get("seed", 0), sample["ranges"]
     if not isinstance(n, int) or isinstance(n, bool) or n < 1:
         raise ConfigError(f"sample.points: expected an integer >= 1, got {n!r}")

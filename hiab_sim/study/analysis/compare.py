@@ -118,13 +118,11 @@ def write_comparison(out: Path, runs: Sequence[RunSummary]) -> list[Path]:
 
 def comparison_figure(runs: Sequence[RunSummary]) -> bytes:
     """PNG: net energy of each run's designs (bars with numbers) and the change of each length [mm]."""
-    import matplotlib
-
-    matplotlib.use("Agg")
     import numpy as np
-    from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(11.0, 4.2), layout="constrained")
+    from hiab_sim.figure_io import new_figure, png_bytes
+
+    fig = new_figure((11.0, 4.2))
     energy_ax, length_ax = fig.subplots(1, 2, width_ratios=(1.0, 1.4))
     x = np.arange(len(runs))
     width = 0.38
@@ -155,6 +153,4 @@ def comparison_figure(runs: Sequence[RunSummary]) -> bytes:
     length_ax.set_ylabel("optimal - initial [mm]")
     length_ax.set_title("change of each link length")
     length_ax.legend(fontsize=8)
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=120)
-    return buffer.getvalue()
+    return png_bytes(fig)

@@ -21,6 +21,7 @@ from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.kinematics import forward_kinematics
 from hiab_sim.results.analysis_sections import Sensitivity
 from hiab_sim.results.schema import HistoryRow
+from hiab_sim.study.report.summary import limit_in_words
 from hiab_sim.style import colour
 
 Array = np.ndarray
@@ -28,7 +29,7 @@ ENERGY_LABELS = ("mechanical\nf v", "copper", "rotor\nfriction", "screw\nviscous
 
 
 def draw_crane(ax: Axes, crane: Crane, lengths: LinkLengths, joints: Array, colour: str, alpha: float = 1.0) -> None:
-    """Draw the crane's links in the plane of {W} at one joint pose (theta1, theta2, xt2)."""
+    """Draw the crane's links in its vertical plane of motion at one joint pose (theta1, theta2, xt2)."""
     f = forward_kinematics(crane, lengths, joints[0:1], joints[1:2], joints[2:3])
 
     def seg(a: Array, b: Array, **kw: Any) -> None:
@@ -86,8 +87,8 @@ def structure_overlay(ax: Axes, crane: Crane, designs: dict[str, LinkLengths], p
             )
     ax.set_aspect("equal")
     ax.grid(alpha=0.3)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m] (up)")
+    ax.set_xlabel("horizontal distance from the column [m]")
+    ax.set_ylabel("height above the column base [m]")
     ax.set_title(f"Initial and optimal structure at {pose_label}")
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), fontsize=8, frameon=False)
 
@@ -148,10 +149,13 @@ def sensitivity_bars(ax: Axes, sensitivity: Sensitivity, count: int = 12) -> Non
     y = np.arange(len(rows))
     values = [m.percent_per_unit for m in rows]
     bars = ax.barh(y, values, color="0.45")  # one neutral colour: the bars are limits, not designs
-    ax.bar_label(bars, labels=[f"{v:.4f} %/{m.unit}" for v, m in zip(values, rows, strict=True)], fontsize=7, padding=2)
-    ax.set_yticks(y, [m.constraint for m in rows], fontsize=7)
+    ax.bar_label(
+        bars, labels=[f"{v:.3g} % per {m.unit}" for v, m in zip(values, rows, strict=True)], fontsize=8, padding=2
+    )
+    ax.set_yticks(y, [limit_in_words(m.constraint) for m in rows], fontsize=8)
     ax.set_xscale("log")
-    ax.set_xlabel("cost decrease per unit the limit is relaxed [% of the optimal cost]")
-    ax.set_title(f"What each active limit costs (KKT multipliers, residual {sensitivity.kkt_residual:.0e})")
+    ax.set_xlabel("objective saved if the limit were relaxed by one unit [% of the optimal objective]")
+    fit = "exact" if sensitivity.kkt_residual < 1e-6 else f"fit residual {sensitivity.kkt_residual:.0e}"
+    ax.set_title(f"Which limits hold the design back, and by how much\n(optimality-condition multipliers, {fit})")
     ax.margins(x=0.35)
     ax.grid(alpha=0.3, axis="x")

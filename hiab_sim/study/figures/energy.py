@@ -1,37 +1,51 @@
-"""Figure of a result's energy section: EMLA vs hydraulic energy per actuator.
+"""Figure of a result's energy sections: the EMLAs against the hydraulic cylinders they replace.
 
-Draws :func:`hiab_sim.hydraulics.figure.plot_energy_comparison` for the optimal design: per
-actuator the EMLA's drawn energy int max(P_i, 0) dt against the pump input attributed to each
-cylinder, and in total the battery energy against both hydraulic supplies.
+Draws :func:`hiab_sim.hydraulics.figure.plot_energy_comparison` for the optimal design from the
+result alone: the battery and per-drive energies of ``result.energy`` and both supplies of
+``result.hydraulic_baseline`` (nothing is recomputed here).
 """
 
 from __future__ import annotations
 
-import io
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from hiab_sim.atomic_io import write_atomic
-from hiab_sim.crane.description import Crane
-from hiab_sim.crane.names import ACTUATOR_NAMES
-from hiab_sim.hydraulics import hydraulic_baseline
+from hiab_sim.figure_io import save_png
 from hiab_sim.hydraulics.figure import plot_energy_comparison
+from hiab_sim.results.energy_sections import HydraulicVariant
 from hiab_sim.results.schema import Result
-from hiab_sim.study.nlp.interface import SampleState
 
 
-def hydraulic_figure(path: Path, crane: Crane, result: Result, optimal: SampleState) -> list[Path]:
-    """Write the EMLA-vs-hydraulic bars of the optimal design to ``path``; [] without cylinders or energy section."""
-    cylinders, energy = crane.hydraulic_cylinders, result.energy
-    if cylinders is None or energy is None:
+@dataclass(frozen=True)
+class _Supply:
+    """A supply variant of the result as the figure reads it: total and per-actuator input [J]."""
+
+    input_energy: float
+    input_energy_per_actuator: np.ndarray
+
+
+def _supply(variant: HydraulicVariant, names: list[str]) -> _Supply:
+    per = variant.input_energy_per_actuator_J
+    return _Supply(variant.input_energy_J, np.array([per[name] for name in names]))
+
+
+def hydraulic_figure(path: Path, result: Result) -> list[Path]:
+    """Write the EMLA-vs-hydraulic charts of the optimal design to ``path``; [] without both sections."""
+    energy, baseline = result.energy, result.hydraulic_baseline
+    if energy is None or baseline is None:
         return []
-    act = optimal.actuators
-    cp, ls = hydraulic_baseline(optimal.joints.time, act.force, act.velocity, cylinders)
-    drawn = np.array([energy.optimal.drawn_energy_J[name] for name in ACTUATOR_NAMES])
-    title = f"{result.name}, optimal design: EMLA vs the crane's hydraulic cylinders, same motion and loads"
-    fig = plot_energy_comparison(ACTUATOR_NAMES, drawn, energy.optimal.battery_energy_J, cp, ls, title)
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=120)
-    write_atomic(path, buffer.getvalue())
-    return [path]
+    names = list(energy.optimal.drawn_energy_J)
+    drawn = np.array([energy.optimal.drawn_energy_J[name] for name in names])
+    design = baseline.optimal
+    title = f"{result.name}, optimal design: EMLAs against the crane's hydraulic cylinders, same motion and loads"
+    fig = plot_energy_comparison(
+        names,
+        drawn,
+        energy.optimal.battery_energy_J,
+        _supply(design.constant_pressure, names),
+        _supply(design.load_sensing, names),
+        title,
+    )
+    return [save_png(fig, path)]

@@ -33,19 +33,36 @@ from hiab_sim.style import colour
 
 __all__ = ["draw_crane", "write_figures"]
 
+#: What each objective is, in words, for axis labels.
+OBJECTIVE_WORDS = {
+    "costf2": "squared-power cost (the seed paper's costf2, W^2 s)",
+    "battery_energy": "battery energy per cycle (J)",
+}
 
-def objective_figure(history: tuple[HistoryRow, ...], path: Path) -> None:
-    """Scaled cost and max violation per SQP iteration (seed Fig. Objective_function)."""
-    fig = new_figure((6.5, 4.0))
-    ax = fig.add_subplot()
+
+def objective_figure(history: tuple[HistoryRow, ...], path: Path, objective: str = "costf2") -> None:
+    """The objective and the largest violation per SQP iteration, one panel each (seed Fig. Objective_function).
+
+    ``objective`` names what was minimised (the result's ``energy.objective``); the top panel shows
+    it relative to its value at the start, so the saving reads off the axis.
+    """
+    fig = new_figure((6.5, 5.0))
+    top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(2.0, 1.0))
     it = [h.iteration for h in history]
-    ax.plot(it, [h.scaled_cost for h in history], "o-", color=colour("optimal"), markersize=3)
-    ax.set_xlabel("SQP iteration")
-    ax.set_ylabel("cost f / f(start)  (eq. costf2)")
-    ax2 = ax.twinx()
-    ax2.semilogy(it, [max(h.max_violation, 1e-16) for h in history], ".--", color="tab:gray", markersize=3)
-    ax2.set_ylabel("max constraint violation (scaled)")
-    ax.set_title("Objective per iteration")
+    words = OBJECTIVE_WORDS.get(objective, objective.replace("_", " "))
+    top.plot(it, [h.scaled_cost for h in history], "o-", color=colour("optimal"), markersize=3, label=words)
+    top.set_ylabel("objective / its value at the start")
+    top.set_title("How the optimiser got there: objective and constraint violation per iteration", fontsize=10)
+    top.legend(fontsize=8)
+    top.grid(alpha=0.3)
+    bottom.semilogy(
+        it, [max(h.max_violation, 1e-16) for h in history], ".--", color="0.35", markersize=3,
+        label="largest constraint violation (scaled: 1 = a whole tracking band or limit)",
+    )  # fmt: skip
+    bottom.set_ylabel("largest violation")
+    bottom.set_xlabel("SQP iteration")
+    bottom.legend(fontsize=7)
+    bottom.grid(alpha=0.3)
     save_png(fig, path)
 
 
@@ -69,21 +86,52 @@ def structure_figure(crane: Crane, designs: dict[str, LinkLengths], pose: np.nda
 
 
 def spiral_figure(
-    crane: Crane, lengths: LinkLengths, joints: np.ndarray, ref: np.ndarray, tcp: np.ndarray, path: Path
+    crane: Crane,
+    lengths: LinkLengths,
+    joints: np.ndarray,
+    ref: np.ndarray,
+    tcp: np.ndarray,
+    path: Path,
+    time: np.ndarray | None = None,
 ) -> None:
-    """The crane at a few poses along the motion, with the reference spiral (seed Fig. hiab)."""
-    fig = new_figure((7.0, 5.0))
+    """The crane at five poses, light to dark in time order, with the reference path (seed Fig. hiab)."""
+    fig = new_figure((7.0, 5.2))
     ax = fig.add_subplot()
-    for i, idx in enumerate(np.linspace(0, len(joints) - 1, 5).astype(int)):
-        draw_crane(ax, crane, lengths, joints[idx], colour("optimal"), alpha=0.2 + 0.15 * i)
-    ax.plot(ref[:, 0], ref[:, 1], "-", color=colour("reference"), linewidth=2, label="reference spiral")
-    ax.plot(tcp[:, 0], tcp[:, 1], "--", color=colour("optimal"), linewidth=1, label="TCP (optimal design)")
+    picks = np.linspace(0, len(joints) - 1, 5).astype(int)
+    shades = [0.25, 0.4, 0.55, 0.75, 1.0]
+    centre = ref[:, :2].mean(axis=0)
+    labels: list[tuple[np.ndarray, list[str]]] = []  # poses whose tool points coincide share one label
+    for idx, alpha in zip(picks, shades, strict=True):
+        draw_crane(ax, crane, lengths, joints[idx], colour("optimal"), alpha=alpha)
+        when = f"{time[idx]:.1f} s" if time is not None else f"sample {idx}"
+        for point, texts in labels:
+            if np.hypot(*(point - tcp[idx, :2])) < 0.02:
+                texts.append(when)
+                break
+        else:
+            labels.append((tcp[idx, :2], [when]))
+    for point, texts in labels:
+        away = point - centre
+        away = away / max(float(np.hypot(*away)), 1e-9)
+        ax.annotate(
+            "t = " + " and ".join(texts), (float(point[0]), float(point[1])), xytext=(34 * away[0], 34 * away[1]),
+            textcoords="offset points", fontsize=8,
+            ha="center", va="center", color="0.1", arrowprops={"arrowstyle": "-", "color": "0.4", "linewidth": 0.6},
+            bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none", "alpha": 0.85},
+        )  # fmt: skip
+    ax.plot(ref[:, 0], ref[:, 1], "-", color=colour("reference"), linewidth=2, label="reference path of the tool")
+    ax.plot(tcp[:, 0], tcp[:, 1], "--", color=colour("optimal"), linewidth=1, label="tool path of the optimal design")
+    ax.annotate(
+        "", (float(tcp[min(len(tcp) - 1, 8), 0]), float(tcp[min(len(tcp) - 1, 8), 1])),
+        xytext=(float(tcp[0, 0]), float(tcp[0, 1])),
+        arrowprops={"arrowstyle": "->", "color": colour("optimal"), "linewidth": 1.5},
+    )  # fmt: skip
     ax.set_aspect("equal")
     ax.grid(alpha=0.3)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m] (up)")
+    ax.set_xlabel("horizontal distance from the column [m]")
+    ax.set_ylabel("height above the column base [m]")
     ax.legend(loc="lower left", fontsize=8)
-    ax.set_title("Crane following the spiral (vertical plane of {W})")
+    ax.set_title("The optimal design following the path (five poses, darker = later)", fontsize=10)
     save_png(fig, path)
 
 
@@ -121,6 +169,10 @@ def efficiency_figure(emlas: EmlaSet, checks: dict[str, DesignCheck], path: Path
         opt = checks["optimal"].evaluation.actuators
         designs = {"initial": (ini.force[:, i], ini.velocity[:, i]), "optimal": (opt.force[:, i], opt.velocity[:, i])}
         plot_efficiency_map(emap, ax=ax, designs=designs)
+        if i > 0:  # one legend for the three maps: they share every entry
+            legend = ax.get_legend()
+            if legend is not None:
+                legend.remove()
     save_png(fig, path)
 
 
@@ -164,7 +216,7 @@ def write_figures(
         "maps": out / "efficiency_maps.png",
         "energy": out / "energy_breakdown.png",
     }
-    objective_figure(history, paths["objective"])
+    objective_figure(history, paths["objective"], result.energy.objective if result.energy is not None else "costf2")
     low, up = np.asarray(result.settings.xi_low), np.asarray(result.settings.xi_up)
     decision_figure(history, 0, "lift", paths["lift"], low, up)
     decision_figure(history, 1, "tilt", paths["tilt"], low, up)
@@ -172,12 +224,20 @@ def write_figures(
     mid = len(joints) // 2
     label = f"t = {arrays['time'][mid]:.2f} s of the optimal motion"
     structure_figure(crane, designs, joints[mid], paths["structure"], label)
-    spiral_figure(crane, designs["optimal"], joints, arrays["reference_tcp"], arrays["optimal_tcp"], paths["spiral"])
+    spiral_figure(
+        crane,
+        designs["optimal"],
+        joints,
+        arrays["reference_tcp"],
+        arrays["optimal_tcp"],
+        paths["spiral"],
+        arrays["time"],
+    )
     actuator_figure(arrays["time"], checks, paths["actuators"])
     efficiency_figure(emlas, checks, paths["maps"])
     energy_figure(arrays["time"], checks, paths["energy"])
     if result.sensitivity is not None:
         paths["sensitivity"] = out / "sensitivity.png"
         sensitivity_figure(result.sensitivity, paths["sensitivity"])
-    hydraulic = hydraulic_figure(out / "energy_emla_vs_hydraulic.png", crane, result, checks["optimal"].evaluation)
+    hydraulic = hydraulic_figure(out / "energy_emla_vs_hydraulic.png", result)
     return list(paths.values()) + hydraulic

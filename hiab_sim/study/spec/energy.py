@@ -41,7 +41,8 @@ class DutySettings:
 
     ``hold`` says what carries the machine during the rest (:mod:`hiab_sim.emla.hold`): ``brake``
     (the EMLAs' holding brakes), ``motor`` (the motors hold the last pose) or ``none`` (the
-    seed paper's free rest, stated as a choice); None (the key omitted) is ``brake`` when every EMLA of the set has ``holding_brake`` data and otherwise the
+    seed paper's free rest, stated as a choice); None (the key omitted) is ``brake`` when every
+    EMLA of the set has ``holding_brake`` data and otherwise the
     seed paper's free rest (zero torque, zero power), see :meth:`hold_mode`.
     """
 

@@ -1,0 +1,131 @@
+"""``hiab-sim machine show|check``: print and draw a machine description, or check that it assembles.
+
+``show FILE|NAME`` prints links, chains, strokes, usable and reachable ranges, masses and decision
+variables, and writes a labelled PNG drawing (``--figure``, default ``<name>_machine.png``).
+``check FILE|NAME`` assembles every chain over its working range and prints one line per failure
+(a stroke that does not cover the range, a chain passing its toggle, a loop that does not close,
+a TCP outside the declared workspace); it exits 2 when anything fails.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from hiab_sim.machine.assembly import check_machine, reachable_joint_range, usable_stroke
+from hiab_sim.machine.closure import joint_to_stroke
+from hiab_sim.machine.description import Machine
+from hiab_sim.machine.loader import load_machine
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Register the subcommand."""
+    parser = subparsers.add_parser(
+        "machine",
+        help="show or check a machine description",
+        description=(
+            "Work with a machine description (links, closed chains of actuators, tool point): print it and draw "
+            "it labelled, or assemble every chain over its working range and report what fails."
+        ),
+    )
+    actions = parser.add_subparsers(dest="machine_command", metavar="ACTION", required=True)
+    show = actions.add_parser("show", help="print the machine and write a labelled drawing (PNG)")
+    show.add_argument("machine", help="shipped machine name (xs031, exact) or a machine YAML file")
+    show.add_argument("--figure", type=Path, help="PNG to write (default: <name>_machine.png)")
+    show.add_argument("--no-figure", action="store_true", help="print only")
+    show.set_defaults(run=run_show)
+    check = actions.add_parser("check", help="assemble every chain over its working range; exit 2 on failure")
+    check.add_argument("machine", help="shipped machine name or a machine YAML file")
+    check.set_defaults(run=run_check)
+
+
+def _range(values: tuple[float, float], unit: str) -> str:
+    return f"[{values[0]:+.4f}, {values[1]:+.4f}] {unit}"
+
+
+def describe(machine: Machine) -> list[str]:
+    """The lines ``machine show`` prints."""
+    lines = [f"{machine.name}  (gravity {machine.gravity:g} m/s^2)", f"source: {' '.join(machine.source.split())}"]
+    lines.append("links:")
+    for link in machine.links:
+        where = "root" if link.parent is None else f"{link.joint_kind} joint {link.joint} on {link.parent}"
+        span = "" if link.joint_range is None else f", working range {_range(link.joint_range, link.unit)}"
+        lines.append(f"  {link.name:<16} {where}{span}; mass {link.mass:.3f} kg in {len(link.parts)} part(s)")
+    lines.append("chains:")
+    for chain in machine.chains:
+        act = chain.actuator
+        link = machine.joint_link(chain.joint)
+        unit = link.unit
+        head = f"  {chain.name:<10} {chain.kind} driving {chain.joint}; EMLA {act.emla}"
+        lines.append(head + (f", hydraulic cylinder {act.hydraulic_cylinder}" if act.hydraulic_cylinder else ""))
+        for pivot in chain.pivots:
+            lines.append(f"      pivot {pivot.role:<8} on {pivot.link:<14} at {np.round(pivot.position, 5).tolist()} m")
+        if chain.linkage is not None:
+            lk = chain.linkage
+            lines.append(
+                f"      rocker {lk.rocker_length:g} m, coupler {lk.coupler_length:g} m, pin side {lk.pin_side:+d}"
+            )
+        x0 = act.retracted_length
+        lengths = (
+            "" if x0 is None else f", retracted {x0:.4f} m (Lc0 {act.piston_offset:.4f} + Lc {act.rod_length:.4f})"
+        )
+        lines.append(f"      stroke {act.stroke:.4f} m{lengths}; usable stroke {_range(usable_stroke(chain), 'm')}")
+        working = link.joint_range or (0.0, 0.0)
+        x = joint_to_stroke(machine, chain, np.linspace(*working, 201))
+        reach = reachable_joint_range(machine, chain)
+        shown = "none" if reach is None else _range(reach, unit)
+        lines.append(
+            f"      working range {_range(working, unit)} uses x in [{x.min():.4f}, {x.max():.4f}] m; reachable {shown}"
+        )
+        body_mass = sum(b.mass for b in (act.cylinder_body, act.rod_body) if b is not None)
+        if chain.linkage is not None:
+            body_mass += sum(b.mass for b in (chain.linkage.rocker_body, chain.linkage.coupler_body) if b is not None)
+        lines.append(f"      chain bodies {body_mass:.3f} kg")
+    total = sum(link.mass for link in machine.links) + sum(
+        b.mass
+        for c in machine.chains
+        for b in (
+            c.actuator.cylinder_body,
+            c.actuator.rod_body,
+            *(() if c.linkage is None else (c.linkage.rocker_body, c.linkage.coupler_body)),
+        )
+        if b is not None
+    )
+    lines.append(
+        f"total moving and fixed mass {total:.3f} kg; TCP on {machine.tcp_link} at {list(machine.tcp.position)} m"
+    )
+    lines.append("decision variables:")
+    for variable, value in zip(machine.decision_variables, machine.design_values(), strict=True):
+        on = f" of pivot {variable.pivot}" if variable.pivot else ""
+        bounds = f"[{variable.low:.5g}, {variable.high:.5g}] m"
+        lines.append(f"  {variable.key:<14} {variable.kind}{on} = {value:.5f} m, bounds {bounds}")
+    if not machine.decision_variables:
+        lines.append("  none")
+    return lines
+
+
+def run_show(args: argparse.Namespace) -> int:
+    """Print the machine and write its drawing."""
+    machine = load_machine(args.machine)
+    for line in describe(machine):
+        print(line)
+    if not args.no_figure:
+        from hiab_sim.machine.drawing import save_drawing
+
+        path = args.figure or Path(f"{Path(str(args.machine)).stem}_machine.png")
+        print(f"drawing: {save_drawing(machine, path)}")
+    return 0
+
+
+def run_check(args: argparse.Namespace) -> int:
+    """Check the assembly; one line per failure, exit 2 when anything fails."""
+    machine = load_machine(args.machine, check_assembly=False)
+    failures = check_machine(machine)
+    for failure in failures:
+        print(f"FAIL {failure}")
+    if failures:
+        return 2
+    print(f"{machine.name}: every chain assembles over its working range ({len(machine.chains)} chains)")
+    return 0

@@ -1,0 +1,197 @@
+"""The report's second half: constraints and margins, thermal state, sensitivities, hydraulics, closed loop, mix."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from hiab_sim.design_report.answer import actuator_table
+from hiab_sim.design_report.page import figure, num, paragraph, section, table
+from hiab_sim.results.schema import Result
+
+
+def constraints(result: Result) -> str:
+    """Feasibility at the optimum: solver, worst row, re-check with the other path, buildable checks, envelope."""
+    o, rc, sol = result.optimal, result.recheck, result.solver
+    rows = [
+        ("solver", f"{sol.method}: {sol.message}, {sol.iterations} iterations, {sol.wall_time_s:.1f} s"),
+        ("largest violation (optimiser's grid, scaled)", f"{sol.max_violation_scaled:.2e}"),
+        (
+            f"re-check: {rc.grid_points} points, {rc.id_path} inverse dynamics",
+            f"largest violation {rc.max_violation_scaled:.2e}; TCP error {1e3 * rc.tracking_error.position_m:.3f} mm; "
+            f"force difference between the two paths {rc.force_difference_between_paths_N:.2e} N",
+        ),
+        ("least margin at the optimum", f"{o.worst_constraint.name}: {o.worst_constraint.scaled_margin:.3e} (scaled)"),
+    ]
+    b = result.buildable
+    if b is not None:
+        for label, check in (
+            ("machine check", b.crane_check),
+            ("tolerance box", b.tolerance_check),
+            ("rounded design re-check", b.recheck),
+        ):
+            rows.append(
+                (label, f"{'passed' if check.passed else 'FAILED'}: {check.worst} ({check.margin:.3g} {check.unit})")
+            )
+    ms = result.multistart
+    if len(ms.starts) > 1:
+        rows.append(("starts", f"{ms.converged_starts} converged; same optimum: {ms.same_optimum}"))
+    return section(
+        "Constraints and margins at the optimum",
+        table(("check", "value"), rows),
+        actuator_table(result),
+    )
+
+
+def thermal(result: Result) -> str:
+    """Each motor's RMS torque and winding temperature over the duty, against its limits."""
+    e = result.energy
+    if e is None or e.optimal.thermal is None:
+        return ""
+    rows = [
+        (
+            name,
+            f"{t.rms_torque_Nm:.2f} / {t.continuous_torque_Nm:.1f} N m",
+            f"{t.peak_winding_temperature_C:.1f} / {t.max_winding_temperature_C:.0f} °C",
+            f"{100 * t.torque_margin:.0f} %",
+        )
+        for name, t in e.optimal.thermal.items()
+    ]
+    return section(
+        "Thermal state",
+        paragraph(
+            f"Duty: {e.duty}. RMS motor torque against the continuous torque, periodic steady-state winding "
+            "temperature against its maximum."
+        ),
+        table(("motor", "RMS torque / continuous", "winding peak / maximum", "torque margin"), rows, numeric=(1, 2, 3)),
+    )
+
+
+def sensitivities(result: Result, folder: Path) -> str:
+    """KKT multipliers: what relaxing each active limit is worth."""
+    s = result.sensitivity
+    if s is None or not s.multipliers:
+        return ""
+    rows = [
+        (m.constraint, m.unit, f"{m.percent_per_unit:.4f} %", f"{m.cost_per_unit_W2s:.4g}")
+        for m in sorted(s.multipliers, key=lambda m: -m.percent_per_unit)
+    ]
+    return section(
+        "Sensitivities",
+        paragraph(
+            f"Cost decrease per unit each active limit is relaxed (KKT residual {s.kkt_residual:.1e}); a slope, "
+            "not a promise for large moves.",
+            "note",
+        ),
+        table(("active constraint", "per", "% of the optimal cost", "cost decrease per unit"), rows, numeric=(2, 3)),
+        figure(folder / "sensitivity.png", "KKT multipliers of the active constraints"),
+    )
+
+
+def hydraulics(result: Result, folder: Path) -> str:
+    """The valve-controlled cylinders the EMLAs replace, for the same motion and loads."""
+    h = result.hydraulic_baseline
+    if h is None:
+        return ""
+    rows = [
+        (
+            design,
+            num(d.emla_battery_energy_J / 1e3, ".2f", "kJ"),
+            f"{d.load_sensing.input_energy_J / 1e3:.1f} kJ ({100 * d.load_sensing.system_efficiency:.1f} %)",
+            f"{d.constant_pressure.input_energy_J / 1e3:.1f} kJ ({100 * d.constant_pressure.system_efficiency:.1f} %)",
+            f"{d.emla_saving_vs_load_sensing_percent:.1f} % / {d.emla_saving_vs_constant_pressure_percent:.1f} %",
+        )
+        for design, d in (("initial", h.initial), ("optimal", h.optimal))
+    ]
+    return section(
+        "Hydraulic comparison",
+        paragraph(h.note, "note"),
+        table(
+            (
+                "design",
+                "EMLA at the battery",
+                "hydraulic, load sensing (system eff.)",
+                "hydraulic, constant pressure",
+                "EMLA saving vs LS / CP",
+            ),
+            rows,
+            numeric=(1, 2, 3, 4),
+        ),
+        figure(folder / "energy_emla_vs_hydraulic.png", "EMLA against hydraulic energy per actuator"),
+    )
+
+
+def closed_loop(folder: Path) -> str:
+    """The closed-loop validation of ``hiab-sim simulate`` when ``simulation.json`` exists."""
+    path = folder / "simulation.json"
+    if not path.is_file():
+        return ""
+    report: dict[str, Any] = json.loads(path.read_text())
+    rows = []
+    for design, entry in report["designs"].items():
+        for row in [entry["nominal"], entry] if "nominal" in entry else [entry]:
+            mass = "planned" if row["payload_error"] == 0 else f"+{100 * row['payload_error']:g} %"
+            rows.append(
+                (
+                    design,
+                    mass,
+                    f"{row['predicted_net_electrical_energy_J']:.1f} J",
+                    f"{row['net_electrical_energy_J']:.1f} J",
+                    f"{row['energy_difference_percent']:+.2f} %",
+                    f"{row['tcp_error_mm']['rms']:.2f} / {row['tcp_error_mm']['max']:.2f} mm",
+                )
+            )
+    return section(
+        "Closed-loop validation",
+        paragraph(
+            "Each design driven by simulated EMLA drives (dq current dynamics, voltage and current limits) under "
+            "a tracking controller through the study's cycle; energy integrated at the motor terminals."
+        ),
+        table(
+            ("design", "end mass", "predicted", "closed loop", "difference", "TCP error rms / max"),
+            rows,
+            numeric=(2, 3, 4, 5),
+        ),
+        figure(folder / "closed_loop_energy.png", "Cumulative energy, closed loop against prediction"),
+    )
+
+
+def duty_mix(result: Result, folder: Path) -> str:
+    """Per-task energies and the cross-evaluation (the price of robustness) of a duty mix."""
+    if not result.tasks:
+        return ""
+    rows = [
+        (
+            t.name,
+            f"{t.weight:g}",
+            f"{t.payload_kg:g} kg",
+            f"{t.initial.net_electrical_energy_J:.1f} → {t.optimal.net_electrical_energy_J:.1f} J",
+        )
+        for t in result.tasks
+    ]
+    parts = [table(("task", "weight", "payload", "net energy initial → optimal"), rows, numeric=(1, 2, 3))]
+    c = result.cross_evaluation
+    if c is not None:
+        cross = [
+            (
+                design,
+                *[num(v, ".1f") for v in c.net_energy_J[i]],
+                num(c.mix_net_energy_J[i], ".1f"),
+                num(c.mix_energy_lost_percent[i], "+.3f", "%"),
+            )
+            for i, design in enumerate(c.designs)
+        ]
+        parts += [
+            paragraph(
+                "Cross-evaluation: each design on every task, trajectories re-optimised at fixed lengths "
+                "(net energy [J])."
+            ),
+            table(
+                ("design", *c.tasks, "mix (weighted)", "mix energy lost"),
+                cross,
+                numeric=tuple(range(1, len(c.tasks) + 3)),
+            ),
+            figure(folder / "cross_evaluation.png", "Cross-evaluation"),
+        ]
+    return section("Duty mix", *parts)

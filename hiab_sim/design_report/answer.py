@@ -1,0 +1,183 @@
+"""The report's first half: the question and the machine, the design to build and its pivot moves, the energies."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.design_report.page import esc, figure, num, paragraph, section, table
+from hiab_sim.results.schema import Result
+
+
+def _lengths_text(lengths: LinkLengths, crane: Crane) -> str:
+    parts = []
+    for chain in crane.chains:
+        xi = getattr(lengths, chain.name)
+        parts.append(f"{chain.name} L / Lc0 / Lc = {xi.L:.3f} / {xi.Lc0:.3f} / {xi.Lc:.3f} m")
+    return "; ".join(parts)
+
+
+def built_lengths(result: Result) -> LinkLengths:
+    """The design to build: the rounded (buildable) design when the result has one, else the optimum."""
+    return result.optimal.lengths if result.buildable is None else result.buildable.lengths
+
+
+def question(result: Result, crane: Crane) -> str:
+    """What was asked, of which machine, for which work."""
+    tasks = (
+        f"{len(result.tasks)} tasks (a duty mix: " + ", ".join(f"{t.name} x {t.weight:g}" for t in result.tasks) + ")"
+        if result.tasks
+        else f"the study's reference motion ({result.settings.fine_grid_points} fine-grid samples)"
+    )
+    names = {
+        "costf2": "the seed paper's cost costf2 (squared summed electrical power)",
+        "battery_energy": "the battery's energy",
+    }
+    objective = (
+        names["costf2"] if result.energy is None else names.get(result.energy.objective, result.energy.objective)
+    )
+    rows = [
+        ("study", result.name),
+        ("machine", f"{crane.name} ({crane.source})"),
+        ("work", tasks),
+        ("payload", f"{result.settings.payload_kg:g} kg"),
+        ("objective", objective),
+        ("decision variables", "per chain: base pivot distance L, piston offset Lc0, rod length Lc [m]"),
+    ]
+    if result.energy is not None:
+        rows.append(("duty", result.energy.duty))
+    return section(
+        "The question",
+        paragraph(
+            "Where should the electromechanical linear actuators be mounted so that the machine does this work "
+            "on the least energy, within its actuators' envelope, strokes, joint ranges and thermal limits?"
+        ),
+        table(("item", "value"), rows),
+    )
+
+
+def design(result: Result, crane: Crane, folder: Path) -> str:
+    """The design to build, the dimensioned pivot moves and the structure drawing."""
+    build = built_lengths(result)
+    initial = result.initial.lengths
+    rows = []
+    for chain in crane.chains:
+        before, after = getattr(initial, chain.name), getattr(build, chain.name)
+        move = 1e3 * (chain.base_pivot(after) - chain.base_pivot(before))
+        rows.append(
+            (
+                chain.name,
+                f"{before.L:.3f} → {after.L:.3f}",
+                f"{1e3 * (after.L - before.L):+.0f} mm along the cylinder axis "
+                f"(Δx {move[0]:+.0f}, Δy {move[1]:+.0f} mm "
+                f"in {chain.parent})",
+                f"{before.Lc0 + before.Lc:.3f} → {after.Lc0 + after.Lc:.3f}",
+                f"{before.Lc0:.3f} / {before.Lc:.3f} → {after.Lc0:.3f} / {after.Lc:.3f}",
+            )
+        )
+    text = f"Build {_lengths_text(build, crane)}."
+    if result.buildable is not None:
+        b = result.buildable
+        text += (
+            f" Rounded to the {1e3 * b.tolerance_m:g} mm manufacturing tolerance with a {1e3 * b.stroke_margin_m:g} mm "
+            f"stroke margin; every design within ±{1e3 * b.tolerance_m:g} mm stays feasible (worst margin "
+            f"{1e3 * b.tolerance_check.margin:.3f} mm) and its net energy differs from the optimum's by "
+            f"{b.net_energy_change_vs_optimum_J + 0.0:+.1f} J. Export: {b.mjcf_command}"
+        )
+    return section(
+        "The answer: the design to build",
+        f'<div class="answer">{paragraph(text)}</div>',
+        table(
+            ("chain", "L [m] (base pivot to boom hinge)", "base pivot move", "retracted length x0 [m]", "Lc0 / Lc [m]"),
+            rows,
+        ),
+        figure(folder / "structure_initial_vs_optimal.png", "Initial (built) and optimal structure, pivot moves"),
+    )
+
+
+def energies(result: Result, folder: Path) -> str:
+    """Every energy with the boundary it is drawn at, initial against the design."""
+    i, o = result.initial, result.optimal
+    saved = result.improvement.net_energy_saved_percent
+    rows: list[tuple[str, str, str, str, str]] = []
+    if result.energy is not None:
+        e = result.energy
+        rows.append(
+            (
+                "battery energy per cycle",
+                "at the battery (inverters, shared DC bus, battery efficiencies)",
+                num(e.initial.battery_energy_J, ".1f", "J"),
+                num(e.optimal.battery_energy_J, ".1f", "J"),
+                f"{-e.battery_energy_saved_percent:+.2f} %",
+            )
+        )
+    rows += [
+        (
+            "net electrical energy",
+            "motor terminals, summed over the drives (regeneration credited)",
+            num(i.net_electrical_energy_J, ".1f", "J"),
+            num(o.net_electrical_energy_J, ".1f", "J"),
+            f"{-saved:+.2f} %",
+        ),
+        (
+            "energy drawn, summed power",
+            "motor terminals, positive part of the summed power",
+            num(i.drawn_energy_summed_drives_J, ".1f", "J"),
+            num(o.drawn_energy_summed_drives_J, ".1f", "J"),
+            "",
+        ),
+        (
+            "copper loss",
+            "stator windings",
+            num(i.energy_breakdown_J.copper, ".1f", "J"),
+            num(o.energy_breakdown_J.copper, ".1f", "J"),
+            "",
+        ),
+        (
+            "costf2 (the seed's cost)",
+            "squared summed power, not an energy",
+            num(i.cost_W2s, ".4g", "W² s"),
+            num(o.cost_W2s, ".4g", "W² s"),
+            "",
+        ),
+    ]
+    d = result.improvement.decomposition
+    note = ""
+    if d.from_lengths_J is not None and d.from_trajectory_J is not None:
+        note = paragraph(
+            f"Of the net energy saved, {d.from_lengths_J:.1f} J come from the lengths alone (optimal lengths on the "
+            f"initial trajectory) and {d.from_trajectory_J:.1f} J from re-shaping the trajectory within the tracking "
+            "bands.",
+            "note",
+        )
+    return section(
+        "Energies and their boundaries",
+        table(("quantity", "boundary", "initial", "design", "change"), rows, numeric=(2, 3, 4)),
+        note,
+        figure(folder / "energy_breakdown.png", "Energy by power flow, initial and optimal"),
+    )
+
+
+def actuator_table(result: Result) -> str:
+    """Peaks and envelope margins per actuator at the optimum."""
+    rows = [
+        (
+            name,
+            num(a.peak_force_N / 1e3, ".1f", "kN"),
+            num(a.peak_velocity_m_per_s, ".3f", "m/s"),
+            num(a.peak_electrical_power_W / 1e3, ".2f", "kW"),
+            num(a.min_envelope_margin, ".3f"),
+            num(a.net_energy_J, ".1f", "J"),
+        )
+        for name, a in result.optimal.actuators.items()
+    ]
+    return table(
+        ("actuator", "peak force", "peak speed", "peak power", "min envelope margin (>= 0)", "net energy"),
+        rows,
+        numeric=(1, 2, 3, 4, 5),
+    )
+
+
+def esc_list(items: list[str]) -> str:
+    """An HTML list of escaped items."""
+    return "<ul>" + "".join(f"<li>{esc(i)}</li>" for i in items) + "</ul>" if items else ""

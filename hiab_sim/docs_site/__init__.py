@@ -1,0 +1,1 @@
+"""Pages of the documentation site generated from the code: file formats, result schema, CLI, test catalogue."""

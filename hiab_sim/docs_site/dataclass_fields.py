@@ -1,0 +1,140 @@
+"""A dataclass's fields as documented keys: type, default, description and unit from the class, ranges from its checks.
+
+The description is the field's entry under ``Attributes:`` in the class docstring (Google style), the
+unit the first ``[...]`` in it; the allowed range is read from the ``check_range`` / ``check_positive`` /
+``check_non_negative`` / ``check_choice`` calls of ``__post_init__`` that test ``self.<field>``, so the
+reference states exactly what the dataclass enforces.
+"""
+
+from __future__ import annotations
+
+import ast
+import dataclasses
+import inspect
+import math
+import re
+import textwrap
+from typing import Any
+
+UNIT = re.compile(r"\[([^\]]+)\]")
+
+
+def attribute_docs(cls: type) -> dict[str, str]:
+    """``name -> description`` from the ``Attributes:`` section of ``cls``'s docstring."""
+    doc = inspect.getdoc(cls) or ""
+    out: dict[str, str] = {}
+    inside, current = False, None
+    for line in doc.splitlines():
+        if line.strip() == "Attributes:":
+            inside = True
+            continue
+        if not inside:
+            continue
+        if line and not line.startswith(" "):
+            break
+        match = re.match(r"^ {4}(\w+)(?: \([^)]*\))?: (.*)$", line)
+        if match:
+            current = match.group(1)
+            out[current] = match.group(2).strip()
+        elif current and line.strip():
+            out[current] += " " + line.strip()
+    return out
+
+
+def _literal(node: ast.expr) -> Any:
+    try:
+        return ast.literal_eval(node)
+    except ValueError:
+        return ast.unparse(node)
+
+
+def _interval(args: list[Any], keywords: dict[str, Any]) -> str:
+    low = args[0] if len(args) > 0 else keywords.get("low")
+    high = args[1] if len(args) > 1 else keywords.get("high")
+    low_open, high_open = keywords.get("low_open", False), keywords.get("high_open", False)
+    integer = " (integer)" if keywords.get("integral") else ""
+    show = lambda v: f"{v:g}" if isinstance(v, int | float) else str(v).replace("self.", "")  # noqa: E731
+    if low is not None and high is not None:
+        return f"{'(' if low_open else '['}{show(low)}, {show(high)}{')' if high_open else ']'}{integer}"
+    if low is not None:
+        return f"{'>' if low_open else '>='} {show(low)}{integer}"
+    if high is not None:
+        return f"{'<' if high_open else '<='} {show(high)}{integer}"
+    return "finite" + integer
+
+
+def checked_ranges(cls: type) -> dict[str, str]:
+    """``field -> allowed range`` from the range checks of ``cls.__post_init__`` on ``self.<field>``."""
+    method = cls.__dict__.get("__post_init__")
+    if method is None:
+        return {}
+    tree = ast.parse(textwrap.dedent(inspect.getsource(method)))
+    out: dict[str, str] = {}
+    for call in ast.walk(tree):
+        if not (isinstance(call, ast.Call) and isinstance(call.func, ast.Name) and len(call.args) >= 2):
+            continue
+        target = call.args[1]
+        if isinstance(target, ast.Call) and target.args:  # e.g. math.degrees(self.x): reported in its own key
+            target = target.args[0]
+        if not (isinstance(target, ast.Attribute) and isinstance(target.value, ast.Name) and target.value.id == "self"):
+            continue
+        args = [_literal(a) for a in call.args[2:]]
+        keywords = {k.arg: _literal(k.value) for k in call.keywords if k.arg}
+        name = call.func.id
+        if name == "check_range":
+            out[target.attr] = _interval(args, keywords)
+        elif name == "check_positive":
+            out[target.attr] = "> 0"
+        elif name == "check_non_negative":
+            out[target.attr] = ">= 0"
+        elif name == "check_choice" and args:
+            choices = args[0]
+            out[target.attr] = (
+                "one of " + ", ".join(f"`{c}`" for c in choices) if isinstance(choices, tuple) else str(choices)
+            )
+    return out
+
+
+def _type_name(annotation: Any) -> str:
+    text = annotation if isinstance(annotation, str) else getattr(annotation, "__name__", str(annotation))
+    text = text.replace(" | None", "")
+    return {"float": "number", "int": "integer", "str": "text", "bool": "true/false"}.get(
+        text,
+        text.replace("tuple[float, float, float]", "[number, number, number]").replace(
+            "tuple[float, float]", "[number, number]"
+        ),
+    )
+
+
+def _default(field: dataclasses.Field[Any]) -> str:
+    if field.default is dataclasses.MISSING and field.default_factory is dataclasses.MISSING:
+        return "required"
+    if field.default is dataclasses.MISSING:
+        return "(built in)"
+    value = field.default
+    if value is None:
+        return "none"
+    if isinstance(value, float):
+        return f"{value:g}" if math.isfinite(value) else str(value)
+    if isinstance(value, tuple):
+        return "[" + ", ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in value) + "]"
+    return str(value)
+
+
+def field_rows(cls: type, skip: tuple[str, ...] = ("label",)) -> dict[str, dict[str, str]]:
+    """``field -> {type, unit, default, allowed, description}`` for the init fields of dataclass ``cls``."""
+    docs, ranges = attribute_docs(cls), checked_ranges(cls)
+    rows: dict[str, dict[str, str]] = {}
+    for field in dataclasses.fields(cls):
+        if field.name in skip or not field.init:
+            continue
+        description = docs.get(field.name, "")
+        unit = UNIT.search(description)
+        rows[field.name] = {
+            "type": _type_name(field.type),
+            "unit": unit.group(1) if unit else "",
+            "default": _default(field),
+            "allowed": ranges.get(field.name, ""),
+            "description": description,
+        }
+    return rows

@@ -1,0 +1,120 @@
+"""The file formats hiab-sim reads: each one's loader (a parsed document in, a checked object out) and valid examples.
+
+:mod:`hiab_sim.docs_site.probe` asks these loaders which keys they accept; the test of the file-format
+reference compares that with the keys :mod:`hiab_sim.docs_site.field_specs` documents.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from hiab_sim.resources import Source, shipped, shipped_names
+
+
+@dataclass(frozen=True)
+class FileFormat:
+    """One kind of file: its title, what reads it, and valid documents to probe the loader with."""
+
+    name: str
+    title: str
+    reader: str  # the function that reads it, for the page
+    load: Callable[[Any], object]
+    documents: Callable[[], list[Any]]
+
+
+def _parsed(source: Source) -> Any:
+    return yaml.safe_load(source.read_text())
+
+
+def _load_crane(document: Any) -> object:
+    from hiab_sim.crane.loader import crane_from_dict
+
+    return crane_from_dict(document)
+
+
+def _load_emla(document: Any) -> object:
+    from hiab_sim.emla.config import emla_set_from_mapping
+
+    return emla_set_from_mapping(document)
+
+
+def _study_documents() -> list[Any]:
+    names = sorted(shipped_names("study"))
+    out = []
+    for name in names:
+        document = _parsed(shipped("study", name))
+        if isinstance(document, dict) and ("reference" in document or "tasks" in document):
+            out.append(document)
+    return out
+
+
+def _load_study(document: Any) -> object:
+    from hiab_sim.study.spec.study_file import study_from_dict
+
+    return study_from_dict(document, shipped("study", "xs031_spiral"))
+
+
+def _via_file(document: Any, reader: Callable[[Path], object]) -> object:
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "probe.yaml"
+        path.write_text(yaml.safe_dump(document))
+        return reader(path)
+
+
+def _load_sweep(document: Any) -> object:
+    from hiab_sim.sweep.spec import load_sweep
+
+    return _via_file(document, load_sweep)
+
+
+def _sweep_documents() -> list[Any]:
+    sample = {"study": "xs031_spiral", "sample": {"points": 2, "seed": 1, "ranges": {"payload": [0.0, 100.0]}}}
+    return [sample, {"study": "xs031_spiral", "name": "grid", "set": {"solver.maxiter": 5}, "grid": {"payload": [0.0]}}]
+
+
+def _load_cases(document: Any) -> object:
+    from hiab_sim.validation import load_cases
+
+    return _via_file(document, load_cases)
+
+
+def _cases_documents() -> list[Any]:
+    document = _parsed(shipped("cases", "cases"))
+    one = {"cases": [{**document["cases"][0], "payload": "none"}]}
+    return [document, one]
+
+
+FORMATS: dict[str, FileFormat] = {
+    f.name: f
+    for f in (
+        FileFormat(
+            "crane",
+            "Crane (machine) file",
+            "hiab_sim.crane.loader.load_crane",
+            _load_crane,
+            lambda: [_parsed(shipped("crane", "xs031"))],
+        ),
+        FileFormat(
+            "emla",
+            "EMLA file",
+            "hiab_sim.emla.config.load_emla_set",
+            _load_emla,
+            lambda: [_parsed(shipped("emla", "default"))],
+        ),
+        FileFormat("study", "Study file", "hiab_sim.study.spec.study_file.load_study", _load_study, _study_documents),
+        FileFormat("sweep", "Sweep file", "hiab_sim.sweep.spec.load_sweep", _load_sweep, _sweep_documents),
+        FileFormat(
+            "cases",
+            "Validation cases file",
+            "hiab_sim.validation.load_cases",
+            _load_cases,
+            _cases_documents,
+        ),
+    )
+}

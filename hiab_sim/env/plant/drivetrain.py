@@ -1,0 +1,147 @@
+"""Two-mass drive train per EMLA: the motor side on a spring with free play to the rod.
+
+Coordinates at the rod (the motor angle divided by k = 2 pi G / rho): the motor side x_m with mass
+m_m = J_m k^2 + M_sm (the rotor and screw inertia reflected to the rod, eq. ``torque_torque`` x k),
+the rod x (the MuJoCo slide). With the deflection d = x_m - x, the free play 2 b and the contact
+deflection e = d - b (d > b), d + b (d < -b), 0 otherwise,
+
+    f_s = k_s e + c_s (v_m - v)     while in contact, never pulling across the gap (sign of e kept),
+    m_m dv_m/dt = f_drive - b_f v_m - f_s,
+
+f_drive = k (tau_m - tau_f tanh(omega_m / omega_eps)) from the drive (:mod:`hiab_sim.emla.drive_sim`),
+b_f the screw's viscous friction (it acts at the screw's speed, the motor side's), and f_s the force
+on the rod. c_s = 2 zeta sqrt(k_s m_m) damps the locked-rod mode.
+
+Integration. The rod side is the slide's actuator, affine in the rod's stroke and rate,
+f = ctrl - k_c x - c_c v (:meth:`TwoMassDriveTrain.rod_actuator`), with (k_c, c_c) = (k_s, c_s + k_s h)
+in contact and 0 in the gap, and ctrl = k_s x_anchor + c_s v_m. MuJoCo's ``implicitfast`` step takes
+the rate terms at the new rate v', so the spring acts at the predicted stroke x + h v': backward
+Euler for the spring, stable however light the rod side (the telescope's slide sees 76 kg, the
+two boom slides together a few kg in some directions: an explicit spring of 1.9e8 N/m would need a
+step below 0.1 ms). Its price is a numerical damping k_s h, zeta_num = omega h / 2 of a mode
+(0.04 for the lowest, 12.5 Hz, at h = 1 ms), counted with the spring's damping; the frequency
+is kept to (omega h)^2 / 8. The motor side then takes the force the rod received, f = ctrl - k_c x
+- c_c v' (action and reaction), in a symplectic Euler step with the screw friction implicit.
+
+Two-mass frequency with the rod on a load m_L: omega^2 = k_s (1/m_m + 1/m_L); its lowest value,
+the rod locked (m_L -> infinity), is omega_lock = sqrt(k_s / m_m), the bound the controller's
+bandwidth is designed against (:func:`locked_rod_frequency_Hz`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from hiab_sim.env.plant.config import DriveTrain
+
+Array = NDArray[np.float64]
+
+
+def locked_rod_frequency_Hz(train: DriveTrain, motor_mass: Array) -> Array:
+    """sqrt(k_s / m_m) / 2 pi [Hz] per drive: the lowest two-mass frequency (module docstring)."""
+    return np.sqrt(train.axial_stiffness_N_per_m / np.asarray(motor_mass, dtype=float)) / (2.0 * math.pi)
+
+
+class TwoMassDriveTrain:
+    """Motor-side states of n drives and their springs with free play (module docstring).
+
+    Args:
+        train: Stiffness, damping ratio and free play.
+        motor_mass: m_m per drive [kg].
+        viscous: b_f per drive [N s/m], acting on the motor side.
+
+    """
+
+    def __init__(self, train: DriveTrain, motor_mass: Array, viscous: Array) -> None:
+        self.stiffness = train.axial_stiffness_N_per_m
+        self.half_play = 0.5 * train.backlash_m
+        self.mass = np.asarray(motor_mass, dtype=float)
+        self.damping = 2.0 * train.damping_ratio * np.sqrt(self.stiffness * self.mass)
+        self.viscous = np.asarray(viscous, dtype=float)
+        self.position = np.zeros_like(self.mass)
+        self.velocity = np.zeros_like(self.mass)
+
+    def reset(self, rod_position: Array, rod_velocity: Array, force: Array) -> None:
+        """Put the motor side where the spring carries ``force`` [N] at rest relative to the rod."""
+        force = np.asarray(force, dtype=float)
+        offset = force / self.stiffness + self.half_play * np.sign(force)
+        self.position = np.asarray(rod_position, dtype=float) + offset
+        self.velocity = np.asarray(rod_velocity, dtype=float).copy()
+
+    def contact_deflection(self, rod_position: Array) -> Array:
+        """e: the deflection beyond the free play [m] (0 inside the gap)."""
+        d = self.position - rod_position
+        return np.where(d > self.half_play, d - self.half_play, np.where(d < -self.half_play, d + self.half_play, 0.0))
+
+    def spring_force(self, rod_position: Array, rod_velocity: Array) -> Array:
+        """f_s [N] on the rod, positive extending (module docstring)."""
+        e = self.contact_deflection(rod_position)
+        force = self.stiffness * e + np.where(e != 0.0, self.damping * (self.velocity - rod_velocity), 0.0)
+        return np.where(e > 0.0, np.maximum(force, 0.0), np.where(e < 0.0, np.minimum(force, 0.0), 0.0))
+
+    def rod_actuator(self, rod_position: Array, h: float) -> tuple[Array, Array, Array]:
+        """(ctrl [N], k_c [N/m], c_c [N s/m]) of the rod's actuator f = ctrl - k_c x - c_c v (module docstring)."""
+        d = self.position - rod_position
+        above, below = d > self.half_play, d < -self.half_play
+        contact = above | below
+        anchor = self.position - np.where(above, self.half_play, np.where(below, -self.half_play, 0.0))
+        k_c = np.where(contact, self.stiffness, 0.0)
+        c_c = np.where(contact, self.damping, 0.0)
+        return k_c * anchor + c_c * self.velocity, k_c, c_c
+
+    def spring_energy(self, rod_position: Array) -> Array:
+        """1/2 k_s e^2 [J] per drive."""
+        e = self.contact_deflection(rod_position)
+        return 0.5 * self.stiffness * e * e
+
+    def kinetic_energy(self) -> Array:
+        """1/2 m_m v_m^2 [J] per drive."""
+        return 0.5 * self.mass * self.velocity**2
+
+    def step(self, drive_force: Array, rod_force: Array, rod_velocity: Array, h: float) -> Array:
+        """Advance the motor side by h [s] under the drive's force and the rod's reaction [N].
+
+        Returns:
+            The energy the drive train dissipated over the step [J]: the screw friction b_f v_m^2 h, the
+            spring's damping c_s (v_m - v')^2 h and the numerical k_s h^2 v'^2 (module docstring).
+
+        """
+        contact = rod_force != 0.0
+        slip = self.velocity - rod_velocity
+        spring = np.where(contact, h * self.damping * slip * slip, 0.0)
+        # Screw friction implicit (-b_f v_m at the new rate): its work over the step is -b_f v_m^2 h exactly.
+        self.velocity = (self.velocity + h * (drive_force - rod_force) / self.mass) / (
+            1.0 + h * self.viscous / self.mass
+        )
+        self.position = self.position + h * self.velocity
+        dissipated: Array = h * self.viscous * self.velocity**2 + spring
+        return dissipated
+
+
+def coupled_step(
+    train: TwoMassDriveTrain,
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    actuators: NDArray[np.int64],
+    dofs: NDArray[np.int64],
+    drive_force: Array,
+    h: float,
+) -> Array:
+    """One physics step of the rods (``mj_step``) and the motor sides on their springs; return the loss [J].
+
+    ``actuators`` are the slides' affine actuators (gain 1, bias (0, -k_c, -c_c)), ``dofs`` the slides'
+    degrees of freedom; see the module docstring.
+    """
+    x = data.qpos[dofs].copy()
+    ctrl, k_c, c_c = train.rod_actuator(x, h)
+    data.ctrl[actuators] = ctrl
+    model.actuator_biasprm[actuators, 1] = -k_c
+    model.actuator_biasprm[actuators, 2] = -c_c
+    mujoco.mj_step(model, data)
+    v_new = data.qvel[dofs]
+    force = ctrl - k_c * x - c_c * v_new  # what the rod received over the step
+    return train.step(drive_force, force, v_new, h)

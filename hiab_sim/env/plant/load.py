@@ -1,0 +1,77 @@
+"""Read a plant YAML file (a shipped preset such as ``realistic``, or a path) into a :class:`Plant`.
+
+The file has one mapping per effect of :data:`~hiab_sim.env.plant.config.EFFECTS`; each holds
+``enabled: true|false`` and the section's fields, every number either bare or ``{value, source}``
+with a source whose first word is ``read``, ``estimate``, ``derived`` or ``model``. Structure and
+types raise :class:`~hiab_sim.errors.ConfigError`; ranges are checked by the dataclasses.
+"""
+
+from __future__ import annotations
+
+import typing
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from hiab_sim.emla.config import PROVENANCE_KINDS
+from hiab_sim.env.plant.config import EFFECTS, CurrentLoop, DriveTrain, JointFriction, Mismatch, Plant, Sensors, Thermal
+from hiab_sim.errors import ConfigError
+from hiab_sim.resources import Source, locate
+from hiab_sim.yaml_fields import integer, mapping, number, read_yaml, vector
+
+_SECTIONS: dict[str, type] = {
+    "drive_train": DriveTrain,
+    "joint_friction": JointFriction,
+    "sensors": Sensors,
+    "current_loop": CurrentLoop,
+    "thermal": Thermal,
+    "mismatch": Mismatch,
+}
+
+
+def _value_and_source(raw: Any, key: str) -> tuple[Any, str]:
+    """The raw value and its provenance from a bare value or a ``{value, source}`` mapping."""
+    if not isinstance(raw, Mapping):
+        return raw, "unspecified"
+    mapping(raw, key, {"value", "source"}, {"value"})
+    source = raw.get("source", "unspecified")
+    if "source" in raw and (not isinstance(source, str) or source.split(":", 1)[0].strip() not in PROVENANCE_KINDS):
+        raise ConfigError(f"{key}.source must be a string starting with one of {', '.join(PROVENANCE_KINDS)}")
+    return raw["value"], source
+
+
+def _read_section(cls: type, node: Any, where: str, provenance: list[tuple[str, str]]) -> Any:
+    """One effect's section as its dataclass; appends (field, source) of every value to ``provenance``."""
+    hints = typing.get_type_hints(cls)
+    data = mapping(node, where, set(hints), {n for n in hints if n != "seed"})
+    values: dict[str, Any] = {}
+    for name, kind in hints.items():
+        if name not in data:
+            continue
+        key = f"{where}.{name}"
+        if name == "enabled":
+            if not isinstance(data[name], bool):
+                raise ConfigError(f"{key}: expected true or false, got {data[name]!r}")
+            values[name] = data[name]
+            continue
+        raw, source = _value_and_source(data[name], key)
+        if kind is int:
+            values[name] = integer(raw, key)
+        elif kind is float:
+            values[name] = number(raw, key)
+        else:
+            values[name] = vector(raw, key, 3)
+        provenance.append((key, source))
+    return cls(**values)
+
+
+def load_plant(source: str | Path | Source) -> Plant:
+    """Load a plant: a shipped preset name (``realistic``), ``ideal`` (realistic, every effect off) or a YAML path."""
+    if isinstance(source, str) and source == "ideal":
+        return load_plant("realistic").ideal()
+    found = source if isinstance(source, Source) else locate(source, "plant")
+    data = mapping(read_yaml(found), found.label, set(EFFECTS))
+    provenance: list[tuple[str, str]] = []
+    sections = {name: _read_section(cls, data[name], name, provenance) for name, cls in _SECTIONS.items()}
+    name = Path(found.label).stem if not found.shipped else found.label
+    return Plant(name=name, provenance=tuple(provenance), **sections)

@@ -1,0 +1,1 @@
+"""Any planar parallel-serial machine: description, loader, loop closure and kinematics."""

@@ -1,0 +1,147 @@
+"""Drawing of a machine: links, pivots, actuators and the TCP labelled, the reachable TCP workspace shaded.
+
+The machine is drawn at the middle of every joint's working range, in the world plane (x forward,
+y up, metres). The workspace is the set of TCP positions over every combination of the joints'
+working ranges, sampled on a grid and shaded as the occupied cells of a 2D raster (so a crescent
+stays a crescent); it is the workspace of the working ranges, which the assembly check holds
+inside every chain's reachable range.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+from numpy.typing import NDArray
+
+from hiab_sim.figure_io import new_figure, save_png
+from hiab_sim.machine.assembly import joint_grid
+from hiab_sim.machine.description import Machine
+from hiab_sim.machine.kinematics import Frames, forward_kinematics, pin_positions
+
+Array = NDArray[np.float64]
+
+#: Grid samples per joint for the workspace, by number of joints (about 60 000 poses at most).
+_PER_JOINT = {1: 400, 2: 250, 3: 40, 4: 16, 5: 9}
+_RASTER = 160
+
+
+def _xy(point: Array) -> tuple[float, float]:
+    return (float(point[0]), float(point[1]))
+
+
+def workspace_points(machine: Machine) -> Array:
+    """TCP positions (N, 2) over the grid of the joints' working ranges [m]."""
+    per_joint = _PER_JOINT.get(len(machine.joint_names), 5)
+    return forward_kinematics(machine, joint_grid(machine, per_joint)).tcp_position[:, :2]
+
+
+def _shade_workspace(ax: object, points: Array) -> None:
+    low, high = points.min(axis=0), points.max(axis=0)
+    span = np.maximum(high - low, 1e-6)
+    idx = np.clip(((points - low) / span * (_RASTER - 1)).round().astype(int), 0, _RASTER - 1)
+    grid = np.zeros((_RASTER, _RASTER), dtype=bool)
+    grid[idx[:, 1], idx[:, 0]] = True
+    filled = grid.copy()  # close one-cell gaps between samples
+    filled[1:, :] |= grid[:-1, :]
+    filled[:-1, :] |= grid[1:, :]
+    filled[:, 1:] |= grid[:, :-1]
+    filled[:, :-1] |= grid[:, 1:]
+    image = np.zeros((_RASTER, _RASTER, 4))
+    image[filled] = (0.35, 0.55, 0.85, 0.25)
+    ax.imshow(  # type: ignore[attr-defined]
+        image, origin="lower", extent=(low[0], high[0], low[1], high[1]), interpolation="nearest", zorder=0
+    )
+
+
+def _link_points(machine: Machine, frames: Frames, link: str) -> list[Array]:
+    """World points that outline a link: its origin, its children's joints, its pivots, the TCP."""
+    points = [frames.position[link][:2]]
+    points += [frames.position[c.name][:2] for c in machine.links if c.parent == link]
+    for chain in machine.chains:
+        points += [frames.point(p.link, p.position)[:2] for p in chain.pivots if p.link == link]
+    if machine.tcp_link == link:
+        points.append(frames.tcp_position[:2])
+    return points
+
+
+def draw_machine(machine: Machine) -> Figure:
+    """The labelled drawing of the machine (see the module docstring)."""
+    fig = new_figure((9.0, 7.0))
+    ax = fig.add_subplot()
+    middle = np.array([0.5 * sum(machine.joint_link(j).joint_range or (0.0, 0.0)) for j in machine.joint_names])
+    frames = forward_kinematics(machine, middle)
+    cloud = workspace_points(machine)
+    _shade_workspace(ax, cloud)
+    for link in machine.links:
+        pts = _link_points(machine, frames, link.name)
+        if len(pts) > 1:
+            origin = pts[0]
+            for p in pts[1:]:
+                ax.plot([origin[0], p[0]], [origin[1], p[1]], color="0.35", lw=5, solid_capstyle="round", zorder=2)
+        centre = np.mean(pts, axis=0)
+        ax.annotate(
+            link.name, _xy(centre), xytext=(0, 9), textcoords="offset points", ha="center", fontsize=9, zorder=6
+        )
+        if link.parent is not None:
+            o = frames.position[link.name][:2]
+            ax.plot(*o, "o", ms=8, mfc="white", mec="black", zorder=5)
+            ax.annotate(
+                f"{link.joint} ({link.joint_kind})", _xy(o), xytext=(6, -12), textcoords="offset points", fontsize=7
+            )
+    for chain in machine.chains:
+        if chain.kind == "direct":
+            link = machine.joint_link(chain.joint)
+            start = frames.position[str(link.parent)] + frames.rotation[str(link.parent)] @ np.asarray(
+                link.joint_frame.position
+            )
+            slide = frames.position[link.name]
+            ax.plot([start[0], slide[0]], [start[1], slide[1]], color="tab:orange", lw=3, zorder=4)
+            ax.annotate(
+                f"{chain.name} actuator (direct), stroke {chain.actuator.stroke:g} m",
+                _xy(slide),
+                xytext=(5, -16),
+                textcoords="offset points",
+                fontsize=8,
+                color="tab:orange",
+            )
+            continue
+        pins = pin_positions(machine, frames, chain.name)
+        end = pins["pin"] if chain.kind == "linkage" else pins["end"]
+        base = pins["base"]
+        ax.plot([base[0], end[0]], [base[1], end[1]], color="tab:orange", lw=3, zorder=3)
+        mid = 0.5 * (base[:2] + end[:2])
+        ax.annotate(
+            f"{chain.name} actuator, stroke {chain.actuator.stroke:g} m",
+            _xy(mid),
+            xytext=(5, 5),
+            textcoords="offset points",
+            fontsize=8,
+            color="tab:orange",
+            zorder=6,
+        )
+        if chain.kind == "linkage":
+            for a, b in (("rocker", "pin"), ("pin", "coupler")):
+                ax.plot([pins[a][0], pins[b][0]], [pins[a][1], pins[b][1]], color="tab:green", lw=2.5, zorder=3)
+        for role, p in pins.items():
+            if role == "hinge":
+                continue
+            ax.plot(p[0], p[1], "o", ms=5, color="black", zorder=5)
+            ax.annotate(f"{chain.name}.{role}", _xy(p[:2]), xytext=(4, 4), textcoords="offset points", fontsize=7)
+    tcp = frames.tcp_position
+    ax.plot(tcp[0], tcp[1], "*", ms=12, color="tab:red", zorder=6)
+    ax.annotate("TCP", _xy(tcp[:2]), xytext=(6, -4), textcoords="offset points", color="tab:red", fontsize=9)
+    ax.plot([], [], "s", color=(0.35, 0.55, 0.85, 0.4), label="TCP workspace over the working ranges")
+    ax.legend(loc="best", fontsize=8)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m] (up)")
+    ax.set_title(f"{machine.name}: joints at the middle of their working ranges")
+    ax.grid(True, alpha=0.3)
+    return fig
+
+
+def save_drawing(machine: Machine, path: Path) -> Path:
+    """Draw the machine and write the PNG atomically."""
+    return save_png(draw_machine(machine), path)

@@ -1,0 +1,147 @@
+"""The answer first: the short summary a designer reads in ten seconds, built from the typed result.
+
+``hiab-sim optimize`` prints it last and writes the same text to ``summary.md`` in the run folder.
+It says what to build (the buildable design, each link length and its move from the initial
+design in mm), the energy per cycle before and after at the boundary the study reports (the
+battery on the shared DC bus when the result has an energy section, else the motors' net
+electrical energy), the limits that bind at the optimum (the active constraints of largest
+multiplier, in words) and where the files are. Every number is read from the result; nothing is
+recomputed here.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import fields
+from pathlib import Path
+
+from hiab_sim.crane.description import LinkLengths
+from hiab_sim.results.schema import Result
+
+#: File name of the summary inside a run folder.
+SUMMARY_FILE = "summary.md"
+#: Binding limits named in the summary (largest cost per unit of relaxation first).
+BINDING_SHOWN = 3
+
+#: Link-length fields of one chain in words (see :class:`hiab_sim.crane.description.ChainLengths`).
+LENGTH_WORDS = {
+    "L": "base pivot to boom hinge",
+    "Lc0": "piston offset in the barrel",
+    "Lc": "rod length",
+}
+
+_ENVELOPE_WORDS = {"peak_torque": "motor peak torque", "rated_speed": "motor rated speed", "voltage": "drive voltage"}
+_STROKE_WORDS = {
+    "x >= 0": "cylinder fully retracted",
+    "x <= Lc": "rod fully out of the barrel",
+    "x <= stroke": "end of stroke",
+}
+_TRACKING = re.compile(r"^tracking\.(\w+)\.(\S+)")
+_BOUND = re.compile(r"^bound (\w+)\.(\w+) (low|up) = (\S+) m$")
+
+
+def limit_in_words(name: str, detail: bool = True) -> str:
+    """A constraint row name of the NLP (``envelope.lift.peak_torque``, ``bound tilt.L up = 1.3 m``) in words.
+
+    Names the sensitivity section groups over samples; an unknown pattern keeps its name with
+    underscores as spaces. ``detail`` False drops the coordinate of a tracking band (one phrase
+    for the band, as the summary names it).
+    """
+    match = _BOUND.match(name)
+    if match:
+        chain, field, side, value = match.groups()
+        words = LENGTH_WORDS.get(field, field)
+        return f"{chain} {words} at its {'lower' if side == 'low' else 'upper'} bound ({float(value) * 1e3:.0f} mm)"
+    match = _TRACKING.match(name)
+    if match:
+        band = f"TCP tracking band ({match.group(1)})"
+        return f"{band}, {match.group(2).replace('_', ' ')}" if detail else band
+    block, _, rest = name.partition(".")
+    if block == "envelope":
+        actuator, _, limit = rest.partition(".")
+        return f"{actuator} {_ENVELOPE_WORDS.get(limit, limit.replace('_', ' '))}"
+    if block in ("stroke", "working_range", "buildable_range"):
+        chain, _, row = rest.partition(".")
+        end = ""
+        for side in ("low", "up"):
+            suffix = f" at the {side} end"
+            if row.endswith(suffix):
+                row, end = (
+                    row[: -len(suffix)],
+                    f" at the {'lower' if side == 'low' else 'upper'} end of the joint range",
+                )
+        where = {"stroke": "", "working_range": " over the working range", "buildable_range": " over the build range"}
+        return f"{chain} {_STROKE_WORDS.get(row, row)}{where[block]}{end}"
+    if block == "joint_velocity":
+        return f"joint speed limit ({rest.split(' ')[0]})"
+    if block == "mounting":
+        return f"mounting space ({rest.replace('_', ' ')})"
+    return name.replace("_", " ")
+
+
+def _design_lines(built: LinkLengths, initial: LinkLengths, tolerance_mm: float | None) -> list[str]:
+    rounding = f", rounded to {tolerance_mm:g} mm" if tolerance_mm is not None else ""
+    lines = [f"What to build (link lengths in mm, change from the initial design in brackets{rounding}):"]
+    for chain in (f.name for f in fields(LinkLengths)):
+        new, old = getattr(built, chain), getattr(initial, chain)
+        parts = []
+        for field, words in LENGTH_WORDS.items():
+            value, before = getattr(new, field), getattr(old, field)
+            parts.append(f"{words} {value * 1e3:.0f} ({(value - before) * 1e3:+.0f})")
+        lines.append(f"- {chain} chain: " + ", ".join(parts))
+    return lines
+
+
+def _energy_line(r: Result) -> str:
+    if r.energy is not None:
+        e = r.energy
+        before, after = e.initial.battery_energy_J, e.optimal.battery_energy_J
+        where = "at the battery (shared DC bus, regeneration credited)"
+    else:
+        before, after = r.initial.net_electrical_energy_J, r.optimal.net_electrical_energy_J
+        where = "net electrical energy of the motors (regeneration credited; no battery model in this study)"
+    change = 100.0 * (after - before) / before
+    return f"Energy per cycle {where}: {before / 1e3:.3f} kJ before, {after / 1e3:.3f} kJ after ({change:+.2f} %)."
+
+
+def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[str]:
+    """The summary as lines of Markdown (also readable as plain console text)."""
+    built = r.buildable.lengths if r.buildable is not None else r.optimal.lengths
+    tolerance = r.buildable.tolerance_m * 1e3 if r.buildable is not None else None
+    lines = [f"# {r.name}: the answer", ""]
+    lines += _design_lines(built, r.initial.lengths, tolerance)
+    if r.buildable is None:
+        lines.append("  (the optimum itself: this study has no buildable-design check)")
+    lines += ["", _energy_line(r)]
+    binding: list[str] = []
+    for m in () if r.sensitivity is None else r.sensitivity.multipliers:
+        words = limit_in_words(m.constraint, detail=False)
+        if words not in binding and len(binding) < BINDING_SHOWN:
+            binding.append(words)
+    if binding:
+        lines.append(
+            "Binding limits at the optimum (largest energy gain per unit relaxed first): " + "; ".join(binding) + "."
+        )
+    else:
+        lines.append("Binding limits at the optimum: none reported (no sensitivity section).")
+    ms = r.multistart
+    if len(ms.starts) > 1:
+        failed = f", {len(ms.failed_starts)} failed" if ms.failed_starts else ""
+        agree = "the same optimum" if ms.same_optimum else f"{len(ms.distinct_optima)} distinct local optima"
+        lines.append(f"Starts: {ms.converged_starts} of {len(ms.starts)} converged, to {agree}{failed}.")
+    violation = r.recheck.max_violation_scaled
+    lines.append(
+        f"Checked on a {r.recheck.grid_points}-point grid with the other dynamics model: "
+        + ("all limits hold." if violation <= 1e-6 else f"largest violation {violation:.1e} (scaled).")
+    )
+    if r.buildable is not None:
+        lines.append(f"Model of the buildable design: {r.buildable.mjcf_command}")
+    shown = ", ".join(files) if files else "result.json, trajectory.npz"
+    lines += ["", f"Files in {folder}: {shown}."]
+    return lines
+
+
+def summary_text(r: Result, folder: Path, files: Sequence[str] = ()) -> str:
+    """The summary as one text (what ``summary.md`` holds and the console prints)."""
+    return "\n".join(summary_lines(r, folder, files)) + "\n"

@@ -1,0 +1,197 @@
+"""hiab-sim report: one self-contained HTML file that states the answer, opened in a real browser."""
+
+from __future__ import annotations
+
+import functools
+import http.server
+import json
+import subprocess
+import sys
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from browser_helper import References, chromium, load_page, save_artifact
+from test_study_small import small_study, write_study
+
+from hiab_sim.cli import main
+from hiab_sim.results.read import read_result
+from hiab_sim.results.schema import Result
+
+ROOT = Path(__file__).resolve().parents[1]
+needs_chromium = pytest.mark.skipif(
+    chromium() is None, reason="chromium is not installed (scripts/setup.sh installs it)"
+)
+
+
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A small study optimised by the CLI with its figures (no video): optimize writes report.html by default."""
+    folder = tmp_path_factory.mktemp("report")
+    study = write_study(folder, small_study(duty={"cycles_per_hour": 60}))
+    assert main(["optimize", str(study), "--out", str(folder / "run"), "--no-video", "--quiet"]) == 0
+    return folder / "run"
+
+
+@pytest.fixture(scope="module")
+def result(run_dir: Path) -> Result:
+    """The run's result."""
+    return read_result(run_dir)
+
+
+def test_optimize_writes_a_report_with_no_external_reference(run_dir: Path) -> None:
+    """report.html loads nothing from outside itself: no script, link or frame; every src a data: URI."""
+    parser = References()
+    parser.feed((run_dir / "report.html").read_text())
+    assert parser.tags == []
+    assert parser.urls and all(url.startswith("data:image/png;base64,") for url in parser.urls)
+    assert not any("url(" in style or "@import" in style for style in parser.styles)
+
+
+def test_report_states_the_design_to_build_and_its_energies(run_dir: Path, result: Result) -> None:
+    """The buildable lengths, the battery and net energies and the hydraulic baseline of result.json are in the page."""
+    html = (run_dir / "report.html").read_text()
+    assert result.buildable is not None and result.energy is not None and result.hydraulic_baseline is not None
+    lift = result.buildable.lengths.lift
+    assert f"lift L / Lc0 / Lc = {lift.L:.3f} / {lift.Lc0:.3f} / {lift.Lc:.3f} m" in html
+    assert f"{result.energy.optimal.battery_energy_J:.1f} J" in html
+    assert f"{result.optimal.net_electrical_energy_J:.1f} J" in html
+    assert f"{result.hydraulic_baseline.optimal.load_sensing.input_energy_J / 1e3:.1f} kJ" in html
+    for title in ("The question", "Thermal state", "Sensitivities", "Hydraulic comparison", "Provenance"):
+        assert f"<h2>{title}</h2>" in html
+    assert "Closed-loop validation" not in html  # no simulation.json yet
+
+
+def test_report_shows_the_closed_loop_of_simulation_json(run_dir: Path, tmp_path: Path) -> None:
+    """With a simulation.json in the folder the report has its closed-loop section with the file's numbers."""
+    design = {
+        "payload_error": 0.0,
+        "predicted_net_electrical_energy_J": 3978.4,
+        "net_electrical_energy_J": 3976.0,
+        "energy_difference_percent": -0.06,
+        "tcp_error_mm": {"rms": 0.63, "max": 0.83},
+    }
+    (run_dir / "simulation.json").write_text(json.dumps({"designs": {"optimal": design}}))
+    try:
+        out = tmp_path / "with_sim.html"
+        assert main(["report", str(run_dir), "-o", str(out)]) == 0
+        html = out.read_text()
+    finally:
+        (run_dir / "simulation.json").unlink()
+    assert "<h2>Closed-loop validation</h2>" in html and "3976.0 J" in html and "-0.06 %" in html
+
+
+def test_report_of_a_folder_without_a_result_exits_2_and_writes_nothing(tmp_path: Path) -> None:
+    """A missing result is one line on stderr, exit status 2, and no report file."""
+    done = subprocess.run(
+        [sys.executable, "-m", "hiab_sim", "report", str(tmp_path / "nothing"), "-o", str(tmp_path / "r.html")],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 2 and "Traceback" not in done.stderr and len(done.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "r.html").exists()
+
+
+@needs_chromium
+def test_report_renders_in_chromium(run_dir: Path, result: Result) -> None:
+    """Headless Chromium: no console error, every image decoded, no request leaves the file, the answer in the text."""
+    page = load_page((run_dir / "report.html").as_uri())
+    save_artifact("report.png", page.screenshot)
+    assert page.errors == []
+    assert len(page.images) >= 4 and all(i["complete"] and i["width"] > 0 for i in page.images)
+    assert all(url.startswith(("file:", "data:")) for url in page.requests)
+    assert result.buildable is not None and result.energy is not None
+    assert f"{result.buildable.lengths.tilt.L:.3f}" in page.text
+    assert f"{result.energy.optimal.battery_energy_J:.1f} J" in page.text
+
+
+@needs_chromium
+def test_report_prints_to_pdf(run_dir: Path, tmp_path: Path) -> None:
+    """--pdf writes a PDF of the same page next to the HTML file."""
+    out = tmp_path / "design.html"
+    assert main(["report", str(run_dir), "-o", str(out), "--pdf"]) == 0
+    assert out.with_suffix(".pdf").read_bytes().startswith(b"%PDF")
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    """The built documentation site (site/ from scripts/test.sh, else built here), served on localhost."""
+    folder = ROOT / "site"
+    if not (folder / "index.html").is_file():
+        folder = tmp_path_factory.mktemp("site")
+        build = [sys.executable, "-m", "mkdocs", "build", "--strict", "--quiet", "--site-dir", str(folder)]
+        subprocess.run(build, cwd=ROOT, check=True, capture_output=True)
+    handler = functools.partial(_QuietHandler, directory=str(folder))
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    yield f"http://127.0.0.1:{server.server_port}"
+    server.shutdown()
+
+
+class _QuietHandler(http.server.SimpleHTTPRequestHandler):
+    def log_message(self, format: str, *args: object) -> None:
+        """Keep the test output clean."""
+
+
+@needs_chromium
+def test_documentation_page_renders_in_chromium(site: str) -> None:
+    """The default-study page: no console error, images decoded, nothing fetched off the host, its numbers shown."""
+    page = load_page(f"{site}/results/default-study/")
+    save_artifact("site_default_study.png", page.screenshot)
+    assert page.errors == []
+    assert page.images and all(i["complete"] and i["width"] > 0 for i in page.images)
+    assert all(url.startswith((site, "data:")) for url in page.requests)
+    block = (ROOT / "docs" / "results" / "default-study.md").read_text().split("<!-- results:start -->")[1]
+    battery = next(line for line in block.splitlines() if line.startswith("| battery energy"))
+    assert battery.split("|")[2].strip().split(" J")[0] in page.text
+
+
+def test_report_of_a_duty_mix_shows_its_tasks_and_cross_evaluation(
+    run_dir: Path, result: Result, tmp_path: Path
+) -> None:
+    """A result with tasks and a cross-evaluation gets the duty-mix section with each task and each design's cells."""
+    import shutil
+    from dataclasses import replace
+
+    from hiab_sim.results.analysis_sections import CrossEvaluation
+    from hiab_sim.results.schema import TaskResult
+
+    task = TaskResult(
+        name="lifting",
+        weight=20.0,
+        kind="spiral",
+        duration_s=6.25,
+        payload_kg=150.0,
+        telescope="prescribed",
+        spline_control_points=16,
+        collocation_points=13,
+        initial=result.initial,
+        optimal=result.optimal,
+        recheck=result.recheck,
+    )
+    cross = CrossEvaluation(
+        note="test",
+        tasks=("lifting",),
+        weights=(20.0,),
+        designs=("lifting alone", "mix"),
+        lengths=(result.optimal.lengths, result.optimal.lengths),
+        net_energy_J=((1234.5,), (None,)),
+        drawn_energy_J=((1300.0,), (None,)),
+        cost_W2s=((1.0,), (None,)),
+        max_violation=((0.0,), (None,)),
+        mix_net_energy_J=(24690.0, None),
+        mix_cost_W2s=(20.0, None),
+        mix_energy_lost_J=(0.0, None),
+        mix_energy_lost_percent=(0.125, None),
+        mix_cost_lost_percent=(0.0, None),
+    )
+    folder = tmp_path / "mix"
+    shutil.copytree(run_dir, folder)
+    mixed = replace(result, tasks=(task,), cross_evaluation=cross)
+    (folder / "result.json").write_text(json.dumps(mixed.to_json()))
+    assert main(["report", str(folder)]) == 0
+    html = (folder / "report.html").read_text()
+    assert "<h2>Duty mix</h2>" in html and "lifting x 20" in html
+    assert "1234.5" in html and "24690.0" in html and "+0.125 %" in html and "–" in html  # a missing cell: en dash

@@ -1,0 +1,99 @@
+"""The answer first: ``hiab-sim optimize`` ends with a short summary, and ``summary.md`` holds the same text."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from test_study_small import small_study, write_study
+
+from hiab_sim.cli import main
+from hiab_sim.results.read import read_result
+from hiab_sim.study.report.summary import SUMMARY_FILE, limit_in_words
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """The small study optimised once through the CLI (no figures, no video); its folder and stdout."""
+    import contextlib
+    import io
+
+    folder = tmp_path_factory.mktemp("summary")
+    study = write_study(folder, small_study())
+    stdout = io.StringIO()
+    with contextlib.redirect_stdout(stdout):
+        assert main(["optimize", str(study), "--out", str(folder / "out"), "--no-video", "--no-figures"]) == 0
+    return folder / "out", stdout.getvalue()
+
+
+def test_console_ends_with_the_summary_that_summary_md_holds(run: tuple[Path, str]) -> None:
+    """The last lines printed are exactly summary.md; without --verbose nothing else but that summary is printed."""
+    folder, printed = run
+    saved = (folder / SUMMARY_FILE).read_text()
+    assert printed.endswith(saved)
+    assert printed.strip() == saved.strip()  # no iteration lines, no KKT report before it
+    assert len(saved.splitlines()) <= 15  # one screen
+
+
+def test_summary_numbers_are_the_results_own(run: tuple[Path, str]) -> None:
+    """The buildable lengths [mm], their moves and the energies before/after are read from result.json."""
+    folder, _ = run
+    text = (folder / SUMMARY_FILE).read_text()
+    r = read_result(folder)
+    assert r.buildable is not None and r.energy is not None
+    built, initial = r.buildable.lengths, r.initial.lengths
+    assert f"base pivot to boom hinge {built.lift.L * 1e3:.0f} ({(built.lift.L - initial.lift.L) * 1e3:+.0f})" in text
+    assert f"rod length {built.tilt.Lc * 1e3:.0f} ({(built.tilt.Lc - initial.tilt.Lc) * 1e3:+.0f})" in text
+    assert f"{r.energy.initial.battery_energy_J / 1e3:.3f} kJ before" in text
+    assert f"{r.energy.optimal.battery_energy_J / 1e3:.3f} kJ after" in text
+    assert "at the battery" in text
+    assert str(folder) in text and r.buildable.mjcf_command in text
+
+
+def test_verbose_prints_the_iterations_before_the_summary(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--verbose adds the per-iteration lines (stderr) and the full report; the summary still comes last."""
+    study = write_study(tmp_path, small_study())
+    out = tmp_path / "out"
+    assert main(["optimize", str(study), "--out", str(out), "--no-video", "--no-figures", "--verbose"]) == 0
+    captured = capsys.readouterr()
+    assert "iter" in captured.err.lower() or "it " in captured.err.lower()
+    assert captured.out.endswith((out / SUMMARY_FILE).read_text())
+    assert len(captured.out.splitlines()) > len((out / SUMMARY_FILE).read_text().splitlines()) + 3
+
+
+def test_rerun_removes_the_earlier_simulation_too_and_says_so(
+    run: tuple[Path, str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A fresh (quiet) run over an earlier one removes every earlier output, simulation.json too, and says which."""
+    import shutil
+
+    folder = tmp_path / "out"
+    shutil.copytree(run[0], folder)
+    (folder / "simulation.json").write_text(json.dumps({"stale": True}))
+    (folder / "closed_loop.mp4").write_bytes(b"old")
+    study = json.loads((folder / "owner.json").read_text())["study"]
+    capsys.readouterr()
+    assert main(["optimize", study, "--out", str(folder), "--no-video", "--no-figures", "--quiet"]) == 0
+    printed = capsys.readouterr().out
+    assert not (folder / "simulation.json").exists() and not (folder / "closed_loop.mp4").exists()
+    assert "removed all" in printed and "simulation.json" in printed and "closed_loop.mp4" in printed
+
+
+@pytest.mark.parametrize(
+    ("row", "words"),
+    [
+        ("envelope.lift.peak_torque", "lift motor peak torque"),
+        ("stroke.tilt.x <= stroke", "tilt end of stroke"),
+        (
+            "working_range.lift.x >= 0 at the low end",
+            "lift cylinder fully retracted over the working range at the lower",
+        ),
+        ("bound tilt.L up = 1.3 m", "tilt base pivot to boom hinge at its upper bound (1300 mm)"),
+        ("tracking.position.x_tcp <= band", "TCP tracking band (position), x tcp"),
+    ],
+)
+def test_constraint_rows_read_in_words(row: str, words: str) -> None:
+    """Row names of the NLP become words a designer reads (no dots, no underscores, no 'x <= Lc')."""
+    assert limit_in_words(row).startswith(words)
+    assert limit_in_words(row.replace(" <= band", "")) == limit_in_words(row)
