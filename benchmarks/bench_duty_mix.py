@@ -22,7 +22,7 @@ from dataclasses import replace
 import numpy as np
 
 from hiab_sim.errors import SolverError
-from hiab_sim.study.nlp.mix import make_problem
+from hiab_sim.study.nlp.problem import make_problem
 from hiab_sim.study.solvers.slsqp import solve
 from hiab_sim.study.spec.study_file import DEFAULT_STUDY, Study, load_study
 

@@ -2,7 +2,7 @@
 
 Usage: ``.venv/bin/python benchmarks/bench_energy_map.py [--grid 50] [--repeats 3] [--loop 100]``.
 Times the whole map (the problem is built once, outside the timing, as the CLI does before the map)
-and, as the baseline, the per-design path (:meth:`LinkLengthProblem.evaluate` on the collocation grid
+and, as the baseline, the per-design path (:meth:`TaskProblem.evaluate` on the collocation grid
 plus the fine-grid power) over ``--loop`` admissible designs, scaled to the grid's cell count.
 Goal: the 50 x 50 map in <= 2 s wall on 2 cores.
 """
@@ -16,8 +16,8 @@ import numpy as np
 
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import HiabSimError
-from hiab_sim.study.nlp.problem import LinkLengthProblem
-from hiab_sim.study.report.result_folder import fine_problem
+from hiab_sim.study.nlp.task_problem import TaskProblem
+from hiab_sim.study.report.design_check import fine_problem
 from hiab_sim.study.spec.study_file import load_study
 from hiab_sim.sweep.energy_map import energy_map, start_design
 
@@ -29,7 +29,7 @@ def main() -> None:
     parser.add_argument("--loop", type=int, default=100)
     args = parser.parse_args()
     study = load_study(None)
-    problem = LinkLengthProblem(study, id_path="analytic")
+    problem = TaskProblem(study, id_path="analytic")
     fine = fine_problem(problem, "analytic")
     base = start_design(problem)
     times = []

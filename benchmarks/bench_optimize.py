@@ -16,14 +16,14 @@ import time
 import numpy as np
 
 from hiab_sim.errors import SolverError
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.solvers.slsqp import solve
 from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
 
 
 def _run(study_path: str, id_path: str | None, gradients: bool) -> dict[str, object]:
     study = load_study(study_path)
-    problem = LinkLengthProblem(study, id_path=id_path)
+    problem = StudyProblem(study, id_path=id_path)
     t0 = time.perf_counter()
     try:
         result = solve(problem, study.initial_lengths, progress=None, use_gradients=gradients)

@@ -41,7 +41,6 @@ from hiab_sim.results.energy_sections import DesignEnergy
 from hiab_sim.results.read import read_result
 from hiab_sim.results.schema import DesignSummary, Result
 from hiab_sim.study.nlp.interface import N_XI
-from hiab_sim.study.nlp.problem import LinkLengthProblem
 from hiab_sim.study.spec.study_file import Study, load_study
 
 __all__ = ["DesignEvaluation", "TaskEvaluation", "evaluate", "load_study", "optimize", "read_result"]
@@ -182,20 +181,21 @@ def evaluate(study: Study | str | Path, lengths: Lengths, trajectory: str = "fix
     """
     if trajectory not in TRAJECTORIES:
         raise InvalidInputError("trajectory", trajectory, f"one of {list(TRAJECTORIES)}")
-    from hiab_sim.study.analysis.cross_evaluation import fixed_lengths_optimum
+    from hiab_sim.study.analysis.cross_evaluation import fixed_lengths_optimum, task_alone
+    from hiab_sim.study.report.design_check import design_summary, fine_problem
     from hiab_sim.study.report.energy_section import design_energy
-    from hiab_sim.study.report.result_folder import design_summary, fine_problem
 
     loaded = _as_study(study)
     design = as_lengths(lengths)
     tasks = []
-    for task in loaded.tasks:
-        problem = LinkLengthProblem(loaded, task=task)
+    for k, task in enumerate(loaded.tasks):
+        alone = task_alone(loaded, k)  # the task's NLP as a study of its own
+        problem = alone.problems[0]
         message = None
         if trajectory == "fixed":
             z = problem.initial_point(design)
         else:
-            z, _, message = fixed_lengths_optimum(problem, design)
+            z, _, message = fixed_lengths_optimum(alone, design)
         fine = fine_problem(problem)
         check = design_summary(fine, z)
         tasks.append(

@@ -1,6 +1,6 @@
 """Independent re-evaluation of a result folder's designs (shared test helper, not a test module).
 
-The optimiser's report evaluates each design through :class:`LinkLengthProblem` on the ID path of
+The optimiser's report evaluates each design through :class:`TaskProblem` on the ID path of
 the run. Here a design is re-evaluated from what the folder holds, without the problem: the link
 lengths of ``result.json``, the joint samples of ``trajectory.npz`` (fine grid), the *other* ID
 path called directly, the EMLA electrical power, and the quadratures written out below.

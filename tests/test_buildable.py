@@ -19,7 +19,8 @@ from hiab_sim.crane.tolerance import buildable_crane
 from hiab_sim.resources import shipped
 from hiab_sim.study.analysis.buildable import RobustXi, rounded_design
 from hiab_sim.study.analysis.sensitivity import sensitivity
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.problem import StudyProblem
+from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.solvers.feasibility import feasible_start
 from hiab_sim.study.solvers.slsqp import solve
 from hiab_sim.study.spec.study_file import Study, study_from_dict
@@ -29,16 +30,16 @@ pytestmark = pytest.mark.e2e
 
 
 @pytest.fixture(scope="module")
-def solved() -> tuple[LinkLengthProblem, np.ndarray]:
+def solved() -> tuple[StudyProblem, np.ndarray]:
     """The small study solved from the built crane."""
     study = study_from_dict(small_study(), "small.yaml")
-    problem = LinkLengthProblem(study)
+    problem = StudyProblem(study)
     result = solve(problem, study.initial_lengths, progress=None)
     return problem, result.z
 
 
 def test_every_design_within_the_tolerance_serves_the_buildable_range(
-    solved: tuple[LinkLengthProblem, np.ndarray],
+    solved: tuple[StudyProblem, np.ndarray],
 ) -> None:
     """Each of the 64 corners Xi +- t of the optimum passes the crane's own check over the buildable range."""
     problem, z = solved
@@ -55,11 +56,11 @@ def test_every_design_within_the_tolerance_serves_the_buildable_range(
     check_lengths(short, rounded)
 
 
-def test_robust_rows_match_the_worst_corner_to_second_order(solved: tuple[LinkLengthProblem, np.ndarray]) -> None:
+def test_robust_rows_match_the_worst_corner_to_second_order(solved: tuple[StudyProblem, np.ndarray]) -> None:
     """G - |dg/dXi| t of the buildable-range rows equals the least margin over the 64 corners within t^2 / s."""
     problem, z = solved
-    block = next(b for b in problem.layout.blocks if isinstance(b, RobustXi) and b.name == "buildable_range")
-    ev = problem.evaluate(z)
+    block = next(b.block for b in problem.blocks if isinstance(b.block, RobustXi) and b.block.name == "buildable_range")
+    ev = problem.evaluate(z).tasks[0]
     robust = block.values(ev) + block.clearance()
     t = problem.study.build.tolerance
     xi = ev.lengths.as_array()
@@ -76,11 +77,11 @@ def test_robust_rows_match_the_worst_corner_to_second_order(solved: tuple[LinkLe
     np.testing.assert_allclose(robust, worst, atol=1e-5)  # t^2 / (2 s 0.1 m) ~ 5e-6 scaled
 
 
-def test_robust_jacobian_matches_finite_differences(solved: tuple[LinkLengthProblem, np.ndarray]) -> None:
+def test_robust_jacobian_matches_finite_differences(solved: tuple[StudyProblem, np.ndarray]) -> None:
     """The robust rows' Jacobian (with the curvature term) agrees with central differences of their values."""
     problem, z = solved
-    block = next(b for b in problem.layout.blocks if isinstance(b, RobustXi))
-    ev = problem.evaluate(z)
+    block = next(b.block for b in problem.blocks if isinstance(b.block, RobustXi))
+    ev = problem.evaluate(z).tasks[0]
     jac = block.jacobian(ev, None).dxi  # type: ignore[arg-type]
     h = 1e-6
     from hiab_sim.study.analysis.buildable import replace_lengths
@@ -95,7 +96,7 @@ def test_robust_jacobian_matches_finite_differences(solved: tuple[LinkLengthProb
     np.testing.assert_allclose(jac, fd, atol=1e-6)
 
 
-def test_multipliers_predict_the_cost_change_of_a_bound_move(solved: tuple[LinkLengthProblem, np.ndarray]) -> None:
+def test_multipliers_predict_the_cost_change_of_a_bound_move(solved: tuple[StudyProblem, np.ndarray]) -> None:
     """Each active Xi bound's multiplier predicts the re-solved cost change of a 1 mm move within 5 %."""
     problem, z = solved
     study = problem.study
@@ -113,16 +114,14 @@ def test_multipliers_predict_the_cost_change_of_a_bound_move(solved: tuple[LinkL
         else:
             low[k] -= 1e-3
         moved = dataclasses.replace(study, bounds=dataclasses.replace(study.bounds, xi_low=tuple(low), xi_up=tuple(up)))
-        p2 = LinkLengthProblem(moved, cost_scale=problem.cost_scale)
+        p2 = StudyProblem(moved, cost_scales=[problem.problems[0].cost_scale])
         z2 = solve(p2, study.initial_lengths, progress=None, z0=z).z
         actual = f0 - p2.evaluate(z2).cost
-        assert actual == pytest.approx(m.cost_per_unit_W2s, rel=0.05), m.constraint
+        assert actual == pytest.approx(m.objective_decrease_per_unit, rel=0.05), m.constraint
 
 
 @pytest.mark.parametrize("chain", ["lift", "tilt"])
-def test_stroke_row_multipliers_predict_a_longer_stroke(
-    solved: tuple[LinkLengthProblem, np.ndarray], chain: str
-) -> None:
+def test_stroke_row_multipliers_predict_a_longer_stroke(solved: tuple[StudyProblem, np.ndarray], chain: str) -> None:
     """A 1 mm longer stroke moves each active 'x <= stroke' row by 1 mm: the multipliers predict the re-solve in 5 %.
 
     The rows are the working range's and the buildable range's at the up end (the lift's buildable
@@ -134,11 +133,11 @@ def test_stroke_row_multipliers_predict_a_longer_stroke(
         m for m in sensitivity(problem, z).multipliers if m.constraint.endswith(f"{chain}.x <= stroke at the up end")
     ]
     assert rows, f"an {chain} stroke row is active at the small study's optimum"
-    predicted = sum(m.cost_per_unit_W2s for m in rows)
+    predicted = sum(m.objective_decrease_per_unit for m in rows)
     old = getattr(study.crane, chain)
     crane = dataclasses.replace(study.crane, **{chain: dataclasses.replace(old, stroke=old.stroke + 1e-3)})
     longer = dataclasses.replace(study, crane=crane)
-    p2 = LinkLengthProblem(longer, cost_scale=problem.cost_scale)
+    p2 = StudyProblem(longer, cost_scales=[problem.problems[0].cost_scale])
     z2 = solve(p2, study.initial_lengths, progress=None, z0=z).z
     actual = problem.evaluate(z).cost - p2.evaluate(z2).cost
     assert actual == pytest.approx(predicted, rel=0.05), [m.constraint for m in rows]
@@ -163,24 +162,24 @@ def test_envelope_multiplier_predicts_a_slightly_stronger_motor(tmp_path: Path) 
         mapping["bounds"]["envelope_margin"] = 0.1
         return study_from_dict(mapping, "small.yaml")
 
-    problem = LinkLengthProblem(study_with(1.0))
+    problem = StudyProblem(study_with(1.0))
     z0, phase = feasible_start(problem, problem.initial_point(problem.study.initial_lengths))
     assert phase is not None  # the raised margin makes the built crane's start infeasible
     z = solve(problem, problem.unpack(z0)[0], progress=None, z0=z0).z
     rows = [m for m in sensitivity(problem, z).multipliers if m.constraint.startswith("envelope.lift.peak_torque")]
     assert len(rows) == 1 and rows[0].unit == "%"
     step = 1e-5  # relative: 0.001 %
-    stronger_problem = LinkLengthProblem(study_with(1.0 + step), cost_scale=problem.cost_scale)
+    stronger_problem = StudyProblem(study_with(1.0 + step), cost_scales=[problem.problems[0].cost_scale])
     z2 = solve(stronger_problem, problem.unpack(z)[0], progress=None, z0=z).z
     actual = problem.evaluate(z).cost - stronger_problem.evaluate(z2).cost
-    assert actual == pytest.approx(rows[0].cost_per_unit_W2s * step * 100.0, rel=0.05)
+    assert actual == pytest.approx(rows[0].objective_decrease_per_unit * step * 100.0, rel=0.05)
 
 
 def test_an_infeasible_start_goes_through_the_feasibility_phase_and_converges(tmp_path: Path) -> None:
     """Lift Lc0 + 1.5 mm leaves x < 0 at the low end of the range: the phase repairs it, the run converges."""
     study = small_study(initial_lengths={"lift": {"L": 1.0071227324212, "Lc0": 0.0865, "Lc": 0.745},
                                          "tilt": {"L": 1.132185817991, "Lc0": 0.085, "Lc": 0.745}})  # fmt: skip
-    problem = LinkLengthProblem(study_from_dict(study, "s.yaml"))
+    problem = StudyProblem(study_from_dict(study, "s.yaml"))
     z0 = problem.initial_point(problem.study.initial_lengths)
     assert problem.max_violation(z0) > 1e-3
     z, phase = feasible_start(problem, z0)
@@ -217,13 +216,17 @@ def test_an_impossible_payload_exits_3_naming_the_limit(tmp_path: Path, capsys: 
     assert not (tmp_path / "run" / "result.json").exists()
 
 
-def test_each_length_moved_by_the_tolerance_keeps_every_nlp_row(solved: tuple[LinkLengthProblem, np.ndarray]) -> None:
+def test_each_length_moved_by_the_tolerance_keeps_every_nlp_row(solved: tuple[StudyProblem, np.ndarray]) -> None:
     """Each length moved by +-t (optimal trajectory kept): every nominal fine-grid row holds (bounds: search box)."""
     problem, z = solved
     study = problem.study
     short = dataclasses.replace(study, crane=buildable_crane(study.crane, study.build.stroke_margin))
-    fine = LinkLengthProblem(
-        short, id_path="mujoco", times=study.grid.fine_times(), cost_scale=problem.cost_scale, tightened=False
+    fine = TaskProblem(
+        short,
+        id_path="mujoco",
+        times=study.grid.fine_times(),
+        cost_scale=problem.problems[0].cost_scale,
+        tightened=False,
     )
     t = study.build.tolerance
     for k in range(6):
@@ -243,7 +246,7 @@ def test_mounting_rows_hold_the_pivots_in_their_polygons_for_every_built_design(
     space = built_space(load_crane("xs031"), along=0.02, across=0.05)
     mounting = {"lift": [list(v) for v in space.lift or ()], "tilt": [list(v) for v in space.tilt or ()]}
     study = study_from_dict(small_study(mounting=mounting), "m.yaml")
-    problem = LinkLengthProblem(study)
+    problem = StudyProblem(study)
     z = solve(problem, study.initial_lengths, progress=None).z
     lengths = problem.unpack(z)[0]
     shift = lengths.as_array() - study.initial_lengths.as_array()
@@ -252,8 +255,8 @@ def test_mounting_rows_hold_the_pivots_in_their_polygons_for_every_built_design(
     assert abs(shift[0]) == pytest.approx(0.02 - study.build.tolerance - 1e-6, abs=1e-8)
     check = check_tolerance(lambda x: polygon_margins(space, study.crane, x), lengths, study.build.tolerance)
     assert check.ok, check.summary()
-    block = next(b for b in problem.layout.blocks if b.name == "mounting")
-    ev = problem.evaluate(z)
+    block = next(b.block for b in problem.blocks if b.block.name == "mounting")
+    ev = problem.evaluate(z).tasks[0]
     from hiab_sim.study.analysis.buildable import replace_lengths
 
     jac = block.jacobian(ev, None).dxi  # type: ignore[arg-type, union-attr]
@@ -267,18 +270,20 @@ def test_mounting_rows_hold_the_pivots_in_their_polygons_for_every_built_design(
     np.testing.assert_allclose(jac, fd, atol=1e-5)
 
 
-def test_tracking_band_multipliers_predict_a_wider_band(solved: tuple[LinkLengthProblem, np.ndarray]) -> None:
+def test_tracking_band_multipliers_predict_a_wider_band(solved: tuple[StudyProblem, np.ndarray]) -> None:
     """The position-band multipliers predict the re-solved cost change of a 0.01 mm wider band within 5 %."""
     problem, z = solved
     study = problem.study
     sens = sensitivity(problem, z)
-    predicted = sum(m.cost_per_unit_W2s for m in sens.multipliers if m.constraint.startswith("tracking.position."))
+    predicted = sum(
+        m.objective_decrease_per_unit for m in sens.multipliers if m.constraint.startswith("tracking.position.")
+    )
     assert predicted > 0.0
     delta = 1e-5  # m
     wider = dataclasses.replace(
         study, tracking=dataclasses.replace(study.tracking, position=study.tracking.position + delta)
     )
-    p2 = LinkLengthProblem(wider, cost_scale=problem.cost_scale)
+    p2 = StudyProblem(wider, cost_scales=[problem.problems[0].cost_scale])
     z2 = solve(p2, study.initial_lengths, progress=None, z0=z).z
     actual = (problem.evaluate(z).cost - p2.evaluate(z2).cost) / (delta * 1e3)  # per mm
     assert actual == pytest.approx(predicted, rel=0.05)

@@ -10,6 +10,9 @@ import pytest
 
 from hiab_sim.cli import BROKEN_PIPE_STATUS, SUBCOMMANDS
 
+#: End-to-end runs of whole commands (optimize, report, Chromium, tutorials): not in the fast tier.
+pytestmark = pytest.mark.e2e
+
 
 def _into_closed_pipe(*args: str) -> subprocess.CompletedProcess[str]:
     """Run ``python -m hiab_sim ARGS`` with stdout a pipe whose reading end is already closed."""

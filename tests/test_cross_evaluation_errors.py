@@ -11,17 +11,17 @@ from test_mix import two_tasks
 
 from hiab_sim.errors import BackendUnavailableError
 from hiab_sim.study.analysis.cross_evaluation import cross_evaluation
-from hiab_sim.study.nlp.mix import MixProblem
+from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.spec.study_file import study_from_dict
 
 
 @pytest.fixture(scope="module")
-def mix() -> MixProblem:
-    return MixProblem(study_from_dict(two_tasks(), "two.yaml"))
+def mix() -> StudyProblem:
+    return StudyProblem(study_from_dict(two_tasks(), "two.yaml"))
 
 
 def test_without_casadi_cross_evaluation_raises_backend_unavailable_naming_the_extra(
-    mix: MixProblem, monkeypatch: pytest.MonkeyPatch
+    mix: StudyProblem, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """No CasADi: BackendUnavailableError naming ``pip install 'hiab-sim[ipopt]'``, not empty cells."""
     monkeypatch.setitem(sys.modules, "casadi", None)  # import casadi raises ImportError
@@ -31,7 +31,7 @@ def test_without_casadi_cross_evaluation_raises_backend_unavailable_naming_the_e
         cross_evaluation(mix, z, alone=[start, start])
 
 
-def test_a_design_outside_the_model_domain_gets_empty_cells_that_say_why(mix: MixProblem) -> None:
+def test_a_design_outside_the_model_domain_gets_empty_cells_that_say_why(mix: StudyProblem) -> None:
     """A design whose lift chain cannot close: every cell on its row is None with the model's reason."""
     pytest.importorskip("casadi")
     start = mix.study.initial_lengths

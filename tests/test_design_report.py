@@ -19,6 +19,9 @@ from hiab_sim.cli import main
 from hiab_sim.results.read import read_result
 from hiab_sim.results.schema import Result
 
+#: End-to-end runs of whole commands (optimize, report, Chromium, tutorials): not in the fast tier.
+pytestmark = pytest.mark.e2e
+
 ROOT = Path(__file__).resolve().parents[1]
 needs_chromium = pytest.mark.skipif(
     chromium() is None, reason="chromium is not installed (scripts/setup.sh installs it)"

@@ -20,7 +20,7 @@ from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import HiabSimError
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.run import run_study
 from hiab_sim.study.spec.study_file import load_study
 from hiab_sim.sweep.energy_map import (
@@ -52,12 +52,12 @@ def test_stacked_designs_match_the_per_design_path(designs: list[list[float]], s
 
 
 @pytest.fixture(scope="module")
-def optimum(tmp_path_factory: pytest.TempPathFactory) -> tuple[LinkLengthProblem, Path, dict]:  # type: ignore[type-arg]
+def optimum(tmp_path_factory: pytest.TempPathFactory) -> tuple[TaskProblem, Path, dict]:  # type: ignore[type-arg]
     """The tiny study optimised on the analytic path: its problem, result folder and result."""
     folder = tmp_path_factory.mktemp("map")
     study = load_study(write_study(folder, small_study(**TINY)))
     output = run_study(study, folder / "run", progress=None, figures=False)
-    return LinkLengthProblem(study, id_path="analytic"), output.folder, output.result
+    return TaskProblem(study, id_path="analytic"), output.folder, output.result
 
 
 def test_map_at_the_optimum_equals_the_optimisers_objective(optimum: tuple) -> None:  # type: ignore[type-arg]
@@ -76,7 +76,7 @@ def test_map_of_a_battery_energy_study_is_its_objective(tmp_path: Path) -> None:
     """With ``objective: battery_energy`` the map's objective at the optimum is the optimiser's final scaled cost."""
     study = load_study(write_study(tmp_path, {**small_study(**TINY), "objective": "battery_energy"}))
     output = run_study(study, tmp_path / "run", progress=None, figures=False)
-    problem = LinkLengthProblem(study, id_path="analytic")
+    problem = TaskProblem(study, id_path="analytic")
     base = optimum_design(output.folder)
     at = evaluate_designs(problem, base, base.xi[None])
     assert problem.objective.name == "battery_energy"
@@ -108,7 +108,7 @@ def test_no_feasible_cell_beats_the_optimum(optimum: tuple, variables: tuple[int
 def test_map_margins_equal_the_problems_constraint_rows() -> None:
     """The map's Xi-dependent margins equal the NLP's rows (min over time) at designs around the start."""
     study = load_study(None)
-    problem = LinkLengthProblem(study, id_path="analytic")
+    problem = TaskProblem(study, id_path="analytic")
     base = start_design(problem)
     rng = np.random.default_rng(4)
     xi = base.xi[None] * (1.0 + rng.uniform(-0.002, 0.002, (3, 6)))

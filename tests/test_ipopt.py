@@ -9,19 +9,19 @@ from test_mix import LOCAL_SPREAD, two_tasks
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.nlp.id_partials import id_length_partials
-from hiab_sim.study.nlp.mix import MixProblem
-from hiab_sim.study.nlp.problem import XI_SCALE
+from hiab_sim.study.nlp.problem import StudyProblem
+from hiab_sim.study.nlp.task_problem import XI_SCALE
 from hiab_sim.study.solvers.ipopt import SparseJacobian, range_pairs, task_rows, task_z
 from hiab_sim.study.solvers.slsqp import solve
 from hiab_sim.study.spec.study_file import study_from_dict
 
 
 @pytest.fixture(scope="module")
-def mix() -> MixProblem:
-    return MixProblem(study_from_dict(two_tasks(), "two.yaml"))
+def mix() -> StudyProblem:
+    return StudyProblem(study_from_dict(two_tasks(), "two.yaml"))
 
 
-def _points(mix: MixProblem, count: int) -> list[np.ndarray]:
+def _points(mix: StudyProblem, count: int) -> list[np.ndarray]:
     """Admissible points around the start: Xi moved by up to +-5 mm, every coefficient perturbed.
 
     The built crane's tilt chain uses its whole stroke, so some moves of Xi leave no working range:
@@ -42,7 +42,7 @@ def _points(mix: MixProblem, count: int) -> list[np.ndarray]:
     return out
 
 
-def test_range_pairs_add_up_to_a_constant_and_have_opposite_jacobians(mix: MixProblem) -> None:
+def test_range_pairs_add_up_to_a_constant_and_have_opposite_jacobians(mix: StudyProblem) -> None:
     """Every declared pair (a, b): g_a + g_b is the same at points with other Xi and coefficients; D g_a = -D g_b."""
     points = _points(mix, 3)
     for k, p in enumerate(mix.problems):
@@ -56,7 +56,7 @@ def test_range_pairs_add_up_to_a_constant_and_have_opposite_jacobians(mix: MixPr
         np.testing.assert_array_equal(jac[first], -jac[second])
 
 
-def test_sparse_jacobian_holds_the_dense_jacobians_rows_and_each_pair_once(mix: MixProblem) -> None:
+def test_sparse_jacobian_holds_the_dense_jacobians_rows_and_each_pair_once(mix: StudyProblem) -> None:
     """Values, rows and bounds of the IPOPT NLP against the mix's dense assembly, row for row."""
     z0, z = _points(mix, 2)
     jac = SparseJacobian(mix, z0)
@@ -85,7 +85,7 @@ def test_sparse_jacobian_holds_the_dense_jacobians_rows_and_each_pair_once(mix: 
     np.testing.assert_allclose(upper[paired] - jac.rows(z)[jac.m_eq :][paired], partners, atol=1e-12)
 
 
-def test_length_partials_on_the_stacked_analytic_path_equal_mujocos_per_design_models(mix: MixProblem) -> None:
+def test_length_partials_on_the_stacked_analytic_path_equal_mujocos_per_design_models(mix: StudyProblem) -> None:
     """dY/dXi with a per-sample payload force: 12 stacked analytic designs against 12 MuJoCo models (1e-6 relative)."""
     p = mix.problems[1]  # the task with the payload schedule
     ev = p.evaluate(task_z(mix, _points(mix, 1)[0], 1))
@@ -105,7 +105,7 @@ def test_ipopt_and_dense_slsqp_reach_the_same_design_of_the_two_task_mix() -> No
     for method in ("slsqp", "ipopt"):
         # the paper's smooth EMLA model: the drive losses' steep brake smoothing spreads local optima beyond 1e-4
         study = study_from_dict({**two_tasks(method=method), "emla": "paper"}, "two.yaml")
-        problem = MixProblem(study)
+        problem = StudyProblem(study)
         result = solve(problem, study.initial_lengths, progress=None)
         assert problem.max_violation(result.z) <= 1e-6
         out[method] = (problem.cost(result.z), problem.unpack(result.z)[0].as_array())

@@ -8,10 +8,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hiab_sim.crane.description import Crane
-from hiab_sim.machine import closure
-from hiab_sim.machine.closure_numeric import numeric_closure
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.kinematics import forward_kinematics, pin_positions
+from hiab_sim.machine.kinematics import closure
+from hiab_sim.machine.kinematics.closure_numeric import numeric_closure
+from hiab_sim.machine.kinematics.forward import forward_kinematics, pin_positions
 from hiab_sim.machine.loader import load_machine, machine_from_dict
 
 MACHINES = ("xs031", "exact")
@@ -228,7 +228,7 @@ def test_design_partials_match_the_crane_and_finite_differences(machine: Machine
     (the excavator's pivot x/y and retracted length included): central differences.
     """
     from hiab_sim.crane import mechanism
-    from hiab_sim.machine.design_partials import stroke_design_partials
+    from hiab_sim.machine.kinematics.design_partials import stroke_design_partials
 
     values = machine.design_values()
     keys = machine.variable_keys
@@ -259,7 +259,7 @@ def test_four_bar_pivot_partials_match_finite_differences() -> None:
     import dataclasses
 
     from hiab_sim.machine.description import DecisionVariable
-    from hiab_sim.machine.design_partials import stroke_design_partials
+    from hiab_sim.machine.kinematics.design_partials import stroke_design_partials
 
     base = load_machine("exact")
     bucket = base.chain("bucket")

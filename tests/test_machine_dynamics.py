@@ -20,14 +20,14 @@ from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.machine import closure
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.dynamics_mujoco import MujocoMachineDynamics
-from hiab_sim.machine.dynamics_newton_euler import NewtonEulerInverseDynamics
-from hiab_sim.machine.dynamics_paths import MACHINE_ID_PATHS, make_machine_dynamics
-from hiab_sim.machine.dynamics_tree import MachineActuatorSamples
+from hiab_sim.machine.dynamics.mjcf_build import SimulationExtras, build_machine_model
+from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
+from hiab_sim.machine.dynamics.newton_euler import NewtonEulerInverseDynamics
+from hiab_sim.machine.dynamics.paths import MACHINE_ID_PATHS, make_machine_dynamics
+from hiab_sim.machine.dynamics.tree import MachineActuatorSamples
+from hiab_sim.machine.kinematics import closure
 from hiab_sim.machine.loader import load_machine
-from hiab_sim.machine.mjcf_build import SimulationExtras, build_machine_model
 from hiab_sim.machine.parts import Pose, rot_z
 from hiab_sim.model.drives import SlideDrives
 from hiab_sim.model.mjcf import build_model
@@ -116,7 +116,7 @@ def test_both_paths_agree_on_random_states(machine: Machine) -> None:
 
 @MACHINES
 def test_strokes_equal_the_machine_closure(machine: Machine) -> None:
-    """The dynamics' own closed-form closure gives the strokes of :mod:`hiab_sim.machine.closure` (1e-12 m)."""
+    """The dynamics' own closed-form closure gives the strokes of the machine kinematics' closure (1e-12 m)."""
     q, dq, ddq = random_states(machine, 50, seed=9)
     out = NewtonEulerInverseDynamics(machine)(q, dq, ddq)
     for k, chain in enumerate(machine.chains):

@@ -24,11 +24,11 @@ from test_machine_dynamics_machines import (
 )
 
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.dynamics_mujoco import MujocoMachineDynamics
-from hiab_sim.machine.dynamics_newton_euler import NewtonEulerInverseDynamics
-from hiab_sim.machine.dynamics_tree import PinForces, machine_tree
+from hiab_sim.machine.dynamics.mjcf_build import build_machine_model
+from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
+from hiab_sim.machine.dynamics.newton_euler import NewtonEulerInverseDynamics
+from hiab_sim.machine.dynamics.tree import PinForces, machine_tree
 from hiab_sim.machine.loader import load_machine
-from hiab_sim.machine.mjcf_build import build_machine_model
 from hiab_sim.machine.parts import Pose, rot_z
 
 XS031 = load_machine("xs031")

@@ -16,7 +16,7 @@ import numpy as np
 
 from hiab_sim.machine.chains import Actuator, Chain, Linkage, Pivot
 from hiab_sim.machine.description import Link, Machine
-from hiab_sim.machine.dynamics_newton_euler import NewtonEulerInverseDynamics
+from hiab_sim.machine.dynamics.newton_euler import NewtonEulerInverseDynamics
 from hiab_sim.machine.parts import Pose, RigidBody
 
 #: Retracted pin-to-pin lengths [m]: the reference's lengths at the joint ends that retract each EMLA.

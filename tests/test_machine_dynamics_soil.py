@@ -8,7 +8,13 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.machine.soil import SoilProperties, blade_force, failure_plane_angle, force_on_plane, tool_force_world
+from hiab_sim.machine.dynamics.soil import (
+    SoilProperties,
+    blade_force,
+    failure_plane_angle,
+    force_on_plane,
+    tool_force_world,
+)
 
 G = 9.81
 

@@ -10,8 +10,8 @@ import yaml
 
 from hiab_sim.emla.config import EmlaParams, emla_set_from_mapping
 from hiab_sim.emla.pmsm import dq_voltages
-from hiab_sim.machine import closure
-from hiab_sim.machine.assembly import check_machine, usable_stroke
+from hiab_sim.machine.kinematics import closure
+from hiab_sim.machine.kinematics.assembly import check_machine, usable_stroke
 from hiab_sim.machine.loader import PRESETS, load_machine
 
 #: The source's check angles and its polynomial-fit actuator lengths (shared/reference/exact-excavator-arm.yaml).

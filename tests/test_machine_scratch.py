@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from hiab_sim.cli import main
-from hiab_sim.machine.kinematics import forward_kinematics
+from hiab_sim.machine.kinematics.forward import forward_kinematics
 from hiab_sim.machine.loader import load_machine
 
 

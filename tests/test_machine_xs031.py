@@ -9,9 +9,9 @@ from hiab_sim.crane import kinematics as crane_kinematics
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.to_machine import machine_from_crane
-from hiab_sim.machine import closure
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.kinematics import forward_kinematics
+from hiab_sim.machine.kinematics import closure
+from hiab_sim.machine.kinematics.forward import forward_kinematics
 from hiab_sim.machine.loader import load_machine
 
 
@@ -113,7 +113,7 @@ def test_design_scales_actuator_bodies_as_the_crane_does(machine: Machine, crane
 
 def test_reachable_range_and_usable_stroke_match_the_crane(machine: Machine, crane: Crane) -> None:
     """The reachable joint range found by scanning equals crane/mechanism.py's closed form to 1e-12."""
-    from hiab_sim.machine.assembly import reachable_joint_range
+    from hiab_sim.machine.kinematics.assembly import reachable_joint_range
 
     for old, new in zip(crane.chains, machine.chains[:2], strict=True):
         want = mechanism.reachable_joint_range(old, old.default_lengths)

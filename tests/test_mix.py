@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from test_study_small import small_study
 
-from hiab_sim.study.nlp.mix import MixProblem
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.problem import StudyProblem
+from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.run import run_study
 from hiab_sim.study.solvers.ipopt import SparseJacobian, task_rows
 from hiab_sim.study.spec.payload import Payload
@@ -50,11 +50,11 @@ def study() -> Study:
 
 
 @pytest.fixture(scope="module")
-def mix(study: Study) -> MixProblem:
-    return MixProblem(study)
+def mix(study: Study) -> StudyProblem:
+    return StudyProblem(study)
 
 
-def _point(mix: MixProblem, seed: int = 1) -> np.ndarray:
+def _point(mix: StudyProblem, seed: int = 1) -> np.ndarray:
     """A point near the start: the built crane's Xi, every task's coefficients perturbed."""
     rng = np.random.default_rng(seed)
     z = mix.initial_point(mix.study.initial_lengths)
@@ -62,12 +62,12 @@ def _point(mix: MixProblem, seed: int = 1) -> np.ndarray:
     return z
 
 
-def test_mix_is_the_weighted_sum_and_the_stack_of_independently_built_tasks(study: Study, mix: MixProblem) -> None:
-    """Cost = sum w_k f_k and rows = each task's rows, against one LinkLengthProblem built per task."""
+def test_mix_is_the_weighted_sum_and_the_stack_of_independently_built_tasks(study: Study, mix: StudyProblem) -> None:
+    """Cost = sum w_k f_k and rows = each task's rows, against one TaskProblem built per task."""
     z = _point(mix)
     cost, rows = 0.0, []
     for k, task in enumerate(study.tasks):
-        alone = LinkLengthProblem(study, task=task)
+        alone = TaskProblem(study, task=task)
         zk = np.concatenate([z[:6], z[mix.offsets[k] : mix.offsets[k] + alone.n_c]])
         cost += task.weight * alone.evaluate(zk).cost
         rows.append(alone.constraints(zk)[mix.rows[k]])
@@ -78,7 +78,7 @@ def test_mix_is_the_weighted_sum_and_the_stack_of_independently_built_tasks(stud
     assert len(mix.constraint_names) == len(mix.constraints(z)) == len(mix.clearance)
 
 
-def test_mix_gradient_and_jacobians_match_central_differences(mix: MixProblem) -> None:
+def test_mix_gradient_and_jacobians_match_central_differences(mix: StudyProblem) -> None:
     """d(cost)/dz, D g/dz and D e/dz of the assembled mix equal central differences column by column."""
     z = _point(mix, 2)
     grad, jac, jeq = mix.cost_gradient(z), mix.constraints_jacobian(z), mix.equalities_jacobian(z)
@@ -92,7 +92,7 @@ def test_mix_gradient_and_jacobians_match_central_differences(mix: MixProblem) -
         np.testing.assert_allclose((mix.equalities(up) - mix.equalities(down)) / (2 * h), jeq[:, i], atol=1e-6)
 
 
-def test_sparsity_pattern_holds_every_nonzero_and_tasks_do_not_couple(mix: MixProblem) -> None:
+def test_sparsity_pattern_holds_every_nonzero_and_tasks_do_not_couple(mix: StudyProblem) -> None:
     """IPOPT's pattern covers every nonzero of D g/dz; a task's rows have no entries in another task's columns."""
     z = _point(mix, 3)
     sparse_jac = SparseJacobian(mix, z)
@@ -108,10 +108,10 @@ def test_sparsity_pattern_holds_every_nonzero_and_tasks_do_not_couple(mix: MixPr
     assert pattern.mean() < 0.3  # the structure IPOPT exploits
 
 
-def test_study_level_payload_schedule_enters_the_id_as_weight_and_inertia(study: Study, mix: MixProblem) -> None:
+def test_study_level_payload_schedule_enters_the_id_as_weight_and_inertia(study: Study, mix: StudyProblem) -> None:
     """The scheduled task's actuators do extra work -F . v_tcp exactly while the load is held, zero outside."""
     task, p = study.tasks[1], mix.problems[1]
-    empty = LinkLengthProblem(study, task=type(task)(task.name, task.weight, task.reference, Payload(0.0)))
+    empty = TaskProblem(study, task=type(task)(task.name, task.weight, task.reference, Payload(0.0)))
     z = _point(mix, 4)
     zk = np.concatenate([z[:6], z[mix.offsets[1] :]])
     loaded, free = p.evaluate(zk), empty.evaluate(zk)
@@ -128,7 +128,7 @@ def test_study_level_payload_schedule_enters_the_id_as_weight_and_inertia(study:
 def test_single_task_study_is_one_link_length_problem() -> None:
     """A study with one task builds today's problem: same grid, spline and start as before the tasks loader."""
     study = study_from_dict(small_study(), "small.yaml")
-    problem = LinkLengthProblem(study)
+    problem = TaskProblem(study)
     np.testing.assert_array_equal(problem.times, np.linspace(0.0, 6.25, 13))
     assert problem.basis.n == 16 and problem.tcp_force is None
 
@@ -217,7 +217,7 @@ def test_an_infeasible_mix_start_goes_through_the_feasibility_phase_and_converge
     data["initial_lengths"] = {"lift": {"L": 1.0071227324212, "Lc0": 0.0865, "Lc": 0.745},
                                "tilt": {"L": 1.132185817991, "Lc0": 0.085, "Lc": 0.745}}  # fmt: skip
     study = study_from_dict(data, tmp_path / "two.yaml")
-    problem = MixProblem(study)
+    problem = StudyProblem(study)
     z0 = problem.initial_point(study.initial_lengths)
     assert problem.max_violation(z0) > 1e-3
     z, phase = feasible_start(problem, z0)
@@ -254,15 +254,15 @@ def test_each_task_reports_its_thermal_state_over_its_own_cycle_and_the_hourly_r
     The mix's hourly RMS torque (weights as cycles per hour) sums w_k rms_k^2 P_k, so it must not
     depend on the duty the tasks' own RMS values were taken over.
     """
+    from hiab_sim.study.report.design_check import design_summary, fine_problem
     from hiab_sim.study.report.energy_section import energy_report, study_duty, weighted_energy_report
-    from hiab_sim.study.report.result_folder import design_summary, fine_problem
 
     rms, hourly = {}, {}
     for per_hour in (60.0, 120.0):
         data = two_tasks()
         data["tasks"][1]["reference"]["duration"] = 7.5
         data["duty"] = {"cycles_per_hour": per_hour}
-        mix = MixProblem(study_from_dict(data, "two.yaml"))
+        mix = StudyProblem(study_from_dict(data, "two.yaml"))
         z = mix.initial_point(mix.study.initial_lengths)
         reports, periods = [], []
         for k, p in enumerate(mix.problems):

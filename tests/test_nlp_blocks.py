@@ -8,9 +8,9 @@ from test_study_small import small_study
 
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.nlp.blocks import ObjectiveBound
-from hiab_sim.study.nlp.interface import ConstraintBlock, DenseRows, SamplePartials, SampleState
+from hiab_sim.study.nlp.interface import ConstraintBlock, DenseRows, Relaxation, SamplePartials, SampleState
 from hiab_sim.study.nlp.objectives import SquaredPowerCost, make_objective
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.solvers.slsqp import start_points
 from hiab_sim.study.spec.study_file import study_from_dict
 
@@ -42,15 +42,19 @@ class RmsForceLimit(ConstraintBlock):
         dxi = d_f @ partials.id_xi[:, 0, :]  # (6,)
         return DenseRows(dq=dq[None], dxi=dxi[None])
 
+    def relaxation(self, values: np.ndarray) -> Relaxation:
+        """Per N of the limit: the row moves by RMS / limit^2 = (1 - g) / limit."""
+        return Relaxation(("N",), (1.0 - np.asarray(values)) / self.limit)
 
-class WithRmsBlock(LinkLengthProblem):
+
+class WithRmsBlock(TaskProblem):
     """The small study's NLP with one more block: the only edit is the block list."""
 
     def _build_blocks(self) -> list[ConstraintBlock]:
         return [*super()._build_blocks(), RmsForceLimit(limit=60e3)]
 
 
-class WithCostBound(LinkLengthProblem):
+class WithCostBound(TaskProblem):
     """The small study's NLP with its own cost held below a bound (an epsilon constraint)."""
 
     def _build_blocks(self) -> list[ConstraintBlock]:
@@ -58,16 +62,16 @@ class WithCostBound(LinkLengthProblem):
         return [*super()._build_blocks(), ObjectiveBound(cost, bound=5e5, scale=1e5)]
 
 
-def _point(problem: LinkLengthProblem) -> np.ndarray:
+def _point(problem: TaskProblem) -> np.ndarray:
     """A feasible start other than the built crane's (drawn on the plain NLP), with perturbed coefficients."""
     rng = np.random.default_rng(5)
-    z = problem.initial_point(start_points(LinkLengthProblem(STUDY, id_path="analytic"), 2)[1])
+    z = problem.initial_point(start_points(TaskProblem(STUDY, id_path="analytic"), 2)[1])
     return z + np.concatenate([np.zeros(6), rng.normal(0.0, 0.02, problem.n_c)])
 
 
 def test_every_row_belongs_to_one_named_block() -> None:
     """Block slices tile the rows in order, each row is named after its block, and values match names."""
-    problem = LinkLengthProblem(STUDY, id_path="analytic")
+    problem = TaskProblem(STUDY, id_path="analytic")
     ev = problem.evaluate(problem.initial_point(STUDY.initial_lengths))
     layout = problem.layout
     stop = 0
@@ -82,15 +86,23 @@ def test_every_row_belongs_to_one_named_block() -> None:
     assert sum(len(rows) for rows in named.values()) == len(ev.constraints)
 
 
-def test_clearance_belongs_to_the_working_range_block_only() -> None:
-    """Solver rows plus the clearance are the nominal rows; only working-range rows (nominal, buildable) carry it."""
-    tight = LinkLengthProblem(STUDY, id_path="analytic")
-    nominal = {name: values for name, values in tight.layout.split(tight.clearance).items() if np.any(values)}
-    assert list(nominal) == ["working_range", "buildable_range"]
+def test_clearance_only_tightens_rows_of_xi_alone_and_adds_back_to_the_nominal_rows() -> None:
+    """The clearance is >= 0, only on rows independent of the trajectory, and adds back to the nominal rows.
+
+    Solver rows plus the clearance are the nominal problem's rows, for every block the nominal problem has too.
+    """
+    tight = TaskProblem(STUDY, id_path="analytic")
     z = tight.initial_point(STUDY.initial_lengths)
-    loose = LinkLengthProblem(STUDY, id_path="analytic", tightened=False)
-    rows = tight.layout.slices["working_range"]
-    np.testing.assert_allclose(tight.margins(z)[rows], loose.constraints(z)[rows], rtol=0, atol=1e-15)
+    assert np.all(tight.clearance >= 0.0) and np.any(tight.clearance > 0.0)
+    jac = tight.constraints_jacobian(z)
+    cleared = tight.clearance > 0.0
+    assert np.all(jac[cleared][:, tight.n_xi :] == 0.0)  # the cleared rows do not move with the trajectory
+    loose = TaskProblem(STUDY, id_path="analytic", tightened=False)
+    for block in tight.layout.blocks:
+        if block.name not in loose.layout.slices or not np.any(tight.layout.split(tight.clearance)[block.name]):
+            continue
+        rows, nominal = tight.layout.slices[block.name], loose.layout.slices[block.name]
+        np.testing.assert_allclose(tight.margins(z)[rows], loose.constraints(z)[nominal], rtol=0, atol=1e-15)
 
 
 @pytest.mark.parametrize(
@@ -98,7 +110,7 @@ def test_clearance_belongs_to_the_working_range_block_only() -> None:
     [(WithRmsBlock, "rms_force.lift <= limit"), (WithCostBound, "bound.costf2 <= 500000 W^2 s")],
     ids=["rms_force", "cost_bound"],
 )
-def test_an_added_integral_block_gets_an_exact_jacobian(kind: type[LinkLengthProblem], last_row: str) -> None:
+def test_an_added_integral_block_gets_an_exact_jacobian(kind: type[TaskProblem], last_row: str) -> None:
     """A row that depends on every sample (RMS force, a cost bound) enters D g / dz and matches central differences."""
     problem = kind(STUDY, id_path="analytic")
     assert problem.constraint_names[-1] == last_row
@@ -113,7 +125,7 @@ def test_an_added_integral_block_gets_an_exact_jacobian(kind: type[LinkLengthPro
         fd[i] = (problem.constraints(up)[-1] - problem.constraints(down)[-1]) / (2 * h)
     np.testing.assert_allclose(row, fd, atol=1e-6 * np.max(np.abs(fd)), rtol=1e-4)
     # the other rows are those of the plain problem
-    plain = LinkLengthProblem(STUDY, id_path="analytic")
+    plain = TaskProblem(STUDY, id_path="analytic")
     np.testing.assert_array_equal(problem.constraints(z)[:-1], plain.constraints(z))
 
 
@@ -126,6 +138,6 @@ def test_cost_bound_row_is_the_bound_less_the_problem_cost() -> None:
 
 def test_unknown_objective_names_the_field() -> None:
     """An objective name outside the registry is rejected with the field ``objective``."""
-    problem = LinkLengthProblem(STUDY, id_path="analytic")
+    problem = TaskProblem(STUDY, id_path="analytic")
     with pytest.raises(InvalidInputError, match="objective"):
         make_objective("fastest", problem.emlas, problem.dt)

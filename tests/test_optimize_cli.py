@@ -47,7 +47,7 @@ def _key_paths(data: object, prefix: str = "") -> set[str]:
 def test_optimum_is_feasible_better_and_reported(solved: Path) -> None:
     """Success, max violation <= 1e-6, lower energy, the renderer's keys, and the figures."""
     r = read_result(solved)
-    assert r.crane == "xs031" and r.schema_version == SCHEMA_VERSION
+    assert r.crane == "xs031" and r.schema_version == SCHEMA_VERSION == 2
     assert r.solver.success and r.solver.max_violation_scaled <= 1e-6
     assert r.optimal.net_electrical_energy_J < r.initial.net_electrical_energy_J
     assert r.optimal.collocation_cost_W2s is not None and r.initial.collocation_cost_W2s is not None

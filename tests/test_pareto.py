@@ -11,21 +11,21 @@ from test_study_small import small_study, write_study
 from test_sweep import TINY
 
 from hiab_sim.cli import main
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.solvers.slsqp import SolveResult, solve
 from hiab_sim.study.spec.study_file import study_from_dict
 from hiab_sim.sweep.pareto import EpsilonProblem, criterion, pareto_front, samples_of_points
 
 
 @pytest.fixture(scope="module")
-def plain() -> tuple[LinkLengthProblem, SolveResult]:
+def plain() -> tuple[TaskProblem, SolveResult]:
     """The tiny study (analytic ID) and its plain optimum."""
     study = study_from_dict(small_study(**TINY), "tiny.yaml")
-    problem = LinkLengthProblem(study)
+    problem = TaskProblem(study)
     return problem, solve(problem, study.initial_lengths, progress=None)
 
 
-def test_stacked_samples_equal_the_problems_own_forces(plain: tuple[LinkLengthProblem, SolveResult]) -> None:
+def test_stacked_samples_equal_the_problems_own_forces(plain: tuple[TaskProblem, SolveResult]) -> None:
     """The criterion's forces (designs stacked on the analytic path) equal the NLP's ID forces at start and optimum."""
     problem, result = plain
     for z in (result.z0, result.z):
@@ -35,7 +35,7 @@ def test_stacked_samples_equal_the_problems_own_forces(plain: tuple[LinkLengthPr
         np.testing.assert_array_equal(stacked[0], stacked[1])
 
 
-def test_inactive_epsilon_reproduces_the_plain_optimum(plain: tuple[LinkLengthProblem, SolveResult]) -> None:
+def test_inactive_epsilon_reproduces_the_plain_optimum(plain: tuple[TaskProblem, SolveResult]) -> None:
     """With epsilon far above the optimum's criterion, the epsilon problem from the start finds the plain optimum."""
     problem, result = plain
     c0 = criterion(problem, result.z, "rms_torque")
@@ -46,12 +46,12 @@ def test_inactive_epsilon_reproduces_the_plain_optimum(plain: tuple[LinkLengthPr
 
 
 @pytest.mark.e2e
-def test_front_is_monotone_from_the_plain_optimum(plain: tuple[LinkLengthProblem, SolveResult]) -> None:
+def test_front_is_monotone_from_the_plain_optimum(plain: tuple[TaskProblem, SolveResult]) -> None:
     """A lower peak force never comes with a lower objective; each point holds its epsilon; it starts at the optimum."""
     problem, result = plain
     front = pareto_front(problem, result.z, "peak_force", 3)
     assert all(p.accepted for p in front), [p.message for p in front]
-    assert front[0].cost == problem.evaluate(result.z).cost
+    assert front[0].objective_value == problem.evaluate(result.z).cost
     for previous, point in itertools.pairwise(front):
         assert point.epsilon < previous.epsilon
         assert point.criterion <= point.epsilon * (1.0 + 1e-6)

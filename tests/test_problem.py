@@ -12,8 +12,8 @@ from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla import electrical_power, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study.nlp import problem as problem_module
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp import task_problem as problem_module
+from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.solvers.slsqp import START_TOLERANCE, check_start, start_points
 from hiab_sim.study.spec.study_file import load_study, study_from_dict
 
@@ -21,12 +21,12 @@ STUDY = study_from_dict(small_study(), "small.yaml")
 
 
 @pytest.fixture(scope="module", params=["analytic", "mujoco"])
-def problem(request: pytest.FixtureRequest) -> LinkLengthProblem:
+def problem(request: pytest.FixtureRequest) -> TaskProblem:
     """The small study's NLP on either inverse-dynamics path."""
-    return LinkLengthProblem(STUDY, id_path=request.param)
+    return TaskProblem(STUDY, id_path=request.param)
 
 
-def _point(problem: LinkLengthProblem) -> np.ndarray:
+def _point(problem: TaskProblem) -> np.ndarray:
     rng = np.random.default_rng(3)
     z = problem.initial_point(start_points(problem, 2)[1])
     return z + np.concatenate([np.zeros(6), rng.normal(0.0, 0.02, problem.n_c)])
@@ -39,7 +39,7 @@ def _central(fun, z: np.ndarray, i: int, h: float) -> np.ndarray:  # type: ignor
     return (np.asarray(fun(zp)) - np.asarray(fun(zm))) / (2.0 * h)
 
 
-def test_cost_gradient_matches_finite_differences(problem: LinkLengthProblem) -> None:
+def test_cost_gradient_matches_finite_differences(problem: TaskProblem) -> None:
     """D f / dz (ID partials batched, chained through the B-spline matrices) equals central differences."""
     z = _point(problem)
     grad = problem.cost_gradient(z)
@@ -47,7 +47,7 @@ def test_cost_gradient_matches_finite_differences(problem: LinkLengthProblem) ->
     np.testing.assert_allclose(grad, fd, atol=1e-5 * np.max(np.abs(grad)), rtol=1e-4)
 
 
-def test_constraint_jacobian_matches_finite_differences(problem: LinkLengthProblem) -> None:
+def test_constraint_jacobian_matches_finite_differences(problem: TaskProblem) -> None:
     """D g / dz for every constraint row, Xi and spline-coefficient columns alike."""
     z = _point(problem)
     jac = problem.constraints_jacobian(z)
@@ -57,7 +57,7 @@ def test_constraint_jacobian_matches_finite_differences(problem: LinkLengthProbl
         np.testing.assert_allclose(jac[:, i], fd, atol=2e-5 * np.max(np.abs(jac[:, i])) + 1e-7, err_msg=f"column {i}")
 
 
-def test_equality_jacobian_is_exact(problem: LinkLengthProblem) -> None:
+def test_equality_jacobian_is_exact(problem: TaskProblem) -> None:
     """The rest-to-rest equalities are linear in c; their jacobian reproduces them."""
     z = _point(problem)
     jac = problem.equalities_jacobian(z)
@@ -72,7 +72,7 @@ def test_cost_equals_a_quadrature_of_power_from_the_other_id_path(path: str) -> 
     The joint samples at z are taken from the problem; the forces are recomputed by calling the other
     inverse-dynamics implementation directly, and Dt is the grid's spacing (6.25 s / 12 intervals).
     """
-    problem = LinkLengthProblem(STUDY, id_path=path)
+    problem = TaskProblem(STUDY, id_path=path)
     ev = problem.evaluate(_point(problem))
     joints = JointSamples(ev.joints.position, ev.joints.velocity, ev.joints.acceleration)
     if path == "analytic":
@@ -94,7 +94,7 @@ def test_default_collocation_grid_has_26_points_a_quarter_second_apart() -> None
     study = load_study()
     times = study.grid.times()
     assert len(times) == 26 and times[0] == 0.0 and times[-1] == 6.25
-    problem = LinkLengthProblem(study, id_path="analytic", cost_scale=1.0)
+    problem = TaskProblem(study, id_path="analytic", cost_scale=1.0)
     assert problem.dt == 0.25
     np.testing.assert_allclose(np.diff(problem.times), 0.25, rtol=0, atol=1e-15)
 
@@ -112,7 +112,7 @@ def test_cost_of_known_powers_matches_a_hand_computation(monkeypatch: pytest.Mon
         return next(powers)
 
     monkeypatch.setattr(problem_module, "electrical_power", fake_power)
-    problem = LinkLengthProblem(STUDY, id_path="analytic", times=np.linspace(0.0, 6.25, 26), cost_scale=1.0)
+    problem = TaskProblem(STUDY, id_path="analytic", times=np.linspace(0.0, 6.25, 26), cost_scale=1.0)
     powers = iter([np.arange(26.0), np.full(26, 100.0), np.full(26, -100.0)])
     ev = problem.evaluate(problem.initial_point(STUDY.initial_lengths))
     assert ev.cost == 690.625
@@ -125,7 +125,7 @@ def test_built_crane_is_a_start_with_no_violation() -> None:
 
     The optimiser's working-range clearance is not a constraint of the start.
     """
-    problem = LinkLengthProblem(STUDY, id_path="analytic")
+    problem = TaskProblem(STUDY, id_path="analytic")
     z0 = problem.initial_point(STUDY.initial_lengths)
     assert problem.max_violation(z0) <= 1e-9
     assert problem.margins(z0).min() >= -1e-12
@@ -135,7 +135,7 @@ def test_built_crane_is_a_start_with_no_violation() -> None:
 
 def test_start_violating_a_constraint_names_it() -> None:
     """A start whose stroke leaves [0, stroke] is rejected with the constraint's name."""
-    problem = LinkLengthProblem(STUDY, id_path="analytic")
+    problem = TaskProblem(STUDY, id_path="analytic")
     bad = LinkLengths(ChainLengths(1.0071227324212, 0.2, 0.745), STUDY.initial_lengths.tilt)
     with pytest.raises(InvalidInputError, match=r"initial_lengths .*lift"):
         check_start(problem, problem.initial_point(bad))
@@ -143,7 +143,7 @@ def test_start_violating_a_constraint_names_it() -> None:
 
 def test_start_violating_a_constraint_by_a_small_real_amount_is_rejected() -> None:
     """Lc0 + 10 um makes the lift stroke -1e-5 m at the low end of the working range: -1e-4 scaled, rejected."""
-    problem = LinkLengthProblem(STUDY, id_path="analytic")
+    problem = TaskProblem(STUDY, id_path="analytic")
     built = STUDY.initial_lengths.lift
     bad = LinkLengths(ChainLengths(built.L, built.Lc0 + 1e-5, built.Lc), STUDY.initial_lengths.tilt)
     z = problem.initial_point(bad)

@@ -297,3 +297,45 @@ def test_a_schema_1_file_loads_with_the_renamed_energy_keys() -> None:
     assert result.initial.drawn_energy_per_drive_sum_J == 14.0
     written = result.to_json()
     assert "drawn_energy_without_regeneration_J" not in json.dumps(written)
+
+
+def test_a_schema_2_file_with_either_set_of_old_names_reads_under_the_new_ones() -> None:
+    """Files written as version 2 before both renamings met carry one set of old keys: each is renamed."""
+    data = {**_minimal_result_json(), "schema_version": 2}
+    result = Result.from_json(data)
+    assert result.initial.drawn_energy_summed_drives_J == 12.0
+    assert result.initial.drawn_energy_per_drive_sum_J == 14.0
+
+
+def test_a_schema_1_sensitivity_of_a_battery_study_reads_with_its_keys_renamed_and_its_unit_joules() -> None:
+    """Schema 1 stored the battery energy [J] as ``sensitivity.cost_W2s``: it reads as objective_value in J."""
+    data = {
+        **_minimal_result_json(),
+        "energy": None,
+        "sensitivity": {
+            "cost_W2s": 5153.4,
+            "active_tolerance": 1e-6,
+            "kkt_residual": 2e-8,
+            "multipliers": [
+                {
+                    "constraint": "tracking.position.y_tcp",
+                    "multiplier": 1e-3,
+                    "unit": "mm",
+                    "cost_per_unit_W2s": 7.3,
+                    "percent_per_unit": 0.142,
+                    "rows": 10,
+                }
+            ],
+        },
+    }
+    data.pop("energy")
+    as_costf2 = Result.from_json(data).sensitivity
+    assert as_costf2 is not None and as_costf2.objective == "costf2" and as_costf2.objective_unit == "W^2 s"
+    data["energy"] = {"objective": "battery_energy"}
+    from hiab_sim.results.schema import upgrade
+
+    upgraded = upgrade(data)
+    assert upgraded["schema_version"] == 2 and upgraded["sensitivity"]["objective_unit"] == "J"
+    assert upgraded["sensitivity"]["objective_value"] == 5153.4
+    assert upgraded["sensitivity"]["multipliers"][0]["objective_decrease_per_unit"] == 7.3
+    assert "cost_W2s" not in upgraded["sensitivity"] and data["sensitivity"]["cost_W2s"] == 5153.4  # input untouched

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from hiab_sim.crane.kinematics import tcp_position
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.solvers.slsqp import START_TOLERANCE, check_start
 from hiab_sim.study.spec.study_file import load_study
 
@@ -34,7 +34,7 @@ def test_shipped_study_starts_feasible_on_its_documented_start(path: Path) -> No
     expected = STARTS.get(path.stem)
     start = study.crane.default_lengths.as_array() if expected is None else np.array(expected)
     np.testing.assert_array_equal(study.initial_lengths.as_array(), start)
-    problem = LinkLengthProblem(study)
+    problem = TaskProblem(study)
     z0 = problem.initial_point(study.initial_lengths)
     check_start(problem, z0)
     assert problem.max_violation(z0) <= START_TOLERANCE
@@ -49,7 +49,7 @@ def test_shipped_study_reference_is_tracked_by_its_start(path: Path) -> None:
     prescribed telescope extension xt2 within tracking.position x collocation_fraction.
     """
     study = load_study(path)
-    problem = LinkLengthProblem(study)
+    problem = TaskProblem(study)
     ev = problem.evaluate(problem.initial_point(study.initial_lengths))
     theta1, theta2, xt2 = ev.joints.position.T
     tcp = tcp_position(study.crane, theta1, theta2, xt2)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -11,9 +12,10 @@ import pytest
 import yaml
 
 from hiab_sim.emla.battery import rest_battery_energy
+from hiab_sim.emla.config import EmlaSet
 from hiab_sim.emla.duty_energy import drive_duty
 from hiab_sim.resources import locate
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.report.energy_section import design_energy
 from hiab_sim.study.run import run_study
 from hiab_sim.study.spec.study_file import load_study, study_from_dict
@@ -32,9 +34,9 @@ def _default_study(**duty: Any) -> dict[str, Any]:
     return data
 
 
-def _start_problem(data: dict[str, Any]) -> tuple[LinkLengthProblem, np.ndarray]:
+def _start_problem(data: dict[str, Any]) -> tuple[TaskProblem, np.ndarray]:
     study = study_from_dict(data, locate("xs031_spiral", "study"))
-    problem = LinkLengthProblem(study, tightened=False)
+    problem = TaskProblem(study, tightened=False)
     return problem, problem.initial_point(study.initial_lengths)
 
 
@@ -102,7 +104,7 @@ def test_a_brake_too_weak_for_the_pose_is_reported_infeasible_naming_the_motor(t
     data = _default_study(hold="brake")
     data["emla"] = str(tmp_path / "weak.yaml")
     study = study_from_dict(data, locate("xs031_spiral", "study"))
-    problem = LinkLengthProblem(study, tightened=False)
+    problem = TaskProblem(study, tightened=False)
     ev = problem.evaluate(problem.initial_point(study.initial_lengths))
     duty = design_energy(problem, ev).duty
     assert duty is not None
@@ -113,7 +115,7 @@ def test_a_brake_too_weak_for_the_pose_is_reported_infeasible_naming_the_motor(t
 def test_study_gradients_with_hot_windings_and_the_hold_match_finite_differences(objective: str) -> None:
     """Objective and thermal-row derivatives w.r.t. Xi and spline coefficients agree with central differences."""
     study = load_study("xs031_spiral")
-    problem = LinkLengthProblem(study, objective=objective)
+    problem = TaskProblem(study, objective=objective)
     z = problem.initial_point(study.initial_lengths)
     grad, jac = problem.cost_gradient(z), problem.constraints_jacobian(z)
     rows = [i for i, n in enumerate(problem.constraint_names) if n.startswith("thermal")]
@@ -131,7 +133,7 @@ def test_study_gradients_with_hot_windings_and_the_hold_match_finite_differences
 def test_the_battery_objective_adds_the_rest_through_the_motoring_branches() -> None:
     """With a duty model the battery objective is the cycle's smooth energy plus sum_i E_rest,i / (eta_inv eta_dis)."""
     study = load_study("xs031_spiral")
-    problem = LinkLengthProblem(study, objective="battery_energy")
+    problem = TaskProblem(study, objective="battery_energy")
     ev = problem.evaluate(problem.initial_point(study.initial_lengths))
     from hiab_sim.emla import battery_energy
 
@@ -159,7 +161,7 @@ def test_the_hydraulic_section_compares_every_variant_with_the_emla_cycle_at_the
     from hiab_sim.study.report.energy_section import energy_report, hydraulic_report
 
     study = load_study("xs031_spiral")
-    fine = LinkLengthProblem(study, times=study.grid.fine_times(), tightened=False, cost_scale=1.0)
+    fine = TaskProblem(study, times=study.grid.fine_times(), tightened=False, cost_scale=1.0)
     ev = fine.evaluate(fine.initial_point(study.initial_lengths))
     energy = energy_report(fine, ev, ev)
     section = hydraulic_report(fine, ev, ev, energy)
@@ -177,7 +179,7 @@ def test_the_hydraulic_section_compares_every_variant_with_the_emla_cycle_at_the
 def test_brake_rows_hold_the_pose_and_their_partials_match_finite_differences() -> None:
     """brake.<name> holding torque = 1 - max |f_x / k| / M_4 at the start, its derivative by central differences."""
     study = load_study("xs031_spiral")
-    problem = LinkLengthProblem(study)
+    problem = TaskProblem(study)
     z = problem.initial_point(study.initial_lengths)
     names = problem.constraint_names
     rows = [i for i, n in enumerate(names) if n.startswith("brake.")]
@@ -195,3 +197,22 @@ def test_brake_rows_hold_the_pose_and_their_partials_match_finite_differences() 
         zm[j] -= h
         fd = (problem.constraints(zp)[rows] - problem.constraints(zm)[rows]) / (2 * h)
         assert jac[rows, j] == pytest.approx(fd, rel=1e-5, abs=1e-8)
+
+
+def test_brake_rows_relaxation_is_the_rows_move_when_every_holding_torque_grows_one_percent() -> None:
+    """The brake block's relaxation (per % of M_4) equals the row change of a problem with 1.01 M_4 brakes."""
+    study = load_study("xs031_spiral")
+    problem = TaskProblem(study, tightened=False)
+    z = problem.initial_point(study.initial_lengths)
+    rows = [i for i, n in enumerate(problem.constraint_names) if n.startswith("brake.")]
+    block = next(b for b in problem.layout.blocks if b.name == "brake")
+    g = problem.constraints(z)[rows]
+    relaxation = block.relaxation(g)
+    stronger = EmlaSet(
+        *(replace(p, brake=replace(p.brake, holding_torque=1.01 * p.brake.holding_torque)) for p in problem.emlas),
+        battery=problem.emlas.battery,
+    )
+    relaxed = TaskProblem(study, emlas=stronger, tightened=False, cost_scale=problem.cost_scale)
+    moved = relaxed.constraints(z)[rows] - g
+    assert relaxation.units == ("%",) * len(rows)
+    assert moved == pytest.approx(relaxation.per_unit, rel=1e-9, abs=1e-15)

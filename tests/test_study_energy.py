@@ -17,7 +17,7 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.results.energy_sections import TransmissionChoice
 from hiab_sim.results.read import read_result
 from hiab_sim.study.analysis.codesign import combinations, solve_combination, with_transmission
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.nlp.thermal_rows import ThermalLimits
 from hiab_sim.study.spec.study_file import study_from_dict
 
@@ -29,9 +29,9 @@ def _study(**changes: object):  # type: ignore[no-untyped-def]
 
 
 @pytest.fixture(scope="module")
-def energy_problem() -> LinkLengthProblem:
+def energy_problem() -> TaskProblem:
     """The small study with the battery-energy objective, a 60 cycles/hour duty and the paper's EMLA model."""
-    return LinkLengthProblem(_study(objective="battery_energy", duty={"cycles_per_hour": 60}, emla="paper"))
+    return TaskProblem(_study(objective="battery_energy", duty={"cycles_per_hour": 60}, emla="paper"))
 
 
 def _directions(n: int, count: int = 3) -> list[np.ndarray]:
@@ -46,7 +46,7 @@ def _exact_battery_energy(time: np.ndarray, power: np.ndarray, eta_inv: float, e
 
 
 def test_battery_objective_gradient_matches_finite_differences_through_the_nlp(
-    energy_problem: LinkLengthProblem,
+    energy_problem: TaskProblem,
 ) -> None:
     """d(scaled battery energy)/dz agrees with central differences of the NLP's cost in random directions."""
     p = energy_problem
@@ -64,7 +64,7 @@ def test_smooth_battery_objective_converges_to_the_exact_trapezoid_on_a_fine_gri
     gaps = []
     for eps in (10.0, 1.0, 0.1, 0.01):
         emlas = replace(study.emlas, battery=replace(study.emlas.battery, smoothing_power=eps))
-        fine = LinkLengthProblem(study, emlas=emlas, times=study.grid.fine_times(), tightened=False, cost_scale=1.0)
+        fine = TaskProblem(study, emlas=emlas, times=study.grid.fine_times(), tightened=False, cost_scale=1.0)
         ev = fine.evaluate(fine.initial_point(study.initial_lengths))
         b = emlas.battery
         exact = _exact_battery_energy(
@@ -76,7 +76,7 @@ def test_smooth_battery_objective_converges_to_the_exact_trapezoid_on_a_fine_gri
     assert gaps[-1] < 1e-3 * gaps[0] and gaps[-1] < 1e-4
 
 
-def test_regeneration_of_one_drive_feeds_another_in_the_nlp_objective(energy_problem: LinkLengthProblem) -> None:
+def test_regeneration_of_one_drive_feeds_another_in_the_nlp_objective(energy_problem: TaskProblem) -> None:
     """Lift drawing 1000 W while tilt returns 400 W: the bus nets them before the battery (hand numbers)."""
     ev = energy_problem.evaluate(energy_problem.initial_point(energy_problem.study.initial_lengths))
     power = np.zeros_like(ev.power)
@@ -91,7 +91,7 @@ def test_regeneration_of_one_drive_feeds_another_in_the_nlp_objective(energy_pro
     assert shared < separate - 1.0
 
 
-def test_thermal_rows_partials_match_finite_differences(energy_problem: LinkLengthProblem) -> None:
+def test_thermal_rows_partials_match_finite_differences(energy_problem: TaskProblem) -> None:
     """The RMS-torque and winding-temperature rows' Jacobian agrees with central differences."""
     p = energy_problem
     z = p.initial_point(p.study.initial_lengths)
@@ -105,12 +105,12 @@ def test_thermal_rows_partials_match_finite_differences(energy_problem: LinkLeng
 
 def test_thermal_rows_exist_only_with_a_duty_and_hold_at_60_cycles_per_hour_not_back_to_back() -> None:
     """No duty, no rows; the start meets both limits at 60 cycles/hour and breaks the lift's RMS limit without rest."""
-    assert "thermal" not in LinkLengthProblem(_study()).layout.slices
-    busy = LinkLengthProblem(_study(duty={"cycles_per_hour": 60}))
+    assert "thermal" not in TaskProblem(_study()).layout.slices
+    busy = TaskProblem(_study(duty={"cycles_per_hour": 60}))
     assert any(isinstance(block, ThermalLimits) for block in busy.layout.blocks)
     z = busy.initial_point(busy.study.initial_lengths)
     assert busy.margins(z)[busy.layout.slices["thermal"]].min() > 0.0
-    nonstop = LinkLengthProblem(_study(duty={"rest_time": 0.0}))
+    nonstop = TaskProblem(_study(duty={"rest_time": 0.0}))
     values = nonstop.layout.split(nonstop.margins(z))["thermal"]
     assert values[0] < 0.0  # lift rms torque above the continuous torque
 
@@ -215,7 +215,7 @@ def test_drive_losses_enabled_in_the_emla_file_flow_into_the_objective_and_the_r
     study_on = _study(objective="battery_energy", emla=str(_losses_on(tmp_path)))
     study_off = _study(objective="battery_energy", emla="paper")
     assert study_on.emlas.lift.losses.inverter_on and study_on.emlas.battery.inverter_efficiency == 1.0
-    on, off = (LinkLengthProblem(s, cost_scale=1.0) for s in (study_on, study_off))
+    on, off = (TaskProblem(s, cost_scale=1.0) for s in (study_on, study_off))
     z = on.initial_point(study_on.initial_lengths)
     assert on.cost(z) > off.cost(z)
     g = on.cost_gradient(z)
@@ -223,7 +223,7 @@ def test_drive_losses_enabled_in_the_emla_file_flow_into_the_objective_and_the_r
         h = 1e-5
         fd = (on.cost(z + h * d) - on.cost(z - h * d)) / (2 * h)
         assert abs(fd - g @ d) <= 1e-5 * max(1.0, abs(fd))
-    fine = LinkLengthProblem(study_on, times=study_on.grid.fine_times(), tightened=False, cost_scale=1.0)
+    fine = TaskProblem(study_on, times=study_on.grid.fine_times(), tightened=False, cost_scale=1.0)
     e = design_energy(fine, fine.evaluate(z))
     assert e.drive_loss_energy_J is not None
     assert e.drive_loss_energy_J["lift"]["transmission_loss"] > 0 and e.drive_loss_energy_J["lift"]["inverter_loss"] > 0
@@ -234,7 +234,7 @@ def test_drive_losses_enabled_in_the_emla_file_flow_into_the_objective_and_the_r
     assert 0.0 <= kinks <= e.smoothing_bound_J
     assert (
         design_energy(
-            LinkLengthProblem(study_off, times=study_off.grid.fine_times(), tightened=False, cost_scale=1.0),
+            TaskProblem(study_off, times=study_off.grid.fine_times(), tightened=False, cost_scale=1.0),
             fine.evaluate(z),
         ).drive_loss_energy_J
         is None

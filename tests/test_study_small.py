@@ -44,9 +44,9 @@ def write_study(folder: Path, study: dict[str, Any], name: str = "study.yaml") -
 
 def test_small_study_loads_with_a_feasible_start() -> None:
     """The shared small study is valid and its start satisfies every constraint."""
-    from hiab_sim.study.nlp.problem import LinkLengthProblem
+    from hiab_sim.study.nlp.task_problem import TaskProblem
     from hiab_sim.study.spec.study_file import study_from_dict
 
     study = study_from_dict(small_study(), "small.yaml")
-    problem = LinkLengthProblem(study)
+    problem = TaskProblem(study)
     assert problem.max_violation(problem.initial_point(study.initial_lengths)) <= 1e-9

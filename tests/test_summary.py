@@ -12,6 +12,9 @@ from hiab_sim.cli import main
 from hiab_sim.results.read import read_result
 from hiab_sim.study.report.summary import SUMMARY_FILE, limit_in_words
 
+#: End-to-end runs of whole commands (optimize, report, Chromium, tutorials): not in the fast tier.
+pytestmark = pytest.mark.e2e
+
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:

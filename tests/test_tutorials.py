@@ -10,6 +10,9 @@ from pathlib import Path
 
 import pytest
 
+#: End-to-end runs of whole commands (optimize, report, Chromium, tutorials): not in the fast tier.
+pytestmark = pytest.mark.e2e
+
 TUTORIALS = Path(__file__).resolve().parents[1] / "docs" / "tutorials"
 #: A fenced block: its language, an optional title (a file the block's text is written to) and its text.
 BLOCK = re.compile(r'^```(?P<lang>\w+)(?: title="(?P<title>[^"]+)")?\n(?P<body>.*?)^```', re.M | re.S)

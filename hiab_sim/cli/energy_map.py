@@ -39,7 +39,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Compute and write the map; return the exit status."""
-    from hiab_sim.study.nlp.problem import LinkLengthProblem
+    from hiab_sim.study.nlp.task_problem import TaskProblem
     from hiab_sim.study.report.summary import limit_in_words
     from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
     from hiab_sim.sweep.energy_map import energy_map, optimum_design, parse_variables, result_study, start_design
@@ -47,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
 
     variables = parse_variables(args.vars)
     study = load_study(args.study or (result_study(args.result) if args.result else DEFAULT_STUDY))
-    problem = LinkLengthProblem(study, id_path="analytic")
+    problem = TaskProblem(study, id_path="analytic")
     base = optimum_design(args.result) if args.result else start_design(problem)
     m = energy_map(problem, base, variables, args.grid)
     out = Path(args.out) if args.out else Path("runs") / study.name / "energy_map"

@@ -14,9 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-from hiab_sim.machine.assembly import check_machine, reachable_joint_range, usable_stroke
-from hiab_sim.machine.closure import joint_to_stroke
 from hiab_sim.machine.description import Machine
+from hiab_sim.machine.kinematics.assembly import check_machine, reachable_joint_range, usable_stroke
+from hiab_sim.machine.kinematics.closure import joint_to_stroke
 from hiab_sim.machine.loader import load_machine
 
 
@@ -39,6 +39,16 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     check = actions.add_parser("check", help="assemble every chain over its working range; exit 2 on failure")
     check.add_argument("machine", help="shipped machine name or a machine YAML file")
     check.set_defaults(run=run_check)
+    imp = actions.add_parser("import", help="read an MJCF with closed loops into a machine file; exit 2 if unsupported")
+    imp.add_argument("model", help="MJCF file (slide joints for the actuators, connect equalities closing the loops)")
+    imp.add_argument("-o", "--output", type=Path, required=True, metavar="MACHINE.yaml", help="machine file to write")
+    imp.add_argument("--tcp", metavar="SITE_OR_BODY", help="the TCP: a site or body name (default: site 'tcp')")
+    imp.add_argument(
+        "--lock", action="append", default=[], metavar="JOINT=VALUE", help="hold a joint (e.g. slewing) at VALUE"
+    )
+    imp.add_argument("--plane", choices=("auto", "xz", "xy", "yz"), default="auto", help="plane of motion")
+    imp.add_argument("--samples", type=int, default=40, help="random states of the round trip (default: 40)")
+    imp.set_defaults(run=run_import)
 
 
 def _range(values: tuple[float, float], unit: str) -> str:
@@ -128,4 +138,62 @@ def run_check(args: argparse.Namespace) -> int:
     if failures:
         return 2
     print(f"{machine.name}: every chain assembles over its working range ({len(machine.chains)} chains)")
+    return 0
+
+
+def _locks(items: list[str]) -> dict[str, float]:
+    from hiab_sim.errors import InvalidInputError
+
+    out = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise InvalidInputError("--lock", item, "must be JOINT=VALUE with VALUE a number (rad or m)") from None
+        if not sep or not name.strip():
+            raise InvalidInputError("--lock", item, "must be JOINT=VALUE")
+    return out
+
+
+def run_import(args: argparse.Namespace) -> int:
+    """Import the MJCF, check it, print the round trip, then write the file (nothing written on failure)."""
+    import sys
+
+    import yaml
+
+    from hiab_sim.atomic_io import write_atomic
+    from hiab_sim.machine.loader import machine_from_dict
+    from hiab_sim.machine.mjcf_import.importer import UnsupportedMJCFError, import_mjcf
+    from hiab_sim.machine.mjcf_import.round_trip import fit_ranges, machine_yaml, round_trip
+
+    try:
+        imported = import_mjcf(args.model, tcp=args.tcp, locks=_locks(args.lock), plane=args.plane)
+    except UnsupportedMJCFError as error:
+        for line in error.lines:
+            print(f"hiab-sim machine import: unsupported: {line}", file=sys.stderr)
+        return 2
+    machine = fit_ranges(imported)
+    command = " ".join(["hiab-sim machine import", str(args.model), *(f"--lock {x}" for x in args.lock)])
+    text = machine_yaml(imported, command + (f" --tcp {args.tcp}" if args.tcp else ""))
+    machine = machine_from_dict(yaml.safe_load(text), origin=str(args.output), check_assembly=False)  # as written
+    failures = check_machine(machine)
+    for failure in failures:
+        print(f"hiab-sim machine import: FAIL {failure}", file=sys.stderr)
+    if failures:
+        return 2
+    errors = round_trip(imported, machine, samples=args.samples)
+    for line in describe(machine):
+        print(line)
+    for path, value in errors.items():
+        print(
+            f"round trip ({args.samples} random loop-consistent states): {path} vs the MJCF, "
+            f"max relative force difference {value:.2e}"
+        )
+    if not args.output.parent.is_dir():
+        from hiab_sim.errors import InvalidInputError
+
+        raise InvalidInputError("--output", str(args.output), "its folder must exist")
+    write_atomic(args.output, text)
+    print(f"wrote {args.output}")
     return 0

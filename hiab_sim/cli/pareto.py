@@ -34,7 +34,7 @@ def run(args: argparse.Namespace) -> int:
     import pandas as pd
 
     from hiab_sim.atomic_io import write_atomic
-    from hiab_sim.study.nlp.problem import LinkLengthProblem
+    from hiab_sim.study.nlp.problem import make_problem
     from hiab_sim.study.solvers.slsqp import check_start, solve
     from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
     from hiab_sim.sweep.pareto import CRITERIA, front_figure_png, pareto_front
@@ -44,11 +44,16 @@ def run(args: argparse.Namespace) -> int:
 
         raise InvalidInputError("--points", args.points, "must be >= 2")
     study = load_study(args.study or DEFAULT_STUDY)
-    problem = LinkLengthProblem(study)
-    check_start(problem, problem.initial_point(study.initial_lengths))
+    study_problem = make_problem(study)
+    if study_problem.n_tasks != 1:
+        from hiab_sim.errors import InvalidInputError
+
+        raise InvalidInputError("tasks", study_problem.n_tasks, "the Pareto front serves a study of one task")
+    problem = study_problem.problems[0]
+    check_start(study_problem, study_problem.initial_point(study.initial_lengths))
     out = Path(args.out) if args.out else Path("runs") / study.name / f"pareto_{args.against}"
     print(f"optimising {study.name} (the front's end at an inactive epsilon) ...", file=sys.stderr)
-    optimum = solve(problem, study.initial_lengths, progress=None)
+    optimum = solve(study_problem, study.initial_lengths, progress=None)
     front = pareto_front(problem, optimum.z, args.against, args.points)
     frame = pd.DataFrame([p.as_row() for p in front])
     out.mkdir(parents=True, exist_ok=True)

@@ -74,17 +74,18 @@ def sensitivities(result: Result, folder: Path) -> str:
     if s is None or not s.multipliers:
         return ""
     rows = [
-        (m.constraint, m.unit, f"{m.percent_per_unit:.4f} %", f"{m.cost_per_unit_W2s:.4g}")
+        (m.constraint, m.unit, f"{m.percent_per_unit:.4f} %", f"{m.objective_decrease_per_unit:.4g} {s.objective_unit}")
         for m in sorted(s.multipliers, key=lambda m: -m.percent_per_unit)
     ]
     return section(
         "Sensitivities",
         paragraph(
-            f"Cost decrease per unit each active limit is relaxed (KKT residual {s.kkt_residual:.1e}); a slope, "
+            f"Decrease of the objective ({s.objective}, {s.objective_value:.6g} {s.objective_unit} at the optimum) "
+            f"per unit each active limit is relaxed (KKT residual {s.kkt_residual:.1e}); a slope, "
             "not a promise for large moves.",
             "note",
         ),
-        table(("active constraint", "per", "% of the optimal cost", "cost decrease per unit"), rows, numeric=(2, 3)),
+        table(("active constraint", "per", "% of the objective", "objective decrease per unit"), rows, numeric=(2, 3)),
         figure(folder / "sensitivity.png", "KKT multipliers of the active constraints"),
     )
 

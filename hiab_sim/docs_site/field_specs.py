@@ -216,7 +216,7 @@ def emla_keys() -> list[Key]:
     """The EMLA file (:func:`hiab_sim.emla.config.emla_set_from_mapping`); values may carry a provenance."""
     from hiab_sim.emla.battery import BatteryParams
     from hiab_sim.emla.brake import HoldingBrake
-    from hiab_sim.emla.config import EmlaParams, PmsmParams
+    from hiab_sim.emla.config import DriveStiffness, EmlaParams, PmsmParams, ScrewColumn
     from hiab_sim.emla.electrothermal import WindingResistance
     from hiab_sim.emla.losses import DriveLosses
     from hiab_sim.emla.thermal import ThermalParams
@@ -225,9 +225,15 @@ def emla_keys() -> list[Key]:
     actuator = [
         k
         for k in _sourced(
-            from_class("", EmlaParams, skip=("name", "motor", "losses", "thermal", "winding", "brake", "provenance"))
+            from_class(
+                "",
+                EmlaParams,
+                skip=("name", "motor", "losses", "thermal", "winding", "brake", "provenance", "screw", "stiffness"),
+            )
         )
     ]
+    screw = _sourced(from_class("", ScrewColumn))
+    stiffness = _sourced(from_class("", DriveStiffness))
     thermal = _sourced(from_class("", ThermalParams))
     losses = _sourced(from_class("", DriveLosses), required=False)
     winding = _sourced(from_class("", WindingResistance))
@@ -253,6 +259,12 @@ def emla_keys() -> list[Key]:
         ):
             rows.append(section(f"{where}.{key}", doc, default="none"))
             rows += [replace(k, path=f"{where}.{key}.{k.path}", default="shared") for k in keys]
+        rows.append(section(f"{where}.screw", "Overrides of the shared `screw` keys.", default="none"))
+        rows += [replace(k, path=f"{where}.screw.{k.path}", default="shared") for k in screw]
+        rows.append(
+            section(f"{where}.drive_stiffness", "Overrides of the shared `drive_stiffness` keys.", default="none")
+        )
+        rows += [replace(k, path=f"{where}.drive_stiffness.{k.path}", default="shared") for k in stiffness]
     rows += [
         section(
             "thermal",
@@ -278,6 +290,18 @@ def emla_keys() -> list[Key]:
         *[replace(k, path=f"winding_resistance.{k.path}") for k in winding],
         section("holding_brake", "The holding brake on every motor shaft (hiab_sim.emla.hold).", default="none"),
         *[replace(k, path=f"holding_brake.{k.path}") for k in brake],
+        section(
+            "screw",
+            "Every screw as a column under its push force (buckling rows and margins); none: no buckling check.",
+            default="none",
+        ),
+        *[replace(k, path=f"screw.{k.path}") for k in screw],
+        section(
+            "drive_stiffness",
+            "Axial stiffness of every drive train (natural frequencies); none: no frequency check.",
+            default="none",
+        ),
+        *[replace(k, path=f"drive_stiffness.{k.path}") for k in stiffness],
         section("battery", "Shared DC bus and battery efficiencies (battery energy).", default="defaults"),
         *[replace(k, path=f"battery.{k.path}") for k in _sourced(from_class("", BatteryParams), required=False)],
     ]
@@ -370,10 +394,28 @@ def _payload_keys(where: str) -> list[Key]:
     return rows
 
 
+def _structure_keys() -> list[Key]:
+    """The study's ``structure`` section (:meth:`hiab_sim.structure.settings.StructureSettings.from_mapping`)."""
+    from hiab_sim.structure.settings import StructureSettings
+
+    rows = from_class("structure", StructureSettings, skip=("pin_load_limits_N",))
+    return [
+        section("structure", "Structural rows of the NLP: buckling, pin loads, natural frequency.", "none"),
+        *rows,
+        free(
+            "structure.pin_load_limits",
+            "Pin name (`<chain>.<pin>`, as `hiab-sim machine show` lists them) -> largest |F| [N] > 0; "
+            "one row per pin and sample.",
+            "number",
+        ),
+    ]
+
+
 def study_keys() -> list[Key]:
     """The study file (:func:`hiab_sim.study.spec.study_file.study_from_dict`)."""
+    from hiab_sim.study.nlp.objectives import OBJECTIVES
     from hiab_sim.study.spec.build import BuildSettings
-    from hiab_sim.study.spec.energy import OBJECTIVE_NAMES, DutySettings
+    from hiab_sim.study.spec.energy import DutySettings
     from hiab_sim.study.spec.study_file import GridSettings, SolverSettings, SplineSettings, Tracking
 
     rows = [
@@ -423,6 +465,7 @@ def study_keys() -> list[Key]:
         *_payload_keys("tasks[].payload"),
     ]
     rows += [section("tracking", "Tolerance bands of const_b..const_d.", "defaults"), *from_class("tracking", Tracking)]
+    rows += _structure_keys()
     rows += [
         section("bounds", "Box and path bounds of the NLP."),
         *[
@@ -524,7 +567,7 @@ def study_keys() -> list[Key]:
             "objective",
             type="text",
             default="costf2",
-            allowed="one of " + ", ".join(f"`{n}`" for n in OBJECTIVE_NAMES),
+            allowed="one of " + ", ".join(f"`{n}`" for n in OBJECTIVES),
             description="What the optimiser minimises: the seed's eq. `costf2` or the battery energy.",
         ),
         section("duty", "Rest between cycles: thermal rows and report (give exactly one key).", "none"),

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-from hiab_sim.checks import check_non_negative, check_positive
+from hiab_sim.checks import check_non_negative, check_positive, check_range
 from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.emla.battery import BatteryParams
 from hiab_sim.emla.brake import HoldingBrake
@@ -94,6 +94,78 @@ class PmsmParams:
 
 
 @dataclass(frozen=True)
+class ScrewColumn:
+    """The screw of an EMLA as a column under its push force (buckling, :mod:`hiab_sim.structure.buckling`).
+
+    Attributes:
+        root_diameter: Thread root (minor) diameter d_r of the screw shaft [m]; the section
+            A = pi d_r^2 / 4, I = pi d_r^4 / 64 of the ball-screw catalogues' buckling formula.
+        elastic_modulus: Young's modulus E of the screw steel [Pa].
+        yield_strength: Compressive yield strength sigma_y of the screw core [Pa] (Johnson parabola).
+        end_fixity_factor: The catalogues' mounting factor N of P = N pi^2 E I / l^2 [-]: 1 pinned-
+            pinned, 2 fixed-supported, 4 fixed-fixed, 0.25 fixed-free (effective length l / sqrt(N)).
+        retracted_length: Column length at zero stroke [m] of an actuator that is not in a closed
+            chain (a direct actuator); None for a chain's actuator, whose column is its pin-to-pin
+            length x0 + x.
+        label: Prefix used in error messages.
+
+    """
+
+    root_diameter: float
+    elastic_modulus: float
+    yield_strength: float
+    end_fixity_factor: float
+    retracted_length: float | None = None
+    label: str = "screw"
+
+    def __post_init__(self) -> None:
+        check_positive(f"{self.label}.root_diameter", self.root_diameter, "m")
+        check_positive(f"{self.label}.elastic_modulus", self.elastic_modulus, "Pa")
+        check_positive(f"{self.label}.yield_strength", self.yield_strength, "Pa")
+        if not (math.isfinite(self.yield_strength) and self.yield_strength < self.elastic_modulus):
+            raise InvalidInputError(
+                f"{self.label}.yield_strength", self.yield_strength, "must be < elastic_modulus", "Pa"
+            )
+        check_range(f"{self.label}.end_fixity_factor", self.end_fixity_factor, 0.0, 4.0, low_open=True)
+        if self.retracted_length is not None:
+            check_positive(f"{self.label}.retracted_length", self.retracted_length, "m")
+
+
+@dataclass(frozen=True)
+class DriveStiffness:
+    """Axial stiffness of an EMLA's load path between its two pins (:mod:`hiab_sim.structure.natural_frequency`).
+
+    The screw between its fixed bearing and the nut is a bar E A_r / (support_length + x) (E and
+    A_r of the actuator's :class:`ScrewColumn`), in series with the nut, the support bearing and
+    ``pin_count`` pins.
+
+    Attributes:
+        support_length: Screw length between the fixed bearing and the nut at zero stroke [m].
+        nut_stiffness: Axial stiffness of the loaded nut [N/m].
+        bearing_stiffness: Axial stiffness of the screw's fixed support bearing [N/m].
+        pin_stiffness: Radial stiffness of one pin with its eye and bearing [N/m].
+        pin_count: Pins in the load path [-] (2 for a pin-to-pin actuator).
+        label: Prefix used in error messages.
+
+    """
+
+    support_length: float
+    nut_stiffness: float
+    bearing_stiffness: float
+    pin_stiffness: float
+    pin_count: float
+    label: str = "drive_stiffness"
+
+    def __post_init__(self) -> None:
+        check_positive(f"{self.label}.support_length", self.support_length, "m")
+        for key in ("nut_stiffness", "bearing_stiffness", "pin_stiffness"):
+            check_positive(f"{self.label}.{key}", getattr(self, key), "N/m")
+        check_range(f"{self.label}.pin_count", self.pin_count, 0.0, 8.0)
+        if not float(self.pin_count).is_integer():
+            raise InvalidInputError(f"{self.label}.pin_count", self.pin_count, "must be a whole number of pins")
+
+
+@dataclass(frozen=True)
 class EmlaParams:
     """One electromechanical linear actuator: PMSM, gearbox, screw (eqs. ``torque_torque``, ``torque_force``).
 
@@ -111,6 +183,8 @@ class EmlaParams:
         winding: Temperature dependence of R_s (:mod:`hiab_sim.emla.electrothermal`), or None
             (R_s constant, the seed paper's model).
         brake: The holding brake on the motor shaft (:mod:`hiab_sim.emla.brake`), or None.
+        screw: The screw as a column (buckling), or None when the file gives no ``screw`` section.
+        stiffness: The drive train's axial stiffness, or None when the file gives no ``drive_stiffness``.
         provenance: (parameter key, source label) pairs, e.g.
             ``("pmsm.peak_torque", "estimate: 3 x rated torque ...")``.
 
@@ -129,6 +203,8 @@ class EmlaParams:
     winding: WindingResistance | None = None
     brake: HoldingBrake | None = None
     provenance: tuple[tuple[str, str], ...] = ()
+    screw: ScrewColumn | None = None
+    stiffness: DriveStiffness | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.gear_ratio) and self.gear_ratio > 1.0):
@@ -193,6 +269,8 @@ _ACTUATOR_OPTIONAL: tuple[str, ...] = (
     "drive_losses",
     "winding_resistance",
     "holding_brake",
+    "screw",
+    "drive_stiffness",
 )
 #: Optional sections (shared at the top level; ``thermal`` and ``drive_losses`` may be overridden per actuator).
 _THERMAL_KEYS: tuple[str, ...] = tuple(f.name for f in fields(ThermalParams) if f.name != "label")
@@ -200,6 +278,10 @@ _LOSS_KEYS: tuple[str, ...] = tuple(f.name for f in fields(DriveLosses) if f.nam
 _WINDING_KEYS: tuple[str, ...] = tuple(f.name for f in fields(WindingResistance) if f.name != "label")
 _BRAKE_KEYS: tuple[str, ...] = tuple(f.name for f in fields(HoldingBrake) if f.name != "label")
 _BATTERY_KEYS: tuple[str, ...] = tuple(f.name for f in fields(BatteryParams))
+_SCREW_KEYS: tuple[str, ...] = tuple(f.name for f in fields(ScrewColumn) if f.name != "label")
+_STIFFNESS_KEYS: tuple[str, ...] = tuple(f.name for f in fields(DriveStiffness) if f.name != "label")
+#: Keys of the optional sections that may be left out (their dataclass default applies).
+_SCREW_OPTIONAL: tuple[str, ...] = ("retracted_length",)
 
 
 def load_emla_set(path: str | Path | Source | None = None, relative_to: Source | None = None) -> EmlaSet:
@@ -228,7 +310,17 @@ def emla_set_from_mapping(document: object, where: str = "<mapping>") -> EmlaSet
     root = mapping(
         document,
         f"{where}: top level",
-        {"pmsm", "actuators", "thermal", "drive_losses", "battery", "winding_resistance", "holding_brake"},
+        {
+            "pmsm",
+            "actuators",
+            "thermal",
+            "drive_losses",
+            "battery",
+            "winding_resistance",
+            "holding_brake",
+            "screw",
+            "drive_stiffness",
+        },
         {"pmsm", "actuators"},
     )
     shared_pmsm = mapping(root["pmsm"], f"{where}: pmsm", set(_PMSM_KEYS))
@@ -271,12 +363,37 @@ def emla_set_from_mapping(document: object, where: str = "<mapping>") -> EmlaSet
         values["brake"] = _optional_section(
             HoldingBrake, _BRAKE_KEYS, root, node, "holding_brake", where, name, provenance, required=True
         )
+        for section, cls, keys, optional in (
+            ("screw", ScrewColumn, _SCREW_KEYS, _SCREW_OPTIONAL),
+            ("drive_stiffness", DriveStiffness, _STIFFNESS_KEYS, ()),
+        ):
+            if section in root or section in node:
+                _require_keys(root, node, section, keys, optional, where, name)
+                built_section = _optional_section(cls, keys, root, node, section, where, name, provenance)
+                values["screw" if section == "screw" else "stiffness"] = built_section
         built[name] = EmlaParams(name=name, motor=motor, provenance=tuple(provenance), **values)
     battery: dict[str, Any] = {}
     if "battery" in root:
         node = mapping(root["battery"], f"{where}: battery", set(_BATTERY_KEYS), set())
         battery = {key: sourced_number(node[key], f"{where}: battery.{key}", PROVENANCE_KINDS)[0] for key in node}
     return EmlaSet(**built, battery=BatteryParams(**battery))
+
+
+def _require_keys(
+    root: Mapping[str, Any],
+    actuator: Mapping[str, Any],
+    section: str,
+    keys: tuple[str, ...],
+    optional: tuple[str, ...],
+    where: str,
+    name: str,
+) -> None:
+    """Raise :class:`ConfigError` unless the shared ``section`` and the actuator's give every required key."""
+    shared = mapping(root.get(section, {}), f"{where}: {section}", set(keys), set())
+    override = mapping(actuator.get(section, {}), f"{where}: actuators.{name}.{section}", set(keys), set())
+    missing = sorted(set(keys) - set(optional) - set(shared) - set(override))
+    if missing:
+        raise ConfigError(f"{where}: actuators.{name}.{section}: missing key(s) {', '.join(missing)}")
 
 
 def _optional_section(

@@ -1,7 +1,7 @@
 """Machine description: frozen, validated dataclasses of any planar parallel-serial machine (SI units).
 
 YAML in :mod:`hiab_sim.machine.loader`; loop closure and forward kinematics in
-:mod:`hiab_sim.machine.closure`. Nothing here spells a machine's names: links, joints, chains and
+:mod:`hiab_sim.machine.kinematics.closure`. Nothing here spells a machine's names: links, joints, chains and
 decision variables are named by the file.
 
 Conventions

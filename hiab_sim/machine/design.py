@@ -67,7 +67,7 @@ def with_design(machine: MachineT, values: Any, *, check_bounds: bool = True) ->
     Values outside the declared bounds raise :class:`InvalidInputError` unless ``check_bounds`` is
     False (e.g. finite differences at a bound). With ``body_scaling: slender`` the cylinder body
     scales with x0 and the rod body with Lc (:meth:`hiab_sim.machine.parts.RigidBody.scaled_slender`).
-    The loop closure is not checked here (:func:`hiab_sim.machine.closure.check_machine` does).
+    The loop closure is not checked here (:func:`hiab_sim.machine.kinematics.closure.check_machine` does).
     """
     values = np.asarray(values, dtype=float).reshape(-1)
     variables = machine.decision_variables

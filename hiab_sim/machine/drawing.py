@@ -16,9 +16,9 @@ from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
 from hiab_sim.figure_io import new_figure, save_png
-from hiab_sim.machine.assembly import joint_grid
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.kinematics import Frames, forward_kinematics, pin_positions
+from hiab_sim.machine.kinematics.assembly import joint_grid
+from hiab_sim.machine.kinematics.forward import Frames, forward_kinematics, pin_positions
 
 Array = NDArray[np.float64]
 

@@ -5,7 +5,7 @@ loader reads structure and types (:mod:`hiab_sim.yaml_fields`: unknown or missin
 where a number belongs raise :class:`ConfigError`); ranges and names are checked by the
 dataclasses when they are built, and the assembly over the working ranges (a loop that cannot
 close, a chain passing its toggle, a stroke shorter than the working range needs) by
-:func:`hiab_sim.machine.assembly.check_machine`; each raises a one-line
+:func:`hiab_sim.machine.kinematics.assembly.check_machine`; each raises a one-line
 :class:`InvalidInputError` naming the field. The file's own values of its decision variables must
 lie within their declared bounds.
 """
@@ -22,9 +22,9 @@ import yaml
 from hiab_sim.checks import check_range
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.hydraulics.cylinders import Cylinder
-from hiab_sim.machine.assembly import check_machine
 from hiab_sim.machine.chains import Actuator, Chain, DecisionVariable, HydraulicSystem, Linkage, Pivot
 from hiab_sim.machine.description import Link, Machine
+from hiab_sim.machine.kinematics.assembly import check_machine
 from hiab_sim.machine.parts import IDENTITY, Matrix3, Pose, RigidBody, Vector3, rot_z
 from hiab_sim.resources import Source
 from hiab_sim.yaml_fields import integer, mapping, number, text, vector

@@ -8,6 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from hiab_sim.crane.description import LinkLengths
+from hiab_sim.results.codec import optional
 
 
 @dataclass(frozen=True)
@@ -68,15 +69,16 @@ class FeasibilityPhase:
 class Multiplier:
     """One active constraint's multiplier in physical units.
 
-    ``multiplier`` is d(scaled cost)/d(scaled row) >= 0; ``cost_per_unit_W2s`` the cost decrease
-    [W^2 s] when the limit is relaxed by one ``unit`` (e.g. ``mm`` of a length bound, ``%`` of an
-    EMLA limit); ``percent_per_unit`` the same as a percentage of the optimal cost.
+    ``multiplier`` is d(scaled objective)/d(scaled row) >= 0; ``objective_decrease_per_unit`` the
+    objective's decrease [the section's ``objective_unit``: W^2 s for costf2, J for battery_energy]
+    when the limit is relaxed by one ``unit`` (e.g. ``mm`` of a length bound, ``%`` of an EMLA
+    limit); ``percent_per_unit`` the same as a percentage of the objective at the optimum.
     """
 
     constraint: str
     multiplier: float
     unit: str
-    cost_per_unit_W2s: float
+    objective_decrease_per_unit: float
     percent_per_unit: float
     rows: int
 
@@ -85,10 +87,13 @@ class Multiplier:
 class Sensitivity:
     """KKT multipliers of the active constraints at the optimum (:mod:`hiab_sim.study.analysis.sensitivity`).
 
-    ``kkt_residual`` = |grad f - J_A^T lambda| / |grad f| of the non-negative least-squares fit.
+    ``kkt_residual`` = |grad f - J_A^T lambda| / |grad f| of the non-negative least-squares fit;
+    ``objective_value`` the objective at the optimum [``objective_unit``] (the weighted sum over the tasks).
     """
 
-    cost_W2s: float
+    objective: str
+    objective_unit: str
+    objective_value: float
     active_tolerance: float
     kkt_residual: float
     multipliers: tuple[Multiplier, ...]
@@ -103,7 +108,8 @@ class CrossEvaluation:
     Rows are the designs (each task's optimum alone, then the mix optimum), columns the tasks; the
     ``mix_*`` entries are the weighted sums over the tasks; None where a design cannot serve a task.
     Energies [J] on each task's fine grid (nominal bands, the optimisation's ID path), costs of eq.
-    ``costf2`` [W^2 s] on the collocation grid (what the optimiser minimises).
+    ``costf2`` [W^2 s] on the collocation grid whatever the objective, and the study's ``objective``
+    [``objective_unit``] on the collocation grid (what the optimiser minimises).
     """
 
     note: str
@@ -122,3 +128,7 @@ class CrossEvaluation:
     mix_cost_lost_percent: tuple[float | None, ...]
     #: Per design and task, why the cell is None ("" where it is computed); absent in older files.
     unserved: tuple[tuple[str, ...], ...] = ()
+    objective: str | None = optional()
+    objective_unit: str | None = optional()
+    objective_value: tuple[tuple[float | None, ...], ...] | None = optional()
+    mix_objective_value: tuple[float | None, ...] | None = optional()

@@ -186,6 +186,8 @@ class CodesignRow:
     initial_battery_energy_J: float | None = optional()
     battery_energy_J: float | None = optional()
     costf2_W2s: float | None = optional()
+    objective_value: float | None = optional()  # the study's objective on the fine grid [objective_unit]
+    objective_unit: str | None = optional()
     lengths: LinkLengths | None = optional()
     max_violation: float | None = optional()
     min_thermal_margin: float | None = optional()

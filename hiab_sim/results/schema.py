@@ -18,17 +18,24 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, TypeVar, cast
 
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import ConfigError
 from hiab_sim.results.analysis_sections import Buildable, CrossEvaluation, FeasibilityPhase, Sensitivity
 from hiab_sim.results.codec import from_json, optional, to_json
 from hiab_sim.results.energy_sections import Codesign, EnergyReport, HydraulicBaseline
+from hiab_sim.structure.summary import StructureSummary
 
-#: Version of the result.json layout; files without the key are version 1 (the same keys).
+#: Version of the result.json layout; files without the key are version 1. Version 2 renames the
+#: ``sensitivity`` keys that held the objective's value whatever its unit (``cost_W2s`` ->
+#: ``objective_value`` with ``objective`` and ``objective_unit``, ``multipliers[].cost_per_unit_W2s``
+#: -> ``objective_decrease_per_unit``) and the energy keys whose names suggested another boundary
+#: (:data:`RENAMED_IN_2`); :func:`upgrade` reads every older file.
 SCHEMA_VERSION = 2
-#: Keys renamed in schema 2 because their names suggested another boundary (old -> new).
+#: The unit of each objective a version-1 file can name (the objectives that existed then).
+_SCHEMA1_UNITS = {"costf2": "W^2 s", "battery_energy": "J"}
+#: Energy keys renamed in schema 2 because their names suggested another boundary (old -> new).
 RENAMED_IN_2: dict[str, str] = {
     "drawn_energy_without_regeneration_J": "drawn_energy_summed_drives_J",
     "drawn_energy_sum_of_actuators_J": "drawn_energy_per_drive_sum_J",
@@ -278,7 +285,9 @@ class HistoryRow:
 
 @dataclass(frozen=True)
 class TaskResult:
-    """One task of a duty mix (:mod:`hiab_sim.study.report.mix`): share, load, grid, designs on its fine grid, re-check.
+    """One task of a study of several tasks: share, load, grid, designs on its fine grid, re-check.
+
+    Written by :func:`hiab_sim.study.report.result_folder.build_result`.
 
     ``telescope`` says how the crane's redundancy is set for the task (prescribed by the reference).
     """
@@ -326,6 +335,7 @@ class Result:
     buildable: Buildable | None = optional()
     feasibility: tuple[FeasibilityPhase, ...] | None = optional()
     sensitivity: Sensitivity | None = optional()
+    structure: StructureSummary | None = optional()  # pin loads, buckling, natural frequencies
     extra: dict[str, Any] = field(default_factory=dict)  # keys of a newer writer, kept verbatim
 
     def __post_init__(self) -> None:
@@ -341,16 +351,46 @@ class Result:
 
     @classmethod
     def from_json(cls, data: Any) -> Result:
-        """Build from a parsed result.json (ConfigError names a missing or mistyped key); schema 1 is upgraded."""
-        if isinstance(data, dict):
-            version = data.get("schema_version", 1)
-            if isinstance(version, int) and version > SCHEMA_VERSION:
-                raise ConfigError(
-                    f"result.json has schema_version {version}; this hiab-sim reads up to {SCHEMA_VERSION}"
-                )
-            if isinstance(version, int) and version < 2:
-                data = {**_renamed(data), "schema_version": SCHEMA_VERSION}
-        return from_json(cls, data)
+        """Build from a parsed result.json of any version up to :data:`SCHEMA_VERSION` (:func:`upgrade`).
+
+        ConfigError names a missing or mistyped key.
+        """
+        return from_json(cls, upgrade(data))
+
+
+def upgrade(data: Any) -> Any:
+    """A parsed result.json of an older layout with its renamed keys under their version-2 names.
+
+    The energy keys of :data:`RENAMED_IN_2` take their new names at any depth. Version 1 stored the
+    objective's value as ``sensitivity.cost_W2s`` and the decreases as
+    ``cost_per_unit_W2s`` whatever the objective (joules under ``battery_energy``); the objective
+    is the file's ``energy.objective`` (``costf2`` without an energy section).
+    """
+    if not isinstance(data, dict):
+        return data
+    version = data.get("schema_version", 1)  # a file without the key is version 1
+    if isinstance(version, int) and version > SCHEMA_VERSION:
+        raise ConfigError(f"result.json has schema_version {version}; this hiab-sim reads up to {SCHEMA_VERSION}")
+    # Files written between the two renamings say version 2 with either set of old names: each
+    # renaming is applied where its old keys are present, so every such file reads.
+    data = {**_renamed(data), "schema_version": max(2, version) if isinstance(version, int) else version}
+    old = data.get("sensitivity")
+    if not isinstance(old, dict) or "cost_W2s" not in old:
+        return data
+    energy = data.get("energy")
+    objective = energy.get("objective", "costf2") if isinstance(energy, dict) else "costf2"
+    sensitivity = {k: v for k, v in old.items() if k != "cost_W2s"}
+    sensitivity = {
+        "objective": objective,
+        "objective_unit": _SCHEMA1_UNITS.get(objective, "unknown"),
+        "objective_value": old["cost_W2s"],
+        **sensitivity,
+    }
+    sensitivity["multipliers"] = [
+        {("objective_decrease_per_unit" if k == "cost_per_unit_W2s" else k): v for k, v in m.items()}
+        for m in old.get("multipliers", [])
+    ]
+    return {**data, "sensitivity": sensitivity}
 
 
 def _renamed(data: Any) -> Any:
@@ -395,8 +435,8 @@ def read_json_as(cls: type[T], path: Path) -> T:
     """``cls`` built from the JSON file ``path``; ConfigError names the file and the bad key."""
     data = parse_json(path)
     try:
-        if cls is Result:
-            return cls.from_json(data)  # type: ignore[attr-defined]
+        if cls is Result:  # every version it reads (upgrade)
+            return cast(T, Result.from_json(data))
         return from_json(cls, data)
     except ConfigError as error:
         raise ConfigError(f"{path}: {error}") from None

@@ -9,15 +9,13 @@ from pathlib import Path
 from typing import TextIO
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.errors import ConfigError, SolverError
+from hiab_sim.errors import BackendUnavailableError, ConfigError, SolverError
 from hiab_sim.results.schema import Result
 from hiab_sim.study import run_safety
 from hiab_sim.study.analysis.codesign import run_codesign
 from hiab_sim.study.analysis.cross_evaluation import cross_evaluation
-from hiab_sim.study.nlp.mix import MixProblem, make_problem
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.problem import make_problem
 from hiab_sim.study.report.analysis_sections import analysis_sections
-from hiab_sim.study.report.mix import build_mix_result
 from hiab_sim.study.report.result_folder import build_result, write_results
 from hiab_sim.study.solvers.feasibility import feasible_starts, moved_start_phase, phase_lines
 from hiab_sim.study.solvers.slsqp import (
@@ -55,10 +53,11 @@ def run_study(
     Bad input (study, unreachable reference, infeasible start, with ``resume`` a checkpoint of
     another study, ID path or start) raises before anything is written. A fresh run (no
     ``resume``) deletes every output of earlier runs; a folder of another study is refused unless
-    ``force`` (:mod:`hiab_sim.study.run_safety`). A study of several tasks is solved as one
-    :class:`~hiab_sim.study.nlp.mix.MixProblem` and reported by :mod:`hiab_sim.study.report.mix`, with
-    the cross-evaluation of :mod:`hiab_sim.study.analysis.cross_evaluation` unless ``cross`` is False.
-    A failure of SLSQP on the
+    ``force`` (:mod:`hiab_sim.study.run_safety`). Every study, of one task or several, is one
+    :class:`~hiab_sim.study.nlp.problem.StudyProblem`, reported by
+    :func:`~hiab_sim.study.report.result_folder.build_result` with its buildable design, feasibility
+    phases and sensitivities; a study of several tasks adds the cross-evaluation of
+    :mod:`hiab_sim.study.analysis.cross_evaluation` unless ``cross`` is False. A failure of SLSQP on the
     study's own start raises :class:`SolverError` after its checkpoint (the partial history) is
     on disk; failures of extra starts are reported (``multistart.failed_starts``).
     """
@@ -100,18 +99,14 @@ def run_study(
             failed.success = False
             failed.message = str(error)
             results.append(failed)
-    if isinstance(problem, MixProblem):
-        evaluation = None
-        if cross:
-            try:
-                evaluation = cross_evaluation(problem, results[0].z)
-            except ConfigError as error:  # CasADi (IPOPT) is an optional dependency
-                if progress is not None:
-                    progress.write(f"no cross-evaluation: {error}\n")
-        result, arrays, checks = build_mix_result(problem, results, time.perf_counter() - t0, evaluation)
-        result = replace(result, feasibility=tuple(phases) if phases else None)
-    else:
-        result, arrays, checks = build_result(problem, results, time.perf_counter() - t0)
+    evaluation = None
+    if cross and problem.n_tasks > 1:  # designs x tasks: each task's own optimum against the study's
+        try:
+            evaluation = cross_evaluation(problem, results[0].z)
+        except (BackendUnavailableError, ConfigError) as error:  # CasADi (IPOPT) is an optional dependency
+            if progress is not None:
+                progress.write(f"no cross-evaluation: {error}\n")
+    result, arrays, checks = build_result(problem, results, time.perf_counter() - t0, evaluation)
     if codesign is not None:
         result = replace(result, codesign=codesign)
     crane_file = study.crane_file
@@ -119,8 +114,7 @@ def run_study(
         write_atomic(folder / "crane.yaml", crane_file.read_bytes())  # a crane file, not a preset name
         result = replace(result, crane="crane.yaml", crane_source=study.crane_source)
     crane_label = study.crane_source if result.crane != "crane.yaml" else str(folder / "crane.yaml")
-    if isinstance(problem, LinkLengthProblem):  # buildable design, feasibility, sensitivity: single-task studies
-        result = replace(result, **analysis_sections(problem, results[0].z, result, crane_label, phases))
+    result = replace(result, **analysis_sections(problem, results[0].z, result, crane_label, phases))
     write_results(folder, result, arrays)
     paths: list[Path] = []
     if figures:

@@ -9,12 +9,14 @@ design's (the optimum's spline, or the start's inverse-kinematics fit), so every
 Per design, on the analytic path with all designs stacked into the sample axis
 (:mod:`hiab_sim.dynamics.analytic_batch`):
 
-* the objective of eq. ``costf2``, f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 [W^2 s] on the collocation
-  grid, and f / f_start (the optimiser's scaled objective, ``objective``);
+* the cost of eq. ``costf2``, f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 [W^2 s] on the collocation
+  grid (``cost``), and the study's objective (any registered one,
+  :data:`hiab_sim.study.nlp.objectives.OBJECTIVES`: the optimiser's own value on the collocation
+  grid, e.g. the smoothed battery energy) divided by its value at the study's start (``objective``);
 * the net electrical energy and the energy drawn without regeneration [J], trapezoid on the fine
   grid (as in ``result.json``); ``battery_energy`` is the energy the battery delivers
   (:func:`hiab_sim.emla.battery.battery_power`, exact kinks, fine grid); with the study's duty model
-  (:func:`hiab_sim.study.nlp.problem.duty_options`) every power is the hot windings' and the rest's
+  (:func:`hiab_sim.study.nlp.task_problem.duty_options`) every power is the hot windings' and the rest's
   hold is in the battery energy, as in ``result.json`` (one design at a time, not batched);
 * the scaled margins of every constraint row that depends on Xi, as the optimiser holds them on
   the collocation grid: EMLA envelope (const_e, const_f, >= envelope_margin), strokes (const_j)
@@ -36,15 +38,17 @@ from numpy.typing import NDArray
 
 from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
+from hiab_sim.dynamics.samples import ActuatorSamples
 from hiab_sim.emla import ENVELOPE_LIMIT_NAMES, electrical_power, energy_summary, envelope_margins
 from hiab_sim.emla.battery import battery_power, rest_battery_energy, trapezoid_weights
-from hiab_sim.emla.duty_energy import DutyOptions, drive_duty
+from hiab_sim.emla.duty_energy import DriveDuty, DutyOptions, drive_duty
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.results.read import open_run, read_result
 from hiab_sim.results.schema import Result
 from hiab_sim.study.analysis.buildable import RobustXi, replace_lengths
 from hiab_sim.study.motion import trajectory as tr
-from hiab_sim.study.nlp.problem import ACTUATORS, STROKE_SCALE, LinkLengthProblem
+from hiab_sim.study.nlp.interface import SampleState
+from hiab_sim.study.nlp.task_problem import ACTUATORS, STROKE_SCALE, TaskProblem
 
 Array = NDArray[np.float64]
 
@@ -68,7 +72,7 @@ class BaseDesign:
     source: str  # "optimum of <folder>" or "start of the study"
 
 
-def start_design(problem: LinkLengthProblem) -> BaseDesign:
+def start_design(problem: TaskProblem) -> BaseDesign:
     """The study's start: its initial lengths and the inverse-kinematics spline fit."""
     times = problem.study.grid.fine_times()
     joints = tr.evaluate(problem.basis, problem.c_ref, times)
@@ -109,7 +113,7 @@ class DesignValues:
 
     xi: Array  # (D, 6) [m]
     cost: Array  # (D,) [W^2 s], collocation grid
-    objective: Array  # (D,) the study's objective (costf2 or battery energy) / its value at the study's start
+    objective: Array  # (D,) the study's objective (any registered one) / its value at the study's start
     net_energy: Array  # (D,) [J], fine grid
     drawn_energy: Array  # (D,) [J], fine grid, without regeneration
     margins: Array  # (D, R) scaled, min over time per row
@@ -146,21 +150,22 @@ def _stroke_rows(xi: Array, x: Array, strokes: Array) -> Array:
 
 
 def _duty_powers(
-    problem: LinkLengthProblem, options: DutyOptions, time: Array, f: Array, v: Array, a: Array, exact: bool = False
-) -> tuple[Array, Array]:
-    """(drive powers (3, D, K) [W], rest energies summed over drives (D,) [J]) of the duty model per design."""
+    problem: TaskProblem, options: DutyOptions, time: Array, f: Array, v: Array, a: Array, exact: bool = False
+) -> tuple[Array, Array, list[tuple[DriveDuty, ...]]]:
+    """(drive powers (3, D, K) [W], rest energies summed over drives (D,) [J], each design's duties)."""
     D = f.shape[0]
-    power = np.empty((len(problem.emlas.as_tuple()), D, len(time)))
-    rest = np.zeros(D)
-    for i, p in enumerate(problem.emlas):
-        for d in range(D):
-            dd = drive_duty(p, time, f[d, :, i], v[d, :, i], a[d, :, i], options, exact)
-            power[i, d] = dd.power
-            rest[d] += dd.rest_energy
-    return power, rest
+    duties = [
+        tuple(
+            drive_duty(p, time, f[d, :, i], v[d, :, i], a[d, :, i], options, exact) for i, p in enumerate(problem.emlas)
+        )
+        for d in range(D)
+    ]
+    power = np.array([[dd[i].power for dd in duties] for i in range(len(problem.emlas.as_tuple()))])
+    rest = np.array([sum(x.rest_energy for x in dd) for dd in duties])
+    return power, rest, duties
 
 
-def evaluate_designs(problem: LinkLengthProblem, base: BaseDesign, xi: Array) -> DesignValues:
+def evaluate_designs(problem: TaskProblem, base: BaseDesign, xi: Array) -> DesignValues:
     """Objective, energies and Xi-dependent margins of designs xi (D, 6) on the base trajectory."""
     xi = np.atleast_2d(np.asarray(xi, dtype=float))
     ff = problem.study.grid.fine_factor
@@ -173,39 +178,54 @@ def evaluate_designs(problem: LinkLengthProblem, base: BaseDesign, xi: Array) ->
     strokes = np.array([chain.stroke for chain in crane.chains])
     working = np.array([[w[0] for w in problem.working] + [0.0], [w[1] for w in problem.working] + [0.0]])
     weights = trapezoid_weights(base.time)
-    colloc_weights = trapezoid_weights(base.time[::ff])
+    joints = tr.JointTrajectory(
+        base.time[::ff], base.position[::ff], base.velocity[::ff], base.acceleration[::ff]
+    )  # the fixed trajectory on the collocation grid, what the optimiser's objective sees
+    tcp_samples = problem.kin.samples(joints.position, joints.velocity, joints.acceleration)
     parts: list[tuple[Array, ...]] = []
     for lo in range(0, len(xi), CHUNK):
         block = xi[lo : lo + CHUNK]
         f, v, a, x = batched_inverse_dynamics(crane, block, base.position, base.velocity, base.acceleration, tcp)
         options = problem.duty_options
-        rest_colloc = rest_exact = np.zeros(len(block))
         if options is None:
             power = np.stack(
                 [electrical_power(p, f[..., i], v[..., i], a[..., i]) for i, p in enumerate(problem.emlas)]
             )
-            colloc_power = power[..., ::ff]
+            colloc_power, duties = power[..., ::ff], None
             exact_power = np.stack(  # exact brake switching and loss kinks, as the report's battery energy
                 [electrical_power(p, f[..., i], v[..., i], a[..., i], exact=True) for i, p in enumerate(problem.emlas)]
             )
+            rest_exact = np.zeros(len(block))
         else:  # hot windings and the rest's hold, as the problem evaluates them
-            power, _ = _duty_powers(problem, options, base.time, f, v, a, exact=False)
-            fc_, vc_, ac_ = f[:, ::ff], v[:, ::ff], a[:, ::ff]
-            colloc_power, rest_colloc = _duty_powers(problem, options, base.time[::ff], fc_, vc_, ac_)
-            exact_power, rest_exact = _duty_powers(problem, options, base.time, f, v, a, exact=True)
+            power, _, _ = _duty_powers(problem, options, base.time, f, v, a)
+            colloc_power, _, duties = _duty_powers(problem, options, joints.time, f[:, ::ff], v[:, ::ff], a[:, ::ff])
+            exact_power, rest_exact, _ = _duty_powers(problem, options, base.time, f, v, a, exact=True)
         total = power.sum(axis=0)  # (D, K)
         colloc = colloc_power.sum(axis=0)
+        objective = np.array(
+            [
+                problem.objective.value(
+                    collocation_state(
+                        joints,
+                        tcp_samples,
+                        block[d],
+                        f,
+                        v,
+                        a,
+                        x,
+                        colloc_power,
+                        ff,
+                        d,
+                        None if duties is None else duties[d],
+                    )
+                )
+                for d in range(len(block))
+            ]
+        )
         cost = 0.5 * problem.dt * np.sum(colloc**2, axis=1)
-        gain = rest_battery_energy([0.0], problem.emlas.battery)[1]
-        if problem.objective.name == "battery_energy":  # the optimiser's value: smooth, collocation grid
-            drives = np.moveaxis(colloc_power, 0, -1)
-            objective = battery_power(drives, problem.emlas.battery, smooth=True)[1] @ colloc_weights
-            objective = objective + gain * rest_colloc
-        else:
-            objective = cost
         net, drawn = energy_summary(base.time, total)
         battery = battery_power(np.moveaxis(exact_power, 0, -1), problem.emlas.battery)[1] @ weights  # (D,) [J]
-        battery = battery + gain * rest_exact
+        battery = battery + rest_battery_energy([0.0], problem.emlas.battery)[1] * rest_exact
         fc, vc, ac = f[:, ::ff], v[:, ::ff], a[:, ::ff]
         env = np.stack(
             [envelope_margins(p, fc[..., i], vc[..., i], ac[..., i]) for i, p in enumerate(problem.emlas)], axis=1
@@ -223,7 +243,28 @@ def evaluate_designs(problem: LinkLengthProblem, base: BaseDesign, xi: Array) ->
     return DesignValues(xi, cost, objective, net, drawn, margins, (*margin_names(), *robust_names), battery)
 
 
-def _robust_rows(problem: LinkLengthProblem, base: BaseDesign, xi: Array) -> tuple[Array, list[str]]:
+def collocation_state(
+    joints: tr.JointTrajectory,
+    tcp: tr.TcpSamples,
+    xi: Array,
+    f: Array,
+    v: Array,
+    a: Array,
+    x: Array,
+    power: Array,
+    ff: int,
+    d: int,
+    duty: tuple[DriveDuty, ...] | None = None,
+) -> SampleState:
+    """Design d of a batch as the NLP's objectives see it: its samples on the collocation grid (every ``ff``-th).
+
+    ``power`` (3, D, Kc) is already on the collocation grid; ``duty`` the design's duty model, if any.
+    """
+    actuators = ActuatorSamples(f[d, ::ff], v[d, ::ff], a[d, ::ff], x[d, ::ff])
+    return SampleState(LinkLengths.from_array(xi), joints, tcp, actuators, power[:, d, :].T, duty=duty)
+
+
+def _robust_rows(problem: TaskProblem, base: BaseDesign, xi: Array) -> tuple[Array, list[str]]:
     """The optimiser's rows of Xi only held within the manufacturing tolerance, per design (D, R).
 
     They depend on the link lengths alone (no samples), so each design is one call of the block
@@ -233,7 +274,7 @@ def _robust_rows(problem: LinkLengthProblem, base: BaseDesign, xi: Array) -> tup
     if not blocks:
         return np.zeros((len(xi), 0)), []
     state = problem.evaluate(problem.initial_point(LinkLengths.from_array(base.xi)))
-    # nominal margins as LinkLengthProblem.margins gives them: the rows without the optimiser's clearance
+    # nominal margins as TaskProblem.margins gives them: the rows without the optimiser's clearance
     rows = np.array([np.concatenate([b.values(replace_lengths(state, x)) + b.clearance() for b in blocks]) for x in xi])
     return rows, [name for b in blocks for name in b.row_names()]
 
@@ -250,7 +291,7 @@ class EnergyMap:
     start_xi: Array
     low: Array  # study bounds of Xi [m]
     up: Array
-    objective: str  # the study's objective (costf2 or battery_energy)
+    objective: str  # the study's objective (a name of the objective registry)
 
     def grid(self, array: NDArray[Any]) -> NDArray[Any]:
         """Reshape a per-design array (D,) to the grid (n0, n1)."""
@@ -265,7 +306,7 @@ def parse_variables(text: str) -> tuple[int, int]:
     return VARIABLES.index(names[0]), VARIABLES.index(names[1])
 
 
-def energy_map(problem: LinkLengthProblem, base: BaseDesign, variables: tuple[int, int], n: int) -> EnergyMap:
+def energy_map(problem: TaskProblem, base: BaseDesign, variables: tuple[int, int], n: int) -> EnergyMap:
     """Evaluate the n x n grid of two link lengths over their study bounds, the rest at the base design."""
     if n < 2:
         raise InvalidInputError("--grid", n, "must be >= 2")

@@ -9,7 +9,7 @@ and one more, criterion(z) <= epsilon:
   ``torque_torque`` at the collocation samples (a proxy of the motors' thermal load).
 
 The epsilon rows are appended to the NLP's own rows (:class:`EpsilonProblem` wraps a
-:class:`~hiab_sim.study.nlp.problem.LinkLengthProblem` through its public methods); their Jacobian is
+:class:`~hiab_sim.study.nlp.task_problem.TaskProblem` through its public methods); their Jacobian is
 by central differences in z. The front's epsilon runs from the plain optimum's criterion c_0
 (epsilon inactive: the plain study) down to the least criterion c_min the constraints allow
 (:func:`minimise_criterion`, the epigraph form min t s.t. -t <= s_k <= t), equally spaced, so
@@ -29,7 +29,8 @@ from scipy.optimize import minimize
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.emla.drive import drive_state
 from hiab_sim.errors import InvalidInputError, SolverError
-from hiab_sim.study.nlp.problem import C_SCALE, XI_SCALE, LinkLengthProblem
+from hiab_sim.study.nlp.objectives import costf2
+from hiab_sim.study.nlp.task_problem import C_SCALE, XI_SCALE, TaskProblem
 from hiab_sim.style import colour
 
 Array = NDArray[np.float64]
@@ -38,7 +39,7 @@ CRITERIA = {"peak_force": "N", "rms_torque": "N m"}
 FEASIBLE = 1e-6
 
 
-def samples_of_points(problem: LinkLengthProblem, Z: Array, name: str) -> Array:
+def samples_of_points(problem: TaskProblem, Z: Array, name: str) -> Array:
     """What the criterion bounds at each row z of Z (m, n): forces f_x (m, 3 K) [N] or the rms torque (m, 1) [N m].
 
     On the analytic path with the m designs and their trajectories stacked into one call
@@ -62,12 +63,12 @@ def samples_of_points(problem: LinkLengthProblem, Z: Array, name: str) -> Array:
     raise InvalidInputError("--against", name, f"must be one of {', '.join(CRITERIA)}")
 
 
-def criterion_samples(problem: LinkLengthProblem, z: Array, name: str) -> Array:
+def criterion_samples(problem: TaskProblem, z: Array, name: str) -> Array:
     """What the criterion bounds at one z: forces f_x (3 K,) [N] or the rms motor torque (1,) [N m]."""
     return samples_of_points(problem, np.asarray(z, dtype=float)[None], name)[0]
 
 
-def samples_jacobian(problem: LinkLengthProblem, z: Array, name: str) -> Array:
+def samples_jacobian(problem: TaskProblem, z: Array, name: str) -> Array:
     """D samples / dz by central differences, all 2 n perturbations in one stacked call, (S, n)."""
     z = np.asarray(z, dtype=float)
     n = len(z)
@@ -79,7 +80,7 @@ def samples_jacobian(problem: LinkLengthProblem, z: Array, name: str) -> Array:
     return ((s[:n] - s[n:]) / (2.0 * step[:, None])).T
 
 
-def criterion(problem: LinkLengthProblem, z: Array, name: str) -> float:
+def criterion(problem: TaskProblem, z: Array, name: str) -> float:
     """The criterion's value at z [N or N m]."""
     return float(np.max(np.abs(criterion_samples(problem, z, name))))
 
@@ -87,7 +88,7 @@ def criterion(problem: LinkLengthProblem, z: Array, name: str) -> float:
 class EpsilonProblem:
     """The study's NLP with criterion <= epsilon appended (rows scaled by ``scale``)."""
 
-    def __init__(self, problem: LinkLengthProblem, name: str, epsilon: float, scale: float) -> None:
+    def __init__(self, problem: TaskProblem, name: str, epsilon: float, scale: float) -> None:
         self.problem, self.name, self.epsilon, self.scale = problem, name, float(epsilon), float(scale)
 
     def rows(self, z: Array) -> Array:
@@ -143,11 +144,17 @@ class EpsilonProblem:
 
 @dataclass(frozen=True)
 class FrontPoint:
-    """One point of the front: epsilon, the criterion reached, the cost [W^2 s], objective, status."""
+    """One point of the front: epsilon, the criterion reached, costf2 [W^2 s], the objective, status.
+
+    ``objective_value`` is the study's objective [``objective_unit``: J for battery_energy, W^2 s
+    for costf2], ``objective`` the same divided by its value at the study's start.
+    """
 
     epsilon: float
     criterion: float
-    cost: float
+    costf2_W2s: float
+    objective_value: float
+    objective_unit: str
     objective: float
     xi: tuple[float, ...]
     accepted: bool
@@ -156,13 +163,16 @@ class FrontPoint:
 
     def as_row(self) -> dict[str, Any]:
         """A table row."""
-        row: dict[str, Any] = {k: getattr(self, k) for k in ("epsilon", "criterion", "cost", "objective")}
+        row: dict[str, Any] = {
+            k: getattr(self, k)
+            for k in ("epsilon", "criterion", "costf2_W2s", "objective_value", "objective_unit", "objective")
+        }
         row.update({f"xi_{k}": v for k, v in enumerate(self.xi)})
         row.update(accepted=self.accepted, message=self.message, iterations=self.iterations)
         return row
 
 
-def minimise_criterion(problem: LinkLengthProblem, z0: Array, name: str) -> tuple[Array, float, bool]:
+def minimise_criterion(problem: TaskProblem, z0: Array, name: str) -> tuple[Array, float, bool]:
     """The least criterion the study's constraints allow: min t s.t. -t <= s_k(z) <= t (epigraph form).
 
     Returns (z, c_min, converged); variables (z, t) with t scaled by the criterion at z0.
@@ -211,7 +221,7 @@ def minimise_criterion(problem: LinkLengthProblem, z0: Array, name: str) -> tupl
     return z, criterion(p, z, name), bool(res.success) and p.max_violation(z) <= FEASIBLE
 
 
-def pareto_front(problem: LinkLengthProblem, z_optimum: Array, name: str, points: int) -> list[FrontPoint]:
+def pareto_front(problem: TaskProblem, z_optimum: Array, name: str, points: int) -> list[FrontPoint]:
     """The front from the plain optimum (epsilon = its criterion c_0) to the least criterion c_min.
 
     Args:
@@ -243,13 +253,15 @@ def pareto_front(problem: LinkLengthProblem, z_optimum: Array, name: str, points
 
 
 def _point(
-    problem: LinkLengthProblem, z: Array, name: str, epsilon: float, accepted: bool, message: str, iterations: int
+    problem: TaskProblem, z: Array, name: str, epsilon: float, accepted: bool, message: str, iterations: int
 ) -> FrontPoint:
     ev = problem.evaluate(z)
     return FrontPoint(
         epsilon,
         criterion(problem, z, name),
+        costf2(problem.emlas, problem.dt).value(ev),
         ev.cost,
+        problem.objective.unit,
         ev.cost / problem.cost_scale,
         tuple(float(v) for v in ev.lengths.as_array()),
         accepted,
@@ -292,7 +304,7 @@ def front_figure_png(front: list[FrontPoint], name: str, title: str) -> bytes:
         top = ax.secondary_xaxis("top", functions=(to_percent, from_percent))
         top.set_xlabel(f"{words}: change from the plain optimum [%]")
     ax.set_xlabel(f"{words} [{unit}]")
-    ax.set_ylabel("objective / its value at the start")
+    ax.set_ylabel(f"objective ({front[0].objective_unit}) / its value at the start")
     ax.set_title(f"{title}: what limiting the {words} costs", fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)

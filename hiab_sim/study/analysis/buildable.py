@@ -31,7 +31,7 @@ file accepts the optimum.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Hashable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -40,7 +40,15 @@ from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.tolerance import buildable_crane, round_lengths
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.nlp.blocks import STROKE_SCALE, WorkingRange
-from hiab_sim.study.nlp.interface import N_XI, Array, ConstraintBlock, DenseRows, SamplePartials, SampleState
+from hiab_sim.study.nlp.interface import (
+    N_XI,
+    Array,
+    ConstraintBlock,
+    DenseRows,
+    Relaxation,
+    SamplePartials,
+    SampleState,
+)
 from hiab_sim.study.nlp.mounting_rows import MOUNTING_SCALE, MountingRows
 
 if TYPE_CHECKING:
@@ -113,6 +121,15 @@ class RobustXi(ConstraintBlock):
         """The inner block's clearance."""
         return self.inner.clearance()
 
+    def relaxation(self, values: Array) -> Relaxation:
+        """The inner block's units (the robust rows are its rows less a constant-sign term)."""
+        return self.inner.relaxation(values)
+
+    def shared_key(self) -> Hashable | None:
+        """The inner block's key with this block's name and tolerance (rows of Xi only)."""
+        inner = self.inner.shared_key()
+        return None if inner is None else (self.name, inner, self.tolerance)
+
 
 def replace_lengths(state: SampleState, xi: Array) -> SampleState:
     """The same samples with other link lengths (for rows of Xi only)."""
@@ -143,7 +160,7 @@ def buildable_working_range(study: Study, working: Sequence[tuple[float, float]]
 
 
 def buildable_blocks(study: Study, working: Sequence[tuple[float, float]], tightened: bool) -> list[ConstraintBlock]:
-    """The buildable-design blocks in row order (one line in ``LinkLengthProblem._build_blocks``).
+    """The buildable-design blocks in row order (the ``buildable`` entry of the block registry).
 
     On the optimiser's grid (``tightened``): the stroke rows at the ends of the buildable working
     range and the mounting rows (if the study has ``mounting``), both robust to +-``build.tolerance``.

@@ -11,7 +11,8 @@ violates a constraint (e.g. a lead too long for the peak force) is listed as ``i
 Each optimum is evaluated on the fine grid (nominal bands) by
 :func:`hiab_sim.study.report.energy_section.design_energy`: exact battery energy, costf2 and the thermal
 margins. The best combination is the converged one (max violation <= ``FEASIBLE``, thermal margins
->= 0) of least exact objective (battery energy [J] or costf2 [W^2 s]); the saving of the co-design
+>= 0) of least exact objective (any registered objective in its own unit: battery energy [J],
+costf2 [W^2 s], ...; weighted over the study's tasks); the saving of the co-design
 is compared with the reference row's, both relative to the initial design with the file's
 transmission.
 """
@@ -22,7 +23,7 @@ import itertools
 import os
 import sys
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import TextIO
 
 import numpy as np
@@ -30,7 +31,9 @@ import numpy as np
 from hiab_sim.emla import EmlaSet
 from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.results.energy_sections import Codesign, CodesignRow, DesignEnergy, TransmissionChoice
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.interface import Array
+from hiab_sim.study.nlp.objectives import exact_value
+from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.report.energy_section import design_energy
 from hiab_sim.study.solvers.slsqp import check_start, solve
 from hiab_sim.study.spec.study_file import Study
@@ -71,24 +74,49 @@ def _min_margin(e: DesignEnergy) -> float | None:
     return min(min(t.torque_margin, t.temperature_margin_K / 100.0) for t in e.thermal.values())
 
 
+@dataclass(frozen=True)
+class StudyEnergy:
+    """A design's fine-grid energies, weighted over the study's tasks, and its least thermal margin."""
+
+    battery_energy_J: float
+    costf2_W2s: float
+    objective_value: float  # the study's objective, exact (unsmoothed) where it has an exact form [its unit]
+    min_thermal_margin: float | None
+
+
+def study_energy(fine: StudyProblem, z: Array) -> StudyEnergy:
+    """Battery energy [J], costf2 [W^2 s] and the objective over the tasks' fine grids (weighted), thermal worst."""
+    battery = costf2 = objective = 0.0
+    margins = []
+    for k, (w, p) in enumerate(zip(fine.weights, fine.problems, strict=True)):
+        ev = p.evaluate(fine.task_z(z, k))
+        e = design_energy(p, ev)
+        battery += w * e.battery_energy_J
+        costf2 += w * e.costf2_W2s
+        objective += w * exact_value(p.objective, ev)
+        margins.append(_min_margin(e))
+    known = [m for m in margins if m is not None]
+    return StudyEnergy(float(battery), float(costf2), float(objective), min(known) if known else None)
+
+
 def solve_combination(study: Study, combo: Combination) -> CodesignRow:
     """Optimise the mounting of ``study`` with the transmission ``combo``; one table row (never raises)."""
     emlas = with_transmission(study.emlas, combo)
     try:
-        problem = LinkLengthProblem(study, emlas=emlas)
+        problem = StudyProblem(study, emlas=emlas)
         z0 = problem.initial_point(study.initial_lengths)
         check_start(problem, z0)
     except InvalidInputError as error:
         return CodesignRow(combo, "infeasible start", str(error))
-    fine = LinkLengthProblem(
-        study, emlas=emlas, times=study.grid.fine_times(), cost_scale=problem.cost_scale, tightened=False
+    fine = StudyProblem(
+        study, emlas=emlas, tightened=False, fine=True, cost_scales=[p.cost_scale for p in problem.problems]
     )
-    e0 = design_energy(fine, fine.evaluate(z0))
+    e0 = study_energy(fine, z0)
     try:
         result = solve(problem, study.initial_lengths, progress=None)
     except (SolverError, InvalidInputError) as error:
         return CodesignRow(combo, "solver failed", str(error), initial_battery_energy_J=e0.battery_energy_J)
-    e1 = design_energy(fine, fine.evaluate(result.z))
+    e1 = study_energy(fine, result.z)
     return CodesignRow(
         combo,
         "converged",
@@ -96,22 +124,24 @@ def solve_combination(study: Study, combo: Combination) -> CodesignRow:
         initial_battery_energy_J=e0.battery_energy_J,
         battery_energy_J=e1.battery_energy_J,
         costf2_W2s=e1.costf2_W2s,
+        objective_value=e1.objective_value,
+        objective_unit=problem.objective.unit,
         lengths=problem.unpack(result.z)[0],
         max_violation=problem.max_violation(result.z),
-        min_thermal_margin=_min_margin(e1),
+        min_thermal_margin=e1.min_thermal_margin,
         iterations=result.iterations,
         wall_time_s=result.wall_time,
     )
 
 
-def _score(row: CodesignRow, objective: str) -> float:
+def _score(row: CodesignRow) -> float:
     feasible = (
         row.status == "converged"
         and row.max_violation is not None
         and row.max_violation <= FEASIBLE
         and (row.min_thermal_margin is None or row.min_thermal_margin >= 0.0)
     )
-    value = row.battery_energy_J if objective == "battery_energy" else row.costf2_W2s
+    value = row.objective_value
     return float(value) if feasible and value is not None else float("inf")
 
 
@@ -136,7 +166,7 @@ def run_codesign(
     else:
         rows = [solve_combination(study, c) for c in combos]
     objective = study.energy.objective
-    scores = [_score(r, objective) for r in rows]
+    scores = [_score(r) for r in rows]
     best = int(np.argmin(scores))
     if not np.isfinite(scores[best]):
         raise SolverError("co-design: no transmission combination reached a feasible optimum")

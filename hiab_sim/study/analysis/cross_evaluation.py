@@ -6,7 +6,8 @@ the Xi bounds collapsed to the design), because a crane built with those lengths
 as well as it can on that task. Evaluating it on the mix is the weighted sum over the tasks (the
 mix's NLP decouples into the tasks once Xi is fixed). The matrix rows are the designs, the columns
 the tasks: net electrical energy and energy drawn on each task's fine grid (nominal bands), the
-cost of eq. ``costf2`` on its collocation grid, and the largest violation. ``mix_energy_lost``
+cost of eq. ``costf2`` [W^2 s] and the study's objective [its unit] on its collocation grid, and the
+largest violation. ``mix_energy_lost``
 is what a single-task design costs the mix in net energy over the mix optimum. The optimum
 minimises the squared-power cost, so an energy "loss" may be negative; so may the cost loss, by
 the spread of the non-convex NLP's local optima (~1e-5 relative on the test studies): each
@@ -16,23 +17,31 @@ optimum is local, from its own start.
 from __future__ import annotations
 
 import copy
+from dataclasses import replace
 
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.results.analysis_sections import CrossEvaluation
 from hiab_sim.study.nlp.interface import N_XI, Array
-from hiab_sim.study.nlp.mix import MixProblem
-from hiab_sim.study.nlp.problem import LinkLengthProblem
-from hiab_sim.study.report.result_folder import design_summary, fine_problem
+from hiab_sim.study.nlp.objectives import costf2
+from hiab_sim.study.nlp.problem import StudyProblem
+from hiab_sim.study.report.design_check import design_summary, fine_problem
 from hiab_sim.study.solvers.ipopt import solve_ipopt
 from hiab_sim.study.solvers.slsqp import solve
+from hiab_sim.study.spec.study_file import Study
 
 #: Largest scaled violation of a design's re-optimised trajectory that counts as serving the task.
 FEASIBLE = 1e-6
 
 
+def task_alone(study: Study, k: int) -> StudyProblem:
+    """Task k of a study as a study of its own (weight 1: its NLP is the task's, bit for bit)."""
+    task = replace(study.tasks[k], weight=1.0)
+    return StudyProblem(replace(study, tasks=(task,)))
+
+
 def fixed_lengths_optimum(
-    problem: LinkLengthProblem, lengths: LinkLengths, coefficients: Array | None = None
+    problem: StudyProblem, lengths: LinkLengths, coefficients: Array | None = None
 ) -> tuple[Array, bool, str]:
     """The task's best trajectory for fixed link lengths: IPOPT on the task's NLP with Xi fixed.
 
@@ -42,7 +51,7 @@ def fixed_lengths_optimum(
     on the two-task test study, even for a task's own optimal Xi), where IPOPT converges to < 1e-8.
 
     Args:
-        problem: The task's NLP (collocation grid, tightened bands).
+        problem: The task's NLP (:func:`task_alone`: collocation grid, tightened bands).
         lengths: The design Xi [m].
         coefficients: Start coefficients (3, N) (default: the inverse-kinematics fit).
 
@@ -51,7 +60,7 @@ def fixed_lengths_optimum(
         (:data:`FEASIBLE`).
 
     """
-    z0 = problem.initial_point(lengths, coefficients)
+    z0 = problem.initial_point(lengths, None if coefficients is None else [coefficients])
     settings = problem.study.solver
     fixed = copy.copy(problem)  # the same NLP (and caches) with the Xi bounds collapsed to the design
     fixed.lower, fixed.upper = problem.lower.copy(), problem.upper.copy()
@@ -60,35 +69,36 @@ def fixed_lengths_optimum(
     return outcome.z, outcome.success, outcome.message
 
 
-def single_task_optima(mix: MixProblem) -> list[LinkLengths]:
+def single_task_optima(alone: list[StudyProblem]) -> list[LinkLengths]:
     """Each task's optimum alone, from the study's start (its own NLP, the study's solver settings)."""
     out = []
-    for p in mix.problems:
-        result = solve(p, mix.study.initial_lengths, progress=None)
+    for p in alone:
+        result = solve(p, p.study.initial_lengths, progress=None)
         out.append(p.unpack(result.z)[0])
     return out
 
 
-def cross_evaluation(mix: MixProblem, z_mix: Array, alone: list[LinkLengths] | None = None) -> CrossEvaluation:
+def cross_evaluation(mix: StudyProblem, z_mix: Array, alone: list[LinkLengths] | None = None) -> CrossEvaluation:
     """Rows: each task's optimum alone, then the mix optimum ``z_mix``; columns: the tasks (module docstring)."""
-    alone = single_task_optima(mix) if alone is None else alone
+    tasks = [task_alone(mix.study, k) for k in range(mix.n_tasks)]
+    alone = single_task_optima(tasks) if alone is None else alone
     mix_lengths, mix_c = mix.unpack(z_mix)
     designs = [f"{task.name} alone" for task in mix.tasks] + ["mix"]
     lengths = [*alone, mix_lengths]
     fines = [fine_problem(p) for p in mix.problems]
-    rows: dict[str, list[list[float | None]]] = {k: [] for k in ("net", "drawn", "cost", "viol")}
+    rows: dict[str, list[list[float | None]]] = {k: [] for k in ("net", "drawn", "cost", "viol", "objective")}
     why: list[tuple[str, ...]] = []
     for d, xi in enumerate(lengths):
         row: dict[str, list[float | None]] = {k: [] for k in rows}
         row_why: list[str] = []
         for k, (p, fine) in enumerate(zip(mix.problems, fines, strict=True)):
             start = mix_c[k] if d == len(alone) else None
-            values: tuple[float | None, ...] = (None, None, None, None)
+            values: tuple[float | None, ...] = (None, None, None, None, None)
             reason = ""
             # A design outside the model's domain or a failed solve is this cell's answer, said in
             # words; a missing backend (BackendUnavailableError) is not a cell's answer and propagates.
             try:
-                z, _, message = fixed_lengths_optimum(p, xi, start)
+                z, _, message = fixed_lengths_optimum(tasks[k], xi, start)
             except (InvalidInputError, SolverError) as error:
                 reason = f"cannot be evaluated: {error}"
             else:
@@ -98,8 +108,9 @@ def cross_evaluation(mix: MixProblem, z_mix: Array, alone: list[LinkLengths] | N
                     values = (
                         summary.net_electrical_energy_J,
                         summary.drawn_energy_summed_drives_J,
-                        p.evaluate(z).cost,
+                        costf2(p.emlas, p.dt).value(p.evaluate(z)),
                         summary.max_violation,
+                        p.evaluate(z).cost,
                     )
                 else:
                     reason = (
@@ -144,6 +155,10 @@ def cross_evaluation(mix: MixProblem, z_mix: Array, alone: list[LinkLengths] | N
         max_violation=tuple(tuple(r) for r in rows["viol"]),
         mix_net_energy_J=tuple(mix_net),
         mix_cost_W2s=tuple(mix_cost),
+        objective=mix.objective.name,
+        objective_unit=mix.objective.unit,
+        objective_value=tuple(tuple(r) for r in rows["objective"]),
+        mix_objective_value=tuple(weighted(r) for r in rows["objective"]),
         mix_energy_lost_J=tuple(lost(mix_net, best_net, False)),
         mix_energy_lost_percent=tuple(lost(mix_net, best_net, True)),
         mix_cost_lost_percent=tuple(lost(mix_cost, best_cost, True)),

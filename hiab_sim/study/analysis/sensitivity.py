@@ -8,7 +8,7 @@ stationarity condition with the problem's exact gradients,
 by non-negative least squares on the active set A (rows with scaled margin <= ``active_tolerance``,
 Xi on a bound), the equality multipliers mu split into mu+ - mu-. lambda_i is the decrease of
 the scaled cost f / f_scale per unit relaxation of the scaled row g_i >= 0 -> g_i >= -delta, so
-the cost change of relaxing a physical limit by one unit u is lambda_i f_scale dg_i/du:
+the objective's change on relaxing a physical limit by one unit u is lambda_i f_scale dg_i/du:
 
 * a bound of Xi [m]: dg/du = 1e-3 / XI_SCALE per ``mm``;
 * an EMLA limit g = 1 - (y / y_max)^2 (peak torque, rated speed, voltage; rows scaled by 1 / (1 - m)):
@@ -18,32 +18,34 @@ the cost change of relaxing a physical limit by one unit u is lambda_i f_scale d
   unit of b, so 1e-3 / b per ``mm`` (or mm/s, mm/s^2);
 * the stroke and working-range rows (scale 0.1 m) and the mounting rows (scale 0.1 m):
   1e-3 / 0.1 per ``mm``;
-* a joint-velocity limit: the row 1 - dtheta / limit changes by ~0.01 per ``%``.
+* a joint-velocity limit: the row 1 - dtheta / limit changes by ~0.01 per ``%``;
+* any other block: its own :meth:`~hiab_sim.study.nlp.interface.ConstraintBlock.relaxation`
+  (every block states its rows' unit; thermal rows per ``%`` of the continuous torque and per ``K``
+  of the winding limit, joint limits per ``mrad`` or ``mm``, an epsilon row per unit of its objective).
 
-Rows with the same limit at different samples (``... at t=...``) are summed into one entry.
+Rows of one limit (:meth:`~hiab_sim.study.nlp.interface.ConstraintBlock.limit_name`: the same limit at
+different samples, ``... at t=...``) are summed into one entry. The decrease is in the objective's
+own unit (W^2 s for ``costf2``, J for ``battery_energy``) and in % of its value at the optimum;
+for several tasks the objective is the weighted sum and the rows are named ``<task>: <row>``.
 """
 
 from __future__ import annotations
-
-import re
 
 import numpy as np
 from scipy.optimize import nnls
 
 from hiab_sim.results.analysis_sections import Multiplier, Sensitivity
-from hiab_sim.study.nlp import blocks as bl
-from hiab_sim.study.nlp.mounting_rows import MOUNTING_SCALE
-from hiab_sim.study.nlp.problem import XI_SCALE, LinkLengthProblem
+from hiab_sim.study.nlp.problem import StudyProblem
+from hiab_sim.study.nlp.task_problem import XI_SCALE
 
 Array = np.ndarray
 #: Scaled margin below which a row counts as active.
 ACTIVE_TOLERANCE = 1e-6
-_SAMPLE = re.compile(r" at t=[-0-9.e+]+ s$")
 XI_NAMES = ("lift.L", "lift.Lc0", "lift.Lc", "tilt.L", "tilt.Lc0", "tilt.Lc")
 
 
 def kkt_multipliers(
-    problem: LinkLengthProblem, z: Array, active_tolerance: float = ACTIVE_TOLERANCE
+    problem: StudyProblem, z: Array, active_tolerance: float = ACTIVE_TOLERANCE
 ) -> tuple[Array, Array, Array, float]:
     """(lambda per row (m,), nu_low (6,), nu_up (6,), relative residual) by NNLS on the active set."""
     z = np.asarray(z, dtype=float)
@@ -70,47 +72,31 @@ def kkt_multipliers(
     return lam, nu_low, nu_up, float(residual / max(np.linalg.norm(grad), 1e-300))
 
 
-def _row_unit(problem: LinkLengthProblem, block: str, row: str, value: float) -> tuple[str, float]:
-    """(unit, d(scaled row)/d(one unit of relaxation)) of a row of a block."""
-    study = problem.study
-    if block == "envelope":
-        m = problem.envelope_margin
-        g = value * (1.0 - m) + m
-        return "%", (1.0 - g) * (1.0 - 1.0 / 1.01**2) / (1.0 - m)
-    if block.startswith("tracking."):
-        order = block.split(".")[1]
-        band = getattr(study.tracking, order)
-        unit = {"position": "mm", "velocity": "mm/s", "acceleration": "mm/s^2"}[order]
-        return unit, 1e-3 / band
-    if block in ("stroke", "working_range", "buildable_range"):
-        return "mm", 1e-3 / bl.STROKE_SCALE
-    if block == "mounting":
-        return "mm", 1e-3 / MOUNTING_SCALE
-    if block == "joint_velocity":
-        return "%", 0.01
-    return "scaled unit", 1.0
+def sensitivity(problem: StudyProblem, z: Array, active_tolerance: float = ACTIVE_TOLERANCE) -> Sensitivity:
+    """The ``sensitivity`` section: every active constraint's multiplier in physical units (module docstring).
 
-
-def sensitivity(problem: LinkLengthProblem, z: Array, active_tolerance: float = ACTIVE_TOLERANCE) -> Sensitivity:
-    """The ``sensitivity`` section: every active constraint's multiplier in physical units (module docstring)."""
+    Each block gives its rows' units (:meth:`~hiab_sim.study.nlp.interface.ConstraintBlock.relaxation`)
+    and groups its rows into limits (:meth:`~hiab_sim.study.nlp.interface.ConstraintBlock.limit_name`); the
+    objective's decrease is in the objective's own unit and in % of its value at z.
+    """
     lam, nu_low, nu_up, residual = kkt_multipliers(problem, z, active_tolerance)
-    cost = problem.evaluate(z).cost
+    value = problem.evaluate(z).cost
     scale = problem.cost_scale
     g = problem.constraints(z)
-    entries: dict[str, list[float]] = {}  # key -> [lambda sum, cost per unit, rows]
+    entries: dict[str, list[float]] = {}  # key -> [lambda sum, objective decrease per unit, rows]
     units: dict[str, str] = {}
-    for block, rows in problem.layout.slices.items():
-        for i in range(rows.start, rows.stop):
-            if lam[i] <= 0.0:
+    for stacked in problem.blocks:
+        block, rows = stacked.block, stacked.rows
+        relax = block.relaxation(g[rows])
+        local_names = problem.problems[stacked.task].constraint_names[stacked.local]
+        for i, (row, unit, per_unit) in enumerate(zip(local_names, relax.units, relax.per_unit, strict=True)):
+            lam_i = lam[rows.start + i]
+            if lam_i <= 0.0:
                 continue
-            name = problem.constraint_names[i]
-            key = _SAMPLE.sub("", name)
-            if block == "envelope" or block.startswith("tracking.") or block == "joint_velocity":
-                key = key.rsplit(" ", 2)[0] if block.startswith("tracking.") else key
-            unit, per_unit = _row_unit(problem, block, name, float(g[i]))
+            key = problem.row_name(stacked.task, block.limit_name(row))
             entry = entries.setdefault(key, [0.0, 0.0, 0.0])
-            entry[0] += lam[i]
-            entry[1] += lam[i] * per_unit * scale
+            entry[0] += lam_i
+            entry[1] += lam_i * per_unit * scale
             entry[2] += 1
             units[key] = unit
     for k, name in enumerate(XI_NAMES):
@@ -124,10 +110,17 @@ def sensitivity(problem: LinkLengthProblem, z: Array, active_tolerance: float = 
             constraint=key,
             multiplier=float(v[0]),
             unit=units[key],
-            cost_per_unit_W2s=float(v[1]),
-            percent_per_unit=float(100.0 * v[1] / cost),
+            objective_decrease_per_unit=float(v[1]),
+            percent_per_unit=float(100.0 * v[1] / value),
             rows=int(v[2]),
         )
         for key, v in sorted(entries.items(), key=lambda kv: -kv[1][1])
     )
-    return Sensitivity(cost_W2s=cost, active_tolerance=active_tolerance, kkt_residual=residual, multipliers=multipliers)
+    return Sensitivity(
+        objective=problem.objective.name,
+        objective_unit=problem.objective.unit,
+        objective_value=value,
+        active_tolerance=active_tolerance,
+        kkt_residual=residual,
+        multipliers=multipliers,
+    )

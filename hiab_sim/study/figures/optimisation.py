@@ -27,8 +27,8 @@ from hiab_sim.study.figures.design import (
     structure_overlay,
 )
 from hiab_sim.study.figures.energy import hydraulic_figure
-from hiab_sim.study.nlp.problem import ACTUATORS
-from hiab_sim.study.report.result_folder import DesignCheck
+from hiab_sim.study.nlp.task_problem import ACTUATORS
+from hiab_sim.study.report.design_check import DesignCheck
 from hiab_sim.style import colour
 
 __all__ = ["draw_crane", "write_figures"]

@@ -21,7 +21,7 @@ The stroke trigonometry is :func:`hiab_sim.crane.mechanism.joint_to_stroke` and 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Hashable, Sequence
 
 import numpy as np
 
@@ -38,6 +38,7 @@ from hiab_sim.study.nlp.interface import (
     DenseRows,
     Objective,
     PerSampleBlock,
+    Relaxation,
     SamplePartials,
     SampleRows,
     SampleState,
@@ -49,6 +50,8 @@ STROKE_SCALE = 0.1
 TRACKED = ("x_tcp", "y_tcp", "xt2")
 #: Rows of one chain's stroke limits (const_j), scaled by 1 / STROKE_SCALE.
 STROKE_ROWS = ("x >= 0", "x <= Lc", "x <= stroke")
+#: Unit of one step of relaxation of a tracking band, by derivative order.
+_TRACKING_UNITS = {"position": "mm", "velocity": "mm/s", "acceleration": "mm/s^2"}
 #: Per-sample row pairs (i, i + 3) of a block whose first three rows bound three quantities from one
 #: side and last three from the other (:attr:`hiab_sim.study.nlp.interface.PerSampleBlock.pairs`).
 OPPOSITE_ROWS = ((0, 3), (1, 4), (2, 5))
@@ -70,6 +73,7 @@ class TrackingBand(PerSampleBlock):
         self.order = order
         self.times = times
         self.target = target
+        self.band = band
         self.width = band * fraction
         self.sample_rows = (*(f"{c} <= band" for c in TRACKED), *(f"{c} >= -band" for c in TRACKED))
         self.pairs = OPPOSITE_ROWS  # (1 - e) + (1 + e) = 2
@@ -83,6 +87,14 @@ class TrackingBand(PerSampleBlock):
         """-dr/dq9 / width and +dr/dq9 / width (the TCP kinematics' exact partials)."""
         d = getattr(state.tcp, f"d_{self.order}")
         return SampleRows(np.concatenate([-d / self.width, d / self.width], axis=1))
+
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per mm (mm/s, mm/s^2) of the band: the row 1 - e / (b phi) at an active sample moves by 1e-3 / b."""
+        return Relaxation.uniform(_TRACKING_UNITS[self.order], 1e-3 / self.band, len(values))
+
+    def limit_name(self, row: str) -> str:
+        """``tracking.<order>.<coordinate>``: both sides of one coordinate's band at every sample."""
+        return super().limit_name(row).rsplit(" ", 2)[0]
 
 
 class EnvelopeMargins(PerSampleBlock):
@@ -121,6 +133,12 @@ class EnvelopeMargins(PerSampleBlock):
             dG[:, i, :, i], dG[:, i, :, 3 + i], dG[:, i, :, 6 + i] = gf.T, gv.T, ga.T
         dGY = dG.reshape(K, 9, 9) / (1.0 - self.margin)
         return SampleRows(np.einsum("kmy,kyq->kmq", dGY, partials.id_q), np.einsum("kmy,kyx->kmx", dGY, partials.id_xi))
+
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per % of an EMLA limit: g = 1 - (y / y_max)^2 moves by (1 - g)(1 - 1 / 1.01^2), scaled by 1 / (1 - m)."""
+        m = self.margin
+        g = np.asarray(values, dtype=float) * (1.0 - m) + m
+        return Relaxation(("%",) * len(g), (1.0 - g) * (1.0 - 1.0 / 1.01**2) / (1.0 - m))
 
 
 def stroke_margins(chains: Sequence[ClosedChain], lengths: LinkLengths, theta: Array) -> Array:
@@ -169,6 +187,10 @@ class StrokeLimits(PerSampleBlock):
         """Exact partials of the chain trigonometry (eq. qus_a)."""
         return SampleRows(*stroke_margin_partials(self.chains, state.lengths, state.joints.position))
 
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per mm of stroke: 1e-3 / STROKE_SCALE."""
+        return Relaxation.uniform("mm", 1e-3 / STROKE_SCALE, len(values))
+
 
 class JointLimits(PerSampleBlock):
     """theta - low >= 0 and up - theta >= 0 for (theta1, theta2, xt2) at every sample (const_h, const_k)."""
@@ -193,6 +215,11 @@ class JointLimits(PerSampleBlock):
         jq[:, :3, :3], jq[:, 3:, :3] = eye, -eye
         return SampleRows(jq)
 
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per mrad of an angle's limit, per mm of the telescope's: 1e-3 (the rows are rad and m)."""
+        per_sample = ("mrad", "mrad", "mm") * 2  # rows (theta1, theta2, xt2) >= low, then <= up
+        return Relaxation(per_sample * (len(values) // len(per_sample)), np.full(len(values), 1e-3))
+
 
 class JointVelocityLimits(PerSampleBlock):
     """|dtheta| <= limit for (theta1, theta2, xt2) at every sample, scaled by the limit (const_i)."""
@@ -214,6 +241,10 @@ class JointVelocityLimits(PerSampleBlock):
         vq = np.zeros((len(self.times), 6, N_Q))
         vq[:, :3, 3:6], vq[:, 3:, 3:6] = -np.diag(1.0 / self.limit), np.diag(1.0 / self.limit)
         return SampleRows(vq)
+
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per % of the velocity limit: the row 1 - dtheta / limit moves by ~0.01."""
+        return Relaxation.uniform("%", 0.01, len(values))
 
 
 class WorkingRange(ConstraintBlock):
@@ -253,6 +284,14 @@ class WorkingRange(ConstraintBlock):
         """The optimiser's clearance (scaled)."""
         return self._clearance
 
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per mm of stroke: 1e-3 / STROKE_SCALE."""
+        return Relaxation.uniform("mm", 1e-3 / STROKE_SCALE, len(values))
+
+    def shared_key(self) -> Hashable:
+        """Rows of Xi only: the same for every task with the same chains, range and clearance."""
+        return (self.name, repr(self.chains), self.theta.tobytes(), self._clearance)
+
 
 class ObjectiveBound(ConstraintBlock):
     """(bound - f(state)) / scale >= 0 for an objective f: an epsilon constraint (one row, all samples).
@@ -284,3 +323,7 @@ class ObjectiveBound(ConstraintBlock):
         """-(df/dq9, df/dXi) / scale."""
         dq, dxi = self.objective.gradient(state, partials)
         return DenseRows(dq=-dq[None] / self.scale, dxi=-dxi[None] / self.scale)
+
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per unit of the objective's bound: 1 / scale."""
+        return Relaxation.uniform(self.objective.unit, 1.0 / self.scale, len(values))

@@ -14,7 +14,14 @@ from __future__ import annotations
 import numpy as np
 
 from hiab_sim.emla import EmlaSet
-from hiab_sim.study.nlp.interface import Array, ConstraintBlock, DenseRows, SamplePartials, SampleState
+from hiab_sim.study.nlp.interface import (
+    Array,
+    ConstraintBlock,
+    DenseRows,
+    Relaxation,
+    SamplePartials,
+    SampleState,
+)
 from hiab_sim.study.spec.energy import DutySettings
 
 
@@ -55,6 +62,11 @@ class BrakeHolding(ConstraintBlock):
         dq = np.einsum("mky,kyq->mkq", rows, partials.id_q)
         dxi = np.einsum("mky,kyx->mx", rows, partials.id_xi)
         return DenseRows(dq=dq, dxi=dxi)
+
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per % of the holding torque M_4: the row 1 - |tau| / M_4 moves by (1 - g)(1 - 1 / 1.01)."""
+        g = np.asarray(values, dtype=float)
+        return Relaxation(("%",) * len(g), (1.0 - g) * (1.0 - 1.0 / 1.01))
 
 
 def brake_blocks(emlas: EmlaSet, duty: DutySettings | None) -> list[ConstraintBlock]:

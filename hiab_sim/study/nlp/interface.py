@@ -1,6 +1,6 @@
 """The building blocks of the NLP: what a constraint block or an objective sees, returns and owns.
 
-A point z of the NLP is turned by :class:`hiab_sim.study.nlp.problem.LinkLengthProblem` into a
+A point z of a task's NLP is turned by :class:`hiab_sim.study.nlp.task_problem.TaskProblem` into a
 :class:`SampleState` (link lengths Xi, joint samples q9 = (theta, dtheta, ddtheta) per sample,
 TCP samples, actuator samples [f_x, v_x, a_x] from the inverse dynamics, EMLA electrical power).
 Blocks and objectives read only that state and, for gradients, :class:`SamplePartials` (the
@@ -19,27 +19,28 @@ the Jacobian of one list of blocks, and splits any row vector (margins, multipli
 An objective (:class:`Objective`) returns its value [its unit] and gradient w.r.t. q9 (K, 9)
 and Xi (6,); the problem divides both by its ``cost_scale``.
 
-Extending (one edit each):
+Extending (one module and its registration each, docs/extending.md):
 
 - a block: subclass :class:`PerSampleBlock` (same rows at every sample, return :class:`SampleRows`)
-  or :class:`ConstraintBlock` (return :class:`DenseRows`), and add an instance to
-  ``LinkLengthProblem._build_blocks``. An integral row (RMS torque over the duty, a thermal
+  or :class:`ConstraintBlock` (return :class:`DenseRows`), give its rows' unit
+  (:meth:`ConstraintBlock.relaxation`) and register a factory with
+  :func:`hiab_sim.study.nlp.block_registry.register_block`. An integral row (RMS torque over the duty, a thermal
   steady state) returns ``DenseRows(dq=(m, K, 9), dxi=(m, 6))``; a row of Xi only (working
   range, mounting-space polygons) ``DenseRows(dxi=...)``; an epsilon constraint on any objective
   is :class:`hiab_sim.study.nlp.blocks.ObjectiveBound`.
-- an objective: a class with ``name``, ``unit``, ``value`` and ``gradient`` and one entry in
-  :data:`hiab_sim.study.nlp.objectives.OBJECTIVES`.
-- several tasks: each task's blocks read that task's state; the problem's ``to_z(block, jacobian,
-  rows)`` (passed to :meth:`BlockLayout.jacobian`) receives the block, so it can map q9 partials
-  to the block's task's spline matrices and coefficient columns.
+- an objective: a class with ``name``, ``unit``, ``value`` and ``gradient`` registered with
+  :func:`hiab_sim.study.nlp.objectives.register_objective` (:data:`~hiab_sim.study.nlp.objectives.OBJECTIVES`).
+- several tasks: each task's blocks read that task's state; :class:`hiab_sim.study.nlp.problem.StudyProblem`
+  stacks them, holding a block of Xi only once per :meth:`ConstraintBlock.shared_key`.
 - multipliers or margins by name: :meth:`BlockLayout.split` and :meth:`BlockLayout.named` cut any
   row vector into blocks and rows.
 """
 
 from __future__ import annotations
 
+import re
 from abc import ABC, abstractmethod
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Protocol
@@ -121,12 +122,35 @@ class DenseRows:
 
 BlockJacobian = SampleRows | DenseRows
 
+#: A row name's sample suffix (`` at t=<t> s``): rows of one limit at different samples share the rest.
+_SAMPLE = re.compile(r" at t=[-0-9.e+]+ s$")
+
+
+@dataclass(frozen=True)
+class Relaxation:
+    """What relaxing each row's physical limit by one unit does to the scaled row (for the sensitivities).
+
+    ``units``: per row, the physical unit of one step of relaxation (``mm`` of a band or a stroke,
+    ``%`` of an EMLA limit, ``K`` of a temperature limit, an objective's unit for an epsilon row);
+    ``per_unit``: per row, d(scaled row)/d(one such unit) >= 0 at the row's current value. The
+    objective's decrease per unit of relaxation is then multiplier x ``per_unit`` x the objective's scale.
+    """
+
+    units: tuple[str, ...]
+    per_unit: Array
+
+    @classmethod
+    def uniform(cls, unit: str, per_unit: float, rows: int) -> Relaxation:
+        """Every row in the same unit with the same d(scaled row)/d(unit)."""
+        return cls((unit,) * rows, np.full(rows, float(per_unit)))
+
 
 class ConstraintBlock(ABC):
     """One named group of inequality rows g >= 0 (scaled to O(1)).
 
-    Subclasses set ``name`` and implement :meth:`row_names`, :meth:`values` and :meth:`jacobian`;
-    they may override :meth:`clearance`. Row names start with ``name + "."``.
+    Subclasses set ``name`` and implement :meth:`row_names`, :meth:`values`, :meth:`jacobian` and
+    :meth:`relaxation` (the rows' physical unit); they may override :meth:`clearance`, :meth:`limit_name`
+    and, for rows of Xi only, :meth:`shared_key`. Row names start with ``name + "."``.
     """
 
     name: str
@@ -143,9 +167,25 @@ class ConstraintBlock(ABC):
     def jacobian(self, state: SampleState, partials: SamplePartials) -> BlockJacobian:
         """Partials of :meth:`values` w.r.t. q9 and Xi."""
 
+    @abstractmethod
+    def relaxation(self, values: Array) -> Relaxation:
+        """Each row's physical unit and d(row)/d(one unit of its limit relaxed) at the rows' ``values``."""
+
     def clearance(self) -> Array | float:
         """Added to :meth:`values` gives the nominal margins (a safety only the optimiser keeps); default 0."""
         return 0.0
+
+    def limit_name(self, row: str) -> str:
+        """The physical limit a row holds (rows at different samples of one limit give the same name)."""
+        return _SAMPLE.sub("", row)
+
+    def shared_key(self) -> Hashable | None:
+        """For rows of Xi alone: a key equal for blocks with the same rows (held once in a mix); else None.
+
+        A study of several tasks stacks every task's blocks; two blocks of Xi only with equal keys
+        are the same rows (linearly dependent, a degenerate QP), so the stacked problem keeps the first.
+        """
+        return None
 
 
 class PerSampleBlock(ConstraintBlock):

@@ -8,9 +8,11 @@ L) hold exactly for every design within the manufacturing tolerance.
 
 from __future__ import annotations
 
+from collections.abc import Hashable
+
 from hiab_sim.crane.description import Crane
 from hiab_sim.crane.mounting import MountingSpace, mounting_margins
-from hiab_sim.study.nlp.interface import Array, ConstraintBlock, DenseRows, SamplePartials, SampleState
+from hiab_sim.study.nlp.interface import Array, ConstraintBlock, DenseRows, Relaxation, SamplePartials, SampleState
 
 #: Scale of the mounting rows [m per unit].
 MOUNTING_SCALE = 0.1
@@ -48,3 +50,11 @@ class MountingRows(ConstraintBlock):
     def clearance(self) -> float:
         """The optimiser's clearance (scaled)."""
         return self._clearance
+
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per mm of a polygon edge or clearance: 1e-3 / MOUNTING_SCALE."""
+        return Relaxation.uniform("mm", 1e-3 / MOUNTING_SCALE, len(values))
+
+    def shared_key(self) -> Hashable:
+        """Rows of Xi only: the same for every task of one study (its mounting space and crane)."""
+        return (self.name, repr(self.space), repr(self.crane), self._clearance)

@@ -17,7 +17,8 @@ With a duty model the drive powers P_i are those at the winding temperature (R_s
 dependence on every sample (the adjoint of the coupled winding model).
 
 An objective is chosen by name with :func:`make_objective`; a new one is a class with ``name``,
-``unit``, ``value(state)`` and ``gradient(state, partials)`` plus one entry in :data:`OBJECTIVES`.
+``unit``, ``value(state)`` and ``gradient(state, partials)`` registered with
+:func:`register_objective` (docs/extending.md).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from hiab_sim.emla import EmlaSet, battery_energy, electrical_power_partials
+from hiab_sim.emla import EmlaSet, battery_energy, electrical_power_partials, operating_point
 from hiab_sim.emla.battery import rest_battery_energy
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.nlp.interface import Array, Objective, SamplePartials, SampleState
@@ -78,9 +79,33 @@ class BatteryEnergyCost:
     def value(self, state: SampleState) -> float:
         """Smooth battery energy [J] of the cycle, plus the rest's (exact, it only draws) with a duty model."""
         cycle = battery_energy(state.joints.time, state.power, self.emlas.battery, smooth=True).energy
+        return cycle + self._rest(state)
+
+    def _rest(self, state: SampleState) -> float:
+        """The rest's battery energy [J] with a duty model (the hold), else 0."""
         if state.duty is None:
-            return cycle
-        return cycle + rest_battery_energy([d.rest_energy for d in state.duty], self.emlas.battery)[0]
+            return 0.0
+        return rest_battery_energy([d.rest_energy for d in state.duty], self.emlas.battery)[0]
+
+    def exact(self, state: SampleState) -> float:
+        """Exact battery energy [J]: the drives' exact electrical power, the kinks unsmoothed (as reports give it).
+
+        With a duty model the drive powers are the state's hot ones (R_s(T)) with the battery's kinks
+        unsmoothed, plus the rest's energy; the duty report (:mod:`hiab_sim.study.report.duty_section`)
+        gives the fully exact split.
+        """
+        if state.duty is not None:
+            return battery_energy(state.joints.time, state.power, self.emlas.battery).energy + self._rest(state)
+        act = state.actuators
+        power = np.column_stack(
+            [
+                operating_point(
+                    p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], exact=True
+                ).electrical_power
+                for i, p in enumerate(self.emlas)
+            ]
+        )
+        return battery_energy(state.joints.time, power, self.emlas.battery).energy
 
     def gradient(self, state: SampleState, partials: SamplePartials) -> tuple[Array, Array]:
         """dE/dP_i (per sample and drive) chained through dP/d(f, v, a) and the inverse dynamics' partials."""
@@ -109,15 +134,51 @@ def _chain(
     return np.einsum("ky,kyq->kq", dY, partials.id_q), np.einsum("ky,kyx->x", dY, partials.id_xi)
 
 
-#: Objectives by the name a study gives, each built from (EMLA set, sample step Dt [s]).
-OBJECTIVES: dict[str, Callable[[EmlaSet, float], Objective]] = {
+#: Builds an objective from (EMLA set, sample step Dt [s]).
+ObjectiveFactory = Callable[[EmlaSet, float], Objective]
+
+#: The one registry of objectives, by the name a study gives (``objective:``); the study loader,
+#: the NLP, co-design, the energy map, the Pareto front and the reports read it.
+OBJECTIVES: dict[str, ObjectiveFactory] = {
     "costf2": SquaredPowerCost,
     "battery_energy": BatteryEnergyCost,
 }
 
 
+def register_objective(name: str, factory: ObjectiveFactory) -> None:
+    """Make ``objective: <name>`` available to every study (``factory(emlas, dt)`` builds it)."""
+    if not name.isidentifier():
+        raise InvalidInputError("objective name", name, "must be an identifier (letters, digits, _)")
+    if name in OBJECTIVES:
+        raise InvalidInputError("objective name", name, f"already registered; registered: {', '.join(OBJECTIVES)}")
+    OBJECTIVES[name] = factory
+
+
+def unregister_objective(name: str) -> None:
+    """Remove a registered objective (the built-in ones stay)."""
+    if name in ("costf2", "battery_energy"):
+        raise InvalidInputError("objective name", name, "a built-in objective cannot be removed")
+    OBJECTIVES.pop(name, None)
+
+
+def check_objective_name(name: object, field: str = "objective") -> str:
+    """``name`` if it is a registered objective, else one line naming ``field`` and the allowed names."""
+    if not isinstance(name, str) or name not in OBJECTIVES:
+        raise InvalidInputError(field, name, f"must be one of {', '.join(OBJECTIVES)}")
+    return name
+
+
 def make_objective(name: str, emlas: EmlaSet, dt: float) -> Objective:
     """The objective called ``name`` (one of :data:`OBJECTIVES`)."""
-    if name not in OBJECTIVES:
-        raise InvalidInputError("objective", name, f"must be one of {', '.join(OBJECTIVES)}")
-    return OBJECTIVES[name](emlas, dt)
+    return OBJECTIVES[check_objective_name(name)](emlas, dt)
+
+
+def exact_value(objective: Objective, state: SampleState) -> float:
+    """The objective's exact value [its unit]: its ``exact(state)`` where it smooths for the solver, else its value."""
+    exact = getattr(objective, "exact", None)
+    return float(exact(state)) if callable(exact) else float(objective.value(state))
+
+
+def costf2(emlas: EmlaSet, dt: float) -> SquaredPowerCost:
+    """The squared-power integral of eq. ``costf2`` [W^2 s], reported for every objective."""
+    return SquaredPowerCost(emlas, dt)

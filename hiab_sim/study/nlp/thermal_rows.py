@@ -22,7 +22,7 @@ import numpy as np
 from hiab_sim.emla import EmlaParams, EmlaSet, ThermalCheck, thermal_check
 from hiab_sim.emla.duty_energy import DriveDuty
 from hiab_sim.emla.thermal import Duty
-from hiab_sim.study.nlp.interface import Array, ConstraintBlock, DenseRows, SamplePartials, SampleState
+from hiab_sim.study.nlp.interface import Array, ConstraintBlock, DenseRows, Relaxation, SamplePartials, SampleState
 from hiab_sim.study.spec.energy import DutySettings
 
 #: Winding-temperature margins are divided by this [K] (O(1) rows).
@@ -83,6 +83,14 @@ class ThermalLimits(ConstraintBlock):
         dq = np.einsum("mky,kyq->mkq", dYs, partials.id_q)
         dxi = np.einsum("mky,kyx->mx", dYs, partials.id_xi)
         return DenseRows(dq=dq, dxi=dxi)
+
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per % of the continuous torque (1 - tau_rms / tau_c moves by (1 - g)(1 - 1 / 1.01)), per K of T_max."""
+        g = np.asarray(values, dtype=float)
+        per_unit = np.empty(len(g))
+        per_unit[0::2] = (1.0 - g[0::2]) * (1.0 - 1.0 / 1.01)
+        per_unit[1::2] = 1.0 / TEMPERATURE_SCALE
+        return Relaxation(("%", "K") * (len(g) // 2), per_unit)
 
 
 def duty_check(params: EmlaParams, d: DriveDuty) -> ThermalCheck:

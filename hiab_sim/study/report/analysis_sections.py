@@ -9,7 +9,7 @@ import numpy as np
 from hiab_sim.results.analysis_sections import FeasibilityPhase
 from hiab_sim.results.schema import Result
 from hiab_sim.study.analysis.sensitivity import sensitivity
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.report.buildable_section import buildable_line, buildable_section
 from hiab_sim.study.solvers.feasibility import phase_lines
 
@@ -18,7 +18,7 @@ PRINTED_MULTIPLIERS = 6
 
 
 def analysis_sections(
-    problem: LinkLengthProblem, z: np.ndarray, result: Result, crane_label: str, phases: list[FeasibilityPhase]
+    problem: StudyProblem, z: np.ndarray, result: Result, crane_label: str, phases: list[FeasibilityPhase]
 ) -> dict[str, Any]:
     """Keyword arguments for ``dataclasses.replace(result, ...)``: buildable, feasibility, sensitivity."""
     return {
@@ -38,7 +38,13 @@ def extra_lines(r: Result) -> list[str]:
         lines.append(f"  export: {r.buildable.mjcf_command}")
     if r.sensitivity is not None and r.sensitivity.multipliers:
         s = r.sensitivity
-        lines.append(f"sensitivity (KKT residual {s.kkt_residual:.1e}): cost decrease per unit the limit is relaxed")
+        lines.append(
+            f"sensitivity (KKT residual {s.kkt_residual:.1e}): decrease of {s.objective} "
+            f"({s.objective_value:.6g} {s.objective_unit}) per unit the limit is relaxed"
+        )
         for m in s.multipliers[:PRINTED_MULTIPLIERS]:
-            lines.append(f"  {m.constraint}: {m.percent_per_unit:.3f} % of the optimal cost per {m.unit}")
+            lines.append(
+                f"  {m.constraint}: {m.objective_decrease_per_unit:.4g} {s.objective_unit} "
+                f"({m.percent_per_unit:.3f} % of the optimum) per {m.unit}"
+            )
     return lines

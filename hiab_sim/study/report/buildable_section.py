@@ -7,7 +7,8 @@
    rounded design) on the working-range and mounting rows (:func:`hiab_sim.crane.tolerance.check_tolerance`);
 3. the fine-grid re-check of the rounded lengths with the optimal trajectory: the nominal NLP rows
    (tracking bands, EMLA envelope, strokes, joints, working range) of a study whose crane has the
-   buildable range, on the other inverse-dynamics path, with its energy.
+   buildable range, on the other inverse-dynamics path, with its energy: every task on its fine
+   grid, the energy weighted by the tasks' weights and the violation the worst over the tasks.
 """
 
 from __future__ import annotations
@@ -23,22 +24,21 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.results.analysis_sections import Buildable, RoundedCheck
 from hiab_sim.results.schema import DesignSummary
 from hiab_sim.study.analysis.buildable import rounded_design
-from hiab_sim.study.nlp.problem import LinkLengthProblem
-from hiab_sim.study.report.result_folder import design_summary, other_path
+from hiab_sim.study.nlp.problem import StudyProblem
+from hiab_sim.study.report.design_check import design_summary, other_path
+from hiab_sim.study.report.weighted import weighted_summary
 
 Array = np.ndarray
 
 
-def rounded_point(problem: LinkLengthProblem, z: Array) -> tuple[LinkLengths, Array]:
+def rounded_point(problem: StudyProblem, z: Array) -> tuple[LinkLengths, Array]:
     """The rounded lengths of the optimum z and the point (rounded Xi, optimal trajectory)."""
     lengths, _ = problem.unpack(z)
     study = problem.study
     rounded = rounded_design(
         lengths, study.build.tolerance, np.asarray(study.bounds.xi_low), np.asarray(study.bounds.xi_up)
     )
-    z_rounded = np.array(z, dtype=float)
-    z_rounded[: problem.n_xi] = rounded.as_array()
-    return rounded, z_rounded
+    return rounded, problem.with_lengths(z, rounded)
 
 
 def mjcf_command(study_crane: str, stroke_margin: float, lengths: LinkLengths) -> str:
@@ -47,7 +47,7 @@ def mjcf_command(study_crane: str, stroke_margin: float, lengths: LinkLengths) -
     return f"hiab-sim mjcf --crane {study_crane} --stroke-margin {stroke_margin:g} --lengths {xi}"
 
 
-def buildable_section(problem: LinkLengthProblem, z: Array, optimum: DesignSummary, crane_label: str) -> Buildable:
+def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, crane_label: str) -> Buildable:
     """Round the optimum z to the study's tolerance and re-check it (module docstring)."""
     study = problem.study
     t, margin = study.build.tolerance, study.build.stroke_margin
@@ -62,15 +62,17 @@ def buildable_section(problem: LinkLengthProblem, z: Array, optimum: DesignSumma
     tol = check_tolerance(design_margins(short, study.mounting), lengths, t)
     label, row, value = tol.worst()
     tolerance_check = RoundedCheck(tol.ok, f"{row} at the {label} design", value, "m")
-    fine = LinkLengthProblem(
+    fine = StudyProblem(
         replace(study, crane=short),
         emlas=problem.emlas,
         id_path=other_path(problem.id_path),
-        times=study.grid.fine_times(),
-        cost_scale=problem.cost_scale,
         tightened=False,
+        fine=True,
+        cost_scales=[p.cost_scale for p in problem.problems],
     )
-    summary = design_summary(fine, z_rounded).summary
+    names = [task.name for task in study.tasks]
+    summaries = [design_summary(p, fine.task_z(z_rounded, k)).summary for k, p in enumerate(fine.problems)]
+    summary = weighted_summary(summaries, fine.weights, names)
     worst = summary.worst_constraint
     recheck = RoundedCheck(
         summary.max_violation <= 1e-6,
@@ -87,7 +89,7 @@ def buildable_section(problem: LinkLengthProblem, z: Array, optimum: DesignSumma
         tolerance_check=tolerance_check,
         recheck=recheck,
         recheck_id_path=fine.id_path,
-        recheck_grid_points=len(fine.times),
+        recheck_grid_points=sum(len(p.times) for p in fine.problems),
         net_electrical_energy_J=summary.net_electrical_energy_J,
         drawn_energy_summed_drives_J=summary.drawn_energy_summed_drives_J,
         net_energy_change_vs_optimum_J=summary.net_electrical_energy_J - optimum.net_electrical_energy_J,

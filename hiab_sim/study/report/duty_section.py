@@ -1,6 +1,6 @@
 """The ``energy.*.duty`` section: one design over the duty period with hot windings and the rest's hold.
 
-For a design on the fine grid and the study's duty model (:func:`hiab_sim.study.nlp.problem.duty_options`),
+For a design on the fine grid and the study's duty model (:func:`hiab_sim.study.nlp.task_problem.duty_options`),
 every figure exact (switched brake, kinked losses and battery, :mod:`hiab_sim.emla.duty_energy`):
 
 * the battery energy of the cycle (hot drive powers through the shared DC bus) plus the rest's

@@ -47,7 +47,7 @@ from hiab_sim.results.energy_sections import (
 from hiab_sim.results.schema import Result
 from hiab_sim.study.nlp.interface import SampleState
 from hiab_sim.study.nlp.objectives import SquaredPowerCost
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.nlp.thermal_rows import duty_check
 from hiab_sim.study.report.duty_section import duty_energy
 
@@ -62,7 +62,7 @@ BATTERY_NOTE = (
 )
 
 
-def study_duty(problem: LinkLengthProblem) -> tuple[Duty, str]:
+def study_duty(problem: TaskProblem) -> tuple[Duty, str]:
     """The study's duty for the problem's task (its own cycle time), or back-to-back cycles when none is given."""
     settings, cycle = problem.study.energy.duty, problem.task.reference.duration
     if settings is None:
@@ -70,12 +70,12 @@ def study_duty(problem: LinkLengthProblem) -> tuple[Duty, str]:
     return settings.duty(cycle), settings.describe(cycle, problem.emlas)
 
 
-def costf2(problem: LinkLengthProblem, state: SampleState) -> float:
+def costf2(problem: TaskProblem, state: SampleState) -> float:
     """1/2 Dt sum_k (sum_i P_i)^2 [W^2 s] on ``problem``'s grid, whatever its objective."""
     return SquaredPowerCost(problem.emlas, problem.dt).value(state)
 
 
-def design_energy(problem: LinkLengthProblem, state: SampleState) -> DesignEnergy:
+def design_energy(problem: TaskProblem, state: SampleState) -> DesignEnergy:
     """Battery energy (exact and smooth), costf2, per-actuator energies and thermal state of one design."""
     t, battery, act = state.joints.time, problem.emlas.battery, state.actuators
     ops = [
@@ -129,7 +129,7 @@ def design_energy(problem: LinkLengthProblem, state: SampleState) -> DesignEnerg
     )
 
 
-def energy_report(fine: LinkLengthProblem, initial: SampleState, optimal: SampleState) -> EnergyReport:
+def energy_report(fine: TaskProblem, initial: SampleState, optimal: SampleState) -> EnergyReport:
     """The ``energy`` section from the fine-grid states of the initial and optimal designs."""
     e0, e1 = design_energy(fine, initial), design_energy(fine, optimal)
     b = fine.emlas.battery
@@ -227,7 +227,7 @@ def _variant(s: SupplyResult) -> HydraulicVariant:
     )
 
 
-def hydraulic_supplies(fine: LinkLengthProblem, state: SampleState) -> tuple[SupplyResult, SupplyResult] | None:
+def hydraulic_supplies(fine: TaskProblem, state: SampleState) -> tuple[SupplyResult, SupplyResult] | None:
     """(constant pressure, load sensing) for one design's rod forces and velocities, None without cylinders."""
     cylinders = fine.study.crane.hydraulic_cylinders
     if cylinders is None:
@@ -236,7 +236,7 @@ def hydraulic_supplies(fine: LinkLengthProblem, state: SampleState) -> tuple[Sup
 
 
 def hydraulic_report(
-    fine: LinkLengthProblem, initial: SampleState, optimal: SampleState, energy: EnergyReport
+    fine: TaskProblem, initial: SampleState, optimal: SampleState, energy: EnergyReport
 ) -> HydraulicBaseline | None:
     """The ``hydraulic_baseline`` section, or None when the crane file has no ``hydraulic_cylinders``."""
     cylinders = fine.study.crane.hydraulic_cylinders

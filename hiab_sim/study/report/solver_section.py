@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from hiab_sim.results.schema import SolverSummary
-from hiab_sim.study.nlp.mix import Problem
+from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.solvers.slsqp import SolveResult
 
 #: What each ``solver.method`` is, as result.json's ``solver.method`` says it.
@@ -13,7 +13,7 @@ SOLVER_METHODS = {
 }
 
 
-def solver_summary(problem: Problem, main: SolveResult, wall_time: float) -> SolverSummary:
+def solver_summary(problem: StudyProblem, main: SolveResult, wall_time: float) -> SolverSummary:
     """The ``solver`` section of a result: the method, the main start's outcome and counts."""
     return SolverSummary(
         method=SOLVER_METHODS[problem.study.solver.method],

@@ -16,7 +16,7 @@ names the row that is violated most at the best point, where and by how much in 
 (:func:`describe_violation`). A trial point outside the model's domain (a chain that cannot close)
 counts as a large phi, so the line search steps back.
 
-A duty mix (:class:`~hiab_sim.study.nlp.mix.MixProblem`: thousands of rows) runs the same phase with
+A duty mix (:class:`~hiab_sim.study.nlp.problem.StudyProblem`: thousands of rows) runs the same phase with
 the projection on IPOPT (sparse Jacobians, :func:`hiab_sim.study.solvers.ipopt.solve_ipopt` with the
 distance as its objective): dense SLSQP costs seconds per iteration there. The direct
 least-largest-violation step is dense SLSQP and serves single tasks only; where the penalty
@@ -36,8 +36,7 @@ from hiab_sim.errors import InfeasibleStudyError, InvalidInputError
 from hiab_sim.results.analysis_sections import FeasibilityPhase
 from hiab_sim.study.analysis.sensitivity import XI_NAMES
 from hiab_sim.study.nlp.blocks import STROKE_SCALE
-from hiab_sim.study.nlp.mix import MixProblem, Problem
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.solvers.ipopt import solve_ipopt
 from hiab_sim.study.solvers.slsqp import start_points
 
@@ -59,7 +58,7 @@ _REMEDY = {
 }
 
 
-def describe_violation(problem: Problem, index: int, value: float) -> str:
+def describe_violation(problem: StudyProblem, index: int, value: float) -> str:
     """A row's violation in words and physical units ("lift EMLA peak torque exceeded by 28 % at t = 2.5 s").
 
     A mix's rows are named ``<task>: <row>``; the task is said after the time.
@@ -91,10 +90,17 @@ def describe_violation(problem: Problem, index: int, value: float) -> str:
         return f"{name}{where} violated by {-value * STROKE_SCALE * 1e3:.1f} mm"
     if block == "tracking":
         return f"{name}{where}: the TCP leaves its tracking band by {-value * 100:.0f} % of the band"
+    # any other block (e.g. a registered one) states its rows' unit (ConstraintBlock.relaxation)
+    stacked = next(b for b in problem.blocks if b.rows.start <= index < b.rows.stop)
+    i = index - stacked.rows.start
+    relax = stacked.block.relaxation(np.full(stacked.rows.stop - stacked.rows.start, value))
+    unit, per_unit = relax.units[i], float(relax.per_unit[i])
+    if per_unit > 0.0:
+        return f"{name}{where} violated by {-value / per_unit:.3g} {unit}"
     return f"{name}{where} violated by {-value:.3g} (scaled)"
 
 
-def _phi(problem: Problem, z: Array) -> tuple[float, Array]:
+def _phi(problem: StudyProblem, z: Array) -> tuple[float, Array]:
     try:
         g = problem.constraints(z)
         e = problem.equalities(z)
@@ -106,19 +112,23 @@ def _phi(problem: Problem, z: Array) -> tuple[float, Array]:
     return value, grad
 
 
-def _project(problem: Problem, target: Array, start: Array, bounds: list[tuple[float | None, float | None]]) -> Array:
+def _project(
+    problem: StudyProblem, target: Array, start: Array, bounds: list[tuple[float | None, float | None]]
+) -> Array:
     """The point nearest to ``target`` that satisfies the rows to SLSQP's accuracy, searched from ``start``.
 
-    On a mix the same problem goes to IPOPT (sparse Jacobians).
+    With several tasks (thousands of rows) the same problem goes to IPOPT (sparse Jacobians); one
+    task's goes to SLSQP.
     """
     target = np.array(target)
-    if isinstance(problem, MixProblem):
+    if problem.n_tasks > 1:
         outcome = solve_ipopt(
             problem,
             np.array(start),
             PROJECTION_ITERATIONS,
             1e-12,
             objective=(lambda x: 0.5 * float((x - target) @ (x - target)), lambda x: x - target),
+            constraint_tolerance=0.1 * START_TOLERANCE,  # the phase's point must pass check_start
         )
         return outcome.z
     res = minimize(
@@ -137,7 +147,7 @@ def _project(problem: Problem, target: Array, start: Array, bounds: list[tuple[f
 
 
 def _least_max_violation(
-    problem: LinkLengthProblem, z: Array, bounds: list[tuple[float | None, float | None]], maxiter: int
+    problem: StudyProblem, z: Array, bounds: list[tuple[float | None, float | None]], maxiter: int
 ) -> Array:
     """Min v over (z, v) subject to g(z) + v >= 0, e(z) = 0, v >= -TARGET (SLSQP, exact gradients).
 
@@ -148,7 +158,7 @@ def _least_max_violation(
     """
     n = len(z)
     v0 = max(0.0, -float(problem.constraints(z).min())) + TARGET
-    rows = len(problem.layout)
+    rows = len(problem.constraint_names)
 
     last = [np.hstack([problem.constraints_jacobian(z), np.ones((rows, 1))])]
     e0, E = problem.equalities(z), problem.equalities_jacobian(z)  # the rest equalities are affine in z
@@ -210,7 +220,7 @@ def changes(before: LinkLengths, after: LinkLengths) -> tuple[str, ...]:
 
 
 def feasible_start(
-    problem: Problem, z0: Array, start: int = 0, maxiter: int = 500
+    problem: StudyProblem, z0: Array, start: int = 0, maxiter: int = 500
 ) -> tuple[Array, FeasibilityPhase | None]:
     """The start itself if it is feasible, else the feasibility phase's point and what it changed.
 
@@ -242,7 +252,7 @@ def feasible_start(
     )
     z = np.asarray(res.x, dtype=float)
     g = problem.constraints(z)
-    if g.min() <= -POLISH and isinstance(problem, LinkLengthProblem):  # the penalty stalled far out
+    if g.min() <= -POLISH and problem.n_tasks == 1:  # the penalty stalled far out (dense SLSQP: one task)
         z = _least_max_violation(problem, z, bounds, maxiter)  # minimise the largest violation directly
         g = problem.constraints(z)
     if g.min() > -POLISH:  # near or in the feasible set: the nearest feasible point to the start, else to z
@@ -276,7 +286,7 @@ def feasible_start(
     )
 
 
-def feasible_starts(problem: Problem, count: int, seed: int = 6) -> tuple[list[Array], list[FeasibilityPhase]]:
+def feasible_starts(problem: StudyProblem, count: int, seed: int = 6) -> tuple[list[Array], list[FeasibilityPhase]]:
     """The study's start and ``count - 1`` starts drawn uniformly in the Xi bounds, each made feasible.
 
     A draw the feasibility phase cannot repair is skipped (at most 20 ``count`` draws); the
@@ -316,7 +326,7 @@ def phase_lines(phase: FeasibilityPhase) -> list[str]:
     ]
 
 
-def moved_start_phase(problem: Problem, z: Array) -> FeasibilityPhase | None:
+def moved_start_phase(problem: StudyProblem, z: Array) -> FeasibilityPhase | None:
     """The step that moved the study's start into the bounds, when the built crane's lengths lie outside them.
 
     The loader projects the built crane's lengths onto the bounds and re-centres each moved chain's

@@ -34,8 +34,8 @@ from scipy import sparse
 
 from hiab_sim.errors import BackendUnavailableError
 from hiab_sim.study.nlp.interface import N_XI, Array, PerSampleBlock
-from hiab_sim.study.nlp.mix import Problem
-from hiab_sim.study.nlp.problem import LinkLengthProblem
+from hiab_sim.study.nlp.problem import StudyProblem
+from hiab_sim.study.nlp.task_problem import TaskProblem
 
 #: IPOPT return states counted as converged.
 SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
@@ -54,7 +54,7 @@ class IpoptOutcome:
     iterates: list[Array]
 
 
-def task_sparsity(problem: LinkLengthProblem) -> sparse.csr_matrix:
+def task_sparsity(problem: TaskProblem) -> sparse.csr_matrix:
     """Structural nonzeros of one task's constraint Jacobian (rows, 6 + 3 N) as a 0/1 matrix."""
     support = np.any(problem.B != 0.0, axis=0)  # (K, N): basis functions nonzero at each sample
     n_c = problem.basis.n
@@ -72,7 +72,7 @@ def task_sparsity(problem: LinkLengthProblem) -> sparse.csr_matrix:
     return sparse.csr_matrix(np.vstack(rows).astype(float))
 
 
-def range_pairs(problem: LinkLengthProblem) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+def range_pairs(problem: TaskProblem) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """Task rows (a, b) whose values add up to a constant (:attr:`PerSampleBlock.pairs`), as two index arrays."""
     first: list[Array] = []
     second: list[Array] = []
@@ -91,22 +91,19 @@ def range_pairs(problem: LinkLengthProblem) -> tuple[NDArray[np.intp], NDArray[n
 class TaskRows:
     """The rows IPOPT holds for one task: task-local row indices, each with its pair's row or -1."""
 
-    problem: LinkLengthProblem
+    problem: TaskProblem
     rows: NDArray[np.intp]  # task-local rows, in order
     partner: NDArray[np.intp]  # task-local row of each held row's pair (its upper limit), -1 if none
     offset: int  # first coefficient column of the task in z
 
 
-def task_rows(problem: Problem) -> list[TaskRows]:
+def task_rows(problem: StudyProblem) -> list[TaskRows]:
     """Each task's rows as IPOPT holds them: every kept row, a range pair as one two-sided row.
 
     A pair's second row b is dropped and its first row a bounded 0 <= g_a <= g_a + g_b: the same
     feasible set with half the rows (the interior point's KKT system shrinks with them).
     """
-    if isinstance(problem, LinkLengthProblem):
-        parts = [(problem, np.arange(len(problem.constraint_names)), N_XI)]
-    else:
-        parts = list(zip(problem.problems, problem.rows, problem.offsets, strict=True))
+    parts = list(zip(problem.problems, problem.rows, problem.offsets, strict=True))
     out = []
     for p, kept, offset in parts:
         first, second = range_pairs(p)
@@ -118,9 +115,9 @@ def task_rows(problem: Problem) -> list[TaskRows]:
     return out
 
 
-def task_z(problem: Problem, z: Array, k: int) -> Array:
-    """Task k's own z (the mix's z cut to Xi and the task's coefficients; a task's z itself)."""
-    return z if isinstance(problem, LinkLengthProblem) else problem.task_z(z, k)
+def task_z(problem: StudyProblem, z: Array, k: int) -> Array:
+    """Task k's own z (the study's z cut to Xi and the task's coefficients)."""
+    return problem.task_z(z, k)
 
 
 class SparseJacobian:
@@ -133,7 +130,7 @@ class SparseJacobian:
     Jacobian of the equalities and of the inequalities at the same point).
     """
 
-    def __init__(self, problem: Problem, z0: Array) -> None:
+    def __init__(self, problem: StudyProblem, z0: Array) -> None:
         self.problem = problem
         self.tasks = task_rows(problem)
         self.m_eq = len(problem.equalities(z0))
@@ -264,17 +261,18 @@ def _callback_class(ca: Any) -> Any:
 
 
 def solve_ipopt(
-    problem: Problem,
+    problem: StudyProblem,
     z0: Array,
     maxiter: int,
     tol: float,
     on_iterate: Callable[[Array], None] | None = None,
     objective: tuple[Callable[[Array], float], Callable[[Array], Array]] | None = None,
+    constraint_tolerance: float = 1e-8,
 ) -> IpoptOutcome:
     """Minimise the problem's scaled cost from z0 with IPOPT (L-BFGS Hessian, sparse Jacobians).
 
     Args:
-        problem: A task's or a mix's NLP.
+        problem: The study's NLP (one task or several).
         z0: Start point (scaled).
         maxiter: Iteration limit.
         tol: Relative cost change that ends the solve (as SLSQP's ``ftol``) once the point is
@@ -282,6 +280,7 @@ def solve_ipopt(
         on_iterate: Called with every iterate's z.
         objective: (value, gradient) of another objective over the problem's rows and bounds
             (the feasibility phase's distance to a point); default the problem's scaled cost.
+        constraint_tolerance: Largest scaled row violation IPOPT may end with (its ``constr_viol_tol``).
 
     """
     cost, cost_gradient = (problem.cost, problem.cost_gradient) if objective is None else objective
@@ -334,14 +333,14 @@ def solve_ipopt(
         "ipopt.limited_memory_aug_solver": "extended",
         "ipopt.max_iter": int(maxiter),
         "ipopt.tol": 1e-8,
-        "ipopt.constr_viol_tol": 1e-8,
+        "ipopt.constr_viol_tol": constraint_tolerance,
         # SLSQP's criterion: stop once the cost changes by less than ``tol`` (relative) for
         # ACCEPTABLE_ITERATIONS iterations at a point feasible to 1e-8; the L-BFGS Hessian otherwise
         # spends tens of iterations driving the dual infeasibility down at a flat cost
         "ipopt.acceptable_obj_change_tol": float(tol),
         "ipopt.acceptable_iter": ACCEPTABLE_ITERATIONS,
         "ipopt.acceptable_tol": 1e-2,
-        "ipopt.acceptable_constr_viol_tol": 1e-8,
+        "ipopt.acceptable_constr_viol_tol": constraint_tolerance,
         "ipopt.acceptable_compl_inf_tol": 1e-6,
         "ipopt.print_level": int(os.environ.get("HIAB_IPOPT_PRINT", "0")),
         "ipopt.print_timing_statistics": "yes" if os.environ.get("HIAB_IPOPT_PRINT") else "no",

@@ -27,11 +27,11 @@ from scipy.optimize import OptimizeResult, minimize
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
 from hiab_sim.errors import InvalidInputError, SolverError
-from hiab_sim.study.nlp.mix import Problem
+from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.solvers.ipopt import solve_ipopt
 
 Array = NDArray[np.float64]
-#: Largest violation [scaled units] of a nominal constraint (:meth:`LinkLengthProblem.margins`) a start
+#: Largest violation [scaled units] of a nominal constraint (:meth:`TaskProblem.margins`) a start
 #: may have: round-off only (the built crane's strokes reach exactly 0 at the ends of its joint range).
 START_TOLERANCE = 1e-9
 
@@ -66,7 +66,7 @@ class SolveResult:
     n_gradients: int = 0
 
 
-def check_start(problem: Problem, z: Array, label: str = "initial_lengths") -> None:
+def check_start(problem: StudyProblem, z: Array, label: str = "initial_lengths") -> None:
     """Raise :class:`InvalidInputError` naming the worst violated constraint at a start point."""
     try:
         ev = problem.evaluate(z)
@@ -84,7 +84,7 @@ def check_start(problem: Problem, z: Array, label: str = "initial_lengths") -> N
         )
 
 
-def start_points(problem: Problem, count: int, seed: int = 6) -> list[LinkLengths]:
+def start_points(problem: StudyProblem, count: int, seed: int = 6) -> list[LinkLengths]:
     """The study's start and ``count - 1`` other feasible starts, drawn in the Xi bounds.
 
     Per chain: L uniform in its bounds, the retracted length x0 = Lc0 + Lc so that the stroke is
@@ -129,7 +129,7 @@ def _checkpoint_path(out: Path, start: int) -> Path:
     return out / f"checkpoint_{start}.json"
 
 
-def study_digest(problem: Problem) -> str:
+def study_digest(problem: StudyProblem) -> str:
     """SHA-256 of the study's content: every setting, the crane and the EMLA set.
 
     The file path is recorded separately, and ``solver.maxiter`` is left out: it is the run's
@@ -142,7 +142,7 @@ def study_digest(problem: Problem) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def checkpoint_identity(problem: Problem, initial: LinkLengths) -> dict[str, Any]:
+def checkpoint_identity(problem: StudyProblem, initial: LinkLengths) -> dict[str, Any]:
     """What a checkpoint belongs to: study path and content hash, ID path, start Xi [m]."""
     return {
         "study": str(Path(problem.study.path).resolve()),
@@ -152,7 +152,7 @@ def checkpoint_identity(problem: Problem, initial: LinkLengths) -> dict[str, Any
     }
 
 
-def check_checkpoint(problem: Problem, initial: LinkLengths, out: Path, start: int) -> dict[str, Any] | None:
+def check_checkpoint(problem: StudyProblem, initial: LinkLengths, out: Path, start: int) -> dict[str, Any] | None:
     """The checkpoint of a start if it belongs to this run, None if there is none.
 
     Raises:
@@ -214,7 +214,7 @@ def load_checkpoint(out: Path, start: int) -> dict[str, Any] | None:
 
 
 def solve(
-    problem: Problem,
+    problem: StudyProblem,
     initial: LinkLengths,
     start: int = 0,
     out: Path | None = None,
@@ -345,7 +345,7 @@ def solve(
     return result
 
 
-def _ipopt(problem: Problem, z: Array, limit: int, record: Callable[[Array], None]) -> OptimizeResult:
+def _ipopt(problem: StudyProblem, z: Array, limit: int, record: Callable[[Array], None]) -> OptimizeResult:
     """IPOPT (:mod:`hiab_sim.study.solvers.ipopt`) in SLSQP's result shape; every iterate after the start is kept."""
     seen: list[int] = []
 

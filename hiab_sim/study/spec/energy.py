@@ -2,8 +2,8 @@
 
 Three optional top-level keys of a study file, each validated here into a frozen dataclass:
 
-* ``objective: costf2 | battery_energy`` (default ``costf2``, the seed's eq. ``costf2``);
-  the names are those of :data:`hiab_sim.study.nlp.objectives.OBJECTIVES`.
+* ``objective: <name>`` (default ``costf2``, the seed's eq. ``costf2``; ``battery_energy``): a name
+  registered in :data:`hiab_sim.study.nlp.objectives.OBJECTIVES`, the one objective registry.
 * ``duty: {cycles_per_hour: n}`` or ``duty: {rest_time: T_rest}`` [s]: the cycle (the study's
   trajectory, duration T) repeats with a rest of T_rest at zero torque, or n times an hour
   (T_rest = 3600/n - T). With a duty and an EMLA set that has thermal data, the NLP holds the
@@ -30,9 +30,6 @@ from hiab_sim.emla.hold import HOLD_MODES
 from hiab_sim.emla.thermal import Duty
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.yaml_fields import mapping, number
-
-#: Objective names a study may give (the keys of ``hiab_sim.study.nlp.objectives.OBJECTIVES``).
-OBJECTIVE_NAMES: tuple[str, ...] = ("costf2", "battery_energy")
 
 
 @dataclass(frozen=True)
@@ -141,8 +138,9 @@ class EnergySettings:
     transmission: TransmissionCatalogue | None = None
 
     def __post_init__(self) -> None:
-        if self.objective not in OBJECTIVE_NAMES:
-            raise InvalidInputError("objective", self.objective, f"must be one of {', '.join(OBJECTIVE_NAMES)}")
+        from hiab_sim.study.nlp.objectives import check_objective_name  # the one registry
+
+        check_objective_name(self.objective)
 
 
 #: Top-level study keys this module reads.
@@ -151,9 +149,7 @@ ENERGY_KEYS = {"objective", "duty", "transmission"}
 
 def energy_settings(top: Any) -> EnergySettings:
     """Read ``objective``, ``duty`` and ``transmission`` from a study's top-level mapping."""
-    objective = top.get("objective", "costf2")
-    if not isinstance(objective, str):
-        raise InvalidInputError("objective", objective, f"must be one of {', '.join(OBJECTIVE_NAMES)}")
+    objective = top.get("objective", "costf2")  # EnergySettings checks it against the objective registry
     duty = None
     if top.get("duty") is not None:
         d = dict(mapping(top["duty"], "duty", {"rest_time", "cycles_per_hour", "hold"}, set()))

@@ -31,6 +31,7 @@ from hiab_sim.crane.mounting import MountingSpace
 from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import DEFAULT_STUDY, Source, locate
+from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.references.kinds import TaskReference
 from hiab_sim.study.spec.build import BuildSettings
 from hiab_sim.study.spec.energy import ENERGY_KEYS, EnergySettings, energy_settings
@@ -220,6 +221,7 @@ class Study:
     #: The built crane's lengths when they lie outside the bounds and the loader moved the start into them.
     start_moved_from: LinkLengths | None = field(default=None, repr=False, compare=False)
     energy: EnergySettings = field(default_factory=EnergySettings)  # objective, duty, transmission
+    structure: StructureSettings = field(default_factory=StructureSettings)  # buckling, pin and frequency rows
 
     def __post_init__(self) -> None:
         if not self.tasks:
@@ -264,6 +266,7 @@ _TOP = {
     "tasks",
     "build",
     "mounting",
+    "structure",
 }
 _REQUIRED_TOP = {"crane", "bounds"}
 
@@ -323,6 +326,7 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
         crane_file=crane_file,
         start_moved_from=crane.default_lengths if moved else None,
         energy=energy_settings(top),
+        structure=StructureSettings.from_mapping(top.get("structure"), crane),
     )
 
 

@@ -19,9 +19,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.machine.closure import ChainGeometry, chain_geometry, geometry_closure, pin_position, stroke_to_joint
 from hiab_sim.machine.description import Chain, Machine
-from hiab_sim.machine.kinematics import forward_kinematics
+from hiab_sim.machine.kinematics.closure import (
+    ChainGeometry,
+    chain_geometry,
+    geometry_closure,
+    pin_position,
+    stroke_to_joint,
+)
+from hiab_sim.machine.kinematics.forward import forward_kinematics
 
 Array = NDArray[np.float64]
 

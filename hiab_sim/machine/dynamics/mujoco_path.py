@@ -2,10 +2,10 @@
 
 ``MujocoMachineDynamics(machine)(q, dq, ddq, tcp_force)`` maps samples of the independent joints to
 the actuator forces f_x [N] (> 0 extends), their velocities and strokes, and the force on every
-pin, on the MJCF model of :mod:`hiab_sim.machine.mjcf_build` (built once per design). Per sample:
+pin, on the MJCF model of :mod:`hiab_sim.machine.dynamics.mjcf_build` (built once per design). Per sample:
 
 1. **Loop-consistent state from MuJoCo's kinematics.** The closed-form closure of
-   :func:`hiab_sim.machine.dynamics_planar.close_loops` is the first guess; Newton steps on
+   :func:`hiab_sim.machine.dynamics.planar.close_loops` is the first guess; Newton steps on
    MuJoCo's own pin residuals C = p_a - p_b (sites ``<pin>.a``, ``<pin>.b``, in-plane rows, Jacobian
    ``mj_jacSite``) bring |C| below 1e-13 m. The rates follow from MuJoCo's Jacobians J = [J_i, J_d]:
    J_d dq_d = -J_i dq_i, J_d ddq_d = -(J_i ddq_i + dJ dq) with dJ dq from ``mj_jacDot``.
@@ -35,8 +35,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.dynamics_planar import close_loops, planar_bodies
-from hiab_sim.machine.dynamics_tree import (
+from hiab_sim.machine.dynamics.mjcf_build import SimulationExtras, spec_of_tree
+from hiab_sim.machine.dynamics.planar import close_loops, planar_bodies
+from hiab_sim.machine.dynamics.tree import (
     MachineActuatorSamples,
     PinForces,
     joint_arrays,
@@ -44,7 +45,6 @@ from hiab_sim.machine.dynamics_tree import (
     pin_layout,
     tcp_force_array,
 )
-from hiab_sim.machine.mjcf_build import SimulationExtras, spec_of_tree
 
 Array = NDArray[np.float64]
 
@@ -162,7 +162,7 @@ class MujocoMachineDynamics:
     def __call__(self, q: Any, dq: Any, ddq: Any, tcp_force: Any = None) -> MachineActuatorSamples:
         """Actuator forces, velocities, accelerations, strokes (T, n_chains) and pin forces.
 
-        Args, units and sign conventions as :class:`hiab_sim.machine.dynamics_newton_euler.NewtonEulerInverseDynamics`.
+        Args, units and sign conventions as :class:`hiab_sim.machine.dynamics.newton_euler.NewtonEulerInverseDynamics`.
         """
         q, dq, ddq = joint_arrays(self.tree, q, dq, ddq)
         T = q.shape[0]

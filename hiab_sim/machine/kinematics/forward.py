@@ -3,7 +3,7 @@
 Link frames compose along the tree (see :mod:`hiab_sim.machine.description`):
 ``R = R_parent R_joint motion``, ``p = p_parent + R_parent (p_joint + R_joint t)`` with motion
 Rz(q) for a revolute joint and t = (q, 0, 0) for a prismatic one. Each chain's dependent bodies
-are placed from the closed-form loop closure (:func:`hiab_sim.machine.closure.closure`): the
+are placed from the closed-form loop closure (:func:`hiab_sim.machine.kinematics.closure.closure`): the
 cylinder frame at the base pivot with x towards the end pivot, the rod frame ``Lc0 + x`` further
 along it, and for a linkage the rocker frame (at the rocker pivot, x towards the pin H) and the
 coupler frame (at H, x towards the coupler pivot); their rotations are R_P Rz(angle), with P the
@@ -19,8 +19,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.machine.closure import chain_geometry, geometry_closure
 from hiab_sim.machine.description import Machine
+from hiab_sim.machine.kinematics.closure import chain_geometry, geometry_closure
 
 Array = NDArray[np.float64]
 

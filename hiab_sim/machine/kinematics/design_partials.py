@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hiab_sim.machine.closure import ChainGeometry, chain_geometry, geometry_closure, pin_position
 from hiab_sim.machine.description import Chain, DecisionVariable, Machine
+from hiab_sim.machine.kinematics.closure import ChainGeometry, chain_geometry, geometry_closure, pin_position
 
 Array = NDArray[np.float64]
 

@@ -1,6 +1,6 @@
 """MJCF model of any machine for one design, built with :class:`mujoco.MjSpec` from its description.
 
-:func:`build_machine_spec` adds the bodies of :func:`hiab_sim.machine.dynamics_tree.machine_tree`
+:func:`build_machine_spec` adds the bodies of :func:`hiab_sim.machine.dynamics.tree.machine_tree`
 to the shared template ``assets/mjcf/crane_template.xml`` (materials, lights, cameras, floor,
 options; contacts disabled, energy enabled):
 
@@ -33,7 +33,7 @@ import numpy as np
 
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.dynamics_tree import MachineTree, SimulationExtras, actuator_lengths, machine_tree
+from hiab_sim.machine.dynamics.tree import MachineTree, SimulationExtras, actuator_lengths, machine_tree
 from hiab_sim.machine.parts import RigidBody
 from hiab_sim.model.mjcf import EQUALITY_SOLIMP, EQUALITY_SOLREF, SOURCE_TO_WORLD
 from hiab_sim.resources import mjcf_template

@@ -1,8 +1,8 @@
 """Analytic inverse dynamics of any planar parallel-serial machine: Newton-Euler on the link tree, numpy only.
 
 Written independently of MuJoCo. For each sample the loop-consistent motion of every body comes
-from :mod:`hiab_sim.machine.dynamics_planar`; each moving body b of the tree
-(:mod:`hiab_sim.machine.dynamics_tree`) is then cut free at its joint and at its loop pins. Its
+from :mod:`hiab_sim.machine.dynamics.planar`; each moving body b of the tree
+(:mod:`hiab_sim.machine.dynamics.tree`) is then cut free at its joint and at its loop pins. Its
 planar Newton-Euler equations, in the world with moments about the world origin (Lynch & Park
 eq. 8.41 restricted to se(2)), fix what the forces on it must add up to:
 
@@ -24,7 +24,7 @@ actuators) there are exactly as many hinges as loop-pin force components, so thi
 (2 n_pins square, per sample) gives lambda; then every T_b is known: a hinge's T_b is its pin
 force, a slide's axial component u . F(T_b) is the actuator force f_x (> 0 extends). It is
 regular away from a flat triangle or a four-bar at its toggle. The MuJoCo path
-(:mod:`hiab_sim.machine.dynamics_mujoco`) instead projects MuJoCo's generalised forces on the
+(:mod:`hiab_sim.machine.dynamics.mujoco_path`) instead projects MuJoCo's generalised forces on the
 loops' admissible motions.
 """
 
@@ -38,8 +38,8 @@ from numpy.typing import NDArray
 
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.dynamics_planar import Frames, PlanarBody, frames, loop_state, planar_bodies
-from hiab_sim.machine.dynamics_tree import (
+from hiab_sim.machine.dynamics.planar import Frames, PlanarBody, frames, loop_state, planar_bodies
+from hiab_sim.machine.dynamics.tree import (
     MachineActuatorSamples,
     MachineTree,
     PinForces,

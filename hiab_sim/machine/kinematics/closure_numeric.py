@@ -1,6 +1,6 @@
 """Generic numeric loop closure: any chain as planar vector loops solved by Newton's method.
 
-Independent of the closed forms of :mod:`hiab_sim.machine.closure` (the tests compare the two).
+Independent of the closed forms of :mod:`hiab_sim.machine.kinematics.closure` (the tests compare the two).
 A chain's loops are written in the frame P of the driven joint's parent as sums of terms
 ``rho_k u(alpha_k)`` plus a constant vector, u(a) = (cos a, sin a), where each ``alpha_k`` is
 affine in the loop variables v = [q, s, theta_cyl, (theta_rocker, theta_coupler)] and ``rho_k`` is
@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hiab_sim.machine.closure import ChainGeometry, Closure, chain_geometry
 from hiab_sim.machine.description import Chain, Machine
+from hiab_sim.machine.kinematics.closure import ChainGeometry, Closure, chain_geometry
 
 Array = NDArray[np.float64]
 

@@ -10,7 +10,7 @@ theta the sum of the revolute coordinates from the root. A point r fixed in the 
 and a prismatic child at coordinate q, rate dq, along u = (F_parent R_joint e_x)_xy adds u dq to
 its velocity and 2 i omega u dq + u ddq to its acceleration (Coriolis and slide acceleration).
 
-Loop closure (positions, closed form; :mod:`hiab_sim.machine.dynamics_tree` names the bodies):
+Loop closure (positions, closed form; :mod:`hiab_sim.machine.dynamics.tree` names the bodies):
 
 * triangle: d = end - base = s e^{i psi}; stroke x = s - x0, cylinder hinge angle psi - (angle of
   the base link's x axis);
@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.machine.dynamics_tree import MachineTree, actuator_lengths
+from hiab_sim.machine.dynamics.tree import MachineTree, actuator_lengths
 
 Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]

@@ -4,8 +4,8 @@
 ``id(q, dq, ddq, tcp_force=None) -> MachineActuatorSamples`` evaluating the seed's
 ``[f_x, v_x] = ID(theta, dtheta, ddtheta, robot(Xi))`` (eq. ``dynamics``) for any machine:
 
-- ``"newton_euler"``: :class:`hiab_sim.machine.dynamics_newton_euler.NewtonEulerInverseDynamics`;
-- ``"mujoco"``: :class:`hiab_sim.machine.dynamics_mujoco.MujocoMachineDynamics`.
+- ``"newton_euler"``: :class:`hiab_sim.machine.dynamics.newton_euler.NewtonEulerInverseDynamics`;
+- ``"mujoco"``: :class:`hiab_sim.machine.dynamics.mujoco_path.MujocoMachineDynamics`.
 
 Both give the same actuator and pin forces to round-off (``docs/dynamics.md``).
 """
@@ -17,8 +17,8 @@ from typing import Any, Protocol
 
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.dynamics_newton_euler import NewtonEulerInverseDynamics
-from hiab_sim.machine.dynamics_tree import MachineActuatorSamples, SimulationExtras
+from hiab_sim.machine.dynamics.newton_euler import NewtonEulerInverseDynamics
+from hiab_sim.machine.dynamics.tree import MachineActuatorSamples, SimulationExtras
 
 #: The inverse-dynamics paths of a machine, by name.
 MACHINE_ID_PATHS = ("newton_euler", "mujoco")
@@ -47,7 +47,7 @@ def make_machine_dynamics(
     if path == "newton_euler":
         return NewtonEulerInverseDynamics(machine, design, extras)
     if path == "mujoco":
-        from hiab_sim.machine.dynamics_mujoco import MujocoMachineDynamics  # MuJoCo only when asked for
+        from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics  # MuJoCo only when asked for
 
         return MujocoMachineDynamics(machine, design, extras)
     raise InvalidInputError("id_path", path, f"must be one of {', '.join(MACHINE_ID_PATHS)}")

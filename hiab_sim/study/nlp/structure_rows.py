@@ -1,0 +1,220 @@
+"""Structural rows of the NLP: screw buckling, pin peak loads and the lowest natural frequency, per sample.
+
+Each block is a :class:`~hiab_sim.study.nlp.interface.PerSampleBlock` (the same rows at every sample):
+
+* :class:`BucklingRows` (``structure.buckling``): 1 - n f / P_cr >= 0 per actuator with screw data
+  (:mod:`hiab_sim.structure.buckling`); exact partials of P_cr w.r.t. theta and Xi, chained with the
+  inverse dynamics' partials of f (:class:`~hiab_sim.study.nlp.interface.SamplePartials`);
+* :class:`PinLoadRows` (``structure.pin_load_limits``): 1 - |F_p| / F_max >= 0 per limited pin
+  (:mod:`hiab_sim.structure.pin_loads`, the analytic path); partials by central differences of the
+  vectorised pin forces (all samples perturbed together, as the ID partials are);
+* :class:`NaturalFrequencyRows` (``structure.min_natural_frequency_Hz``): f_1 / f_min - 1 >= 0, the
+  lowest locked-rotor frequency at the sample's pose with the payload held at the TCP
+  (:mod:`hiab_sim.structure.natural_frequency`);
+  partials w.r.t. the sample's positions and Xi by central differences.
+
+:func:`structure_blocks` builds the blocks a study's ``structure`` section asks for.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.emla import EmlaSet
+from hiab_sim.structure.buckling import buckled_actuators, buckling_samples, utilisation_partials
+from hiab_sim.structure.natural_frequency import natural_frequencies
+from hiab_sim.structure.pin_loads import pin_forces, pins
+from hiab_sim.structure.settings import StructureSettings
+from hiab_sim.study.nlp.interface import (
+    N_Q,
+    N_XI,
+    Array,
+    PerSampleBlock,
+    Relaxation,
+    SamplePartials,
+    SampleRows,
+    SampleState,
+)
+
+
+class BucklingRows(PerSampleBlock):
+    """1 - n f / P_cr per actuator with screw data and sample (:mod:`hiab_sim.structure.buckling`)."""
+
+    def __init__(self, times: Array, crane: Crane, emlas: EmlaSet, safety_factor: float) -> None:
+        self.name = "structure.buckling"
+        self.times = times
+        self.crane = crane
+        self.emlas = emlas
+        self.safety_factor = safety_factor
+        self.sample_rows = tuple(f"{a.name} push <= P_cr / n" for a, _ in buckled_actuators(crane, emlas))
+
+    def values(self, state: SampleState) -> Array:
+        """1 - u per sample, sample-major (K * r,)."""
+        u = buckling_samples(
+            self.crane, self.emlas, state.lengths, state.joints.position, state.actuators.force, self.safety_factor
+        ).utilisation
+        return (1.0 - u).ravel()
+
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per % of the buckling load: 1 - n f / (1.01 P_cr) - (1 - n f / P_cr) = (1 - g)(1 - 1 / 1.01)."""
+        g = np.asarray(values, dtype=float)
+        return Relaxation(("%",) * len(g), (1.0 - g) * (1.0 - 1.0 / 1.01))
+
+    def jacobian(self, state: SampleState, partials: SamplePartials) -> SampleRows:
+        """-du/dq9 and -du/dXi (exact P_cr partials, the ID's force partials)."""
+        du_dq, du_dxi = utilisation_partials(
+            self.crane,
+            self.emlas,
+            state.lengths,
+            state.joints.position,
+            state.actuators.force,
+            partials.id_q[:, 0:3, :],
+            partials.id_xi[:, 0:3, :],
+            self.safety_factor,
+        )
+        return SampleRows(-du_dq, -du_dxi)
+
+
+class PinLoadRows(PerSampleBlock):
+    """1 - |F_p| / F_max per limited pin and sample (analytic pin forces)."""
+
+    def __init__(
+        self, times: Array, crane: Crane, limits: tuple[tuple[str, float], ...], tcp_force: Array | None, step: float
+    ) -> None:
+        self.name = "structure.pin_load"
+        self.times = times
+        self.crane = crane
+        names = [pin.name for pin in pins(crane)]
+        self.index = np.array([names.index(name) for name, _ in limits])
+        self.limit = np.array([value for _, value in limits])
+        self.tcp_force = None if tcp_force is None else np.broadcast_to(np.asarray(tcp_force, float), (len(times), 3))
+        self.step = step
+        self.sample_rows = tuple(f"{name} |F| <= {value:.6g} N" for name, value in limits)
+
+    def _rows(self, lengths: LinkLengths, position: Array, velocity: Array, acceleration: Array) -> Array:
+        loads = pin_forces(self.crane, lengths, position, velocity, acceleration, self.tcp_force)
+        return 1.0 - loads.magnitude[:, self.index] / self.limit
+
+    def values(self, state: SampleState) -> Array:
+        """1 - |F| / F_max per sample, sample-major."""
+        j = state.joints
+        return self._rows(state.lengths, j.position, j.velocity, j.acceleration).ravel()
+
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per kN of a pin's rating: d(1 - |F| / F_max)/dF_max = (1 - g) / F_max, times 1e3 N."""
+        g = np.asarray(values, dtype=float)
+        limit = np.tile(self.limit, len(g) // len(self.limit))
+        return Relaxation(("kN",) * len(g), (1.0 - g) * 1e3 / limit)
+
+    def jacobian(self, state: SampleState, partials: SamplePartials) -> SampleRows:
+        """Central differences in each of q9 (all samples at once) and Xi."""
+        j = state.joints
+        q9 = np.concatenate([j.position, j.velocity, j.acceleration], axis=1)
+        K, r = q9.shape[0], len(self.sample_rows)
+        dq = np.zeros((K, r, N_Q))
+        for k in range(N_Q):
+            h = self.step * np.maximum(1.0, np.abs(q9[:, k]))
+            up, down = q9.copy(), q9.copy()
+            up[:, k] += h
+            down[:, k] -= h
+            rows_up = self._rows(state.lengths, up[:, 0:3], up[:, 3:6], up[:, 6:9])
+            rows_down = self._rows(state.lengths, down[:, 0:3], down[:, 3:6], down[:, 6:9])
+            dq[:, :, k] = (rows_up - rows_down) / (2.0 * h[:, None])
+        xi = state.lengths.as_array()
+        dxi = np.zeros((K, r, N_XI))
+        for k in range(N_XI):
+            h = self.step * max(1.0, abs(xi[k]))
+            plus, minus = xi.copy(), xi.copy()
+            plus[k] += h
+            minus[k] -= h
+            rows_up = self._rows(LinkLengths.from_array(plus), j.position, j.velocity, j.acceleration)
+            rows_down = self._rows(LinkLengths.from_array(minus), j.position, j.velocity, j.acceleration)
+            dxi[:, :, k] = (rows_up - rows_down) / (2.0 * h)
+        return SampleRows(dq, dxi)
+
+
+class NaturalFrequencyRows(PerSampleBlock):
+    """f_1(q_k, Xi) / f_min - 1 per sample: the lowest locked-rotor frequency at the sample's pose."""
+
+    def __init__(
+        self,
+        times: Array,
+        crane: Crane,
+        emlas: EmlaSet,
+        minimum_Hz: float,
+        tcp_force: Array | None,
+        step: float,
+        payload_kg: float = 0.0,
+    ) -> None:
+        self.name = "structure.natural_frequency"
+        self.payload_kg = payload_kg
+        self.times = times
+        self.crane = crane
+        self.emlas = emlas
+        self.minimum = minimum_Hz
+        self.tcp_force = None if tcp_force is None else np.broadcast_to(np.asarray(tcp_force, float), (len(times), 3))
+        self.step = step
+        self.sample_rows = (f"lowest frequency >= {minimum_Hz:.6g} Hz",)
+
+    def _rows(self, lengths: LinkLengths, position: Array) -> Array:
+        modes = natural_frequencies(
+            self.crane, self.emlas, lengths, position, self.tcp_force, payload_kg=self.payload_kg
+        )
+        return modes.lowest_Hz / self.minimum - 1.0
+
+    def values(self, state: SampleState) -> Array:
+        """f_1 / f_min - 1 per sample."""
+        return self._rows(state.lengths, state.joints.position)
+
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per Hz of the minimum lowered: d(f / f_min - 1)/d(-f_min) = (1 + g) / f_min."""
+        g = np.asarray(values, dtype=float)
+        return Relaxation(("Hz",) * len(g), (1.0 + g) / self.minimum)
+
+    def jacobian(self, state: SampleState, partials: SamplePartials) -> SampleRows:
+        """Central differences in each position (all samples at once) and in Xi; rates do not enter."""
+        q = state.joints.position
+        K = q.shape[0]
+        dq = np.zeros((K, 1, N_Q))
+        for k in range(q.shape[1]):
+            h = self.step * np.maximum(1.0, np.abs(q[:, k]))
+            up, down = q.copy(), q.copy()
+            up[:, k] += h
+            down[:, k] -= h
+            dq[:, 0, k] = (self._rows(state.lengths, up) - self._rows(state.lengths, down)) / (2.0 * h)
+        xi = state.lengths.as_array()
+        dxi = np.zeros((K, 1, N_XI))
+        for k in range(N_XI):
+            h = self.step * max(1.0, abs(xi[k]))
+            plus, minus = xi.copy(), xi.copy()
+            plus[k] += h
+            minus[k] -= h
+            dxi[:, 0, k] = (
+                self._rows(LinkLengths.from_array(plus), q) - self._rows(LinkLengths.from_array(minus), q)
+            ) / (2.0 * h)
+        return SampleRows(dq, dxi)
+
+
+def structure_blocks(
+    settings: StructureSettings,
+    times: Array,
+    crane: Crane,
+    emlas: EmlaSet,
+    tcp_force: Array | None,
+    step: float,
+    payload_kg: float = 0.0,
+) -> list[PerSampleBlock]:
+    """The structural blocks the study's ``structure`` section asks for (none by default).
+
+    ``tcp_force``: the task's TCP force per sample [N]; ``payload_kg``: its payload, held at the TCP.
+    """
+    out: list[PerSampleBlock] = []
+    if settings.buckling and buckled_actuators(crane, emlas):
+        out.append(BucklingRows(times, crane, emlas, settings.buckling_safety_factor))
+    if settings.pin_load_limits_N:
+        out.append(PinLoadRows(times, crane, settings.pin_load_limits_N, tcp_force, step))
+    if settings.min_natural_frequency_Hz is not None:
+        floor = settings.min_natural_frequency_Hz
+        out.append(NaturalFrequencyRows(times, crane, emlas, floor, tcp_force, step, payload_kg))
+    return out

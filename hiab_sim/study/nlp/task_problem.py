@@ -1,0 +1,449 @@
+"""One task's rows and cost of the seed's NLP (eq. ``costf2`` subject to ``const_a``..``const_m``), exact gradients.
+
+The solvers, reports and analyses take :class:`hiab_sim.study.nlp.problem.StudyProblem`, which stacks
+one :class:`TaskProblem` per task over the shared Xi (a single task is its own study, bit for bit).
+
+Decision variables z = [z_xi (6), z_c (3 N)] (scaled): Xi = ``XI_SCALE`` z_xi [m] (lift L, Lc0,
+Lc, then tilt) and c = c_ref + ``C_SCALE`` z_c, the B-spline coefficients of theta1, theta2, xt2
+around the study's initial fit. The cost f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 [W^2 s] uses the EMLA
+electrical power P_i of :mod:`hiab_sim.emla` (never f v / eta); it is a squared-power integral,
+not an energy, and is scaled by its value at the study's start.
+
+Constraints, all scaled to O(1) and written g(z) >= 0 (rows named in :attr:`constraint_names`):
+
+* ``const_a``: [f_x, v_x, a_x] = ID(theta, dtheta, ddtheta, robot(Xi)), implicit (evaluated);
+* ``const_b``..``const_d``: |r(theta) - r_ref| <= tolerance for position, velocity and
+  acceleration of r = (x_tcp, y_tcp, xt2) at every collocation point (a tolerance band, because
+  156 equalities over-determine 66 coefficients); rest at both ends as 12 linear equalities;
+* ``const_e``, ``const_f``: the EMLA envelope margins (peak torque, rated speed, voltage) >= 0;
+* ``const_g``: Xi within [xi_low, xi_up] (variable bounds);
+* ``const_h``: theta within the crane's joint range and the triangle margin (linear in c);
+* ``const_i``: |dtheta| <= joint velocity limit (linear in c);
+* ``const_j``: 0 <= x <= Lc and x <= stroke at every sample, and at both ends of the working range;
+* ``const_k``: the interior angle at the boom hinge within [margin, pi - margin] (it depends on
+  theta only, so it is part of ``const_h``), which keeps Lc0 + x + Lc < L + L1;
+* ``const_l``, ``const_m`` hold by construction: the chain is solved from its triangle.
+
+Each inequality group is a constraint block (:mod:`hiab_sim.study.nlp.blocks`) and the cost an objective
+(:mod:`hiab_sim.study.nlp.objectives`); the block registry
+(:data:`hiab_sim.study.nlp.block_registry.BLOCKS`) lists the blocks once, and row names, row layout,
+clearances and the Jacobian follow from that list (:class:`~hiab_sim.study.nlp.interface.BlockLayout`).
+
+Gradients: per-sample ID partials by batched central differences (all samples and all 9
+perturbations in one ID call), chained through the B-spline matrices (exact); Xi partials by
+central differences (on the analytic path, which agrees with the MuJoCo path to ~1e-14 relative, or
+with MuJoCo model rebuilds); EMLA and kinematic partials analytic.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.crane.names import ACTUATOR_NAMES
+from hiab_sim.dynamics.interface import InverseDynamics, make_inverse_dynamics
+from hiab_sim.dynamics.samples import JointSamples
+from hiab_sim.emla import (
+    EmlaSet,
+    electrical_power,
+)
+from hiab_sim.emla.duty_energy import DutyOptions, drive_duty
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.study.analysis.buildable import buildable_blocks
+from hiab_sim.study.motion import trajectory as tr
+from hiab_sim.study.nlp import blocks as bl
+from hiab_sim.study.nlp.block_registry import build_blocks, register_block
+from hiab_sim.study.nlp.brake_rows import brake_blocks
+from hiab_sim.study.nlp.id_partials import id_joint_partials, id_length_partials
+from hiab_sim.study.nlp.interface import (
+    N_XI,
+    Array,
+    BlockJacobian,
+    BlockLayout,
+    ConstraintBlock,
+    SamplePartials,
+    SampleRows,
+    SampleState,
+)
+from hiab_sim.study.nlp.objectives import make_objective
+from hiab_sim.study.nlp.structure_rows import structure_blocks
+from hiab_sim.study.nlp.thermal_rows import thermal_blocks
+from hiab_sim.study.references.kinds import ik_start
+from hiab_sim.study.spec.study_file import Study
+from hiab_sim.study.spec.tasks import Task
+
+#: Scale of the link-length variables [m per unit].
+XI_SCALE = 1.0
+#: Scale of the spline-coefficient variables [rad or m per unit] (chosen for fast SQP convergence).
+C_SCALE = 0.1
+STROKE_SCALE = bl.STROKE_SCALE
+ACTUATORS = ACTUATOR_NAMES
+#: The ID's input check uses the working range shrunk by this much at both ends [rad].
+ID_SLACK = 0.02
+#: The optimiser (``tightened``) holds const_j at the ends of the working range with this clearance
+#: [m], so that its optimum passes the crane's exact stroke check despite SLSQP's round-off-level
+#: violations. It is part of the solver's rows only: start checks and reported violations
+#: (:meth:`TaskProblem.margins`) use the nominal const_j, so the built crane, whose strokes reach
+#: exactly 0 and the full stroke at the ends of its joint range, is a start with violation ~0.
+WORKING_CLEARANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class Evaluation(SampleState):
+    """Everything computed at one point z (unscaled quantities in SI units): the state and its rows."""
+
+    z: Array
+    coefficients: Array  # (3, N)
+    cost: float  # the objective's value [its unit; W^2 s for costf2]
+    constraints: Array  # scaled, feasible where >= 0
+    equalities: Array  # scaled, feasible where == 0
+
+
+def duty_options(study: Study, emlas: EmlaSet, cycle_time: float) -> DutyOptions | None:
+    """The duty model of a task of ``cycle_time`` [s], or None for the paper's per-sample model.
+
+    None without a ``duty``, and when no EMLA has winding-resistance data and nothing holds the rest
+    (the seed's model: every number as before these options existed).
+    """
+    settings = study.energy.duty
+    if settings is None:
+        return None
+    options = settings.options(cycle_time, emlas)
+    if options.hold is None and not any(p.winding is not None and p.thermal is not None for p in emlas):
+        return None
+    return options
+
+
+def working_range(crane: Crane, joints: Array, margin: float) -> tuple[tuple[float, float], ...]:
+    """Joint range the design must serve: the samples' range widened by ``margin`` [rad]."""
+    out = []
+    for j, chain in enumerate(crane.chains):
+        lo, hi = chain.joint_range
+        out.append((max(lo, float(joints[:, j].min()) - margin), min(hi, float(joints[:, j].max()) + margin)))
+    return tuple(out)
+
+
+class TaskProblem:
+    """The scaled rows and cost of one task of a study on a time grid (its collocation grid by default).
+
+    Args:
+        study: The study.
+        emlas: EMLA set (default: the study's own).
+        id_path: ``mujoco`` or ``analytic`` (default: the study's).
+        times: Sample times [s] (default: the collocation grid); Dt of the cost is their step.
+        cost_scale: Divisor of the cost [the objective's unit] (default: its value at the study's start).
+        tightened: Hold the tracking bands times ``collocation_fraction`` and the envelope margins
+            >= ``envelope_margin`` (the optimiser's grid); False for the nominal re-check.
+        objective: Name of the objective (:data:`hiab_sim.study.nlp.objectives.OBJECTIVES`; default: the study's).
+        task: The task whose NLP this is (default: the study's only task). Its grid is the study's
+            step over the task's duration, its spline the study's density of control points (or
+            the task's own), its reference and payload force its own (:meth:`Task.id_force`);
+            :class:`hiab_sim.study.nlp.problem.StudyProblem` composes one problem per task.
+
+    """
+
+    def __init__(
+        self,
+        study: Study,
+        emlas: EmlaSet | None = None,
+        id_path: str | None = None,
+        times: Array | None = None,
+        cost_scale: float | None = None,
+        tightened: bool = True,
+        objective: str | None = None,
+        task: Task | None = None,
+    ) -> None:
+        if task is None:
+            if len(study.tasks) != 1:
+                raise InvalidInputError("task", len(study.tasks), "a study of several tasks needs a task per problem")
+            task = study.tasks[0]
+        self.study = study
+        self.task = task
+        self.tightened = tightened
+        self.band_fraction = study.tracking.collocation_fraction if tightened else 1.0
+        self.envelope_margin = study.bounds.envelope_margin if tightened else 0.0
+        self.working_clearance = WORKING_CLEARANCE / STROKE_SCALE if tightened else 0.0
+        self.emlas = emlas if emlas is not None else study.emlas
+        self.id_path = id_path or study.solver.id_path
+        # the task's collocation grid: the study's step over the task's duration (the study's grid for
+        # one task of the grid's duration), its spline: the study's density of control points
+        self.collocation_times = task.times(study.grid.dt)
+        self.times = self.collocation_times if times is None else np.asarray(times, dtype=float)
+        self.dt = float(self.times[1] - self.times[0])
+        duration = task.reference.duration
+        points = task.spline_points(study.spline.control_points, study.grid.duration, study.spline.degree)
+        self.basis = tr.SplineBasis(points, study.spline.degree, duration)
+        self.B = np.stack(self.basis.matrices(self.times))  # (3 orders, K, N)
+        self.kin = tr.TcpKinematics(study.crane)
+        self.reference = task.reference.sample(self.kin, self.times)
+        self.tcp_force = task.id_force(self.kin, study.crane.gravity, self.times)
+        self.fd_step = study.solver.fd_step
+        self.xi_path = "analytic" if study.solver.xi_derivatives == "analytic" else self.id_path
+        # initial fit: inverse kinematics on the fine grid, least-squares spline at rest at both ends
+        fine_ref = task.reference.sample(self.kin, self.fine_times())
+        ik = tr.inverse_kinematics(self.kin, fine_ref, ik_start(task.reference, self.kin, study.crane, fine_ref))
+        self.reference_joints = ik
+        self.c_ref = tr.fit_coefficients(self.basis, ik)
+        margin = study.bounds.triangle_margin
+        # const_h with const_k: the crane's joint range and the hinge-angle margin (theta only)
+        self.theta_low = np.zeros(3)
+        self.theta_up = np.zeros(3)
+        for j, chain in enumerate(study.crane.chains):
+            lo, hi = chain.joint_range
+            self.theta_low[j] = max(lo, chain.joint_offset - math.pi + margin)
+            self.theta_up[j] = min(hi, chain.joint_offset - margin)
+        self.theta_low[2], self.theta_up[2] = study.crane.telescope.joint_range
+        # working range the design must serve (const_j at its ends): the crane's full joint range
+        # (so the redesigned crane keeps its workspace, as every ID path's input check demands) or
+        # the reference's range widened by a margin. The ID sees a slightly narrower range, so trial
+        # points of the line search that violate const_j by a second-order amount stay evaluable.
+        wr_margin = study.bounds.working_margin
+        if study.bounds.working_range == "crane":
+            self.working = tuple(chain.joint_range for chain in study.crane.chains)
+            inner = tuple((lo + ID_SLACK, hi - ID_SLACK) for lo, hi in self.working)
+        else:
+            self.working = working_range(study.crane, ik.position, wr_margin)
+            inner = working_range(study.crane, ik.position, 0.5 * wr_margin)
+        self.crane = replace(
+            study.crane,
+            lift=replace(study.crane.lift, joint_range=inner[0]),
+            tilt=replace(study.crane.tilt, joint_range=inner[1]),
+        )
+        self.n_xi = N_XI
+        self.n_c = 3 * self.basis.n
+        self.n = self.n_xi + self.n_c
+        self.lower = np.concatenate([np.asarray(study.bounds.xi_low) / XI_SCALE, np.full(self.n_c, -np.inf)])
+        self.upper = np.concatenate([np.asarray(study.bounds.xi_up) / XI_SCALE, np.full(self.n_c, np.inf)])
+        self.duty_options = duty_options(study, self.emlas, duration)
+        self.objective = make_objective(objective or study.energy.objective, self.emlas, self.dt)
+        self.layout = BlockLayout(self._build_blocks())
+        self.constraint_names = self.layout.names
+        #: added to the solver's rows gives the nominal scaled margins (each block owns its clearance)
+        self.clearance = self.layout.clearance
+        self._id_cache: dict[bytes, InverseDynamics] = {}
+        self._eval_cache: dict[bytes, Evaluation] = {}
+        self._grad_cache: dict[bytes, tuple[Array, Array]] = {}
+        self.n_evaluations = 0
+        self.n_gradients = 0
+        self.cost_scale = 1.0
+        if cost_scale is None:
+            try:
+                cost_scale = self.evaluate(self.initial_point(study.initial_lengths)).cost
+            except InvalidInputError as error:
+                raise InvalidInputError(
+                    f"initial_lengths ({error.field})",
+                    error.value,
+                    f"the start is not an admissible crane: {error.allowed}",
+                ) from None
+        self.cost_scale = max(float(cost_scale), 1e-300)
+
+    def fine_times(self) -> Array:
+        """The task's re-check grid: ``grid.fine_factor`` times denser than its collocation grid [s]."""
+        intervals = len(self.collocation_times) - 1
+        return np.linspace(0.0, self.task.reference.duration, self.study.grid.fine_factor * intervals + 1)
+
+    def _build_blocks(self) -> list[ConstraintBlock]:
+        """The inequality blocks in row order: :data:`hiab_sim.study.nlp.block_registry.BLOCKS` for this task."""
+        return build_blocks(self)
+
+    # -- variables ---------------------------------------------------------------------------
+
+    def initial_point(self, lengths: LinkLengths, coefficients: Array | None = None) -> Array:
+        """Scaled z for link lengths and coefficients (default: the inverse-kinematics fit)."""
+        c = self.c_ref if coefficients is None else np.asarray(coefficients, dtype=float).reshape(3, -1)
+        return np.concatenate([lengths.as_array() / XI_SCALE, ((c - self.c_ref) / C_SCALE).ravel()])
+
+    def unpack(self, z: Array) -> tuple[LinkLengths, Array]:
+        """(Xi, c (3, N)) from scaled z."""
+        z = np.asarray(z, dtype=float)
+        xi = z[: self.n_xi] * XI_SCALE
+        c = self.c_ref + C_SCALE * z[self.n_xi :].reshape(3, self.basis.n)
+        return LinkLengths.from_array(xi), c
+
+    # -- evaluation --------------------------------------------------------------------------
+
+    def _id(self, lengths: LinkLengths) -> InverseDynamics:
+        key = lengths.as_array().tobytes()
+        if key not in self._id_cache:
+            if len(self._id_cache) > 32:
+                self._id_cache.clear()
+            self._id_cache[key] = make_inverse_dynamics(self.crane, lengths, self.id_path)
+        return self._id_cache[key]
+
+    def joints(self, c: Array) -> tr.JointTrajectory:
+        """Joint samples on this problem's grid for coefficients c (3, N)."""
+        B, dB, ddB = self.B
+        return tr.JointTrajectory(self.times, B @ c.T, dB @ c.T, ddB @ c.T)
+
+    def evaluate(self, z: Array) -> Evaluation:
+        """Cost, constraints and intermediate quantities at z (cached by value)."""
+        z = np.array(z, dtype=float)
+        key = z.tobytes()
+        if key in self._eval_cache:
+            return self._eval_cache[key]
+        self.n_evaluations += 1
+        lengths, c = self.unpack(z)
+        joints = self.joints(c)
+        samples = JointSamples(joints.position, joints.velocity, joints.acceleration)
+        act = self._id(lengths)(samples, tcp_force=self.tcp_force)
+        tcp = self.kin.samples(joints.position, joints.velocity, joints.acceleration)
+        duty = None
+        if self.duty_options is not None:
+            duty = tuple(
+                drive_duty(
+                    p, self.times, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], self.duty_options
+                )
+                for i, p in enumerate(self.emlas)
+            )
+            power = np.column_stack([d.power for d in duty])
+        else:
+            power = np.column_stack(
+                [
+                    electrical_power(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
+                    for i, p in enumerate(self.emlas)
+                ]
+            )
+        state = SampleState(lengths, joints, tcp, act, power, duty=duty)
+        ev = Evaluation(
+            lengths,
+            joints,
+            tcp,
+            act,
+            power,
+            duty=duty,
+            z=z,
+            coefficients=c,
+            cost=self.objective.value(state),
+            constraints=self.layout.values(state),
+            equalities=self._equalities(c),
+        )
+        if len(self._eval_cache) > 8:
+            self._eval_cache.clear()
+        self._eval_cache[key] = ev
+        return ev
+
+    def cost(self, z: Array) -> float:
+        """Scaled cost f / f_scale."""
+        return self.evaluate(z).cost / self.cost_scale
+
+    def constraints(self, z: Array) -> Array:
+        """Scaled inequality constraints g(z) >= 0."""
+        return self.evaluate(z).constraints
+
+    def equalities(self, z: Array) -> Array:
+        """Rest-to-rest equalities (linear in c)."""
+        return self.evaluate(z).equalities
+
+    def margins(self, z: Array) -> Array:
+        """Nominal scaled inequality margins (feasible where >= 0): the solver's rows without the clearance.
+
+        The tracking bands and envelope margins stay as this problem holds them (``tightened``);
+        only the working-range clearance, a safety the optimiser adds for its own optimum, is removed.
+        """
+        return self.evaluate(z).constraints + self.clearance
+
+    def max_violation(self, z: Array) -> float:
+        """Largest violation of any nominal constraint (:meth:`margins`) or bound, in scaled units."""
+        ev = self.evaluate(z)
+        v = max(0.0, float(-self.margins(z).min()), float(np.abs(ev.equalities).max()))
+        zx = np.asarray(z)[: self.n_xi]
+        return max(v, float(np.max(self.lower[: self.n_xi] - zx)), float(np.max(zx - self.upper[: self.n_xi])))
+
+    def _equalities(self, c: Array) -> Array:
+        return (self._rest_matrix() @ c.T).ravel() / C_SCALE
+
+    def _rest_matrix(self) -> Array:
+        ends = np.array([0.0, self.basis.duration])
+        return np.vstack([self.basis.matrix(ends, 1), self.basis.matrix(ends, 2)])  # (4, N)
+
+    # -- gradients ---------------------------------------------------------------------------
+
+    def cost_gradient(self, z: Array) -> Array:
+        """d(scaled cost)/dz."""
+        return self._gradients(z)[0]
+
+    def constraints_jacobian(self, z: Array) -> Array:
+        """D g / dz, shape (m, n)."""
+        return self._gradients(z)[1]
+
+    def equalities_jacobian(self, z: Array) -> Array:
+        """D e / dz (constant), shape (12, n)."""
+        R = self._rest_matrix()  # (4, N)
+        jac = np.zeros((12, self.n))
+        for j in range(3):
+            jac[j * 4 : (j + 1) * 4, self.n_xi + j * self.basis.n : self.n_xi + (j + 1) * self.basis.n] = R
+        # rows of _equalities are (R @ c.T).ravel(): row r, joint j -> index r * 3 + j
+        order = np.array([r * 3 + j for j in range(3) for r in range(4)])
+        out = np.zeros_like(jac)
+        out[order] = jac
+        return out
+
+    def _to_z(self, block: ConstraintBlock, jac: BlockJacobian, rows: int) -> Array:
+        """A block's partials w.r.t. q9 and Xi [per m] as rows of D g / dz (m, n), through the spline matrices."""
+        K = len(self.times)
+        out = np.zeros((rows, self.n))
+        if isinstance(jac, SampleRows):
+            r = jac.dq.shape[1]
+            # q9 index = order * 3 + joint
+            dc = np.einsum("kmoj,okn->kmjn", jac.dq.reshape(K, r, 3, 3), self.B) * C_SCALE
+            out[:, self.n_xi :] = dc.reshape(rows, self.n_c)
+            if jac.dxi is not None:
+                out[:, : self.n_xi] = (jac.dxi * XI_SCALE).reshape(rows, self.n_xi)
+        else:
+            if jac.dq is not None:
+                dc = np.einsum("mkoj,okn->mjn", jac.dq.reshape(rows, K, 3, 3), self.B) * C_SCALE
+                out[:, self.n_xi :] = dc.reshape(rows, self.n_c)
+            if jac.dxi is not None:
+                out[:, : self.n_xi] = jac.dxi * XI_SCALE
+        return out
+
+    def _gradients(self, z: Array) -> tuple[Array, Array]:
+        z = np.array(z, dtype=float)
+        key = z.tobytes()
+        if key in self._grad_cache:
+            return self._grad_cache[key]
+        self.n_gradients += 1
+        ev = self.evaluate(z)
+        samples = JointSamples(ev.joints.position, ev.joints.velocity, ev.joints.acceleration)
+        partials = SamplePartials(
+            lambda: id_joint_partials(self._id(ev.lengths), samples, self.fd_step, self.tcp_force),
+            lambda: id_length_partials(self.crane, ev.lengths, samples, self.xi_path, self.fd_step, self.tcp_force),
+        )
+        jac = self.layout.jacobian(ev, partials, self._to_z)
+        dcost_q, dcost_xi = self.objective.gradient(ev, partials)
+        K = len(self.times)
+        grad_c = np.einsum("koj,okn->jn", dcost_q.reshape(K, 3, 3), self.B).ravel() * C_SCALE
+        grad = np.concatenate([dcost_xi * XI_SCALE, grad_c]) / self.cost_scale
+        if len(self._grad_cache) > 4:
+            self._grad_cache.clear()
+        self._grad_cache[key] = (grad, jac)
+        return grad, jac
+
+
+def _tracking(p: TaskProblem) -> list[ConstraintBlock]:
+    tol, ref, t = p.study.tracking, p.reference, p.times
+    return [
+        bl.TrackingBand(order, t, getattr(ref, order), getattr(tol, order), p.band_fraction)
+        for order in ("position", "velocity", "acceleration")
+    ]
+
+
+# the built-in blocks, in row order (const_b..const_k, thermal limits, holding brakes, buildable design, structure)
+register_block("tracking", _tracking)
+register_block("envelope", lambda p: [bl.EnvelopeMargins(p.times, p.emlas, p.envelope_margin)])
+register_block("stroke", lambda p: [bl.StrokeLimits(p.times, p.crane.chains)])
+register_block("joint", lambda p: [bl.JointLimits(p.times, p.theta_low, p.theta_up)])
+register_block("joint_velocity", lambda p: [bl.JointVelocityLimits(p.times, np.asarray(p.study.bounds.joint_velocity))])
+register_block("working_range", lambda p: [bl.WorkingRange(p.crane.chains, p.working, p.working_clearance)])
+register_block("thermal", lambda p: thermal_blocks(p.emlas, p.study.energy.duty, p.task.reference.duration))
+register_block("brake", lambda p: brake_blocks(p.emlas, p.study.energy.duty))
+register_block("buildable", lambda p: buildable_blocks(p.study, p.working, p.tightened))
+register_block(
+    "structure",
+    lambda p: structure_blocks(
+        p.study.structure, p.times, p.crane, p.emlas, p.tcp_force, p.fd_step, p.task.payload.mass
+    ),
+)
