@@ -39,7 +39,7 @@ def summary(result: dict[str, Any]) -> dict[str, Any]:
         "energies": {
             "initial_net_electrical_energy_J": result["initial"]["net_electrical_energy_J"],
             "optimal_net_electrical_energy_J": result["optimal"]["net_electrical_energy_J"],
-            "optimal_drawn_energy_without_regeneration_J": result["optimal"]["drawn_energy_without_regeneration_J"],
+            "optimal_drawn_energy_summed_drives_J": result["optimal"]["drawn_energy_summed_drives_J"],
         },
     }
     if energy:

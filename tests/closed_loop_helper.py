@@ -28,7 +28,7 @@ def synthetic_plan(crane: Crane, lengths: LinkLengths | None = None, duration: f
     start, delta = np.array([0.55, -1.35, 0.4]), np.array([0.1, 0.1, 0.1])
     joints = JointSamples(start + np.outer(s, delta), np.outer(ds, delta), np.outer(dds, delta))
     actuators = analytic_inverse_dynamics(crane, lengths, joints)
-    emlas = load_emla_set()
+    emlas = load_emla_set("paper")  # the time-domain drives model the paper's drive: no transmission or inverter loss
     power = np.stack(
         [
             electrical_power(p, actuators.force[:, i], actuators.velocity[:, i], actuators.acceleration[:, i])

@@ -17,6 +17,7 @@ from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla import EmlaSet, electrical_power
+from hiab_sim.emla.duty_energy import DutyOptions, drive_duty
 from hiab_sim.results.schema import Result
 
 DESIGNS = ("initial", "optimal")
@@ -28,17 +29,34 @@ def other_path(path: str) -> str:
 
 
 def design_energy(
-    crane: Any, emlas: EmlaSet, lengths: Any, time: np.ndarray, joints: JointSamples, path: str, payload_kg: float
+    crane: Any,
+    emlas: EmlaSet,
+    lengths: Any,
+    time: np.ndarray,
+    joints: JointSamples,
+    path: str,
+    payload_kg: float,
+    duty: DutyOptions | None = None,
 ) -> tuple[float, float]:
-    """(net electrical energy [J] by the trapezoid rule, eq. costf2 cost 1/2 Dt sum_k (sum_i P_i)^2 [W^2 s])."""
+    """(net electrical energy [J] by the trapezoid rule, eq. costf2 cost 1/2 Dt sum_k (sum_i P_i)^2 [W^2 s]).
+
+    With ``duty`` (the study's duty model) the drive powers are those at the coupled winding temperature.
+    """
     tcp_force = None if payload_kg == 0.0 else np.array([0.0, -payload_kg * crane.gravity, 0.0])
     if path == "mujoco":
         act = MujocoInverseDynamics(crane, lengths)(joints, tcp_force=tcp_force)
     else:
         act = analytic_inverse_dynamics(crane, lengths, joints, tcp_force=tcp_force)
-    power: np.ndarray = sum(  # type: ignore[assignment]
-        electrical_power(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i]) for i, p in enumerate(emlas)
-    )
+    if duty is not None:
+        power: np.ndarray = sum(  # type: ignore[assignment]
+            drive_duty(p, time, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], duty).power
+            for i, p in enumerate(emlas)
+        )
+    else:
+        power = sum(  # type: ignore[assignment]
+            electrical_power(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
+            for i, p in enumerate(emlas)
+        )
     step = np.diff(time)
     assert np.allclose(step, step[0], rtol=1e-9), "the fine grid is uniform"
     net = float(np.sum(0.5 * (power[1:] + power[:-1]) * step))
@@ -47,7 +65,7 @@ def design_energy(
 
 
 def four_designs(
-    folder: Path, result: Result, crane: Any, emlas: EmlaSet
+    folder: Path, result: Result, crane: Any, emlas: EmlaSet, duty: DutyOptions | None = None
 ) -> dict[tuple[str, str], tuple[float, float]]:
     """(net energy, cost) of {initial, optimal} lengths x {initial, optimal} joint trajectory, by the other path."""
     data = np.load(folder / "trajectory.npz")
@@ -59,6 +77,6 @@ def four_designs(
         joints = JointSamples(*(data[f"{trajectory}_{kind}"] for kind in ("position", "velocity", "acceleration")))
         for xi in DESIGNS:
             out[xi, trajectory] = design_energy(
-                crane, emlas, lengths[xi], time, joints, path, result.settings.payload_kg
+                crane, emlas, lengths[xi], time, joints, path, result.settings.payload_kg, duty
             )
     return out

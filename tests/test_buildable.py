@@ -154,7 +154,7 @@ def test_envelope_multiplier_predicts_a_slightly_stronger_motor(tmp_path: Path) 
     """
 
     def study_with(peak_scale: float) -> Study:
-        document = yaml.safe_load(shipped("emla", "default").read_text())
+        document = yaml.safe_load(shipped("emla", "paper").read_text())  # the payload is sized for the paper model
         peak = document["pmsm"]["peak_torque"]
         value = float(peak["value"] if isinstance(peak, dict) else peak)
         document["actuators"]["lift"].setdefault("pmsm", {})["peak_torque"] = value * peak_scale

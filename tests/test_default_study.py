@@ -11,6 +11,7 @@ from result_checks import four_designs
 from hiab_sim.emla import load_emla_set
 from hiab_sim.results.read import read_result
 from hiab_sim.results.schema import Result
+from hiab_sim.study.nlp.task_problem import duty_options
 from hiab_sim.study.run import RunOutput, run_study
 from hiab_sim.study.spec.study_file import load_study
 
@@ -72,7 +73,9 @@ def test_saving_decomposes_into_lengths_and_trajectory(run: RunOutput, result: R
     result.json, joints of trajectory.npz) by the analytic ID path (the run used MuJoCo); the
     interaction is evaluated as E10 + E01 - E00 - E11, not as the remainder of the total.
     """
-    e = {k: net for k, (net, _) in four_designs(run.folder, result, load_study().crane, load_emla_set()).items()}
+    study, emlas = load_study(), load_emla_set()
+    duty = duty_options(study, emlas, study.tasks[0].reference.duration)  # hot windings, the brake at rest
+    e = {k: net for k, (net, _) in four_designs(run.folder, result, study.crane, emlas, duty).items()}
     e00, e11 = e["initial", "initial"], e["optimal", "optimal"]
     e10, e01 = e["optimal", "initial"], e["initial", "optimal"]
     d = result.improvement.decomposition

@@ -128,3 +128,18 @@ def test_power_of_the_wrong_shape_is_rejected() -> None:
     """Power must be (K, n) with K the number of time samples."""
     with pytest.raises(InvalidInputError, match="power"):
         battery_energy(np.linspace(0, 1, 5), np.zeros((4, 3)), BatteryParams())
+
+
+def test_bus_and_no_regeneration_figures_differ_by_the_credit_passed_between_drives() -> None:
+    """Hand case: 1000 W and -600 W drives; the bus figure credits the 600 W, the no-regeneration one does not."""
+    from hiab_sim.emla.battery import rest_battery_energy
+
+    params = BatteryParams(inverter_efficiency=0.9, discharge_efficiency=0.8, charge_efficiency=0.5)
+    t = np.array([0.0, 1.0, 2.0])
+    result = battery_energy(t, np.tile([1000.0, -600.0, 0.0], (3, 1)), params)
+    assert result.dc_bus_drawn_energy == pytest.approx(2.0 * (1000.0 / 0.9 - 600.0 * 0.9), rel=1e-14)
+    assert result.no_regeneration_energy_at_battery == pytest.approx(2.0 * 1000.0 / 0.9 / 0.8, rel=1e-14)
+    energy, gain = rest_battery_energy([100.0, 50.0, 0.0], params)
+    assert energy == pytest.approx(150.0 / (0.9 * 0.8), rel=1e-14) and gain == pytest.approx(1 / 0.72)
+    with pytest.raises(InvalidInputError, match="rest_energy"):
+        rest_battery_energy([-1.0, 0.0, 0.0], params)

@@ -33,19 +33,19 @@ SUPPLY_PRESSURE = 19.0e6
 
 
 def _preset_document() -> dict[str, Any]:
-    return yaml.safe_load(shipped("emla", "default").read_text())
+    return yaml.safe_load(shipped("emla", "paper").read_text())
 
 
 def test_preset_iterates_lift_tilt_telescope_in_order() -> None:
     """The default set holds the three XS 031 actuators and iterates them in crane order."""
-    emlas = load_emla_set()
+    emlas = load_emla_set("paper")
     assert tuple(p.name for p in emlas) == ACTUATOR_NAMES
     assert emlas["tilt"] is emlas.tilt
 
 
 def test_every_preset_value_carries_a_provenance_label() -> None:
     """Each parameter of the preset says whether it was read, estimated, derived or a model choice."""
-    for params in load_emla_set():
+    for params in load_emla_set("paper"):
         assert len(params.provenance) >= 15
         for key, source in params.provenance:
             assert source.split(":", 1)[0] in PROVENANCE_KINDS, (key, source)
@@ -55,7 +55,7 @@ def test_every_preset_value_carries_a_provenance_label() -> None:
 
 def test_hydraulic_comparison_forces_match_bore_times_supply_pressure() -> None:
     """The preset's hydraulic push/pull forces are pi/4 bore^2 p and pi/4 (bore^2 - rod^2) p (0.1 %)."""
-    for params in load_emla_set():
+    for params in load_emla_set("paper"):
         bore, rod = HYDRAULIC[params.name]
         push = math.pi / 4 * bore**2 * SUPPLY_PRESSURE
         pull = math.pi / 4 * (bore**2 - rod**2) * SUPPLY_PRESSURE
@@ -69,7 +69,7 @@ def test_each_emla_pushes_at_least_as_hard_as_the_hydraulic_cylinder(name: str) 
 
     The envelope also admits that force while the rod starts to move outwards.
     """
-    params = load_emla_set()[name]
+    params = load_emla_set("paper")[name]
     hydraulic = {"lift": 95.5e3, "tilt": 95.5e3, "telescope": 37.3e3}[name]
     assert params.hydraulic_push_force == hydraulic
     assert peak_force(params) >= hydraulic
@@ -80,7 +80,7 @@ def test_each_emla_pushes_at_least_as_hard_as_the_hydraulic_cylinder(name: str) 
 
 def test_preset_top_speeds_follow_from_rated_motor_speed() -> None:
     """Top rod speed = rated speed x rho / (2 pi G): 0.1875 m/s lift/tilt, 0.375 m/s telescope."""
-    emlas = load_emla_set()
+    emlas = load_emla_set("paper")
     assert top_speed(emlas.lift) == pytest.approx(0.1875, rel=1e-12)
     assert top_speed(emlas.telescope) == pytest.approx(0.375, rel=1e-12)
 
@@ -119,7 +119,7 @@ def test_out_of_range_value_raises_error_naming_field_value_and_range(
 
 def test_dataclass_rejects_bad_values_when_built() -> None:
     """EmlaParams validates at construction, not only in the loader."""
-    lift = load_emla_set().lift
+    lift = load_emla_set("paper").lift
     with pytest.raises(InvalidInputError, match=r"lift\.gear_ratio = -1 is out of range: must be"):
         dataclasses.replace(lift, gear_ratio=-1.0)
     with pytest.raises(InvalidInputError, match=r"pmsm\.stator_resistance"):

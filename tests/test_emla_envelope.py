@@ -17,7 +17,7 @@ from hiab_sim.emla import (
     within_envelope,
 )
 
-EMLAS = load_emla_set()
+EMLAS = load_emla_set("paper")
 
 
 def _random_samples(params, n: int = 400, seed: int = 5):  # type: ignore[no-untyped-def]

@@ -24,7 +24,7 @@ from hiab_sim.emla.losses import DriveLosses
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import shipped
 
-EMLAS = load_emla_set()
+EMLAS = load_emla_set("paper")
 ON = DriveLosses(
     transmission_efficiency_forward=0.87,
     transmission_efficiency_backdriven=0.862,
@@ -175,7 +175,7 @@ def test_gear_ratio_of_one_or_less_is_rejected() -> None:
 
 
 def _preset() -> dict:
-    return yaml.safe_load(shipped("emla", "default").read_text())
+    return yaml.safe_load(shipped("emla", "paper").read_text())
 
 
 def test_enabling_the_presets_drive_losses_loads_them_with_per_actuator_overrides() -> None:

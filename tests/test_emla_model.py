@@ -22,7 +22,7 @@ from hiab_sim.emla import (
 from hiab_sim.emla.pmsm import dq_voltages, electromagnetic_torque
 from hiab_sim.errors import InvalidInputError
 
-EMLAS = load_emla_set()
+EMLAS = load_emla_set("paper")
 
 
 @st.composite

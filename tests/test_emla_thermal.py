@@ -156,7 +156,7 @@ def test_preset_thermal_resistance_heats_the_winding_to_its_limit_at_continuous_
     """The derived R_th: copper loss at the continuous torque, held, brings the winding to T_max (1e-4)."""
     from hiab_sim.emla import load_emla_set
 
-    for params in load_emla_set():
+    for params in load_emla_set("paper"):
         th = params.thermal
         assert th is not None and th.label == f"{params.name}.thermal"
         loss, _ = copper_loss(params.motor.stator_resistance, params.motor.torque_constant, th.continuous_torque)
@@ -173,11 +173,11 @@ def test_negative_thermal_resistance_in_the_emla_file_names_the_field() -> None:
     from hiab_sim.errors import ConfigError
     from hiab_sim.resources import shipped
 
-    doc = yaml.safe_load(shipped("emla", "default").read_text())
+    doc = yaml.safe_load(shipped("emla", "paper").read_text())
     doc["actuators"]["tilt"]["thermal"] = {"thermal_resistance": -0.5}
     with pytest.raises(InvalidInputError, match=re.escape("tilt.thermal.thermal_resistance")):
         emla_set_from_mapping(doc)
-    doc = yaml.safe_load(shipped("emla", "default").read_text())
+    doc = yaml.safe_load(shipped("emla", "paper").read_text())
     del doc["thermal"]["time_constant"]
     with pytest.raises(ConfigError, match="time_constant"):
         emla_set_from_mapping(doc)

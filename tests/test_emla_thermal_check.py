@@ -13,7 +13,7 @@ from hiab_sim.emla.thermal import Duty, periodic_winding_temperature, rms_torque
 from hiab_sim.emla.thermal_check import thermal_check
 from hiab_sim.errors import InvalidInputError
 
-EMLAS = load_emla_set()
+EMLAS = load_emla_set("paper")
 T = np.linspace(0.0, 2.0, 41)
 F = 4.0e4 * np.sin(2 * np.pi * T / 2.0) + 1.0e4
 V = 0.1 * np.sin(2 * np.pi * T / 2.0) ** 2 - 0.02

@@ -11,7 +11,7 @@ from scipy.integrate import solve_ivp
 from hiab_sim.emla import EmlaParams, abc_to_dq0, dq0_to_abc, electrical_power, load_emla_set, operating_point
 from hiab_sim.emla.pmsm import current_derivatives, electromagnetic_torque
 
-EMLAS = load_emla_set()
+EMLAS = load_emla_set("paper")
 SALIENT_LIFT = dataclasses.replace(EMLAS.lift, motor=dataclasses.replace(EMLAS.lift.motor, Ld=1.6e-3, Lq=2.8e-3))
 
 

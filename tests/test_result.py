@@ -175,16 +175,21 @@ def _minimal_result_json() -> dict[str, Any]:
 
 
 def test_a_file_written_before_schema_version_reads_as_schema_1_and_writes_back_every_key() -> None:
-    """A schema-1 file without schema_version loads; written back it has the same keys and values plus the version."""
+    """A schema-1 file without schema_version loads; written back: the same values under schema 2's names."""
     data = _minimal_result_json()
     result = Result.from_json(data)
-    assert result.schema_version == 1 and result.crane_source is None and result.extra == {}
+    assert result.schema_version == 2 and result.crane_source is None and result.extra == {}
     assert result.optimal.lengths == LinkLengths.from_array([1.0, 0.1, 0.7, 1.1, 0.1, 0.7])
     assert result.improvement.decomposition.designs["optimal_lengths_initial_trajectory"].evaluable is False
     assert result.multistart.starts[0].optimal_lengths is None
     written = result.to_json()
-    assert next(iter(written)) == "schema_version" and written.pop("schema_version") == 1
-    assert written == data  # 14 == 14.0 and 150 == 150.0: the same numbers
+    assert next(iter(written)) == "schema_version" and written.pop("schema_version") == 2
+    renamed = json.loads(
+        json.dumps(data)
+        .replace("drawn_energy_without_regeneration_J", "drawn_energy_summed_drives_J")
+        .replace("drawn_energy_sum_of_actuators_J", "drawn_energy_per_drive_sum_J")
+    )
+    assert written == renamed  # 14 == 14.0 and 150 == 150.0: the same numbers
 
 
 def test_unknown_top_level_keys_are_kept_and_written_back() -> None:
@@ -192,7 +197,8 @@ def test_unknown_top_level_keys_are_kept_and_written_back() -> None:
     data = {**_minimal_result_json(), "schema_version": 1, "future_section": {"energy_J": [[1.0, 2.0]]}}
     result = Result.from_json(data)
     assert result.extra == {"future_section": {"energy_J": [[1.0, 2.0]]}}
-    assert result.to_json() == data
+    again = result.to_json()
+    assert Result.from_json(again).to_json() == again
 
 
 def test_a_newer_schema_is_refused_by_name() -> None:
@@ -281,6 +287,24 @@ def test_a_replaced_optional_field_is_written_and_read_back() -> None:
     back = Result.from_json(json.loads(json.dumps(moved.to_json())))
     assert back.crane == "crane.yaml" and back.crane_source == "my_crane.yaml"
     assert "crane_source" not in result.to_json()
+
+
+def test_a_schema_1_file_loads_with_the_renamed_energy_keys() -> None:
+    """Schema 1's two drawn-energy keys land under names that state their boundaries."""
+    result = Result.from_json(_minimal_result_json())
+    assert result.schema_version == 2
+    assert result.initial.drawn_energy_summed_drives_J == 12.0
+    assert result.initial.drawn_energy_per_drive_sum_J == 14.0
+    written = result.to_json()
+    assert "drawn_energy_without_regeneration_J" not in json.dumps(written)
+
+
+def test_a_schema_2_file_with_either_set_of_old_names_reads_under_the_new_ones() -> None:
+    """Files written as version 2 before both renamings met carry one set of old keys: each is renamed."""
+    data = {**_minimal_result_json(), "schema_version": 2}
+    result = Result.from_json(data)
+    assert result.initial.drawn_energy_summed_drives_J == 12.0
+    assert result.initial.drawn_energy_per_drive_sum_J == 14.0
 
 
 def test_a_schema_1_sensitivity_of_a_battery_study_reads_with_its_keys_renamed_and_its_unit_joules() -> None:

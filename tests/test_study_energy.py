@@ -30,8 +30,8 @@ def _study(**changes: object):  # type: ignore[no-untyped-def]
 
 @pytest.fixture(scope="module")
 def energy_problem() -> TaskProblem:
-    """The small study with the battery-energy objective and a 60 cycles/hour duty."""
-    return TaskProblem(_study(objective="battery_energy", duty={"cycles_per_hour": 60}))
+    """The small study with the battery-energy objective, a 60 cycles/hour duty and the paper's EMLA model."""
+    return TaskProblem(_study(objective="battery_energy", duty={"cycles_per_hour": 60}, emla="paper"))
 
 
 def _directions(n: int, count: int = 3) -> list[np.ndarray]:
@@ -118,7 +118,7 @@ def test_thermal_rows_exist_only_with_a_duty_and_hold_at_60_cycles_per_hour_not_
 @pytest.mark.e2e
 def test_every_result_reports_both_objectives_battery_thermal_and_hydraulics(tmp_path: Path) -> None:
     """result.json has the energy and hydraulic sections; costf2 and the battery energy match independent sums."""
-    study = write_study(tmp_path, small_study(duty={"cycles_per_hour": 60}))
+    study = write_study(tmp_path, small_study(duty={"cycles_per_hour": 60}, emla="paper"))
     assert main(["optimize", str(study), "--out", str(tmp_path / "out"), *FLAGS]) == 0
     r = read_result(tmp_path / "out")
     assert r.energy is not None and r.hydraulic_baseline is not None
@@ -197,10 +197,10 @@ def test_negative_thermal_resistance_in_the_emla_file_exits_2(
 
 
 def _losses_on(tmp_path: Path) -> Path:
-    """The default EMLA file with ``drive_losses`` enabled and the battery's inverter efficiency 1."""
+    """The paper's EMLA file with ``drive_losses`` enabled and the battery's inverter efficiency 1."""
     from hiab_sim.resources import locate
 
-    text = locate("default", "emla").read_bytes().decode()
+    text = locate("paper", "emla").read_bytes().decode()
     text = text.replace("drive_losses:\n  enabled: false", "drive_losses:\n  enabled: true")
     text = text.replace("value: 0.97\n", "value: 1.0\n", 1)
     path = tmp_path / "emla_losses.yaml"
@@ -213,7 +213,7 @@ def test_drive_losses_enabled_in_the_emla_file_flow_into_the_objective_and_the_r
     from hiab_sim.study.report.energy_section import design_energy
 
     study_on = _study(objective="battery_energy", emla=str(_losses_on(tmp_path)))
-    study_off = _study(objective="battery_energy")
+    study_off = _study(objective="battery_energy", emla="paper")
     assert study_on.emlas.lift.losses.inverter_on and study_on.emlas.battery.inverter_efficiency == 1.0
     on, off = (TaskProblem(s, cost_scale=1.0) for s in (study_on, study_off))
     z = on.initial_point(study_on.initial_lengths)

@@ -96,7 +96,7 @@ def summary_lines(r: Result) -> list[str]:
             f"{name:8s} lift L={lift.L:.4f} Lc0={lift.Lc0:.4f} Lc={lift.Lc:.4f}  "
             f"tilt L={tilt.L:.4f} Lc0={tilt.Lc0:.4f} Lc={tilt.Lc:.4f} m  "
             f"net motor energy {entry.net_electrical_energy_J / 1e3:.3f} kJ  "
-            f"drawn {entry.drawn_energy_without_regeneration_J / 1e3:.3f} kJ (motor side; battery below)"
+            f"drawn {entry.drawn_energy_summed_drives_J / 1e3:.3f} kJ (motor side; battery below)"
         )
     sol, rc = r.solver, r.recheck
     lines.append(

@@ -58,6 +58,9 @@ def closing_lines(report: dict[str, object]) -> list[str]:
                 f"not a failure), tracking within {heavy['tcp_error_mm']['max']:.2f} mm"
             )
         lines.append(text + ".")
+    boundary = report.get("energy_boundary")
+    if boundary is not None:
+        lines.append(f"Energy boundary: {boundary}.")
     return lines
 
 

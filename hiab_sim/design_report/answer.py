@@ -122,8 +122,8 @@ def energies(result: Result, folder: Path) -> str:
         (
             "energy drawn, summed power",
             "motor terminals, positive part of the summed power",
-            num(i.drawn_energy_without_regeneration_J, ".1f", "J"),
-            num(o.drawn_energy_without_regeneration_J, ".1f", "J"),
+            num(i.drawn_energy_summed_drives_J, ".1f", "J"),
+            num(o.drawn_energy_summed_drives_J, ".1f", "J"),
             "",
         ),
         (

@@ -116,6 +116,28 @@ def crane_keys() -> list[Key]:
             default="none",
             description="Pin-to-pin length at zero stroke (read, not used by the model).",
         ),
+        section(
+            "counterbalance",
+            "Counterbalance valve in the outlet of the load-holding chamber (hydraulic baselines at the battery).",
+            default="none",
+        ),
+        Key("counterbalance.side", type="piston | rod", description="The chamber the valve holds."),
+        Key("counterbalance.pilot_ratio", type="number", allowed="> 0", description="Pilot ratio R."),
+        Key(
+            "counterbalance.setting_pressure",
+            type="number",
+            unit="Pa",
+            allowed="> 0",
+            description="Setting p_set: opens when p_out + R p_pilot = p_set.",
+        ),
+        Key(
+            "counterbalance.check_pressure",
+            type="number",
+            unit="Pa",
+            allowed=">= 0",
+            default="0",
+            description="Cracking pressure of the free-flow check.",
+        ),
     ]
     rows = [
         Key("name", type="text", description="Crane name, used in reports."),
@@ -193,7 +215,9 @@ def crane_keys() -> list[Key]:
 def emla_keys() -> list[Key]:
     """The EMLA file (:func:`hiab_sim.emla.config.emla_set_from_mapping`); values may carry a provenance."""
     from hiab_sim.emla.battery import BatteryParams
+    from hiab_sim.emla.brake import HoldingBrake
     from hiab_sim.emla.config import DriveStiffness, EmlaParams, PmsmParams, ScrewColumn
+    from hiab_sim.emla.electrothermal import WindingResistance
     from hiab_sim.emla.losses import DriveLosses
     from hiab_sim.emla.thermal import ThermalParams
 
@@ -201,13 +225,19 @@ def emla_keys() -> list[Key]:
     actuator = [
         k
         for k in _sourced(
-            from_class("", EmlaParams, skip=("name", "motor", "losses", "thermal", "provenance", "screw", "stiffness"))
+            from_class(
+                "",
+                EmlaParams,
+                skip=("name", "motor", "losses", "thermal", "winding", "brake", "provenance", "screw", "stiffness"),
+            )
         )
     ]
     screw = _sourced(from_class("", ScrewColumn))
     stiffness = _sourced(from_class("", DriveStiffness))
     thermal = _sourced(from_class("", ThermalParams))
     losses = _sourced(from_class("", DriveLosses), required=False)
+    winding = _sourced(from_class("", WindingResistance))
+    brake = _sourced(from_class("", HoldingBrake))
     rows = [
         section("pmsm", "The motor shared by every actuator (an actuator may override any key in its own `pmsm`)."),
         *[replace(k, path=f"pmsm.{k.path}") for k in pmsm],
@@ -223,6 +253,12 @@ def emla_keys() -> list[Key]:
         rows += [replace(k, path=f"{where}.thermal.{k.path}", default="shared") for k in thermal]
         rows.append(section(f"{where}.drive_losses", "Overrides of the shared `drive_losses` keys.", default="none"))
         rows += [replace(k, path=f"{where}.drive_losses.{k.path}", default="shared") for k in losses]
+        for key, doc, keys in (
+            ("winding_resistance", "Overrides of the shared `winding_resistance` keys.", winding),
+            ("holding_brake", "Overrides of the shared `holding_brake` keys.", brake),
+        ):
+            rows.append(section(f"{where}.{key}", doc, default="none"))
+            rows += [replace(k, path=f"{where}.{key}.{k.path}", default="shared") for k in keys]
         rows.append(section(f"{where}.screw", "Overrides of the shared `screw` keys.", default="none"))
         rows += [replace(k, path=f"{where}.screw.{k.path}", default="shared") for k in screw]
         rows.append(
@@ -246,6 +282,14 @@ def emla_keys() -> list[Key]:
             description="`false` keeps every loss off (the keys below are then ignored).",
         ),
         *[replace(k, path=f"drive_losses.{k.path}") for k in losses],
+        section(
+            "winding_resistance",
+            "R_s(T) = R_s,ref (1 + alpha (T - T_ref)): hot windings (hiab_sim.emla.electrothermal).",
+            default="none",
+        ),
+        *[replace(k, path=f"winding_resistance.{k.path}") for k in winding],
+        section("holding_brake", "The holding brake on every motor shaft (hiab_sim.emla.hold).", default="none"),
+        *[replace(k, path=f"holding_brake.{k.path}") for k in brake],
         section(
             "screw",
             "Every screw as a column under its push force (buckling rows and margins); none: no buckling check.",

@@ -39,14 +39,14 @@ def results_block(result: Result) -> str:
         )
     i, o = result.initial, result.optimal
     rows.append(
-        f"| net electrical energy (motor terminals) | {i.net_electrical_energy_J:.1f} → "
+        f"| net electrical energy (drive inputs, DC side with the inverter loss) | {i.net_electrical_energy_J:.1f} → "
         f"{o.net_electrical_energy_J:.1f} J "
         f"({-result.improvement.net_energy_saved_percent:.2f} %) |"
     )
     if result.energy is not None:
         e = result.energy
         rows.append(
-            f"| battery energy per cycle (at the battery) | {e.initial.battery_energy_J:.1f} → "
+            f"| battery energy per duty period, cycle and rest (at the battery) | {e.initial.battery_energy_J:.1f} → "
             f"{e.optimal.battery_energy_J:.1f} J ({-e.battery_energy_saved_percent:.2f} %) |"
         )
         for motor, t in (e.optimal.thermal or {}).items():
@@ -58,7 +58,7 @@ def results_block(result: Result) -> str:
     if result.hydraulic_baseline is not None:
         h = result.hydraulic_baseline.optimal
         rows.append(
-            f"| hydraulic cylinders, same motion (load sensing / constant pressure) | "
+            f"| hydraulic cylinders, same motion, at the pump motor input (load sensing / constant pressure) | "
             f"{h.load_sensing.input_energy_J / 1e3:.2f} / {h.constant_pressure.input_energy_J / 1e3:.2f} kJ |"
         )
     d = result.improvement.decomposition

@@ -26,7 +26,17 @@ for n drives over the duration T (h_bat is Lipschitz with constant alpha_bat): t
 is O(eps) and vanishes as eps -> 0 (tested).
 
 Per-actuator drawn energy int max(P_i, 0) dt (motor side, no regeneration credited) is reported
-alongside; :func:`battery_energy` returns both.
+alongside; :func:`battery_energy` returns both, and the two figures whose boundaries are often
+confused:
+
+* ``dc_bus_drawn_energy`` = int max(B, 0) dt: the positive part of the *shared* DC-bus power, which
+  credits energy passed from one drive to another on the bus;
+* ``no_regeneration_energy_at_battery`` = int sum_i max(D_i, 0) / eta_dis dt: the battery's energy
+  if no drive could return power (every regenerated joule burnt in a braking resistor, no credit
+  passed between drives).
+
+The rest between cycles (:mod:`hiab_sim.emla.hold`) only draws power, so its battery energy is
+linear, sum_i E_rest,i / (eta_inv eta_dis) (:func:`rest_battery_energy`).
 """
 
 from __future__ import annotations
@@ -96,6 +106,8 @@ class BatteryEnergy:
         battery_power: P_bat [W], shape (K,).
         drawn_energy: int max(P_i, 0) dt [J] per drive, shape (n,) (always exact).
         net_energy: int P_i dt [J] per drive, shape (n,).
+        dc_bus_drawn_energy: int max(B, 0) dt [J] on the shared bus (exact).
+        no_regeneration_energy_at_battery: int sum_i max(D_i, 0) / eta_dis dt [J] (exact).
 
     """
 
@@ -105,6 +117,8 @@ class BatteryEnergy:
     battery_power: Array
     drawn_energy: Array
     net_energy: Array
+    dc_bus_drawn_energy: float = 0.0
+    no_regeneration_energy_at_battery: float = 0.0
 
 
 def trapezoid_weights(time: ArrayLike) -> Array:
@@ -180,6 +194,9 @@ def battery_energy(time: ArrayLike, power: ArrayLike, params: BatteryParams, smo
     if p.ndim != 2 or p.shape[0] != w.size:
         raise InvalidInputError("power", f"shape {p.shape}", f"must be (K, n) with K = {w.size} time samples")
     bus, p_bat, d_bat, d_dc = battery_power(p, params, smooth)
+    eta = params.inverter_efficiency
+    dc_exact = kinked_gain(p, 1.0 / eta, eta, None)[0]
+    bus_exact = dc_exact.sum(axis=-1)
     return BatteryEnergy(
         energy=float(w @ p_bat),
         gradient=(w * d_bat)[:, None] * d_dc,
@@ -187,4 +204,20 @@ def battery_energy(time: ArrayLike, power: ArrayLike, params: BatteryParams, smo
         battery_power=p_bat,
         drawn_energy=w @ np.maximum(p, 0.0),
         net_energy=w @ p,
+        dc_bus_drawn_energy=float(w @ np.maximum(bus_exact, 0.0)),
+        no_regeneration_energy_at_battery=float(w @ np.maximum(dc_exact, 0.0).sum(axis=1))
+        / params.discharge_efficiency,
     )
+
+
+def rest_battery_energy(rest_energy: ArrayLike, params: BatteryParams) -> tuple[float, float]:
+    """Return (battery energy [J], dE_bat / dE_rest,i [-]) of the drives' rest energies E_rest,i [J] >= 0.
+
+    The rest only draws (holding currents, standby, coils), so every drive's inverter and the battery
+    are on their motoring branch: E_bat = sum_i E_rest,i / (eta_inv eta_dis).
+    """
+    e = np.asarray(rest_energy, dtype=float)
+    if not np.all(np.isfinite(e)) or np.any(e < 0):
+        raise InvalidInputError("rest_energy", e.tolist(), "must be finite and >= 0 (the rest only draws)", "J")
+    gain = 1.0 / (params.inverter_efficiency * params.discharge_efficiency)
+    return float(e.sum() * gain), gain

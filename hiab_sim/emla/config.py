@@ -11,6 +11,8 @@ from typing import Any
 from hiab_sim.checks import check_non_negative, check_positive, check_range
 from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.emla.battery import BatteryParams
+from hiab_sim.emla.brake import HoldingBrake
+from hiab_sim.emla.electrothermal import WindingResistance
 from hiab_sim.emla.losses import DriveLosses
 from hiab_sim.emla.thermal import ThermalParams
 from hiab_sim.errors import ConfigError, InvalidInputError
@@ -178,6 +180,9 @@ class EmlaParams:
         hydraulic_pull_force: Pull force of that cylinder [N], or None.
         losses: Optional drive losses (:mod:`hiab_sim.emla.losses`); the default is all off.
         thermal: Continuous torque and winding thermal model (:mod:`hiab_sim.emla.thermal`), or None.
+        winding: Temperature dependence of R_s (:mod:`hiab_sim.emla.electrothermal`), or None
+            (R_s constant, the seed paper's model).
+        brake: The holding brake on the motor shaft (:mod:`hiab_sim.emla.brake`), or None.
         screw: The screw as a column (buckling), or None when the file gives no ``screw`` section.
         stiffness: The drive train's axial stiffness, or None when the file gives no ``drive_stiffness``.
         provenance: (parameter key, source label) pairs, e.g.
@@ -195,6 +200,8 @@ class EmlaParams:
     hydraulic_pull_force: float | None = None
     losses: DriveLosses = field(default_factory=DriveLosses)
     thermal: ThermalParams | None = None
+    winding: WindingResistance | None = None
+    brake: HoldingBrake | None = None
     provenance: tuple[tuple[str, str], ...] = ()
     screw: ScrewColumn | None = None
     stiffness: DriveStiffness | None = None
@@ -260,12 +267,16 @@ _ACTUATOR_OPTIONAL: tuple[str, ...] = (
     "pmsm",
     "thermal",
     "drive_losses",
+    "winding_resistance",
+    "holding_brake",
     "screw",
     "drive_stiffness",
 )
 #: Optional sections (shared at the top level; ``thermal`` and ``drive_losses`` may be overridden per actuator).
 _THERMAL_KEYS: tuple[str, ...] = tuple(f.name for f in fields(ThermalParams) if f.name != "label")
 _LOSS_KEYS: tuple[str, ...] = tuple(f.name for f in fields(DriveLosses) if f.name != "label")
+_WINDING_KEYS: tuple[str, ...] = tuple(f.name for f in fields(WindingResistance) if f.name != "label")
+_BRAKE_KEYS: tuple[str, ...] = tuple(f.name for f in fields(HoldingBrake) if f.name != "label")
 _BATTERY_KEYS: tuple[str, ...] = tuple(f.name for f in fields(BatteryParams))
 _SCREW_KEYS: tuple[str, ...] = tuple(f.name for f in fields(ScrewColumn) if f.name != "label")
 _STIFFNESS_KEYS: tuple[str, ...] = tuple(f.name for f in fields(DriveStiffness) if f.name != "label")
@@ -299,7 +310,17 @@ def emla_set_from_mapping(document: object, where: str = "<mapping>") -> EmlaSet
     root = mapping(
         document,
         f"{where}: top level",
-        {"pmsm", "actuators", "thermal", "drive_losses", "battery", "screw", "drive_stiffness"},
+        {
+            "pmsm",
+            "actuators",
+            "thermal",
+            "drive_losses",
+            "battery",
+            "winding_resistance",
+            "holding_brake",
+            "screw",
+            "drive_stiffness",
+        },
         {"pmsm", "actuators"},
     )
     shared_pmsm = mapping(root["pmsm"], f"{where}: pmsm", set(_PMSM_KEYS))
@@ -336,6 +357,12 @@ def emla_set_from_mapping(document: object, where: str = "<mapping>") -> EmlaSet
         )
         if losses is not None:
             values["losses"] = losses
+        values["winding"] = _optional_section(
+            WindingResistance, _WINDING_KEYS, root, node, "winding_resistance", where, name, provenance, required=True
+        )
+        values["brake"] = _optional_section(
+            HoldingBrake, _BRAKE_KEYS, root, node, "holding_brake", where, name, provenance, required=True
+        )
         for section, cls, keys, optional in (
             ("screw", ScrewColumn, _SCREW_KEYS, _SCREW_OPTIONAL),
             ("drive_stiffness", DriveStiffness, _STIFFNESS_KEYS, ()),

@@ -118,6 +118,11 @@ def _cycle_weights(time: ArrayLike, duty: Duty) -> tuple[Array, Array]:
     return t - t[0], w
 
 
+def cycle_time_grid(time: ArrayLike, duty: Duty) -> Array:
+    """Return the cycle's sample times from 0 [s], checked to be increasing and to span ``duty.cycle_time``."""
+    return _cycle_weights(time, duty)[0]
+
+
 def rms_torque(time: ArrayLike, torque: ArrayLike, duty: Duty) -> tuple[float, Array]:
     """Return (tau_rms [N m], d tau_rms / d tau_k [1], shape (K,)) over the duty period.
 

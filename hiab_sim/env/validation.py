@@ -14,6 +14,7 @@ from tqdm import tqdm
 
 from hiab_sim.control.cascade import CascadeGains
 from hiab_sim.crane.description import Crane
+from hiab_sim.emla.config import EmlaSet
 from hiab_sim.env import CURRENT_BANDWIDTH_HZ, PHYSICS_TIMESTEP
 from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.plan import read_plan
@@ -98,10 +99,33 @@ def simulation_report(
             "plant": runs[0].plant if runs else "ideal",
         },
     }
+    boundary = energy_boundary(read_plan(result_dir, runs[0].design).emlas) if runs else None
+    if boundary is not None:
+        report["energy_boundary"] = boundary
     by_design = {run.design: run for run in runs}
     if {"initial", "optimal"} <= by_design.keys():
         report["optimal_below_initial"] = by_design["optimal"].net_energy < by_design["initial"].net_energy
     return report
+
+
+def energy_boundary(emlas: EmlaSet) -> str | None:
+    """Where the prediction and the closed loop differ in what they count, or None where both count the same.
+
+    The plan's energy includes the EMLA file's drive losses (:mod:`hiab_sim.emla.losses`) when any is
+    on; the closed-loop drives (:mod:`hiab_sim.emla.drive_sim`) model none of them (a lossless
+    transmission and brake; inverter losses only with a plant that has them, on the DC bus), so the
+    energy difference then contains those losses and is no measure of the controller alone.
+    """
+    lossy = [p for p in emlas if p.losses.transmission_on or p.losses.inverter_on or p.losses.brake_on]
+    if not lossy:
+        return None
+    described = sorted({p.losses.describe() for p in lossy})
+    return (
+        "the predicted energy includes the EMLA file's "
+        + " | ".join(described)
+        + f" ({', '.join(p.name for p in lossy)}); the closed-loop drives model none of these losses, "
+        "so the difference against the plan is mostly those losses, not a control error"
+    )
 
 
 def table(report: dict[str, object]) -> str:

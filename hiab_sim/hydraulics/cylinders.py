@@ -16,6 +16,36 @@ CYLINDER_NAMES: tuple[str, ...] = ("lift", "tilt", "telescope")
 
 
 @dataclass(frozen=True)
+class CounterbalanceValve:
+    """A pilot-assisted counterbalance (over-centre) valve in the outlet of one chamber of a cylinder.
+
+    It opens when p_chamber + R p_pilot >= p_set, the pilot taken from the other chamber; flow into the
+    chamber passes its check valve (cracking pressure ``check_pressure``).
+
+    Attributes:
+        side: ``piston`` or ``rod``, the chamber the valve holds (the load-holding one).
+        pilot_ratio: R [-] > 0.
+        setting_pressure: p_set [Pa] > 0.
+        check_pressure: Cracking pressure of the free-flow check [Pa] >= 0.
+        label: Prefix of error messages.
+
+    """
+
+    side: str
+    pilot_ratio: float
+    setting_pressure: float
+    check_pressure: float = 0.0
+    label: str = "counterbalance"
+
+    def __post_init__(self) -> None:
+        if self.side not in ("piston", "rod"):
+            raise InvalidInputError(f"{self.label}.side", self.side, "must be one of piston, rod")
+        check_positive(f"{self.label}.pilot_ratio", self.pilot_ratio)
+        check_positive(f"{self.label}.setting_pressure", self.setting_pressure, "Pa")
+        check_non_negative(f"{self.label}.check_pressure", self.check_pressure, "Pa")
+
+
+@dataclass(frozen=True)
 class Cylinder:
     """A double-acting single-rod cylinder.
 
@@ -26,6 +56,7 @@ class Cylinder:
         stroke: Stroke [m] > 0 (reported, not a limit here).
         pin_to_pin_at_zero: Pin-to-pin length [m] > 0 at zero joint angle, if the crane file gives it
             (documentation of the source's cylinder; the EMLA chains' own lengths are the model's).
+        counterbalance: Its counterbalance valve, or None.
 
     """
 
@@ -34,6 +65,7 @@ class Cylinder:
     rod: float
     stroke: float
     pin_to_pin_at_zero: float | None = None
+    counterbalance: CounterbalanceValve | None = None
 
     def __post_init__(self) -> None:
         check_positive(f"hydraulic_cylinders.{self.name}.bore", self.bore, "m")
@@ -91,15 +123,28 @@ def hydraulic_cylinders_from_mapping(data: Any, where: str = "hydraulic_cylinder
     """Build :class:`HydraulicCylinders` from the crane YAML's ``hydraulic_cylinders`` mapping.
 
     Keys: ``lift``, ``tilt``, ``telescope`` (each ``bore``, ``rod``, ``stroke`` [m], optional
-    ``pin_to_pin_at_zero``), ``supply_pressure`` [Pa], optional ``friction: {coulomb, viscous}``.
+    ``pin_to_pin_at_zero`` and ``counterbalance: {side, pilot_ratio, setting_pressure [Pa],
+    check_pressure [Pa]}``), ``supply_pressure`` [Pa], optional ``friction: {coulomb, viscous}``.
     """
     required = {"lift", "tilt", "telescope", "supply_pressure"}
     top = mapping(data, where, required | {"friction"}, required)
     cylinders = {}
     for name in CYLINDER_NAMES:
         keys = {"bore", "rod", "stroke"}
-        node = mapping(top[name], f"{where}.{name}", keys | {"pin_to_pin_at_zero"}, keys)
+        node = mapping(top[name], f"{where}.{name}", keys | {"pin_to_pin_at_zero", "counterbalance"}, keys)
         pin = node.get("pin_to_pin_at_zero")
+        valve = None
+        if "counterbalance" in node:
+            cb_where = f"{where}.{name}.counterbalance"
+            cb_keys = {"side", "pilot_ratio", "setting_pressure"}
+            cb = mapping(node["counterbalance"], cb_where, cb_keys | {"check_pressure"}, cb_keys)
+            valve = CounterbalanceValve(
+                side=cb["side"],
+                pilot_ratio=number(cb["pilot_ratio"], f"{cb_where}.pilot_ratio"),
+                setting_pressure=number(cb["setting_pressure"], f"{cb_where}.setting_pressure"),
+                check_pressure=number(cb.get("check_pressure", 0.0), f"{cb_where}.check_pressure"),
+                label=cb_where,
+            )
         bore, rod, stroke = (number(node[k], f"{where}.{name}.{k}") for k in ("bore", "rod", "stroke"))
         cylinders[name] = Cylinder(
             name,
@@ -107,6 +152,7 @@ def hydraulic_cylinders_from_mapping(data: Any, where: str = "hydraulic_cylinder
             rod,
             stroke,
             pin_to_pin_at_zero=None if pin is None else number(pin, f"{where}.{name}.pin_to_pin_at_zero"),
+            counterbalance=valve,
         )
     friction = mapping(top.get("friction", {}), f"{where}.friction", {"coulomb", "viscous"}, set())
     return HydraulicCylinders(

@@ -296,7 +296,8 @@ def _hydraulic(node: Any) -> HydraulicSystem:
     for name, c in cylinders_node.items():
         cw = f"hydraulic.cylinders.{name}"
         cn = mapping(c, cw, {"bore", "rod", "stroke"})
-        cylinders.append(Cylinder(str(name), *(number(cn[k], f"{cw}.{k}") for k in ("bore", "rod", "stroke"))))
+        bore, rod, stroke = (number(cn[k], f"{cw}.{k}") for k in ("bore", "rod", "stroke"))
+        cylinders.append(Cylinder(str(name), bore, rod, stroke))
     friction = mapping(top.get("friction", {}), "hydraulic.friction", {"coulomb", "viscous"}, set())
     return HydraulicSystem(
         cylinders=tuple(cylinders),

@@ -43,7 +43,7 @@ class Buildable:
     recheck_id_path: str
     recheck_grid_points: int
     net_electrical_energy_J: float
-    drawn_energy_without_regeneration_J: float
+    drawn_energy_summed_drives_J: float
     net_energy_change_vs_optimum_J: float
     mjcf_command: str
 

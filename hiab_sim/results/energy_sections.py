@@ -34,6 +34,48 @@ class ActuatorThermal:
 
 
 @dataclass(frozen=True)
+class MotorDuty:
+    """One motor over the duty period with the study's duty model (:mod:`hiab_sim.emla.duty_energy`)."""
+
+    hold: str  # brake | motor | none (the rest free: zero torque, zero power)
+    rest_energy_J: float  # at the drive over the rest: holding copper, inverter, coil, brake transitions
+    rest_copper_energy_J: float
+    rest_torque_Nm: float  # motor torque through the rest (0 with the brake)
+    first_pose_torque_Nm: float  # static motor torque that holds the cycle's first pose
+    last_pose_torque_Nm: float  # ... and its last (the rest pose)
+    runaway: bool  # no fixed point of the winding temperature below the insulation limit
+    brake_holding_torque_Nm: float | None = optional()  # M4 of the holding brake
+    brake_margin: float | None = optional()  # 1 - max |pose torque| / M4, >= 0 where the brake holds
+    mean_winding_temperature_C: float | None = optional()  # over the cycle's samples
+    peak_winding_temperature_C: float | None = optional()
+    peak_resistance_factor: float | None = optional()  # R_s(T_peak) / R_s,ref
+    rest_standby_energy_J: float | None = optional()  # the part of rest_energy_J that is the inverter's standby
+
+
+@dataclass(frozen=True)
+class DutyEnergy:
+    """One design's energy over a duty period at the battery: hot and cold windings, with and without the hold.
+
+    ``battery_energy_by_model_J`` has the battery energy of the cycle plus the rest for
+    ``cold_windings_free_rest`` (R_s at its reference temperature, the rest at zero torque and zero
+    power: the per-sample model), ``hot_windings_free_rest``, ``cold_windings_with_hold`` and
+    ``hot_windings_with_hold`` (the study's model, = ``battery_energy_J``).
+    """
+
+    hold: str
+    battery_energy_J: float  # the battery's: hot windings, the hold, exact, cycle + rest
+    cycle_battery_energy_J: float
+    rest_battery_energy_J: float
+    hot_winding_extra_J: float  # what R_s(T) adds: hot - cold, both with the hold
+    hold_extra_J: float  # what the hold adds: with - without, both hot
+    dc_bus_drawn_energy_J: float  # int max(bus power, 0) dt over the cycle: credit passed between drives
+    no_regeneration_energy_at_battery_J: float  # the cycle with no regeneration at all, at the battery
+    battery_energy_by_model_J: dict[str, float]
+    motors: dict[str, MotorDuty]
+    infeasible: tuple[str, ...]  # one line per motor whose winding runs away or whose brake cannot hold
+
+
+@dataclass(frozen=True)
 class DesignEnergy:
     """One design on the fine grid: battery energy, the paper's cost, per-actuator energies, thermal state."""
 
@@ -48,6 +90,7 @@ class DesignEnergy:
     # with drive_losses enabled: the part of smooth - exact that the smoothed drive losses (brake, direction-
     # dependent efficiency, inverter current) add, beyond the battery kinks' smoothing_bound_J
     drive_loss_smoothing_J: float | None = optional()
+    duty: DutyEnergy | None = optional()  # with the study's duty model (hot windings, the hold)
 
 
 @dataclass(frozen=True)
@@ -86,14 +129,33 @@ class HydraulicVariant:
 
 
 @dataclass(frozen=True)
+class HydraulicAtBattery:
+    """One hydraulic variant over the cycle at the battery (:mod:`hiab_sim.hydraulics.battery_boundary`)."""
+
+    cycle_battery_energy_J: float  # energy taken from the battery over the cycle
+    terms_J: dict[str, float]  # useful work and every loss, summing to cycle_battery_energy_J
+    max_pilot_pressure_Pa: float  # largest counterbalance pilot pressure the pump supplied
+    pressure_shortfall_samples: int
+    emla_saving_percent: float  # 1 - EMLA cycle battery energy / this, both at the battery, same cycle
+
+
+@dataclass(frozen=True)
 class HydraulicDesign:
-    """Both supply variants for one design, against the EMLAs' battery energy for the same motion."""
+    """Both supply variants for one design, against the EMLAs' battery energy for the same motion.
+
+    ``constant_pressure`` and ``load_sensing`` (and the savings beside them) are drawn at the pump
+    motor's electric input, the EMLA figure at the battery; ``at_battery`` has every variant at the
+    battery over the cycle (with counterbalance valves, leakage and the pump's motor and inverter),
+    compared with the EMLAs' battery energy of the same cycle (``emla_cycle_battery_energy_J``).
+    """
 
     constant_pressure: HydraulicVariant
     load_sensing: HydraulicVariant
     emla_battery_energy_J: float
     emla_saving_vs_load_sensing_percent: float
     emla_saving_vs_constant_pressure_percent: float
+    at_battery: dict[str, HydraulicAtBattery] | None = optional()
+    emla_cycle_battery_energy_J: float | None = optional()
 
 
 @dataclass(frozen=True)

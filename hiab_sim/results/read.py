@@ -121,7 +121,7 @@ def summarise(run_dir: str | Path) -> RunSummary:
         designs[name] = DesignSummary(
             lengths=entry.lengths,
             net_energy_J=entry.net_electrical_energy_J,
-            drawn_energy_J=entry.drawn_energy_without_regeneration_J,
+            drawn_energy_J=entry.drawn_energy_summed_drives_J,
             battery_energy_J=None if energy is None else energy.battery_energy_J,
             peak_force_N={a: entry.actuators[a].peak_force_N for a in ACTUATORS},
             peak_power_W={a: entry.actuators[a].peak_electrical_power_W for a in ACTUATORS},

@@ -27,13 +27,19 @@ from hiab_sim.results.codec import from_json, optional, to_json
 from hiab_sim.results.energy_sections import Codesign, EnergyReport, HydraulicBaseline
 from hiab_sim.structure.summary import StructureSummary
 
-#: Version of the result.json layout; files without the key are version 1 (the same keys). Version 2
-#: renames the ``sensitivity`` keys that held the objective's value whatever its unit (``cost_W2s``
-#: -> ``objective_value`` with ``objective`` and ``objective_unit``, ``multipliers[].cost_per_unit_W2s``
-#: -> ``objective_decrease_per_unit``); :func:`upgrade` reads version-1 files.
+#: Version of the result.json layout; files without the key are version 1. Version 2 renames the
+#: ``sensitivity`` keys that held the objective's value whatever its unit (``cost_W2s`` ->
+#: ``objective_value`` with ``objective`` and ``objective_unit``, ``multipliers[].cost_per_unit_W2s``
+#: -> ``objective_decrease_per_unit``) and the energy keys whose names suggested another boundary
+#: (:data:`RENAMED_IN_2`); :func:`upgrade` reads every older file.
 SCHEMA_VERSION = 2
 #: The unit of each objective a version-1 file can name (the objectives that existed then).
 _SCHEMA1_UNITS = {"costf2": "W^2 s", "battery_energy": "J"}
+#: Energy keys renamed in schema 2 because their names suggested another boundary (old -> new).
+RENAMED_IN_2: dict[str, str] = {
+    "drawn_energy_without_regeneration_J": "drawn_energy_summed_drives_J",
+    "drawn_energy_sum_of_actuators_J": "drawn_energy_per_drive_sum_J",
+}
 RESULT_FILE = "result.json"
 #: Keys of :class:`EnergyBreakdown`, in the order the figures and tables show them.
 T = TypeVar("T")
@@ -104,8 +110,11 @@ class DesignSummary:
     cost_W2s: float
     cost_note: str
     net_electrical_energy_J: float
-    drawn_energy_without_regeneration_J: float
-    drawn_energy_sum_of_actuators_J: float
+    # int max(sum_i P_i, 0) dt: the drives' powers summed before the positive part is taken, so one drive's
+    # regeneration feeds another (the shared bus seen at the drives' inputs; no inverter or battery)
+    drawn_energy_summed_drives_J: float
+    # sum_i int max(P_i, 0) dt: every drive's own positive power, no credit passed between drives
+    drawn_energy_per_drive_sum_J: float
     energy_breakdown_J: EnergyBreakdown
     actuators: dict[str, ActuatorSummary]
     max_violation: float
@@ -124,7 +133,7 @@ class DecompositionDesign:
     evaluable: bool
     error: str | None = optional()
     net_electrical_energy_J: float | None = optional()
-    drawn_energy_without_regeneration_J: float | None = optional()
+    drawn_energy_summed_drives_J: float | None = optional()
     cost_W2s: float | None = optional()
     collocation_cost_W2s: float | None = optional()
     max_violation: float | None = optional()
@@ -350,15 +359,21 @@ class Result:
 
 
 def upgrade(data: Any) -> Any:
-    """A parsed result.json of version 1 with its renamed keys under their version-2 names (else unchanged).
+    """A parsed result.json of an older layout with its renamed keys under their version-2 names.
 
-    Version 1 stored the objective's value as ``sensitivity.cost_W2s`` and the decreases as
+    The energy keys of :data:`RENAMED_IN_2` take their new names at any depth. Version 1 stored the
+    objective's value as ``sensitivity.cost_W2s`` and the decreases as
     ``cost_per_unit_W2s`` whatever the objective (joules under ``battery_energy``); the objective
     is the file's ``energy.objective`` (``costf2`` without an energy section).
     """
     if not isinstance(data, dict):
         return data
-    data = {"schema_version": data.get("schema_version", 1), **data}  # a file without the key is version 1
+    version = data.get("schema_version", 1)  # a file without the key is version 1
+    if isinstance(version, int) and version > SCHEMA_VERSION:
+        raise ConfigError(f"result.json has schema_version {version}; this hiab-sim reads up to {SCHEMA_VERSION}")
+    # Files written between the two renamings say version 2 with either set of old names: each
+    # renaming is applied where its old keys are present, so every such file reads.
+    data = {**_renamed(data), "schema_version": max(2, version) if isinstance(version, int) else version}
     old = data.get("sensitivity")
     if not isinstance(old, dict) or "cost_W2s" not in old:
         return data
@@ -375,7 +390,16 @@ def upgrade(data: Any) -> Any:
         {("objective_decrease_per_unit" if k == "cost_per_unit_W2s" else k): v for k, v in m.items()}
         for m in old.get("multipliers", [])
     ]
-    return {**data, "schema_version": max(2, int(data.get("schema_version", 1))), "sensitivity": sensitivity}
+    return {**data, "sensitivity": sensitivity}
+
+
+def _renamed(data: Any) -> Any:
+    """``data`` with the keys of :data:`RENAMED_IN_2` renamed, at any depth."""
+    if isinstance(data, dict):
+        return {RENAMED_IN_2.get(k, k): _renamed(v) for k, v in data.items()}
+    if isinstance(data, list):
+        return [_renamed(v) for v in data]
+    return data
 
 
 @dataclass(frozen=True)

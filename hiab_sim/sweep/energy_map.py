@@ -15,7 +15,9 @@ Per design, on the analytic path with all designs stacked into the sample axis
   grid, e.g. the smoothed battery energy) divided by its value at the study's start (``objective``);
 * the net electrical energy and the energy drawn without regeneration [J], trapezoid on the fine
   grid (as in ``result.json``); ``battery_energy`` is the energy the battery delivers
-  (:func:`hiab_sim.emla.battery.battery_power`, exact kinks, fine grid);
+  (:func:`hiab_sim.emla.battery.battery_power`, exact kinks, fine grid); with the study's duty model
+  (:func:`hiab_sim.study.nlp.task_problem.duty_options`) every power is the hot windings' and the rest's
+  hold is in the battery energy, as in ``result.json`` (one design at a time, not batched);
 * the scaled margins of every constraint row that depends on Xi, as the optimiser holds them on
   the collocation grid: EMLA envelope (const_e, const_f, >= envelope_margin), strokes (const_j)
   at every sample and at both ends of the working range. Rows that depend on the trajectory only
@@ -38,7 +40,8 @@ from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.dynamics.samples import ActuatorSamples
 from hiab_sim.emla import ENVELOPE_LIMIT_NAMES, electrical_power, energy_summary, envelope_margins
-from hiab_sim.emla.battery import battery_power, trapezoid_weights
+from hiab_sim.emla.battery import battery_power, rest_battery_energy, trapezoid_weights
+from hiab_sim.emla.duty_energy import DriveDuty, DutyOptions, drive_duty
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.results.read import open_run, read_result
 from hiab_sim.results.schema import Result
@@ -146,6 +149,22 @@ def _stroke_rows(xi: Array, x: Array, strokes: Array) -> Array:
     return np.stack(cols, axis=-1) / STROKE_SCALE
 
 
+def _duty_powers(
+    problem: TaskProblem, options: DutyOptions, time: Array, f: Array, v: Array, a: Array, exact: bool = False
+) -> tuple[Array, Array, list[tuple[DriveDuty, ...]]]:
+    """(drive powers (3, D, K) [W], rest energies summed over drives (D,) [J], each design's duties)."""
+    D = f.shape[0]
+    duties = [
+        tuple(
+            drive_duty(p, time, f[d, :, i], v[d, :, i], a[d, :, i], options, exact) for i, p in enumerate(problem.emlas)
+        )
+        for d in range(D)
+    ]
+    power = np.array([[dd[i].power for dd in duties] for i in range(len(problem.emlas.as_tuple()))])
+    rest = np.array([sum(x.rest_energy for x in dd) for dd in duties])
+    return power, rest, duties
+
+
 def evaluate_designs(problem: TaskProblem, base: BaseDesign, xi: Array) -> DesignValues:
     """Objective, energies and Xi-dependent margins of designs xi (D, 6) on the base trajectory."""
     xi = np.atleast_2d(np.asarray(xi, dtype=float))
@@ -167,18 +186,46 @@ def evaluate_designs(problem: TaskProblem, base: BaseDesign, xi: Array) -> Desig
     for lo in range(0, len(xi), CHUNK):
         block = xi[lo : lo + CHUNK]
         f, v, a, x = batched_inverse_dynamics(crane, block, base.position, base.velocity, base.acceleration, tcp)
-        power = np.stack([electrical_power(p, f[..., i], v[..., i], a[..., i]) for i, p in enumerate(problem.emlas)])
+        options = problem.duty_options
+        if options is None:
+            power = np.stack(
+                [electrical_power(p, f[..., i], v[..., i], a[..., i]) for i, p in enumerate(problem.emlas)]
+            )
+            colloc_power, duties = power[..., ::ff], None
+            exact_power = np.stack(  # exact brake switching and loss kinks, as the report's battery energy
+                [electrical_power(p, f[..., i], v[..., i], a[..., i], exact=True) for i, p in enumerate(problem.emlas)]
+            )
+            rest_exact = np.zeros(len(block))
+        else:  # hot windings and the rest's hold, as the problem evaluates them
+            power, _, _ = _duty_powers(problem, options, base.time, f, v, a)
+            colloc_power, _, duties = _duty_powers(problem, options, joints.time, f[:, ::ff], v[:, ::ff], a[:, ::ff])
+            exact_power, rest_exact, _ = _duty_powers(problem, options, base.time, f, v, a, exact=True)
         total = power.sum(axis=0)  # (D, K)
-        colloc = total[:, ::ff]
+        colloc = colloc_power.sum(axis=0)
         objective = np.array(
             [
-                problem.objective.value(collocation_state(joints, tcp_samples, block[d], f, v, a, x, power, ff, d))
+                problem.objective.value(
+                    collocation_state(
+                        joints,
+                        tcp_samples,
+                        block[d],
+                        f,
+                        v,
+                        a,
+                        x,
+                        colloc_power,
+                        ff,
+                        d,
+                        None if duties is None else duties[d],
+                    )
+                )
                 for d in range(len(block))
             ]
         )
         cost = 0.5 * problem.dt * np.sum(colloc**2, axis=1)
         net, drawn = energy_summary(base.time, total)
-        battery = battery_power(np.moveaxis(power, 0, -1), problem.emlas.battery)[1] @ weights  # (D,) exact [J]
+        battery = battery_power(np.moveaxis(exact_power, 0, -1), problem.emlas.battery)[1] @ weights  # (D,) [J]
+        battery = battery + rest_battery_energy([0.0], problem.emlas.battery)[1] * rest_exact
         fc, vc, ac = f[:, ::ff], v[:, ::ff], a[:, ::ff]
         env = np.stack(
             [envelope_margins(p, fc[..., i], vc[..., i], ac[..., i]) for i, p in enumerate(problem.emlas)], axis=1
@@ -207,10 +254,14 @@ def collocation_state(
     power: Array,
     ff: int,
     d: int,
+    duty: tuple[DriveDuty, ...] | None = None,
 ) -> SampleState:
-    """Design d of a batch as the NLP's objectives see it: its samples on the collocation grid (every ``ff``-th)."""
+    """Design d of a batch as the NLP's objectives see it: its samples on the collocation grid (every ``ff``-th).
+
+    ``power`` (3, D, Kc) is already on the collocation grid; ``duty`` the design's duty model, if any.
+    """
     actuators = ActuatorSamples(f[d, ::ff], v[d, ::ff], a[d, ::ff], x[d, ::ff])
-    return SampleState(LinkLengths.from_array(xi), joints, tcp, actuators, power[:, d, ::ff].T)
+    return SampleState(LinkLengths.from_array(xi), joints, tcp, actuators, power[:, d, :].T, duty=duty)
 
 
 def _robust_rows(problem: TaskProblem, base: BaseDesign, xi: Array) -> tuple[Array, list[str]]:

@@ -50,7 +50,7 @@ def summary(m: EnergyMap) -> dict[str, Any]:
             "objective": float(b.objective[0]),
             "cost_W2s": float(b.cost[0]),
             "net_electrical_energy_J": float(b.net_energy[0]),
-            "drawn_energy_without_regeneration_J": float(b.drawn_energy[0]),
+            "drawn_energy_summed_drives_J": float(b.drawn_energy[0]),
             "battery_energy_J": float(b.battery_energy[0]),
             "smallest_margin": float(b.margins.min()),
             "binding_constraint": b.names[int(b.binding[0])],

@@ -80,8 +80,8 @@ def row_from_result(result: Result) -> dict[str, Any]:
     row.update(
         start_net_energy_J=start.net_electrical_energy_J,
         opt_net_energy_J=opt.net_electrical_energy_J,
-        start_drawn_energy_J=start.drawn_energy_without_regeneration_J,
-        opt_drawn_energy_J=opt.drawn_energy_without_regeneration_J,
+        start_drawn_energy_J=start.drawn_energy_summed_drives_J,
+        opt_drawn_energy_J=opt.drawn_energy_summed_drives_J,
         start_cost_W2s=start.collocation_cost_W2s,
         opt_cost_W2s=opt.collocation_cost_W2s,
         net_energy_saved_percent=result.improvement.net_energy_saved_percent,

@@ -133,7 +133,9 @@ class RobustXi(ConstraintBlock):
 
 def replace_lengths(state: SampleState, xi: Array) -> SampleState:
     """The same samples with other link lengths (for rows of Xi only)."""
-    return SampleState(LinkLengths.from_array(xi), state.joints, state.tcp, state.actuators, state.power)
+    return SampleState(
+        LinkLengths.from_array(xi), state.joints, state.tcp, state.actuators, state.power, duty=state.duty
+    )
 
 
 def rounded_design(lengths: LinkLengths, tolerance: float, low: Array, up: Array) -> LinkLengths:

@@ -107,7 +107,7 @@ def cross_evaluation(mix: StudyProblem, z_mix: Array, alone: list[LinkLengths] |
                     summary = design_summary(fine, z).summary
                     values = (
                         summary.net_electrical_energy_J,
-                        summary.drawn_energy_without_regeneration_J,
+                        summary.drawn_energy_summed_drives_J,
                         costf2(p.emlas, p.dt).value(p.evaluate(z)),
                         summary.max_violation,
                         p.evaluate(z).cost,

@@ -41,7 +41,7 @@ from __future__ import annotations
 import re
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Hashable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Protocol
 
@@ -50,6 +50,7 @@ from numpy.typing import NDArray
 
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.dynamics.samples import ActuatorSamples
+from hiab_sim.emla.duty_energy import DriveDuty
 from hiab_sim.study.motion import trajectory as tr
 
 Array = NDArray[np.float64]
@@ -68,7 +69,10 @@ class SampleState:
     joints: tr.JointTrajectory  # (K, 3) each
     tcp: tr.TcpSamples  # (K, 3) each, partials (K, 3, 9)
     actuators: ActuatorSamples  # (K, 3) each
-    power: Array  # (K, 3) EMLA electrical power [W]
+    power: Array  # (K, 3) EMLA electrical power [W] (at the winding temperature when ``duty`` is set)
+    #: each EMLA over the study's duty period (hot windings, the rest's hold), or None: the paper's
+    #: per-sample model with R_s at its data-sheet value and a free rest (:mod:`hiab_sim.emla.duty_energy`)
+    duty: tuple[DriveDuty, ...] | None = field(default=None, kw_only=True)
 
 
 class SamplePartials:

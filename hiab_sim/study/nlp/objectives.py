@@ -9,7 +9,12 @@
   battery charge/discharge efficiencies; regeneration of one drive feeds the others first),
   trapezoid rule on the sample grid [J]. The solver sees the softplus-smoothed kinks (width
   ``battery.smoothing_power`` of the EMLA set, error <= :meth:`BatteryParams.smoothing_bound`);
-  reports use the exact value (:mod:`hiab_sim.study.report.energy_section`).
+  reports use the exact value (:mod:`hiab_sim.study.report.energy_section`). With the study's duty
+  model (``state.duty``) it adds the rest's battery energy (the hold, :mod:`hiab_sim.emla.hold`).
+
+With a duty model the drive powers P_i are those at the winding temperature (R_s(T),
+:mod:`hiab_sim.emla.duty_energy`), and both objectives' gradients include the temperature's
+dependence on every sample (the adjoint of the coupled winding model).
 
 An objective is chosen by name with :func:`make_objective`; a new one is a class with ``name``,
 ``unit``, ``value(state)`` and ``gradient(state, partials)`` registered with
@@ -23,6 +28,7 @@ from collections.abc import Callable
 import numpy as np
 
 from hiab_sim.emla import EmlaSet, battery_energy, electrical_power_partials, operating_point
+from hiab_sim.emla.battery import rest_battery_energy
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.nlp.interface import Array, Objective, SamplePartials, SampleState
 
@@ -71,11 +77,25 @@ class BatteryEnergyCost:
         self.dt = dt
 
     def value(self, state: SampleState) -> float:
-        """Smooth battery energy [J] (within the smoothing bound of the exact one)."""
-        return battery_energy(state.joints.time, state.power, self.emlas.battery, smooth=True).energy
+        """Smooth battery energy [J] of the cycle, plus the rest's (exact, it only draws) with a duty model."""
+        cycle = battery_energy(state.joints.time, state.power, self.emlas.battery, smooth=True).energy
+        return cycle + self._rest(state)
+
+    def _rest(self, state: SampleState) -> float:
+        """The rest's battery energy [J] with a duty model (the hold), else 0."""
+        if state.duty is None:
+            return 0.0
+        return rest_battery_energy([d.rest_energy for d in state.duty], self.emlas.battery)[0]
 
     def exact(self, state: SampleState) -> float:
-        """Exact battery energy [J]: the drives' exact electrical power, the kinks unsmoothed (as reports give it)."""
+        """Exact battery energy [J]: the drives' exact electrical power, the kinks unsmoothed (as reports give it).
+
+        With a duty model the drive powers are the state's hot ones (R_s(T)) with the battery's kinks
+        unsmoothed, plus the rest's energy; the duty report (:mod:`hiab_sim.study.report.duty_section`)
+        gives the fully exact split.
+        """
+        if state.duty is not None:
+            return battery_energy(state.joints.time, state.power, self.emlas.battery).energy + self._rest(state)
         act = state.actuators
         power = np.column_stack(
             [
@@ -90,14 +110,25 @@ class BatteryEnergyCost:
     def gradient(self, state: SampleState, partials: SamplePartials) -> tuple[Array, Array]:
         """dE/dP_i (per sample and drive) chained through dP/d(f, v, a) and the inverse dynamics' partials."""
         dE_dP = battery_energy(state.joints.time, state.power, self.emlas.battery, smooth=True).gradient
-        return _chain(self.emlas, state, partials, dE_dP)
+        gain = 0.0 if state.duty is None else rest_battery_energy([0.0], self.emlas.battery)[1]
+        return _chain(self.emlas, state, partials, dE_dP, gain)
 
 
-def _chain(emlas: EmlaSet, state: SampleState, partials: SamplePartials, df_dP: Array) -> tuple[Array, Array]:
-    """(d/dq9 (K, 9), d/dXi (6,)) of an objective from its partials w.r.t. each drive's power, df_dP (K, 3)."""
+def _chain(
+    emlas: EmlaSet, state: SampleState, partials: SamplePartials, df_dP: Array, df_drest: float = 0.0
+) -> tuple[Array, Array]:
+    """(d/dq9 (K, 9), d/dXi (6,)) of an objective from its partials w.r.t. each drive's power, df_dP (K, 3).
+
+    With a duty model (``state.duty``) the powers are the hot ones and ``df_drest`` [-] multiplies each
+    drive's rest energy; the partials then carry the winding temperature's dependence on every sample.
+    """
     act = state.actuators
     dY = np.zeros((len(state.power), 9))  # w.r.t. Y = (f0 f1 f2 v0 v1 v2 a0 a1 a2)
     for i, p in enumerate(emlas):
+        if state.duty is not None:
+            pf, pv, pa = state.duty[i].energy_partials(df_dP[:, i], df_drest)
+            dY[:, i], dY[:, 3 + i], dY[:, 6 + i] = pf, pv, pa
+            continue
         pf, pv, pa = electrical_power_partials(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
         dY[:, i], dY[:, 3 + i], dY[:, 6 + i] = df_dP[:, i] * pf, df_dP[:, i] * pv, df_dP[:, i] * pa
     return np.einsum("ky,kyq->kq", dY, partials.id_q), np.einsum("ky,kyx->x", dY, partials.id_xi)

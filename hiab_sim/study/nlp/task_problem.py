@@ -50,11 +50,13 @@ from hiab_sim.emla import (
     EmlaSet,
     electrical_power,
 )
+from hiab_sim.emla.duty_energy import DutyOptions, drive_duty
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.analysis.buildable import buildable_blocks
 from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.nlp import blocks as bl
 from hiab_sim.study.nlp.block_registry import build_blocks, register_block
+from hiab_sim.study.nlp.brake_rows import brake_blocks
 from hiab_sim.study.nlp.id_partials import id_joint_partials, id_length_partials
 from hiab_sim.study.nlp.interface import (
     N_XI,
@@ -98,6 +100,21 @@ class Evaluation(SampleState):
     cost: float  # the objective's value [its unit; W^2 s for costf2]
     constraints: Array  # scaled, feasible where >= 0
     equalities: Array  # scaled, feasible where == 0
+
+
+def duty_options(study: Study, emlas: EmlaSet, cycle_time: float) -> DutyOptions | None:
+    """The duty model of a task of ``cycle_time`` [s], or None for the paper's per-sample model.
+
+    None without a ``duty``, and when no EMLA has winding-resistance data and nothing holds the rest
+    (the seed's model: every number as before these options existed).
+    """
+    settings = study.energy.duty
+    if settings is None:
+        return None
+    options = settings.options(cycle_time, emlas)
+    if options.hold is None and not any(p.winding is not None and p.thermal is not None for p in emlas):
+        return None
+    return options
 
 
 def working_range(crane: Crane, joints: Array, margin: float) -> tuple[tuple[float, float], ...]:
@@ -200,6 +217,7 @@ class TaskProblem:
         self.n = self.n_xi + self.n_c
         self.lower = np.concatenate([np.asarray(study.bounds.xi_low) / XI_SCALE, np.full(self.n_c, -np.inf)])
         self.upper = np.concatenate([np.asarray(study.bounds.xi_up) / XI_SCALE, np.full(self.n_c, np.inf)])
+        self.duty_options = duty_options(study, self.emlas, duration)
         self.objective = make_objective(objective or study.energy.objective, self.emlas, self.dt)
         self.layout = BlockLayout(self._build_blocks())
         self.constraint_names = self.layout.names
@@ -272,19 +290,30 @@ class TaskProblem:
         samples = JointSamples(joints.position, joints.velocity, joints.acceleration)
         act = self._id(lengths)(samples, tcp_force=self.tcp_force)
         tcp = self.kin.samples(joints.position, joints.velocity, joints.acceleration)
-        power = np.column_stack(
-            [
-                electrical_power(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
+        duty = None
+        if self.duty_options is not None:
+            duty = tuple(
+                drive_duty(
+                    p, self.times, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], self.duty_options
+                )
                 for i, p in enumerate(self.emlas)
-            ]
-        )
-        state = SampleState(lengths, joints, tcp, act, power)
+            )
+            power = np.column_stack([d.power for d in duty])
+        else:
+            power = np.column_stack(
+                [
+                    electrical_power(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
+                    for i, p in enumerate(self.emlas)
+                ]
+            )
+        state = SampleState(lengths, joints, tcp, act, power, duty=duty)
         ev = Evaluation(
             lengths,
             joints,
             tcp,
             act,
             power,
+            duty=duty,
             z=z,
             coefficients=c,
             cost=self.objective.value(state),
@@ -402,7 +431,7 @@ def _tracking(p: TaskProblem) -> list[ConstraintBlock]:
     ]
 
 
-# the built-in blocks, in row order (const_b..const_k, thermal limits, buildable design, structure)
+# the built-in blocks, in row order (const_b..const_k, thermal limits, holding brakes, buildable design, structure)
 register_block("tracking", _tracking)
 register_block("envelope", lambda p: [bl.EnvelopeMargins(p.times, p.emlas, p.envelope_margin)])
 register_block("stroke", lambda p: [bl.StrokeLimits(p.times, p.crane.chains)])
@@ -410,6 +439,7 @@ register_block("joint", lambda p: [bl.JointLimits(p.times, p.theta_low, p.theta_
 register_block("joint_velocity", lambda p: [bl.JointVelocityLimits(p.times, np.asarray(p.study.bounds.joint_velocity))])
 register_block("working_range", lambda p: [bl.WorkingRange(p.crane.chains, p.working, p.working_clearance)])
 register_block("thermal", lambda p: thermal_blocks(p.emlas, p.study.energy.duty, p.task.reference.duration))
+register_block("brake", lambda p: brake_blocks(p.emlas, p.study.energy.duty))
 register_block("buildable", lambda p: buildable_blocks(p.study, p.working, p.tightened))
 register_block(
     "structure",

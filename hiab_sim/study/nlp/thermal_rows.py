@@ -15,15 +15,20 @@ collocation grid is the optimiser's quadrature; the result re-checks on the 10x 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from hiab_sim.emla import EmlaSet, ThermalCheck, thermal_check
+from hiab_sim.emla import EmlaParams, EmlaSet, ThermalCheck, thermal_check
+from hiab_sim.emla.duty_energy import DriveDuty
 from hiab_sim.emla.thermal import Duty
 from hiab_sim.study.nlp.interface import Array, ConstraintBlock, DenseRows, Relaxation, SamplePartials, SampleState
 from hiab_sim.study.spec.energy import DutySettings
 
 #: Winding-temperature margins are divided by this [K] (O(1) rows).
 TEMPERATURE_SCALE = 100.0
+#: Peak temperature above T_max [K] reported when the winding has no fixed point (thermal runaway).
+RUNAWAY_EXCESS = 1000.0
 
 
 class ThermalLimits(ConstraintBlock):
@@ -48,6 +53,8 @@ class ThermalLimits(ConstraintBlock):
 
     def _checks(self, state: SampleState) -> list[tuple[int, ThermalCheck]]:
         act, t = state.actuators, state.joints.time
+        if state.duty is not None:
+            return [(i, duty_check(self.emlas[i], state.duty[i])) for i in self.indices]
         return [
             (
                 i,
@@ -84,6 +91,25 @@ class ThermalLimits(ConstraintBlock):
         per_unit[0::2] = (1.0 - g[0::2]) * (1.0 - 1.0 / 1.01)
         per_unit[1::2] = 1.0 / TEMPERATURE_SCALE
         return Relaxation(("%", "K") * (len(g) // 2), per_unit)
+
+
+def duty_check(params: EmlaParams, d: DriveDuty) -> ThermalCheck:
+    """The thermal check of one EMLA from its duty model (hot windings and the rest's hold).
+
+    Without a fixed point of the winding temperature (thermal runaway) the peak is reported as
+    ``RUNAWAY_EXCESS`` above T_max with zero partials, so the row is infeasible but finite.
+    """
+    thermal = params.thermal
+    assert thermal is not None
+    peak = d.peak_temperature if math.isfinite(d.peak_temperature) else thermal.max_winding_temperature + RUNAWAY_EXCESS
+    return ThermalCheck(
+        rms_torque=d.rms_torque,
+        continuous_torque=thermal.continuous_torque,
+        peak_temperature=peak,
+        max_temperature=thermal.max_winding_temperature,
+        d_rms=d.rms_partials(),
+        d_peak=d.peak_partials(),
+    )
 
 
 def thermal_blocks(emlas: EmlaSet, duty: DutySettings | None, cycle_time: float) -> list[ConstraintBlock]:

@@ -91,7 +91,7 @@ def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, c
         recheck_id_path=fine.id_path,
         recheck_grid_points=sum(len(p.times) for p in fine.problems),
         net_electrical_energy_J=summary.net_electrical_energy_J,
-        drawn_energy_without_regeneration_J=summary.drawn_energy_without_regeneration_J,
+        drawn_energy_summed_drives_J=summary.drawn_energy_summed_drives_J,
         net_energy_change_vs_optimum_J=summary.net_electrical_energy_J - optimum.net_electrical_energy_J,
         mjcf_command=mjcf_command(crane_label, margin, rounded),
     )

@@ -29,13 +29,17 @@ import numpy as np
 
 from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.emla import battery_energy, operating_point, thermal_check
+from hiab_sim.emla.battery import rest_battery_energy
+from hiab_sim.emla.duty_energy import drive_duty
 from hiab_sim.emla.thermal import Duty
 from hiab_sim.hydraulics import SupplyResult, hydraulic_baseline
+from hiab_sim.hydraulics.battery_boundary import battery_boundary_baselines
 from hiab_sim.quadrature import trapezoid
 from hiab_sim.results.energy_sections import (
     ActuatorThermal,
     DesignEnergy,
     EnergyReport,
+    HydraulicAtBattery,
     HydraulicBaseline,
     HydraulicDesign,
     HydraulicVariant,
@@ -44,6 +48,8 @@ from hiab_sim.results.schema import Result
 from hiab_sim.study.nlp.interface import SampleState
 from hiab_sim.study.nlp.objectives import SquaredPowerCost
 from hiab_sim.study.nlp.task_problem import TaskProblem
+from hiab_sim.study.nlp.thermal_rows import duty_check
+from hiab_sim.study.report.duty_section import duty_energy
 
 #: Drive-loss energies reported per actuator when an option of :mod:`hiab_sim.emla.losses` is on
 #: (electrical = mechanical + copper + rotor friction + screw viscous + inertial + these).
@@ -61,7 +67,7 @@ def study_duty(problem: TaskProblem) -> tuple[Duty, str]:
     settings, cycle = problem.study.energy.duty, problem.task.reference.duration
     if settings is None:
         return Duty(cycle, 0.0), f"none given: back-to-back cycles ({cycle:g} s, no rest)"
-    return settings.duty(cycle), settings.describe(cycle)
+    return settings.duty(cycle), settings.describe(cycle, problem.emlas)
 
 
 def costf2(problem: TaskProblem, state: SampleState) -> float:
@@ -79,7 +85,12 @@ def design_energy(problem: TaskProblem, state: SampleState) -> DesignEnergy:
     exact_power = np.column_stack([op.electrical_power for op in ops])
     exact = battery_energy(t, exact_power, battery)
     smooth = battery_energy(t, state.power, battery, smooth=True)
+    smooth_energy = smooth.energy
     duty, _ = study_duty(problem)
+    options = problem.duty_options
+    duty_section = duty_energy(problem.emlas, state, options) if options is not None else None
+    if state.duty is not None:
+        smooth_energy += rest_battery_energy([d.rest_energy for d in state.duty], battery)[0]
     losses = {
         p.name: {key: float(trapezoid(getattr(op, key), t)) for key in DRIVE_LOSS_PARTS}
         for p, op in zip(problem.emlas, ops, strict=True)
@@ -89,7 +100,11 @@ def design_energy(problem: TaskProblem, state: SampleState) -> DesignEnergy:
     for i, p in enumerate(problem.emlas):
         if p.thermal is None:
             continue
-        c = thermal_check(p, t, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], duty, exact=True)
+        if options is not None:  # hot windings and the rest's hold
+            d = drive_duty(p, t, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], options, exact=True)
+            c = duty_check(p, d)
+        else:
+            c = thermal_check(p, t, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], duty, exact=True)
         thermal[p.name] = ActuatorThermal(
             c.rms_torque,
             c.continuous_torque,
@@ -99,8 +114,8 @@ def design_energy(problem: TaskProblem, state: SampleState) -> DesignEnergy:
             c.temperature_margin,
         )
     return DesignEnergy(
-        battery_energy_J=exact.energy,
-        battery_energy_smooth_J=smooth.energy,
+        battery_energy_J=duty_section.battery_energy_J if duty_section is not None else exact.energy,
+        battery_energy_smooth_J=smooth_energy,
         smoothing_bound_J=battery.smoothing_bound(len(ACTUATOR_NAMES), float(t[-1] - t[0])),
         costf2_W2s=costf2(problem, state),
         drawn_energy_J=dict(zip(ACTUATOR_NAMES, map(float, exact.drawn_energy), strict=True)),
@@ -110,6 +125,7 @@ def design_energy(problem: TaskProblem, state: SampleState) -> DesignEnergy:
         drive_loss_smoothing_J=(
             smooth.energy - battery_energy(t, exact_power, battery, smooth=True).energy if losses else None
         ),
+        duty=duty_section,
     )
 
 
@@ -230,17 +246,34 @@ def hydraulic_report(
         if supplies is None or cylinders is None:
             return None
         cp, ls = supplies
+        emla_cycle = e.duty.cycle_battery_energy_J if e.duty is not None else e.battery_energy_J
+        act = state.actuators
+        at_battery = {
+            b.variant: HydraulicAtBattery(
+                cycle_battery_energy_J=b.battery_energy,
+                terms_J=b.terms,
+                max_pilot_pressure_Pa=b.max_pilot_pressure,
+                pressure_shortfall_samples=b.pressure_shortfall_samples,
+                emla_saving_percent=100.0 * (1.0 - emla_cycle / b.battery_energy),
+            )
+            for b in battery_boundary_baselines(
+                state.joints.time, act.force, act.velocity, cylinders, fine.emlas.battery
+            )
+        }
         designs[name] = HydraulicDesign(
             constant_pressure=_variant(cp),
             load_sensing=_variant(ls),
             emla_battery_energy_J=e.battery_energy_J,
             emla_saving_vs_load_sensing_percent=100.0 * (1.0 - e.battery_energy_J / ls.input_energy),
             emla_saving_vs_constant_pressure_percent=100.0 * (1.0 - e.battery_energy_J / cp.input_energy),
+            at_battery=at_battery,
+            emla_cycle_battery_energy_J=emla_cycle,
         )
     return HydraulicBaseline(
         note=(
             "valve-controlled cylinders of the crane file for the same rod forces and velocities (fine grid): "
-            "electric energy into the pump motor; EMLA: battery energy"
+            "constant_pressure and load_sensing at the pump motor's electric input, EMLA at the battery; at_battery: "
+            "every variant (also pump-controlled EHAs) at the battery over the cycle, against the EMLAs' cycle"
         ),
         supply_pressure_Pa=cylinders.supply_pressure if cylinders is not None else float("nan"),
         initial=designs["initial"],
@@ -262,6 +295,25 @@ def energy_lines(r: Result) -> list[str]:
         "drawn energy per actuator (no regeneration) at the optimum: "
         + ", ".join(f"{k} {v / 1e3:.3f} kJ" for k, v in e.optimal.drawn_energy_J.items()),
     ]
+    dd = e.optimal.duty
+    if dd is not None:
+        m = dd.battery_energy_by_model_J
+        lines.append(
+            f"duty period at the optimum (hold: {dd.hold}): battery {dd.battery_energy_J / 1e3:.4f} kJ = cycle "
+            f"{dd.cycle_battery_energy_J / 1e3:.4f} + rest {dd.rest_battery_energy_J / 1e3:.4f} kJ; hot windings add "
+            f"{dd.hot_winding_extra_J:.1f} J, the hold {dd.hold_extra_J:.1f} J (cold windings, free rest: "
+            f"{m['cold_windings_free_rest'] / 1e3:.4f} kJ); cycle with no regeneration at all: "
+            f"{dd.no_regeneration_energy_at_battery_J / 1e3:.3f} kJ at the battery"
+        )
+        lines.append(
+            "windings at the optimum: "
+            + "; ".join(
+                f"{k} mean {md.mean_winding_temperature_C:.1f} deg C, R_s x{md.peak_resistance_factor:.3f}"
+                for k, md in dd.motors.items()
+                if md.mean_winding_temperature_C is not None and md.peak_resistance_factor is not None
+            )
+        )
+        lines += [f"INFEASIBLE at the optimum: {line}" for line in dd.infeasible]
     if e.optimal.thermal:
         parts = [
             f"{k} RMS {th.rms_torque_Nm:.2f}/{th.continuous_torque_Nm:.1f} N m, "
@@ -286,6 +338,14 @@ def energy_lines(r: Result) -> list[str]:
                 f"{th.peak_winding_temperature_C:.1f}/{th.max_winding_temperature_C:.0f} deg C"
             )
     h = r.hydraulic_baseline
+    if h is not None and h.optimal.at_battery is not None:
+        lines.append(
+            "hydraulic baselines at the battery, same cycle: "
+            + ", ".join(
+                f"{k} {v.cycle_battery_energy_J / 1e3:.2f} kJ (EMLA -{v.emla_saving_percent:.1f} %)"
+                for k, v in h.optimal.at_battery.items()
+            )
+        )
     if h is not None:
         o = h.optimal
         lines.append(

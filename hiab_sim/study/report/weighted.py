@@ -62,8 +62,8 @@ def weighted_summary(summaries: list[DesignSummary], weights: Array, names: list
         cost_W2s=total([s.cost_W2s for s in summaries]),
         cost_note="sum over the tasks of weight x (1/2 Dt sum_k (sum_i P_i)^2) on each task's grid",
         net_electrical_energy_J=total([s.net_electrical_energy_J for s in summaries]),
-        drawn_energy_without_regeneration_J=total([s.drawn_energy_without_regeneration_J for s in summaries]),
-        drawn_energy_sum_of_actuators_J=total([s.drawn_energy_sum_of_actuators_J for s in summaries]),
+        drawn_energy_summed_drives_J=total([s.drawn_energy_summed_drives_J for s in summaries]),
+        drawn_energy_per_drive_sum_J=total([s.drawn_energy_per_drive_sum_J for s in summaries]),
         energy_breakdown_J=EnergyBreakdown(
             *(total([getattr(s.energy_breakdown_J, k) for s in summaries]) for k in ENERGY_PARTS)
         ),
@@ -120,8 +120,8 @@ def weighted_decomposition(parts: list[Decomposition], weights: Array) -> Decomp
                 net_electrical_energy_J=sum(
                     wk * float(d.net_electrical_energy_J or 0.0) for wk, d in zip(w, each, strict=True)
                 ),
-                drawn_energy_without_regeneration_J=sum(
-                    wk * float(d.drawn_energy_without_regeneration_J or 0.0) for wk, d in zip(w, each, strict=True)
+                drawn_energy_summed_drives_J=sum(
+                    wk * float(d.drawn_energy_summed_drives_J or 0.0) for wk, d in zip(w, each, strict=True)
                 ),
                 cost_W2s=sum(wk * float(d.cost_W2s or 0.0) for wk, d in zip(w, each, strict=True)),
                 collocation_cost_W2s=sum(

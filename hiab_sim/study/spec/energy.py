@@ -7,7 +7,10 @@ Three optional top-level keys of a study file, each validated here into a frozen
 * ``duty: {cycles_per_hour: n}`` or ``duty: {rest_time: T_rest}`` [s]: the cycle (the study's
   trajectory, duration T) repeats with a rest of T_rest at zero torque, or n times an hour
   (T_rest = 3600/n - T). With a duty and an EMLA set that has thermal data, the NLP holds the
-  motors' thermal limits (:mod:`hiab_sim.study.nlp.thermal_rows`).
+  motors' thermal limits (:mod:`hiab_sim.study.nlp.thermal_rows`). ``hold: brake | motor`` says
+  what carries the machine during the rest (:mod:`hiab_sim.emla.hold`); with a duty, the energy
+  and the thermal rows use R_s at the winding temperature of EMLAs with ``winding_resistance``
+  data (:mod:`hiab_sim.emla.duty_energy`).
 * ``transmission: {lift: [{gear_ratio: G, screw_lead: rho}, ...], tilt: [...], ...}``: a catalogue
   of discrete (G, rho) options per actuator; actuators not listed keep the EMLA file's. The
   co-design (:mod:`hiab_sim.study.analysis.codesign`) optimises the mounting for every combination.
@@ -19,8 +22,11 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from hiab_sim.checks import check_range
+from hiab_sim.checks import check_choice, check_range
 from hiab_sim.crane.names import ACTUATOR_NAMES
+from hiab_sim.emla.config import EmlaSet
+from hiab_sim.emla.duty_energy import DutyOptions
+from hiab_sim.emla.hold import HOLD_MODES
 from hiab_sim.emla.thermal import Duty
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.yaml_fields import mapping, number
@@ -28,12 +34,22 @@ from hiab_sim.yaml_fields import mapping, number
 
 @dataclass(frozen=True)
 class DutySettings:
-    """Rest between cycles: exactly one of ``rest_time`` [s] >= 0 or ``cycles_per_hour`` [1/h] > 0."""
+    """Rest between cycles: exactly one of ``rest_time`` [s] >= 0 or ``cycles_per_hour`` [1/h] > 0.
+
+    ``hold`` says what carries the machine during the rest (:mod:`hiab_sim.emla.hold`): ``brake``
+    (the EMLAs' holding brakes), ``motor`` (the motors hold the last pose) or ``none`` (the
+    seed paper's free rest, stated as a choice); None (the key omitted) is ``brake`` when every
+    EMLA of the set has ``holding_brake`` data and otherwise the
+    seed paper's free rest (zero torque, zero power), see :meth:`hold_mode`.
+    """
 
     rest_time: float | None = None
     cycles_per_hour: float | None = None
+    hold: str | None = None
 
     def __post_init__(self) -> None:
+        if self.hold is not None:
+            check_choice("duty.hold", self.hold, (*HOLD_MODES, "none"))
         if (self.rest_time is None) == (self.cycles_per_hour is None):
             raise InvalidInputError(
                 "duty",
@@ -52,11 +68,25 @@ class DutySettings:
         assert self.rest_time is not None
         return Duty(cycle_time, self.rest_time)
 
-    def describe(self, cycle_time: float) -> str:
-        """E.g. ``60 cycles/hour (6.25 s cycle + 53.75 s rest)``."""
+    def hold_mode(self, emlas: EmlaSet) -> str | None:
+        """The hold of the rest for ``emlas``: the given one, else ``brake`` if every EMLA has brake data, else None."""
+        if self.hold is not None:
+            return None if self.hold == "none" else self.hold
+        return "brake" if all(p.brake is not None for p in emlas) else None
+
+    def options(self, cycle_time: float, emlas: EmlaSet) -> DutyOptions:
+        """The :class:`~hiab_sim.emla.duty_energy.DutyOptions` of a cycle of ``cycle_time`` [s] (hot windings on)."""
+        return DutyOptions(self.duty(cycle_time), self.hold_mode(emlas), hot=True)
+
+    def describe(self, cycle_time: float, emlas: EmlaSet | None = None) -> str:
+        """E.g. ``60 cycles/hour (6.25 s cycle + 53.75 s rest), hold: brake``."""
         d = self.duty(cycle_time)
         head = f"{self.cycles_per_hour:g} cycles/hour" if self.cycles_per_hour is not None else "rest between cycles"
-        return f"{head} ({d.cycle_time:g} s cycle + {d.rest_time:g} s rest)"
+        text = f"{head} ({d.cycle_time:g} s cycle + {d.rest_time:g} s rest)"
+        if emlas is not None:
+            mode = self.hold_mode(emlas)
+            text += f", hold: {mode}" if mode is not None else ", rest at zero torque and zero power (no hold modelled)"
+        return text
 
 
 @dataclass(frozen=True)
@@ -122,8 +152,11 @@ def energy_settings(top: Any) -> EnergySettings:
     objective = top.get("objective", "costf2")  # EnergySettings checks it against the objective registry
     duty = None
     if top.get("duty") is not None:
-        d = mapping(top["duty"], "duty", {"rest_time", "cycles_per_hour"}, set())
-        duty = DutySettings(**{k: number(v, f"duty.{k}") for k, v in d.items()})
+        d = dict(mapping(top["duty"], "duty", {"rest_time", "cycles_per_hour", "hold"}, set()))
+        hold = d.pop("hold", None)
+        if hold is not None and not isinstance(hold, str):
+            raise InvalidInputError("duty.hold", hold, f"must be one of {', '.join((*HOLD_MODES, 'none'))}")
+        duty = DutySettings(**{k: number(v, f"duty.{k}") for k, v in d.items()}, hold=hold)
     elif "duty" in top:
         raise InvalidInputError("duty", None, "give exactly one of rest_time [s] or cycles_per_hour")
     transmission = None
