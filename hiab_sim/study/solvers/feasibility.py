@@ -295,10 +295,13 @@ def feasible_starts(problem: StudyProblem, count: int, seed: int = 6) -> tuple[l
     z, phase = feasible_start(problem, problem.initial_point(problem.study.initial_lengths), 0)
     points, phases = [z], [phase] if phase else []
     if count > 1:
-        try:  # the solver's own draw of feasible starts (sensible retracted lengths for the working range)
-            points += [problem.initial_point(lengths) for lengths in start_points(problem, count, seed)[1:]]
+        # The solver's own draw of feasible starts (sensible retracted lengths for the working range);
+        # where it finds fewer than ``count``, the uniform draws below fill in.
+        try:
+            drawn = start_points(problem, count, seed)[1:]
         except InvalidInputError:
-            pass
+            drawn = []
+        points += [problem.initial_point(lengths) for lengths in drawn]
     rng = np.random.default_rng(seed)
     low, up = problem.lower[: problem.n_xi], problem.upper[: problem.n_xi]
     for _ in range(20 * count):
