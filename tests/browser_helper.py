@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import base64
+import contextlib
 import json
+import os
 import re
 import shutil
+import signal
 import subprocess
 import tempfile
 import time
@@ -68,7 +71,8 @@ def load_page(url: str, width: int = 1100, height: int = 1400) -> PageLoad:
     """Load ``url`` in a fresh headless Chromium and report what it saw (see :class:`PageLoad`)."""
     exe = chromium()
     assert exe is not None, "chromium is not installed (apt-get install chromium)"
-    with tempfile.TemporaryDirectory() as profile:
+    profile = tempfile.mkdtemp(prefix="chromium-profile-")
+    try:
         process = subprocess.Popen(
             [
                 exe,
@@ -82,6 +86,7 @@ def load_page(url: str, width: int = 1100, height: int = 1400) -> PageLoad:
             ],
             stderr=subprocess.PIPE,
             text=True,
+            start_new_session=True,  # its helper processes share the group: all of them are stopped below
         )
         try:
             assert process.stderr is not None
@@ -123,6 +128,21 @@ def load_page(url: str, width: int = 1100, height: int = 1400) -> PageLoad:
         finally:
             process.terminate()
             process.wait(timeout=30)
+            with contextlib.suppress(ProcessLookupError):  # the group is gone already: nothing left to stop
+                os.killpg(process.pid, signal.SIGKILL)
+    finally:
+        _remove_profile(profile)
+
+
+def _remove_profile(profile: str) -> None:
+    """Remove Chromium's profile folder; a helper process may still write into it for a moment, so retry."""
+    for _ in range(20):
+        try:
+            shutil.rmtree(profile)
+            return
+        except OSError:
+            time.sleep(0.25)
+    shutil.rmtree(profile)  # the last try raises what stands in the way
 
 
 def save_artifact(name: str, data: bytes) -> Path:
