@@ -52,11 +52,10 @@ from hiab_sim.emla import (
 )
 from hiab_sim.emla.duty_energy import DutyOptions, drive_duty
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.study.analysis.buildable import buildable_blocks
 from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.nlp import blocks as bl
-from hiab_sim.study.nlp.block_registry import build_blocks, register_block
-from hiab_sim.study.nlp.brake_rows import brake_blocks
+from hiab_sim.study.nlp import builtin_blocks  # noqa: F401  (registers the built-in blocks, in row order)
+from hiab_sim.study.nlp.block_registry import build_blocks
 from hiab_sim.study.nlp.id_partials import id_joint_partials, id_length_partials
 from hiab_sim.study.nlp.interface import (
     N_XI,
@@ -69,8 +68,6 @@ from hiab_sim.study.nlp.interface import (
     SampleState,
 )
 from hiab_sim.study.nlp.objectives import make_objective
-from hiab_sim.study.nlp.structure_rows import structure_blocks
-from hiab_sim.study.nlp.thermal_rows import thermal_blocks
 from hiab_sim.study.references.kinds import ik_start
 from hiab_sim.study.spec.study_file import Study
 from hiab_sim.study.spec.tasks import Task
@@ -421,29 +418,3 @@ class TaskProblem:
             self._grad_cache.clear()
         self._grad_cache[key] = (grad, jac)
         return grad, jac
-
-
-def _tracking(p: TaskProblem) -> list[ConstraintBlock]:
-    tol, ref, t = p.study.tracking, p.reference, p.times
-    return [
-        bl.TrackingBand(order, t, getattr(ref, order), getattr(tol, order), p.band_fraction)
-        for order in ("position", "velocity", "acceleration")
-    ]
-
-
-# the built-in blocks, in row order (const_b..const_k, thermal limits, holding brakes, buildable design, structure)
-register_block("tracking", _tracking)
-register_block("envelope", lambda p: [bl.EnvelopeMargins(p.times, p.emlas, p.envelope_margin)])
-register_block("stroke", lambda p: [bl.StrokeLimits(p.times, p.crane.chains)])
-register_block("joint", lambda p: [bl.JointLimits(p.times, p.theta_low, p.theta_up)])
-register_block("joint_velocity", lambda p: [bl.JointVelocityLimits(p.times, np.asarray(p.study.bounds.joint_velocity))])
-register_block("working_range", lambda p: [bl.WorkingRange(p.crane.chains, p.working, p.working_clearance)])
-register_block("thermal", lambda p: thermal_blocks(p.emlas, p.study.energy.duty, p.task.reference.duration))
-register_block("brake", lambda p: brake_blocks(p.emlas, p.study.energy.duty))
-register_block("buildable", lambda p: buildable_blocks(p.study, p.working, p.tightened))
-register_block(
-    "structure",
-    lambda p: structure_blocks(
-        p.study.structure, p.times, p.crane, p.emlas, p.tcp_force, p.fd_step, p.task.payload.mass
-    ),
-)

@@ -1,0 +1,48 @@
+"""The built-in constraint blocks of a task's NLP, registered in their row order (seed eqs. ``const_b``..``const_k``).
+
+Each factory takes the :class:`~hiab_sim.study.nlp.task_problem.TaskProblem` being built and returns its
+blocks; :mod:`hiab_sim.study.nlp.task_problem` imports this module once, so these come first in every
+problem's rows and blocks registered later (:func:`~hiab_sim.study.nlp.block_registry.register_block`)
+follow them.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from hiab_sim.study.analysis.buildable import buildable_blocks
+from hiab_sim.study.nlp import blocks as bl
+from hiab_sim.study.nlp.block_registry import register_block
+from hiab_sim.study.nlp.brake_rows import brake_blocks
+from hiab_sim.study.nlp.interface import ConstraintBlock
+from hiab_sim.study.nlp.structure_rows import structure_blocks
+from hiab_sim.study.nlp.thermal_rows import thermal_blocks
+
+
+def _tracking(p: Any) -> list[ConstraintBlock]:
+    """The TCP tracking bands of const_b..const_d, tightened by the problem's band fraction."""
+    tol, ref, t = p.study.tracking, p.reference, p.times
+    return [
+        bl.TrackingBand(order, t, getattr(ref, order), getattr(tol, order), p.band_fraction)
+        for order in ("position", "velocity", "acceleration")
+    ]
+
+
+# the built-in blocks, in row order (const_b..const_k, thermal limits, holding brakes, buildable design, structure)
+register_block("tracking", _tracking)
+register_block("envelope", lambda p: [bl.EnvelopeMargins(p.times, p.emlas, p.envelope_margin)])
+register_block("stroke", lambda p: [bl.StrokeLimits(p.times, p.crane.chains)])
+register_block("joint", lambda p: [bl.JointLimits(p.times, p.theta_low, p.theta_up)])
+register_block("joint_velocity", lambda p: [bl.JointVelocityLimits(p.times, np.asarray(p.study.bounds.joint_velocity))])
+register_block("working_range", lambda p: [bl.WorkingRange(p.crane.chains, p.working, p.working_clearance)])
+register_block("thermal", lambda p: thermal_blocks(p.emlas, p.study.energy.duty, p.task.reference.duration))
+register_block("brake", lambda p: brake_blocks(p.emlas, p.study.energy.duty))
+register_block("buildable", lambda p: buildable_blocks(p.study, p.working, p.tightened))
+register_block(
+    "structure",
+    lambda p: structure_blocks(
+        p.study.structure, p.times, p.crane, p.emlas, p.tcp_force, p.fd_step, p.task.payload.mass
+    ),
+)
