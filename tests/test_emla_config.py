@@ -132,7 +132,7 @@ def test_dataclass_rejects_bad_values_when_built() -> None:
     [
         (lambda d: d["pmsm"].update(bogus=1.0), "unknown key.*bogus"),
         (lambda d: d["actuators"]["lift"].pop("screw_lead"), "missing key.*screw_lead"),
-        (lambda d: d["actuators"].pop("telescope"), "missing key.*telescope"),
+        (lambda d: d["actuators"].clear(), "at least one actuator"),
         (lambda d: d["pmsm"].update(Ld="2.2e-3"), "expected a number.*1.0e\\+3"),
         (lambda d: d["pmsm"].update(Ld={"value": 2e-3, "source": "guess"}), "source must be"),
         (lambda d: d.update(extra={}), "unknown key.*extra"),
@@ -144,6 +144,18 @@ def test_malformed_document_raises_config_error(edit: Any, pattern: str) -> None
     edit(document)
     with pytest.raises(ConfigError, match=pattern):
         emla_set_from_mapping(document)
+
+
+def test_set_missing_a_machine_actuator_is_refused_naming_the_actuators() -> None:
+    """An EMLA file is read with any actuator names; a machine's check names what it lacks."""
+    document = _preset_document()
+    document["actuators"].pop("telescope")
+    emlas = emla_set_from_mapping(document)
+    assert emlas.names == ("lift", "tilt")
+    with pytest.raises(InvalidInputError, match=r"actuators = 'lift, tilt' .*must be the machine's actuators: lift, tilt, telescope"):
+        emlas.renamed(("lift", "tilt", "telescope"))
+    full = emla_set_from_mapping(_preset_document())
+    assert full.renamed(("telescope", "lift", "tilt")).names == ("telescope", "lift", "tilt")
 
 
 def test_unparsable_yaml_file_raises_config_error(tmp_path: Path) -> None:

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field, fields
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
 from hiab_sim.checks import check_non_negative, check_positive, check_range
-from hiab_sim.crane.names import ACTUATOR_NAMES
+from hiab_sim.crane.names import ACTUATOR_NAMES  # noqa: F401  (the XS 031 callers still import it from here)
 from hiab_sim.emla.battery import BatteryParams
 from hiab_sim.emla.brake import HoldingBrake
 from hiab_sim.emla.electrothermal import WindingResistance
@@ -227,36 +227,94 @@ class EmlaParams:
         return dict(self.provenance).get(key, "unspecified")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class EmlaSet:
-    """The three EMLAs of an XS 031 crane and their DC bus; iterate for ``lift``, ``tilt``, ``telescope``."""
+    """The EMLAs of a machine, one per actuator in the machine's actuator order, and their DC bus.
 
-    lift: EmlaParams
-    tilt: EmlaParams
-    telescope: EmlaParams
-    battery: BatteryParams = field(default_factory=BatteryParams)
+    Iterating gives the :class:`EmlaParams` in order; ``emlas[name]`` and ``emlas.<name>`` give one
+    actuator's by its name (each EMLA's ``name`` is its actuator's). Build it as
+    ``EmlaSet(p1, p2, ..., battery=...)`` or ``EmlaSet(**{name: params})`` (keywords in the
+    machine's actuator order).
+    """
 
-    def __post_init__(self) -> None:
-        if self.battery.inverter_efficiency < 1.0 and any(p.losses.inverter_on for p in self.as_tuple()):
+    params: tuple[EmlaParams, ...]
+    battery: BatteryParams
+
+    def __init__(
+        self, *params: EmlaParams, battery: BatteryParams | None = None, **named: EmlaParams | BatteryParams
+    ) -> None:
+        values = list(params)
+        given = named.pop("params", None)  # dataclasses.replace passes the fields by name
+        if isinstance(given, tuple):
+            values += list(given)
+        if values and isinstance(values[-1], BatteryParams) and battery is None:
+            battery = values.pop()  # positional battery last, as the dataclass constructor took it
+        for name, value in named.items():
+            if not isinstance(value, EmlaParams):
+                raise InvalidInputError(f"actuators.{name}", type(value).__name__, "must be an EMLA's parameters")
+            values.append(value if value.name == name else replace(value, name=name))
+        if not values:
+            raise InvalidInputError("actuators", "none", "an EMLA set needs at least one actuator")
+        names = [p.name for p in values]
+        if len(set(names)) != len(names):
+            raise InvalidInputError("actuators", ", ".join(names), "names must be unique")
+        object.__setattr__(self, "params", tuple(values))
+        object.__setattr__(self, "battery", battery if battery is not None else BatteryParams())
+        if self.battery.inverter_efficiency < 1.0 and any(p.losses.inverter_on for p in self.params):
             raise InvalidInputError(
                 "battery.inverter_efficiency",
                 self.battery.inverter_efficiency,
                 "must be 1 when drive_losses models the inverter (it would be counted twice)",
             )
 
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The actuators' names, in order."""
+        return tuple(p.name for p in self.params)
+
+    def __len__(self) -> int:
+        return len(self.params)
+
     def __iter__(self) -> Iterator[EmlaParams]:
-        return iter((self.lift, self.tilt, self.telescope))
+        return iter(self.params)
 
     def __getitem__(self, name: str) -> EmlaParams:
-        """Return the actuator called ``name`` (one of :data:`ACTUATOR_NAMES`)."""
-        if name not in ACTUATOR_NAMES:
-            raise InvalidInputError("actuator", name, f"must be one of {', '.join(ACTUATOR_NAMES)}")
-        params: EmlaParams = getattr(self, name)
-        return params
+        """Return the actuator called ``name`` (one of :attr:`names`)."""
+        for p in self.params:
+            if p.name == name:
+                return p
+        raise InvalidInputError("actuator", name, f"must be one of {', '.join(self.names)}")
 
-    def as_tuple(self) -> tuple[EmlaParams, EmlaParams, EmlaParams]:
-        """Return ``(lift, tilt, telescope)``."""
-        return (self.lift, self.tilt, self.telescope)
+    def __getattr__(self, name: str) -> EmlaParams:
+        if name.startswith("_") or name in ("params", "battery"):
+            raise AttributeError(name)
+        for p in self.__dict__.get("params", ()):
+            if p.name == name:
+                return p
+        raise AttributeError(f"EmlaSet has no actuator {name!r}")
+
+    def as_tuple(self) -> tuple[EmlaParams, ...]:
+        """Return the EMLAs in actuator order."""
+        return self.params
+
+    def replaced(self, **named: EmlaParams) -> EmlaSet:
+        """This set with the named actuators' parameters replaced (the others and the battery kept)."""
+        unknown = set(named) - set(self.names)
+        if unknown:
+            raise InvalidInputError("actuator", ", ".join(sorted(unknown)), f"must be one of {', '.join(self.names)}")
+        return EmlaSet(*(named.get(p.name, p) for p in self.params), battery=self.battery)
+
+    def with_battery(self, battery: BatteryParams) -> EmlaSet:
+        """This set on another DC bus and battery."""
+        return EmlaSet(*self.params, battery=battery)
+
+    def renamed(self, names: Sequence[str], where: str = "emla") -> EmlaSet:
+        """This set checked against a machine's actuator names (same names, put in the machine's order)."""
+        if set(names) != set(self.names) or len(names) != len(self.names):
+            raise InvalidInputError(
+                f"{where}: actuators", ", ".join(self.names), f"must be the machine's actuators: {', '.join(names)}"
+            )
+        return EmlaSet(*(self[n] for n in names), battery=self.battery)
 
 
 _PMSM_KEYS: tuple[str, ...] = tuple(f.name for f in fields(PmsmParams) if f.name != "label")
@@ -324,10 +382,14 @@ def emla_set_from_mapping(document: object, where: str = "<mapping>") -> EmlaSet
         {"pmsm", "actuators"},
     )
     shared_pmsm = mapping(root["pmsm"], f"{where}: pmsm", set(_PMSM_KEYS))
-    actuators = mapping(root["actuators"], f"{where}: actuators", set(ACTUATOR_NAMES))
+    actuators = mapping(root["actuators"], f"{where}: actuators", None)
+    if not actuators:
+        raise ConfigError(f"{where}: actuators: at least one actuator is needed")
 
     built: dict[str, EmlaParams] = {}
-    for name in ACTUATOR_NAMES:
+    for name in actuators:
+        if not isinstance(name, str) or not name.isidentifier():
+            raise InvalidInputError(f"{where}: actuators", name, "names must be identifiers (letters, digits, _)")
         section = f"actuators.{name}"
         node = mapping(
             actuators[name], f"{where}: {section}", {*_ACTUATOR_REQUIRED, *_ACTUATOR_OPTIONAL}, set(_ACTUATOR_REQUIRED)
@@ -376,7 +438,7 @@ def emla_set_from_mapping(document: object, where: str = "<mapping>") -> EmlaSet
     if "battery" in root:
         node = mapping(root["battery"], f"{where}: battery", set(_BATTERY_KEYS), set())
         battery = {key: sourced_number(node[key], f"{where}: battery.{key}", PROVENANCE_KINDS)[0] for key in node}
-    return EmlaSet(**built, battery=BatteryParams(**battery))
+    return EmlaSet(*built.values(), battery=BatteryParams(**battery))
 
 
 def _require_keys(

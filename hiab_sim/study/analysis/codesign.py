@@ -62,10 +62,10 @@ def combinations(study: Study) -> list[Combination]:
 
 def with_transmission(emlas: EmlaSet, combo: Combination) -> EmlaSet:
     """The EMLA set with each actuator's (G, rho) replaced by the combination's."""
-    lift, tilt, tele = (
-        replace(p, gear_ratio=combo[p.name].gear_ratio, screw_lead=combo[p.name].screw_lead) for p in emlas
+    return EmlaSet(
+        *(replace(p, gear_ratio=combo[p.name].gear_ratio, screw_lead=combo[p.name].screw_lead) for p in emlas),
+        battery=emlas.battery,
     )
-    return replace(emlas, lift=lift, tilt=tilt, telescope=tele)
 
 
 def _min_margin(e: DesignEnergy) -> float | None:
