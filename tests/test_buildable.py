@@ -138,7 +138,7 @@ def test_stroke_row_multipliers_predict_a_longer_stroke(solved: tuple[StudyProbl
     predicted = sum(m.objective_decrease_per_unit for m in rows)
     old = getattr(study.crane, chain)
     crane = dataclasses.replace(study.crane, **{chain: dataclasses.replace(old, stroke=old.stroke + 1e-3)})
-    longer = dataclasses.replace(study, crane=crane)
+    longer = dataclasses.replace(study, crane_description=crane)
     p2 = StudyProblem(longer, cost_scales=[problem.problems[0].cost_scale])
     z2 = solve(p2, study.initial_lengths, progress=None, z0=z).z
     actual = problem.evaluate(z).cost - p2.evaluate(z2).cost
@@ -222,7 +222,7 @@ def test_each_length_moved_by_the_tolerance_keeps_every_nlp_row(solved: tuple[St
     """Each length moved by +-t (optimal trajectory kept): every nominal fine-grid row holds (bounds: search box)."""
     problem, z = solved
     study = problem.study
-    short = dataclasses.replace(study, crane=buildable_crane(study.crane, study.build.stroke_margin))
+    short = dataclasses.replace(study, crane_description=buildable_crane(study.crane, study.build.stroke_margin))
     fine = TaskProblem(
         short,
         id_path="mujoco",

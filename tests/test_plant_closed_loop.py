@@ -137,7 +137,7 @@ def test_true_mass_prediction_agrees_with_the_optimiser_on_the_true_crane(tmp_pa
 
     nominal = run_study(None, tmp_path / "nominal", progress=None, figures=False).folder
     study = load_study(None)
-    true_study = dataclasses.replace(study, crane=true_crane(study.crane, REALISTIC.mismatch))
+    true_study = dataclasses.replace(study, crane_description=true_crane(study.crane, REALISTIC.mismatch))
     replanned = run_study(true_study, tmp_path / "true", progress=None, figures=False, force=True, cross=False).folder
     result = json.loads((replanned / "result.json").read_text())
     initial = true_mass_prediction(read_plan(nominal, "initial"), REALISTIC)

@@ -75,7 +75,7 @@ def replanned_prediction(result_dir: str | Path, plant: Plant) -> dict[str, obje
     study = load_study(read_result(result_dir).study)
     if len(study.tasks) != 1:
         return {"skipped": f"the study has {len(study.tasks)} tasks; re-planning is done for single-task studies"}
-    true_study = replace(study, crane=true_crane(study.crane, plant.mismatch))
+    true_study = replace(study, crane_description=true_crane(study.crane, plant.mismatch))
     with tempfile.TemporaryDirectory(prefix="hiab_sim_replan_") as folder:
         out = run_study(true_study, Path(folder) / "replan", progress=None, figures=False, force=True, cross=False)
         result = json.loads((out.folder / "result.json").read_text(encoding="utf-8"))

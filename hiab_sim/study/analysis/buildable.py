@@ -169,9 +169,11 @@ def buildable_blocks(study: Study, working: Sequence[tuple[float, float]], tight
     """
     t = study.build.tolerance
     blocks: list[ConstraintBlock] = []
+    if study.crane_description is None:
+        return blocks  # a machine file's study: the buildable design is not yet available for it
     if tightened:
         # the clearance covers the first-order error of the robust rows (<= t^2 / (2 s), module docstring)
-        wr = WorkingRange(study.crane.chains, buildable_working_range(study, working), ROBUST_CLEARANCE / STROKE_SCALE)
+        wr = WorkingRange(study.model, buildable_working_range(study, working), ROBUST_CLEARANCE / STROKE_SCALE)
         blocks.append(RobustXi(wr, t, "buildable_range"))
     if study.mounting is not None:
         if tightened:

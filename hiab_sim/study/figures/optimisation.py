@@ -27,7 +27,6 @@ from hiab_sim.study.figures.design import (
     structure_overlay,
 )
 from hiab_sim.study.figures.energy import hydraulic_figure
-from hiab_sim.study.nlp.task_problem import ACTUATORS
 from hiab_sim.study.report.design_check import DesignCheck
 from hiab_sim.style import colour
 
@@ -147,16 +146,17 @@ def spiral_figure(
 
 def actuator_figure(time: np.ndarray, checks: dict[str, DesignCheck], path: Path) -> None:
     """Force, velocity and electrical power per actuator over time, initial vs optimal."""
-    fig = new_figure((12.0, 8.0))
-    axes = fig.subplots(3, 3, sharex=True)
+    names = checks["initial"].actuator_names
+    fig = new_figure((4.0 * len(names), 8.0))
+    axes = fig.subplots(3, len(names), sharex=True, squeeze=False)
     for name in ("initial", "optimal"):
         ev = checks[name].evaluation
-        for i, act in enumerate(ACTUATORS):
+        for i, act in enumerate(names):
             axes[0, i].plot(time, ev.actuators.force[:, i] / 1e3, color=colour(name), label=name)
             axes[1, i].plot(time, ev.actuators.velocity[:, i], color=colour(name))
             axes[2, i].plot(time, ev.power[:, i] / 1e3, color=colour(name))
             axes[0, i].set_title(act)
-    for i in range(3):
+    for i in range(len(names)):
         axes[2, i].set_xlabel("time [s]")
     axes[0, 0].set_ylabel("force f_x [kN]")
     axes[1, 0].set_ylabel("velocity v_x [m/s]")

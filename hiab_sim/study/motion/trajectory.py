@@ -58,7 +58,7 @@ class SplineBasis:
 
 @dataclass(frozen=True)
 class JointTrajectory:
-    """theta, dtheta, ddtheta at sample times, each (T, 3) for (theta1, theta2, xt2)."""
+    """q, dq, ddq at sample times, each (T, n) for the machine's joints (the crane's theta1, theta2, xt2)."""
 
     time: Array
     position: Array
@@ -67,8 +67,8 @@ class JointTrajectory:
 
 
 def evaluate(basis: SplineBasis, coefficients: Array, times: Array) -> JointTrajectory:
-    """Joint samples from coefficients c of shape (3, n) (eqs. ``matrix_basis``..``_dd``)."""
-    c = np.asarray(coefficients, dtype=float).reshape(3, basis.n)
+    """Joint samples from coefficients c of shape (n_joints, n) (eqs. ``matrix_basis``..``_dd``)."""
+    c = np.asarray(coefficients, dtype=float).reshape(-1, basis.n)
     B, dB, ddB = basis.matrices(times)
     return JointTrajectory(np.asarray(times, dtype=float), B @ c.T, dB @ c.T, ddB @ c.T)
 
@@ -277,7 +277,7 @@ def inverse_kinematics(
 
 
 def fit_coefficients(basis: SplineBasis, joints: JointTrajectory, rate_weight: float = 0.1) -> Array:
-    """Least-squares spline coefficients (3, n) for dense joint samples, at rest at both ends.
+    """Least-squares spline coefficients (n_joints, n) for dense joint samples, at rest at both ends.
 
     Minimises sum |B c - theta|^2 + w^2 |dB c - dtheta|^2 + w^4 |ddB c - ddtheta|^2 (w =
     ``rate_weight`` [s]) subject to dtheta = ddtheta = 0 at t = 0 and t = duration (linear).
@@ -288,8 +288,8 @@ def fit_coefficients(basis: SplineBasis, joints: JointTrajectory, rate_weight: f
     ends = np.array([0.0, basis.duration])
     E = np.vstack([basis.matrix(ends, 1), basis.matrix(ends, 2)])
     kkt = np.block([[lhs.T @ lhs, E.T], [E, np.zeros((len(E), len(E)))]])
-    out = np.zeros((3, basis.n))
-    for j in range(3):
+    out = np.zeros((joints.position.shape[1], basis.n))
+    for j in range(joints.position.shape[1]):
         rhs = np.concatenate([joints.position[:, j], w * joints.velocity[:, j], w**2 * joints.acceleration[:, j]])
         sol = np.linalg.solve(kkt, np.concatenate([lhs.T @ rhs, np.zeros(len(E))]))
         out[j] = sol[: basis.n]

@@ -19,6 +19,7 @@ points, and used to check every point of a task's reference before any optimisat
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -26,6 +27,9 @@ from numpy.typing import ArrayLike, NDArray
 from hiab_sim.crane.description import Crane
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.motion.trajectory import Reference, TcpKinematics
+
+if TYPE_CHECKING:
+    from hiab_sim.study.machines.protocol import StudyMachine
 
 Array = NDArray[np.float64]
 
@@ -96,27 +100,46 @@ def dense_times(duration: float, step: float = 0.01) -> Array:
     return np.linspace(0.0, duration, max(2, int(np.ceil(duration / step))) + 1)
 
 
-def check_workspace(kin: TcpKinematics, crane: Crane, reference: Reference, where: str = "reference") -> Array:
-    """Joints (T, 3) of every reference sample by closed-form IK; raise naming the first unreachable time.
+def tracked_units(model: StudyMachine) -> tuple[str, ...]:
+    """The unit of each tracked coordinate: m for the TCP's x and y, a joint's own, rad for an attitude."""
+    units = {name: unit for name, unit in zip(model.joint_names, model.joint_units, strict=True)}
+    return ("m", "m", *(units.get(name, "rad") for name in model.tracked_names[2:]))
+
+
+def describe_point(model: StudyMachine, point: Array) -> str:
+    """``TCP (x, y) m with xt2 = 0.4 m``: a point of tracked coordinates in words."""
+    units = tracked_units(model)
+    extra = ", ".join(
+        f"{name} = {value:.4g} {unit}"
+        for name, value, unit in zip(model.tracked_names[2:], point[2:], units[2:], strict=True)
+    )
+    return f"TCP ({point[0]:.4g}, {point[1]:.4g}) m" + (f" with {extra}" if extra else "")
+
+
+def check_workspace(model: StudyMachine | Crane, reference: Reference, where: str = "reference") -> Array:
+    """Joints (T, n) of every reference sample by the machine's IK; raise naming the first unreachable time.
+
+    ``model``: the study's machine (a crane description stands for its own, closed-form IK).
 
     Raises:
         InvalidInputError: a sample out of reach or needing a joint outside its range.
 
     """
-    ik = planar_ik(kin, crane, reference.position[:, :2], reference.position[:, 2])
+    from hiab_sim.study.machines import as_study_machine  # the study's machines import this module
+
+    model = as_study_machine(model)
+    ik = model.reach(reference.position)
     bad = np.flatnonzero(ik.status)
     if len(bad):
         i = int(bad[0])
-        x, y, xt = reference.position[i]
         raise InvalidInputError(
             f"{where} at t = {reference.time[i]:.6g} s",
-            f"TCP ({x:.4g}, {y:.4g}) m with xt2 = {xt:.4g} m",
-            f"the point {REASONS[int(ik.status[i])]}",
+            describe_point(model, reference.position[i]),
+            f"the point {ik.reasons[int(ik.status[i])]}",
         )
-    return ik.joints
+    return np.asarray(ik.joints, dtype=float)
 
 
-def initial_joints(kin: TcpKinematics, crane: Crane, reference: Reference) -> tuple[float, float]:
-    """(theta1, theta2) [rad] of the first reference sample: the start of the Newton IK continuation."""
-    joints = check_workspace(kin, crane, reference)
-    return float(joints[0, 0]), float(joints[0, 1])
+def initial_joints(model: StudyMachine | Crane, reference: Reference) -> Array:
+    """Joints (n,) of the first reference sample: the start of the Newton IK continuation."""
+    return check_workspace(model, reference)[0]

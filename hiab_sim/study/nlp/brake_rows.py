@@ -52,7 +52,7 @@ class BrakeHolding(ConstraintBlock):
         """D row / d f_x at the larger of the first and last samples, through the ID partials."""
         assert state.duty is not None
         K = len(state.joints.time)
-        rows = np.zeros((len(self.indices), K, 9))
+        rows = np.zeros((len(self.indices), K, 3 * len(self.emlas)))  # w.r.t. Y = (f, v, a) of every actuator
         for r, i in enumerate(self.indices):
             p, hold = self.emlas[i], state.duty[i].hold
             assert hold is not None and p.brake is not None

@@ -25,7 +25,7 @@ def _tracking(p: Any) -> list[ConstraintBlock]:
     """The TCP tracking bands of const_b..const_d, tightened by the problem's band fraction."""
     tol, ref, t = p.study.tracking, p.reference, p.times
     return [
-        bl.TrackingBand(order, t, getattr(ref, order), getattr(tol, order), p.band_fraction)
+        bl.TrackingBand(order, t, getattr(ref, order), getattr(tol, order), p.band_fraction, p.model.tracked_names)
         for order in ("position", "velocity", "acceleration")
     ]
 
@@ -33,16 +33,22 @@ def _tracking(p: Any) -> list[ConstraintBlock]:
 # the built-in blocks, in row order (const_b..const_k, thermal limits, holding brakes, buildable design, structure)
 register_block("tracking", _tracking)
 register_block("envelope", lambda p: [bl.EnvelopeMargins(p.times, p.emlas, p.envelope_margin)])
-register_block("stroke", lambda p: [bl.StrokeLimits(p.times, p.crane.chains)])
-register_block("joint", lambda p: [bl.JointLimits(p.times, p.theta_low, p.theta_up)])
-register_block("joint_velocity", lambda p: [bl.JointVelocityLimits(p.times, np.asarray(p.study.bounds.joint_velocity))])
-register_block("working_range", lambda p: [bl.WorkingRange(p.crane.chains, p.working, p.working_clearance)])
+register_block("stroke", lambda p: [bl.StrokeLimits(p.times, p.model)])
+register_block(
+    "joint",
+    lambda p: [bl.JointLimits(p.times, p.theta_low, p.theta_up, p.model.joint_names, p.model.joint_units)],
+)
+register_block(
+    "joint_velocity",
+    lambda p: [bl.JointVelocityLimits(p.times, np.asarray(p.study.bounds.joint_velocity), p.model.joint_names)],
+)
+register_block("working_range", lambda p: [bl.WorkingRange(p.model, p.working, p.working_clearance)])
 register_block("thermal", lambda p: thermal_blocks(p.emlas, p.study.energy.duty, p.task.reference.duration))
 register_block("brake", lambda p: brake_blocks(p.emlas, p.study.energy.duty))
 register_block("buildable", lambda p: buildable_blocks(p.study, p.working, p.tightened))
 register_block(
     "structure",
-    lambda p: structure_blocks(
-        p.study.structure, p.times, p.crane, p.emlas, p.tcp_force, p.fd_step, p.task.payload.mass
-    ),
+    lambda p: []
+    if p.study.crane_description is None  # a machine file's study: structure rows not yet available for it
+    else structure_blocks(p.study.structure, p.times, p.crane, p.emlas, p.tcp_force, p.fd_step, p.task.payload.mass),
 )

@@ -16,8 +16,8 @@ optimiser keeps that is not part of the nominal constraint). Its Jacobian is eit
 e.g. the working range). :class:`BlockLayout` assembles row names, row slices, clearances and
 the Jacobian of one list of blocks, and splits any row vector (margins, multipliers) by block.
 
-An objective (:class:`Objective`) returns its value [its unit] and gradient w.r.t. q9 (K, 9)
-and Xi (6,); the problem divides both by its ``cost_scale``.
+An objective (:class:`Objective`) returns its value [its unit] and gradient w.r.t. q9 (K, 3 n)
+and Xi (n_xi,); the problem divides both by its ``cost_scale``.
 
 Extending (one module and its registration each, docs/extending.md):
 
@@ -25,7 +25,7 @@ Extending (one module and its registration each, docs/extending.md):
   or :class:`ConstraintBlock` (return :class:`DenseRows`), give its rows' unit
   (:meth:`ConstraintBlock.relaxation`) and register a factory with
   :func:`hiab_sim.study.nlp.block_registry.register_block`. An integral row (RMS torque over the duty, a thermal
-  steady state) returns ``DenseRows(dq=(m, K, 9), dxi=(m, 6))``; a row of Xi only (working
+  steady state) returns ``DenseRows(dq=(m, K, 3 n), dxi=(m, n_xi))``; a row of Xi only (working
   range, mounting-space polygons) ``DenseRows(dxi=...)``; an epsilon constraint on any objective
   is :class:`hiab_sim.study.nlp.blocks.ObjectiveBound`.
 - an objective: a class with ``name``, ``unit``, ``value`` and ``gradient`` registered with
@@ -48,16 +48,18 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.crane.description import LinkLengths
 from hiab_sim.dynamics.samples import ActuatorSamples
 from hiab_sim.emla.duty_energy import DriveDuty
+from hiab_sim.study.machines.protocol import Design
 from hiab_sim.study.motion import trajectory as tr
 
 Array = NDArray[np.float64]
 
-#: Per-sample joint quantities a block may depend on: q9 = (theta 0-2, dtheta 3-5, ddtheta 6-8).
+#: The XS 031 crane's per-sample joint quantities q9 = (theta 0-2, dtheta 3-5, ddtheta 6-8): the
+#: crane-only blocks (structure, buildable design) use it; every other block reads n from its state
+#: (a machine of n joints has 3 n per sample: q, dq, ddq).
 N_Q = 9
-#: Link-length variables Xi = (lift L, Lc0, Lc, tilt L, Lc0, Lc) [m].
+#: The XS 031 crane's link-length variables Xi = (lift L, Lc0, Lc, tilt L, Lc0, Lc) [m] (crane-only blocks).
 N_XI = 6
 
 
@@ -65,11 +67,11 @@ N_XI = 6
 class SampleState:
     """What blocks and objectives read at one point (SI units, K samples at ``joints.time``)."""
 
-    lengths: LinkLengths
-    joints: tr.JointTrajectory  # (K, 3) each
-    tcp: tr.TcpSamples  # (K, 3) each, partials (K, 3, 9)
-    actuators: ActuatorSamples  # (K, 3) each
-    power: Array  # (K, 3) EMLA electrical power [W] (at the winding temperature when ``duty`` is set)
+    lengths: Design  # Xi (the crane's LinkLengths, a machine's design values)
+    joints: tr.JointTrajectory  # (K, n) each
+    tcp: tr.TcpSamples  # tracked coordinates (K, n) each, partials (K, n, 3 n)
+    actuators: ActuatorSamples  # (K, n) each
+    power: Array  # (K, n) EMLA electrical power [W] (at the winding temperature when ``duty`` is set)
     #: each EMLA over the study's duty period (hot windings, the rest's hold), or None: the paper's
     #: per-sample model with R_s at its data-sheet value and a free rest (:mod:`hiab_sim.emla.duty_energy`)
     duty: tuple[DriveDuty, ...] | None = field(default=None, kw_only=True)
@@ -78,9 +80,8 @@ class SampleState:
 class SamplePartials:
     """Inverse-dynamics partials at one point, each computed on first use and then kept.
 
-    ``id_q``: d(f, v, a)/d(q9) per sample, (K, 9 outputs, 9 inputs); outputs in the order
-    (f_lift, f_tilt, f_tele, v_lift, ..., a_tele). ``id_xi``: d(f, v, a)/dXi per sample,
-    (K, 9, 6) [per m].
+    ``id_q``: d(f, v, a)/d(q9) per sample, (K, 3 n outputs, 3 n inputs); outputs in the order
+    (f of each actuator, then v, then a). ``id_xi``: d(f, v, a)/dXi per sample, (K, 3 n, n_xi) [per m].
     """
 
     def __init__(self, id_q: Callable[[], Array], id_xi: Callable[[], Array]) -> None:
@@ -89,12 +90,12 @@ class SamplePartials:
 
     @cached_property
     def id_q(self) -> Array:
-        """d(f, v, a)/d(theta, dtheta, ddtheta), (K, 9, 9)."""
+        """d(f, v, a)/d(theta, dtheta, ddtheta), (K, 3 n, 3 n)."""
         return self._id_q()
 
     @cached_property
     def id_xi(self) -> Array:
-        """d(f, v, a)/dXi, (K, 9, 6) [per m]."""
+        """d(f, v, a)/dXi, (K, 3 n, n_xi) [per m]."""
         return self._id_xi()
 
 
@@ -102,7 +103,7 @@ class SamplePartials:
 class SampleRows:
     """Jacobian of r rows per sample (row k * r + i depends on sample k only).
 
-    ``dq``: (K, r, 9) w.r.t. that sample's q9; ``dxi``: (K, r, 6) w.r.t. Xi [per m], None if zero.
+    ``dq``: (K, r, 3 n) w.r.t. that sample's q9; ``dxi``: (K, r, n_xi) w.r.t. Xi [per m], None if zero.
     """
 
     dq: Array
@@ -113,7 +114,7 @@ class SampleRows:
 class DenseRows:
     """Jacobian of m rows that may depend on every sample (integrals) or on Xi only.
 
-    ``dq``: (m, K, 9) w.r.t. every sample's q9, None if zero; ``dxi``: (m, 6) [per m], None if zero.
+    ``dq``: (m, K, 3 n) w.r.t. every sample's q9, None if zero; ``dxi``: (m, n_xi) [per m], None if zero.
     """
 
     dq: Array | None = None
@@ -214,7 +215,7 @@ class Objective(Protocol):
         ...
 
     def gradient(self, state: SampleState, partials: SamplePartials) -> tuple[Array, Array]:
-        """(d/dq9 per sample (K, 9), d/dXi (6,) [per m]) [``unit`` per unit of q9 or m]."""
+        """(d/dq9 per sample (K, 3 n), d/dXi (n_xi,) [per m]) [``unit`` per unit of q9 or m]."""
         ...
 
 

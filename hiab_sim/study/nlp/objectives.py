@@ -57,7 +57,7 @@ class SquaredPowerCost:
     def gradient(self, state: SampleState, partials: SamplePartials) -> tuple[Array, Array]:
         """Dt (sum_i P_i) dP/d(f, v, a) chained through the inverse dynamics' partials."""
         total = state.power.sum(axis=1)
-        return _chain(self.emlas, state, partials, self.dt * np.repeat(total[:, None], 3, axis=1))
+        return _chain(self.emlas, state, partials, self.dt * np.repeat(total[:, None], len(self.emlas), axis=1))
 
 
 class BatteryEnergyCost:
@@ -117,20 +117,21 @@ class BatteryEnergyCost:
 def _chain(
     emlas: EmlaSet, state: SampleState, partials: SamplePartials, df_dP: Array, df_drest: float = 0.0
 ) -> tuple[Array, Array]:
-    """(d/dq9 (K, 9), d/dXi (6,)) of an objective from its partials w.r.t. each drive's power, df_dP (K, 3).
+    """(d/dq9 (K, 3 n), d/dXi (n_xi,)) of an objective from its partials w.r.t. each drive's power, df_dP (K, n).
 
     With a duty model (``state.duty``) the powers are the hot ones and ``df_drest`` [-] multiplies each
     drive's rest energy; the partials then carry the winding temperature's dependence on every sample.
     """
     act = state.actuators
-    dY = np.zeros((len(state.power), 9))  # w.r.t. Y = (f0 f1 f2 v0 v1 v2 a0 a1 a2)
+    n = len(emlas)
+    dY = np.zeros((len(state.power), 3 * n))  # w.r.t. Y = (f_0..f_n-1, v_0.., a_0..)
     for i, p in enumerate(emlas):
         if state.duty is not None:
             pf, pv, pa = state.duty[i].energy_partials(df_dP[:, i], df_drest)
-            dY[:, i], dY[:, 3 + i], dY[:, 6 + i] = pf, pv, pa
+            dY[:, i], dY[:, n + i], dY[:, 2 * n + i] = pf, pv, pa
             continue
         pf, pv, pa = electrical_power_partials(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
-        dY[:, i], dY[:, 3 + i], dY[:, 6 + i] = df_dP[:, i] * pf, df_dP[:, i] * pv, df_dP[:, i] * pa
+        dY[:, i], dY[:, n + i], dY[:, 2 * n + i] = df_dP[:, i] * pf, df_dP[:, i] * pv, df_dP[:, i] * pa
     return np.einsum("ky,kyq->kq", dY, partials.id_q), np.einsum("ky,kyx->x", dY, partials.id_xi)
 
 

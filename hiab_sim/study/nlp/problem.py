@@ -32,9 +32,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.crane.description import LinkLengths
 from hiab_sim.emla import EmlaSet
-from hiab_sim.study.nlp.interface import N_XI, Array, ConstraintBlock
+from hiab_sim.study.machines.protocol import Design
+from hiab_sim.study.nlp.interface import Array, ConstraintBlock
 from hiab_sim.study.nlp.task_problem import Evaluation, TaskProblem
 from hiab_sim.study.spec.study_file import Study
 
@@ -44,7 +44,7 @@ class StudyEvaluation:
     """The study at one point: weighted objective [its unit], stacked rows, and each task's evaluation."""
 
     z: Array
-    lengths: LinkLengths
+    lengths: Design
     cost: float  # sum_k w_k f_k [the objective's unit, weighted]
     constraints: Array
     equalities: Array
@@ -111,7 +111,7 @@ class StudyProblem:
         self.objective = first.objective  # every task's (the study's); the study weighs their values
         self.emlas = first.emlas
         self.id_path = first.id_path
-        self.crane = first.crane
+        self.model = first.model
         self.tightened = tightened
         self.envelope_margin = first.envelope_margin  # the study's, the same for every task
         self.weights = np.array([task.weight for task in study.tasks])
@@ -120,15 +120,15 @@ class StudyProblem:
             (min(p.working[j][0] for p in self.problems), max(p.working[j][1] for p in self.problems))
             for j in range(len(first.working))
         )
-        self.n_xi = N_XI
+        self.n_xi = n_xi = first.n_xi
         self.offsets: list[int] = []
-        n = N_XI
+        n = n_xi
         for p in self.problems:
             self.offsets.append(n)
             n += p.n_c
         self.n = n
-        self.lower = np.concatenate([first.lower[:N_XI], np.full(n - N_XI, -np.inf)])
-        self.upper = np.concatenate([first.upper[:N_XI], np.full(n - N_XI, np.inf)])
+        self.lower = np.concatenate([first.lower[:n_xi], np.full(n - n_xi, -np.inf)])
+        self.upper = np.concatenate([first.upper[:n_xi], np.full(n - n_xi, np.inf)])
         self.blocks: tuple[StackedBlock, ...] = self._stack_blocks()
         self.rows: list[NDArray[np.intp]] = [
             np.concatenate(
@@ -142,7 +142,7 @@ class StudyProblem:
             for i in rows
         ]
         self.clearance = np.concatenate([p.clearance[rows] for p, rows in zip(self.problems, self.rows, strict=True)])
-        self.equality_names = [self.row_name(k, f"rest {i}") for k in range(len(self.tasks)) for i in range(12)]
+        self.equality_names = [self.row_name(k, f"rest {i}") for k in range(len(self.tasks)) for i in range(first.n_equalities)]
         self.cost_scale = 1.0
         self.cost_scale = max(self.evaluate(self.initial_point(study.initial_lengths)).cost, 1e-300)
 
@@ -179,25 +179,25 @@ class StudyProblem:
         """Task k's own z = [z_xi, z_ck] from the study's z."""
         z = np.asarray(z, dtype=float)
         off = self.offsets[k]
-        return np.concatenate([z[:N_XI], z[off : off + self.problems[k].n_c]])
+        return np.concatenate([z[: self.n_xi], z[off : off + self.problems[k].n_c]])
 
-    def initial_point(self, lengths: LinkLengths, coefficients: list[Array] | None = None) -> Array:
+    def initial_point(self, lengths: Design, coefficients: list[Array] | None = None) -> Array:
         """Scaled z for link lengths and each task's coefficients (default: their inverse-kinematics fits)."""
-        parts = [self.problems[0].initial_point(lengths)[:N_XI]]
+        parts = [self.problems[0].initial_point(lengths)[: self.n_xi]]
         for k, p in enumerate(self.problems):
             c = None if coefficients is None else coefficients[k]
-            parts.append(p.initial_point(lengths, c)[N_XI:])
+            parts.append(p.initial_point(lengths, c)[self.n_xi :])
         return np.concatenate(parts)
 
-    def unpack(self, z: Array) -> tuple[LinkLengths, list[Array]]:
-        """(Xi, [c_k (3, N_k)]) from scaled z."""
+    def unpack(self, z: Array) -> tuple[Design, list[Array]]:
+        """(Xi, [c_k (n, N_k)]) from scaled z."""
         lengths = self.problems[0].unpack(self.task_z(z, 0))[0]
         return lengths, [p.unpack(self.task_z(z, k))[1] for k, p in enumerate(self.problems)]
 
-    def with_lengths(self, z: Array, lengths: LinkLengths) -> Array:
+    def with_lengths(self, z: Array, lengths: Design) -> Array:
         """Z with its Xi replaced by ``lengths`` (every trajectory kept)."""
         out = np.array(z, dtype=float)
-        out[:N_XI] = self.problems[0].initial_point(lengths)[:N_XI]
+        out[: self.n_xi] = self.problems[0].initial_point(lengths)[: self.n_xi]
         return out
 
     # -- evaluation --------------------------------------------------------------------------
@@ -252,8 +252,8 @@ class StudyProblem:
         grad = np.zeros(self.n)
         for k, p in enumerate(self.problems):
             g = p.cost_gradient(self.task_z(z, k)) * (self.weights[k] * p.cost_scale / self.cost_scale)
-            grad[:N_XI] += g[:N_XI]
-            grad[self.offsets[k] : self.offsets[k] + p.n_c] = g[N_XI:]
+            grad[: self.n_xi] += g[: self.n_xi]
+            grad[self.offsets[k] : self.offsets[k] + p.n_c] = g[self.n_xi :]
         return grad
 
     def constraints_jacobian(self, z: Array) -> Array:
@@ -261,7 +261,7 @@ class StudyProblem:
         return self._stack([p.constraints_jacobian(self.task_z(z, k))[rows] for k, (p, rows) in self._pairs()])
 
     def equalities_jacobian(self, z: Array) -> Array:
-        """D e / dz (constant), (12 T, n)."""
+        """D e / dz (constant), (4 n T, n)."""
         return self._stack([p.equalities_jacobian(self.task_z(z, k)) for k, (p, _) in self._pairs()])
 
     def _pairs(self) -> list[tuple[int, tuple[TaskProblem, NDArray[np.intp]]]]:
@@ -272,8 +272,8 @@ class StudyProblem:
         r = 0
         for k, part in enumerate(parts):
             off, n_c = self.offsets[k], self.problems[k].n_c
-            out[r : r + len(part), :N_XI] = part[:, :N_XI]
-            out[r : r + len(part), off : off + n_c] = part[:, N_XI:]
+            out[r : r + len(part), : self.n_xi] = part[:, : self.n_xi]
+            out[r : r + len(part), off : off + n_c] = part[:, self.n_xi :]
             r += len(part)
         return out
 

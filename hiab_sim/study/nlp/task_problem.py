@@ -3,9 +3,10 @@
 The solvers, reports and analyses take :class:`hiab_sim.study.nlp.problem.StudyProblem`, which stacks
 one :class:`TaskProblem` per task over the shared Xi (a single task is its own study, bit for bit).
 
-Decision variables z = [z_xi (6), z_c (3 N)] (scaled): Xi = ``XI_SCALE`` z_xi [m] (lift L, Lc0,
-Lc, then tilt) and c = c_ref + ``C_SCALE`` z_c, the B-spline coefficients of theta1, theta2, xt2
-around the study's initial fit. The cost f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 [W^2 s] uses the EMLA
+Decision variables z = [z_xi (n_xi), z_c (n N)] (scaled): Xi = ``XI_SCALE`` z_xi (the machine's
+decision variables: for the crane lift L, Lc0, Lc, then tilt [m]) and c = c_ref + ``C_SCALE`` z_c,
+the B-spline coefficients of the n joints (the crane's theta1, theta2, xt2) around the study's
+initial fit. The machine is seen through :class:`hiab_sim.study.machines.protocol.StudyMachine`. The cost f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 [W^2 s] uses the EMLA
 electrical power P_i of :mod:`hiab_sim.emla` (never f v / eta); it is a squared-power integral,
 not an energy, and is scaled by its value at the study's start.
 
@@ -13,7 +14,7 @@ Constraints, all scaled to O(1) and written g(z) >= 0 (rows named in :attr:`cons
 
 * ``const_a``: [f_x, v_x, a_x] = ID(theta, dtheta, ddtheta, robot(Xi)), implicit (evaluated);
 * ``const_b``..``const_d``: |r(theta) - r_ref| <= tolerance for position, velocity and
-  acceleration of r = (x_tcp, y_tcp, xt2) at every collocation point (a tolerance band, because
+  acceleration of the tracked r (the crane's (x_tcp, y_tcp, xt2)) at every collocation point (a tolerance band, because
   156 equalities over-determine 66 coefficients); rest at both ends as 12 linear equalities;
 * ``const_e``, ``const_f``: the EMLA envelope margins (peak torque, rated speed, voltage) >= 0;
 * ``const_g``: Xi within [xi_low, xi_up] (variable bounds);
@@ -37,14 +38,12 @@ with MuJoCo model rebuilds); EMLA and kinematic partials analytic.
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from hiab_sim.crane.description import Crane, LinkLengths
-from hiab_sim.crane.names import ACTUATOR_NAMES
-from hiab_sim.dynamics.interface import InverseDynamics, make_inverse_dynamics
+from hiab_sim.dynamics.interface import InverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla import (
     EmlaSet,
@@ -56,9 +55,9 @@ from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.nlp import blocks as bl
 from hiab_sim.study.nlp import builtin_blocks  # noqa: F401  (registers the built-in blocks, in row order)
 from hiab_sim.study.nlp.block_registry import build_blocks
-from hiab_sim.study.nlp.id_partials import id_joint_partials, id_length_partials
+from hiab_sim.study.machines.protocol import Design, StudyMachine
+from hiab_sim.study.nlp.id_partials import id_joint_partials
 from hiab_sim.study.nlp.interface import (
-    N_XI,
     Array,
     BlockJacobian,
     BlockLayout,
@@ -77,7 +76,6 @@ XI_SCALE = 1.0
 #: Scale of the spline-coefficient variables [rad or m per unit] (chosen for fast SQP convergence).
 C_SCALE = 0.1
 STROKE_SCALE = bl.STROKE_SCALE
-ACTUATORS = ACTUATOR_NAMES
 #: The ID's input check uses the working range shrunk by this much at both ends [rad].
 ID_SLACK = 0.02
 #: The optimiser (``tightened``) holds const_j at the ends of the working range with this clearance
@@ -93,7 +91,7 @@ class Evaluation(SampleState):
     """Everything computed at one point z (unscaled quantities in SI units): the state and its rows."""
 
     z: Array
-    coefficients: Array  # (3, N)
+    coefficients: Array  # (n, N)
     cost: float  # the objective's value [its unit; W^2 s for costf2]
     constraints: Array  # scaled, feasible where >= 0
     equalities: Array  # scaled, feasible where == 0
@@ -114,11 +112,12 @@ def duty_options(study: Study, emlas: EmlaSet, cycle_time: float) -> DutyOptions
     return options
 
 
-def working_range(crane: Crane, joints: Array, margin: float) -> tuple[tuple[float, float], ...]:
-    """Joint range the design must serve: the samples' range widened by ``margin`` [rad]."""
+def working_range(model: StudyMachine, joints: Array, margin: float) -> tuple[tuple[float, float], ...]:
+    """Joint range each stroke chain must serve: the samples' range widened by ``margin`` [rad]."""
     out = []
-    for j, chain in enumerate(crane.chains):
-        lo, hi = chain.joint_range
+    ranges = model.joint_ranges()
+    for j in model.stroke_joints:
+        lo, hi = ranges[j]
         out.append((max(lo, float(joints[:, j].min()) - margin), min(hi, float(joints[:, j].max()) + margin)))
     return tuple(out)
 
@@ -174,46 +173,42 @@ class TaskProblem:
         points = task.spline_points(study.spline.control_points, study.grid.duration, study.spline.degree)
         self.basis = tr.SplineBasis(points, study.spline.degree, duration)
         self.B = np.stack(self.basis.matrices(self.times))  # (3 orders, K, N)
-        self.kin = tr.TcpKinematics(study.crane)
+        model = study.model
+        self.n_joints = len(model.joint_names)
+        self.kin = model.kinematics
         self.reference = task.reference.sample(self.kin, self.times)
-        self.tcp_force = task.id_force(self.kin, study.crane.gravity, self.times)
+        self.tcp_force = task.id_force(self.kin, model.gravity, self.times)
         self.fd_step = study.solver.fd_step
         self.xi_path = "analytic" if study.solver.xi_derivatives == "analytic" else self.id_path
         # initial fit: inverse kinematics on the fine grid, least-squares spline at rest at both ends
         fine_ref = task.reference.sample(self.kin, self.fine_times())
-        ik = tr.inverse_kinematics(self.kin, fine_ref, ik_start(task.reference, self.kin, study.crane, fine_ref))
+        ik = model.inverse_kinematics(fine_ref, ik_start(task.reference, model, fine_ref))
         self.reference_joints = ik
         self.c_ref = tr.fit_coefficients(self.basis, ik)
-        margin = study.bounds.triangle_margin
-        # const_h with const_k: the crane's joint range and the hinge-angle margin (theta only)
-        self.theta_low = np.zeros(3)
-        self.theta_up = np.zeros(3)
-        for j, chain in enumerate(study.crane.chains):
-            lo, hi = chain.joint_range
-            self.theta_low[j] = max(lo, chain.joint_offset - math.pi + margin)
-            self.theta_up[j] = min(hi, chain.joint_offset - margin)
-        self.theta_low[2], self.theta_up[2] = study.crane.telescope.joint_range
+        # const_h with const_k: the machine's joint range and a triangle's hinge-angle margin (q only)
+        self.theta_low, self.theta_up = model.joint_bounds(study.bounds.triangle_margin)
         # working range the design must serve (const_j at its ends): the crane's full joint range
         # (so the redesigned crane keeps its workspace, as every ID path's input check demands) or
         # the reference's range widened by a margin. The ID sees a slightly narrower range, so trial
         # points of the line search that violate const_j by a second-order amount stay evaluable.
         wr_margin = study.bounds.working_margin
-        if study.bounds.working_range == "crane":
-            self.working = tuple(chain.joint_range for chain in study.crane.chains)
+        if study.bounds.working_range in ("crane", "machine"):
+            ranges = model.joint_ranges()
+            self.working = tuple(ranges[j] for j in model.stroke_joints)
             inner = tuple((lo + ID_SLACK, hi - ID_SLACK) for lo, hi in self.working)
         else:
-            self.working = working_range(study.crane, ik.position, wr_margin)
-            inner = working_range(study.crane, ik.position, 0.5 * wr_margin)
-        self.crane = replace(
-            study.crane,
-            lift=replace(study.crane.lift, joint_range=inner[0]),
-            tilt=replace(study.crane.tilt, joint_range=inner[1]),
-        )
-        self.n_xi = N_XI
-        self.n_c = 3 * self.basis.n
+            self.working = working_range(model, ik.position, wr_margin)
+            inner = working_range(model, ik.position, 0.5 * wr_margin)
+        #: the machine the inverse dynamics and the rows see: its stroke chains' ranges narrowed to ``inner``
+        self.model = model.with_stroke_ranges(inner)
+        self.n_xi = len(model.design_names)
+        self.n_c = self.n_joints * self.basis.n
         self.n = self.n_xi + self.n_c
-        self.lower = np.concatenate([np.asarray(study.bounds.xi_low) / XI_SCALE, np.full(self.n_c, -np.inf)])
-        self.upper = np.concatenate([np.asarray(study.bounds.xi_up) / XI_SCALE, np.full(self.n_c, np.inf)])
+        xi_low, xi_up = study.bounds.xi_low, study.bounds.xi_up
+        self.lower = np.concatenate([np.asarray(xi_low) / XI_SCALE, np.full(self.n_c, -np.inf)])
+        self.upper = np.concatenate([np.asarray(xi_up) / XI_SCALE, np.full(self.n_c, np.inf)])
+        #: rest at both ends: dq = ddq = 0 at t = 0 and at the end, per joint
+        self.n_equalities = 4 * self.n_joints
         self.duty_options = duty_options(study, self.emlas, duration)
         self.objective = make_objective(objective or study.energy.objective, self.emlas, self.dt)
         self.layout = BlockLayout(self._build_blocks())
@@ -248,30 +243,39 @@ class TaskProblem:
 
     # -- variables ---------------------------------------------------------------------------
 
-    def initial_point(self, lengths: LinkLengths, coefficients: Array | None = None) -> Array:
+    @property
+    def crane(self) -> Any:
+        """The crane description this problem's rows see (crane-only blocks and reports; a machine file has none)."""
+        crane = getattr(self.model, "crane", None)
+        if crane is None:
+            raise InvalidInputError("machine", self.model.name, "this part of the study needs a crane file (crane:)")
+        return crane
+
+    def initial_point(self, lengths: Design, coefficients: Array | None = None) -> Array:
         """Scaled z for link lengths and coefficients (default: the inverse-kinematics fit)."""
-        c = self.c_ref if coefficients is None else np.asarray(coefficients, dtype=float).reshape(3, -1)
+        n = self.n_joints
+        c = self.c_ref if coefficients is None else np.asarray(coefficients, dtype=float).reshape(n, -1)
         return np.concatenate([lengths.as_array() / XI_SCALE, ((c - self.c_ref) / C_SCALE).ravel()])
 
-    def unpack(self, z: Array) -> tuple[LinkLengths, Array]:
-        """(Xi, c (3, N)) from scaled z."""
+    def unpack(self, z: Array) -> tuple[Design, Array]:
+        """(Xi, c (n, N)) from scaled z."""
         z = np.asarray(z, dtype=float)
         xi = z[: self.n_xi] * XI_SCALE
-        c = self.c_ref + C_SCALE * z[self.n_xi :].reshape(3, self.basis.n)
-        return LinkLengths.from_array(xi), c
+        c = self.c_ref + C_SCALE * z[self.n_xi :].reshape(self.n_joints, self.basis.n)
+        return self.model.design(xi), c
 
     # -- evaluation --------------------------------------------------------------------------
 
-    def _id(self, lengths: LinkLengths) -> InverseDynamics:
+    def _id(self, lengths: Design) -> InverseDynamics:
         key = lengths.as_array().tobytes()
         if key not in self._id_cache:
             if len(self._id_cache) > 32:
                 self._id_cache.clear()
-            self._id_cache[key] = make_inverse_dynamics(self.crane, lengths, self.id_path)
+            self._id_cache[key] = self.model.inverse_dynamics(lengths, self.id_path)
         return self._id_cache[key]
 
     def joints(self, c: Array) -> tr.JointTrajectory:
-        """Joint samples on this problem's grid for coefficients c (3, N)."""
+        """Joint samples on this problem's grid for coefficients c (n, N)."""
         B, dB, ddB = self.B
         return tr.JointTrajectory(self.times, B @ c.T, dB @ c.T, ddB @ c.T)
 
@@ -367,31 +371,32 @@ class TaskProblem:
         return self._gradients(z)[1]
 
     def equalities_jacobian(self, z: Array) -> Array:
-        """D e / dz (constant), shape (12, n)."""
+        """D e / dz (constant), shape (4 n_joints, n)."""
         R = self._rest_matrix()  # (4, N)
-        jac = np.zeros((12, self.n))
-        for j in range(3):
+        nj = self.n_joints
+        jac = np.zeros((4 * nj, self.n))
+        for j in range(nj):
             jac[j * 4 : (j + 1) * 4, self.n_xi + j * self.basis.n : self.n_xi + (j + 1) * self.basis.n] = R
-        # rows of _equalities are (R @ c.T).ravel(): row r, joint j -> index r * 3 + j
-        order = np.array([r * 3 + j for j in range(3) for r in range(4)])
+        # rows of _equalities are (R @ c.T).ravel(): row r, joint j -> index r * n_joints + j
+        order = np.array([r * nj + j for j in range(nj) for r in range(4)])
         out = np.zeros_like(jac)
         out[order] = jac
         return out
 
     def _to_z(self, block: ConstraintBlock, jac: BlockJacobian, rows: int) -> Array:
         """A block's partials w.r.t. q9 and Xi [per m] as rows of D g / dz (m, n), through the spline matrices."""
-        K = len(self.times)
+        K, nj = len(self.times), self.n_joints
         out = np.zeros((rows, self.n))
         if isinstance(jac, SampleRows):
             r = jac.dq.shape[1]
-            # q9 index = order * 3 + joint
-            dc = np.einsum("kmoj,okn->kmjn", jac.dq.reshape(K, r, 3, 3), self.B) * C_SCALE
+            # q9 index = order * n_joints + joint
+            dc = np.einsum("kmoj,okn->kmjn", jac.dq.reshape(K, r, 3, nj), self.B) * C_SCALE
             out[:, self.n_xi :] = dc.reshape(rows, self.n_c)
             if jac.dxi is not None:
                 out[:, : self.n_xi] = (jac.dxi * XI_SCALE).reshape(rows, self.n_xi)
         else:
             if jac.dq is not None:
-                dc = np.einsum("mkoj,okn->mjn", jac.dq.reshape(rows, K, 3, 3), self.B) * C_SCALE
+                dc = np.einsum("mkoj,okn->mjn", jac.dq.reshape(rows, K, 3, nj), self.B) * C_SCALE
                 out[:, self.n_xi :] = dc.reshape(rows, self.n_c)
             if jac.dxi is not None:
                 out[:, : self.n_xi] = jac.dxi * XI_SCALE
@@ -407,12 +412,12 @@ class TaskProblem:
         samples = JointSamples(ev.joints.position, ev.joints.velocity, ev.joints.acceleration)
         partials = SamplePartials(
             lambda: id_joint_partials(self._id(ev.lengths), samples, self.fd_step, self.tcp_force),
-            lambda: id_length_partials(self.crane, ev.lengths, samples, self.xi_path, self.fd_step, self.tcp_force),
+            lambda: self.model.design_partials(ev.lengths, samples, self.xi_path, self.fd_step, self.tcp_force),
         )
         jac = self.layout.jacobian(ev, partials, self._to_z)
         dcost_q, dcost_xi = self.objective.gradient(ev, partials)
         K = len(self.times)
-        grad_c = np.einsum("koj,okn->jn", dcost_q.reshape(K, 3, 3), self.B).ravel() * C_SCALE
+        grad_c = np.einsum("koj,okn->jn", dcost_q.reshape(K, 3, self.n_joints), self.B).ravel() * C_SCALE
         grad = np.concatenate([dcost_xi * XI_SCALE, grad_c]) / self.cost_scale
         if len(self._grad_cache) > 4:
             self._grad_cache.clear()

@@ -72,14 +72,14 @@ class ThermalLimits(ConstraintBlock):
 
     def jacobian(self, state: SampleState, partials: SamplePartials) -> DenseRows:
         """Rows' partials: d/d(f, v, a)_k from the thermal check, chained through the ID partials."""
-        K = len(state.joints.time)
+        K, n = len(state.joints.time), len(self.emlas)
         rows = []
         for i, c in self._checks(state):
             for d, scale in ((c.d_rms, -1.0 / c.continuous_torque), (c.d_peak, -1.0 / TEMPERATURE_SCALE)):
-                dY = np.zeros((K, 9))
-                dY[:, i], dY[:, 3 + i], dY[:, 6 + i] = scale * d[0], scale * d[1], scale * d[2]
+                dY = np.zeros((K, 3 * n))  # w.r.t. Y = (f, v, a) of every actuator
+                dY[:, i], dY[:, n + i], dY[:, 2 * n + i] = scale * d[0], scale * d[1], scale * d[2]
                 rows.append(dY)
-        dYs = np.stack(rows) if rows else np.zeros((0, K, 9))
+        dYs = np.stack(rows) if rows else np.zeros((0, K, 3 * n))
         dq = np.einsum("mky,kyq->mkq", dYs, partials.id_q)
         dxi = np.einsum("mky,kyx->mx", dYs, partials.id_xi)
         return DenseRows(dq=dq, dxi=dxi)

@@ -1,5 +1,9 @@
 """A task's reference from a trajectory file: TCP ``t, x, y[, xt2]`` or joints ``t, theta1, theta2, xt2``.
 
+The columns are the machine's: the TCP form is ``t, x, y`` and each further tracked coordinate by
+name (the crane's ``xt2``, an excavator's ``tcp_angle``); the joint form ``t`` and every joint by
+name. The crane's names are the defaults.
+
 File format: comma-separated, SI units (s, m, rad), one header row naming the columns (any
 order), then one sample per row; blank lines and lines starting with ``#`` are skipped (use them
 to say where the data comes from). Rows are named by their line number in the file, as an
@@ -14,9 +18,10 @@ row within ``fit_tolerance``; a row it misses (noisy data, a file that does not 
 rest, too few control points) is named.
 
 TCP form: the fit is r = (x, y, xt2) directly; without an ``xt2`` column the telescope is held at
-the task's ``telescope`` [m] (prescribed, see :mod:`hiab_sim.study.references.kinds`). Joint form:
-the fit is (theta1, theta2, xt2) and r follows by the planar TCP kinematics with exact rates.
-Every row is checked against the crane's reach and joint ranges (closed-form IK,
+the task's ``telescope`` [m] (prescribed, see :mod:`hiab_sim.study.references.kinds`); a machine
+with one further tracked coordinate may likewise hold it at ``telescope`` [its unit]. Joint form:
+the fit is the joints and r follows by the planar TCP kinematics with exact rates.
+Every row is checked against the machine's reach and joint ranges (its IK,
 :mod:`hiab_sim.study.motion.workspace`), then the fitted reference every 10 ms.
 """
 
@@ -25,24 +30,31 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.crane.description import Crane
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study.motion.trajectory import JointTrajectory, Reference, SplineBasis, TcpKinematics, fit_coefficients
-from hiab_sim.study.motion.workspace import REASONS, check_workspace, dense_times, planar_ik
+from hiab_sim.study.motion.workspace import check_workspace, dense_times, describe_point
 from hiab_sim.yaml_fields import mapping, number, positive
 
+if TYPE_CHECKING:
+    from hiab_sim.crane.description import Crane
+    from hiab_sim.study.machines.protocol import StudyMachine
+
 Array = NDArray[np.float64]
-#: Accepted column sets (any order) and the form they give.
-FORMS = {
-    frozenset({"t", "x", "y"}): "tcp",
-    frozenset({"t", "x", "y", "xt2"}): "tcp",
-    frozenset({"t", "theta1", "theta2", "xt2"}): "joints",
-}
+#: The crane's tracked coordinates beyond the TCP's x, y and its joints: the default columns.
+CRANE_NAMES = (("xt2",), ("theta1", "theta2", "xt2"))
+
+
+def forms(extra: tuple[str, ...], joints: tuple[str, ...]) -> dict[frozenset[str], str]:
+    """Accepted column sets (any order) and the form they give, for a machine's tracked ``extra`` and ``joints``."""
+    out = {frozenset({"t", "x", "y", *extra}): "tcp", frozenset({"t", *joints}): "joints"}
+    if len(extra) == 1:
+        out[frozenset({"t", "x", "y"})] = "tcp"  # the one further coordinate held at the task's value
+    return out
 DEGREE = 5
 #: Default knot spacing of the fit [s]: the seed's 22 control points over 6.25 s space knots ~0.37 s.
 KNOT_SPACING = 0.25
@@ -58,8 +70,12 @@ class CsvTable:
     lines: tuple[int, ...]
 
 
-def read_table(path: Path) -> CsvTable:
-    """Parse a trajectory file (module docstring); malformed files raise :class:`ConfigError`."""
+def read_table(path: Path, names: tuple[tuple[str, ...], tuple[str, ...]] = CRANE_NAMES) -> CsvTable:
+    """Parse a trajectory file (module docstring); malformed files raise :class:`ConfigError`.
+
+    ``names``: the machine's tracked coordinates beyond x, y and its joints (default: the crane's).
+    """
+    accepted = forms(*names)
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as error:
@@ -70,8 +86,9 @@ def read_table(path: Path) -> CsvTable:
         raise ConfigError(f"{path}: no header row and no data")
     head_line, head = rows[0]
     columns = tuple(c.strip() for c in head.split(","))
-    if FORMS.get(frozenset(columns)) is None or len(set(columns)) != len(columns):
-        expected = "; ".join(", ".join(sorted(f, key=("t", "x", "y", "theta1", "theta2", "xt2").index)) for f in FORMS)
+    if accepted.get(frozenset(columns)) is None or len(set(columns)) != len(columns):
+        order = ("t", "x", "y", *names[0], *names[1])
+        expected = "; ".join(", ".join(sorted(f, key=order.index)) for f in accepted)
         raise ConfigError(f"{path} row {head_line}: header columns {list(columns)}; expected one of: {expected}")
     values = np.empty((len(rows) - 1, len(columns)))
     for i, (n, line) in enumerate(rows[1:]):
@@ -102,6 +119,7 @@ class CsvReference:
 
     table: CsvTable
     telescope: float | None = None
+    names: tuple[tuple[str, ...], tuple[str, ...]] = CRANE_NAMES
     control_points: int | None = None
     fit_tolerance: float = 5e-3
     kind: ClassVar[str] = "csv"
@@ -111,7 +129,8 @@ class CsvReference:
 
     def __post_init__(self) -> None:
         tab, columns = self.table, self.table.columns
-        form = FORMS[frozenset(columns)]
+        form = forms(*self.names)[frozenset(columns)]
+        extra = self.names[0]
         object.__setattr__(self, "form", form)
         if len(tab.values) < DEGREE + 2:
             raise InvalidInputError(f"{tab.path} rows", len(tab.values), f"need at least {DEGREE + 2} data rows")
@@ -132,13 +151,13 @@ class CsvReference:
                 f"times must increase strictly (row {tab.lines[i - 1]} has t = {t[i - 1]:.6g} s)",
                 "s",
             )
-        if form == "tcp" and ("xt2" in columns) == (self.telescope is not None):
+        if form == "tcp" and (set(extra) <= set(columns)) == (self.telescope is not None):
             raise ConfigError(
-                f"{tab.path}: give the telescope either as an 'xt2' column or as the task's 'telescope' [m], not "
+                f"{tab.path}: give the telescope either as an '{extra[-1]}' column or as the task's 'telescope', not "
                 + ("both" if self.telescope is not None else "neither")
             )
         if form == "joints" and self.telescope is not None:
-            raise ConfigError(f"{tab.path}: a joint file has its own 'xt2' column; remove the task's 'telescope'")
+            raise ConfigError(f"{tab.path}: a joint file has its own joint columns; remove the task's 'telescope'")
         _require(self.fit_tolerance > 0.0, "fit_tolerance", self.fit_tolerance, "must be > 0")
         time = t - t[0]
         object.__setattr__(self, "time", time)
@@ -178,14 +197,14 @@ class CsvReference:
         n = self.control_points or math.ceil(self.duration / KNOT_SPACING) + DEGREE
         return SplineBasis(n, DEGREE, self.duration)
 
-    def _fit_columns(self) -> tuple[str, str, str]:
-        return ("x", "y", "xt2") if self.form == "tcp" else ("theta1", "theta2", "xt2")
+    def _fit_columns(self) -> tuple[str, ...]:
+        return ("x", "y", *self.names[0]) if self.form == "tcp" else self.names[1]
 
     def _data(self) -> Array:
-        """The fitted columns (R, 3): (x, y, xt2) or (theta1, theta2, xt2)."""
+        """The fitted columns (R, n): (x, y, tracked...) or the joints."""
         tab = self.table
         cols = [tab.values[:, tab.columns.index(c)] for c in self._fit_columns() if c in tab.columns]
-        if len(cols) == 2:
+        if len(cols) < len(self._fit_columns()):
             assert self.telescope is not None
             cols.append(np.full(len(tab.values), self.telescope))
         return np.column_stack(cols)
@@ -201,21 +220,25 @@ class CsvReference:
             q, dq, ddq = s.position, s.velocity, s.acceleration
         return Reference(time=t, position=q, velocity=dq, acceleration=ddq, z=kin.z, centre=(q[0, 0], q[0, 1]))
 
-    def check_reach(self, kin: TcpKinematics, crane: Crane) -> None:
-        """Every row, then the fit every 10 ms, within the crane's reach and joint ranges."""
+    def check_reach(self, kin: TcpKinematics, model: StudyMachine | Crane) -> None:
+        """Every row, then the fit every 10 ms, within the machine's reach and joint ranges."""
+        from hiab_sim.study.machines import as_study_machine  # the study's machines import this module
+
+        model = as_study_machine(model)
         tab, data = self.table, self._data()
         t = tab.values[:, tab.columns.index("t")]
         if self.form == "tcp":
-            status = planar_ik(kin, crane, data[:, :2], data[:, 2]).status
-            if np.any(status):
-                i = int(np.argmax(status != 0))
+            reach = model.reach(data)
+            if np.any(reach.status):
+                i = int(np.argmax(reach.status != 0))
                 raise InvalidInputError(
                     f"{tab.path} row {tab.lines[i]} (t = {t[i]:.6g} s)",
-                    f"TCP ({data[i, 0]:.4g}, {data[i, 1]:.4g}) m with xt2 = {data[i, 2]:.4g} m",
-                    f"the point {REASONS[int(status[i])]}",
+                    describe_point(model, data[i]),
+                    f"the point {reach.reasons[int(reach.status[i])]}",
                 )
         else:
-            ranges = [c.joint_range for c in crane.chains] + [crane.telescope.joint_range]
+            ranges = model.joint_ranges()
+            units = model.joint_units
             for j, (name, (lo, hi)) in enumerate(zip(self._fit_columns(), ranges, strict=True)):
                 out = (data[:, j] < lo) | (data[:, j] > hi)
                 if np.any(out):
@@ -223,13 +246,15 @@ class CsvReference:
                     raise InvalidInputError(
                         f"{tab.path} row {tab.lines[i]} (t = {t[i]:.6g} s), column '{name}'",
                         float(data[i, j]),
-                        f"must lie in the crane's range [{lo:.6g}, {hi:.6g}]",
-                        "m" if name == "xt2" else "rad",
+                        f"must lie in the machine's range [{lo:.6g}, {hi:.6g}]",
+                        units[j],
                     )
-        check_workspace(kin, crane, self.sample(kin, dense_times(self.duration)), where=f"{tab.path} fit")
+        check_workspace(model, self.sample(kin, dense_times(self.duration)), where=f"{tab.path} fit")
 
     @classmethod
-    def from_mapping(cls, data: Any, where: str, folder: Path) -> CsvReference:
+    def from_mapping(
+        cls, data: Any, where: str, folder: Path, names: tuple[tuple[str, ...], tuple[str, ...]] = CRANE_NAMES
+    ) -> CsvReference:
         """Read ``{kind: csv, file, telescope?, control_points?, fit_tolerance?}``; ``file`` relative to ``folder``."""
         d = mapping(data, where, {"kind", "file", "telescope", "control_points", "fit_tolerance"}, {"file"})
         path = Path(str(d["file"]))
@@ -239,8 +264,9 @@ class CsvReference:
             raise InvalidInputError(f"{where}.control_points", points, f"must be an integer >= {DEGREE + 2}")
         telescope = d.get("telescope")
         return cls(
-            table=read_table(path),
+            table=read_table(path, names),
             telescope=None if telescope is None else number(telescope, f"{where}.telescope"),
+            names=names,
             control_points=points,
             fit_tolerance=positive(d.get("fit_tolerance", 5e-3), f"{where}.fit_tolerance"),
         )

@@ -35,17 +35,20 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar, Protocol
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import brentq
 
-from hiab_sim.crane.description import Crane
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study.motion.trajectory import Reference, TcpKinematics, timing_law
 from hiab_sim.study.motion.workspace import check_workspace, dense_times, initial_joints
-from hiab_sim.study.references.csv_file import CsvReference
+
+if TYPE_CHECKING:
+    from hiab_sim.crane.description import Crane
+    from hiab_sim.study.machines.protocol import StudyMachine
+from hiab_sim.study.references.csv_file import CRANE_NAMES, CsvReference
 from hiab_sim.yaml_fields import mapping, number, positive
 
 Array = NDArray[np.float64]
@@ -64,8 +67,8 @@ class TaskReference(Protocol):
     def sample(self, kin: TcpKinematics, times: Array) -> Reference:
         """Reference r = (x_tcp, y_tcp, xt2) and its rates at ``times`` [s], each (T, 3)."""
 
-    def check_reach(self, kin: TcpKinematics, crane: Crane) -> None:
-        """Raise :class:`InvalidInputError` naming the first time (or file row) the crane cannot reach."""
+    def check_reach(self, kin: TcpKinematics, model: StudyMachine | Crane) -> None:
+        """Raise :class:`InvalidInputError` naming the first time (or file row) the machine cannot reach."""
 
 
 def septic_law(times: Array, start: float, duration: float) -> tuple[Array, Array, Array]:
@@ -161,9 +164,9 @@ class Spiral:
             centre=(cx, cy),
         )
 
-    def check_reach(self, kin: TcpKinematics, crane: Crane) -> None:
-        """Closed-form IK of the reference every <= 10 ms; raises naming the first unreachable time."""
-        check_workspace(kin, crane, self.sample(kin, dense_times(self.duration)))
+    def check_reach(self, kin: TcpKinematics, model: StudyMachine | Crane) -> None:
+        """The machine's IK of the reference every <= 10 ms; raises naming the first unreachable time."""
+        check_workspace(model, self.sample(kin, dense_times(self.duration)))
 
     @classmethod
     def from_mapping(cls, data: Any, where: str, default_duration: float) -> Spiral:
@@ -266,9 +269,9 @@ class PickAndPlace:
             centre=self.pick,
         )
 
-    def check_reach(self, kin: TcpKinematics, crane: Crane) -> None:
-        """Closed-form IK of the reference every <= 10 ms; raises naming the first unreachable time."""
-        check_workspace(kin, crane, self.sample(kin, dense_times(self.duration)))
+    def check_reach(self, kin: TcpKinematics, model: StudyMachine | Crane) -> None:
+        """The machine's IK of the reference every <= 10 ms; raises naming the first unreachable time."""
+        check_workspace(model, self.sample(kin, dense_times(self.duration)))
 
     @classmethod
     def from_mapping(cls, data: Any, where: str) -> PickAndPlace:
@@ -300,7 +303,13 @@ def _apex(y0: float, y3: float, h: float) -> float:
 # ---------------------------------------------------------------------------------------------
 
 
-def reference_from_mapping(data: Any, where: str, folder: Path, default_duration: float) -> TaskReference:
+def reference_from_mapping(
+    data: Any,
+    where: str,
+    folder: Path,
+    default_duration: float,
+    names: tuple[tuple[str, ...], tuple[str, ...]] = CRANE_NAMES,
+) -> TaskReference:
     """Build the reference kind named by ``kind`` (default ``spiral``: today's single reference).
 
     Args:
@@ -308,6 +317,7 @@ def reference_from_mapping(data: Any, where: str, folder: Path, default_duration
         where: Its dotted path for messages, e.g. ``tasks[1].reference``.
         folder: Folder of the study file (relative CSV paths resolve there).
         default_duration: The grid's duration [s], used by a spiral without ``duration``.
+        names: The machine's tracked coordinates beyond the TCP's x, y, and its joints (a CSV's columns).
 
     """
     kind = str(mapping(data, where, None).get("kind", "spiral"))
@@ -316,22 +326,24 @@ def reference_from_mapping(data: Any, where: str, folder: Path, default_duration
     if kind == "pick_and_place":
         return PickAndPlace.from_mapping(data, where)
     if kind == "csv":
-        return CsvReference.from_mapping(data, where, folder)
+        return CsvReference.from_mapping(data, where, folder, names)
     raise InvalidInputError(f"{where}.kind", kind, f"must be one of {', '.join(KINDS)}")
 
 
-def ik_start(reference: TaskReference, kin: TcpKinematics, crane: Crane, sampled: Reference) -> tuple[float, float]:
-    """(theta1, theta2) [rad] that starts the Newton IK of ``sampled``.
+def ik_start(reference: TaskReference, model: StudyMachine, sampled: Reference) -> Array:
+    """Joints (n,) that start the Newton IK of ``sampled`` (the crane reads its first two).
 
     A spiral's ``centre_joints`` (today's start), or the middle of the joint ranges for a spiral
-    given by its TCP centre; any other kind: the closed-form IK of its first sample.
+    given by its TCP centre (the prescribed joints at their first sample); any other kind: the
+    machine's IK of its first sample (:meth:`~hiab_sim.study.machines.protocol.StudyMachine.ik_guess`).
     """
     if isinstance(reference, Spiral):
+        first = sampled.position[0]
         if reference.centre_joints is not None:
-            return reference.centre_joints
-        (lo1, hi1), (lo2, hi2) = crane.lift.joint_range, crane.tilt.joint_range
-        return (0.5 * (lo1 + hi1), 0.5 * (lo2 + hi2))
-    return initial_joints(kin, crane, sampled)
+            return np.array([*reference.centre_joints, *first[2:]])
+        (lo1, hi1), (lo2, hi2) = model.joint_ranges()[:2]
+        return np.array([0.5 * (lo1 + hi1), 0.5 * (lo2 + hi2), *first[2:]])
+    return model.ik_guess(sampled.position[0])
 
 
 def _check(ok: bool, field: str, value: float, allowed: str, unit: str = "") -> None:

@@ -63,7 +63,7 @@ def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, c
     label, row, value = tol.worst()
     tolerance_check = RoundedCheck(tol.ok, f"{row} at the {label} design", value, "m")
     fine = StudyProblem(
-        replace(study, crane=short),
+        replace(study, crane_description=short),
         emlas=problem.emlas,
         id_path=other_path(problem.id_path),
         tightened=False,

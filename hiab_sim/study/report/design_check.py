@@ -31,7 +31,7 @@ from hiab_sim.results.schema import (
     WorstConstraint,
 )
 from hiab_sim.study.nlp.objectives import costf2
-from hiab_sim.study.nlp.task_problem import ACTUATORS, Evaluation, TaskProblem
+from hiab_sim.study.nlp.task_problem import Evaluation, TaskProblem
 from hiab_sim.study.spec.study_file import Study
 
 Array = NDArray[np.float64]
@@ -44,6 +44,11 @@ class DesignCheck:
     evaluation: Evaluation
     summary: DesignSummary
 
+    @property
+    def actuator_names(self) -> tuple[str, ...]:
+        """The actuators, in the order of the evaluation's columns."""
+        return tuple(self.summary.actuators)
+
 
 def design_summary(problem: TaskProblem, z: Array) -> DesignCheck:
     """Evaluate z on ``problem``'s grid (the fine grid, nominal bands): energies, peaks, violations."""
@@ -53,7 +58,7 @@ def design_summary(problem: TaskProblem, z: Array) -> DesignCheck:
     net, drawn = energy_summary(t, ev.power.T)
     breakdown = np.zeros(len(ENERGY_PARTS))
     per_actuator: dict[str, ActuatorSummary] = {}
-    for i, (name, params) in enumerate(zip(ACTUATORS, problem.emlas, strict=True)):
+    for i, (name, params) in enumerate(zip(problem.emlas.names, problem.emlas, strict=True)):
         op = operating_point(params, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
         parts = EnergyBreakdown(
             mechanical=float(trapezoid(op.mechanical_power, t)),

@@ -28,6 +28,12 @@ from hiab_sim.checks import check_choice, check_range
 from hiab_sim.crane.description import CHAIN_NAMES, ChainLengths, Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.crane.mounting import MountingSpace
+from hiab_sim.machine.description import Machine
+from hiab_sim.machine.loader import PRESETS as MACHINE_PRESETS
+from hiab_sim.machine.loader import load_machine, locate_machine
+from hiab_sim.study.machines.crane_model import CraneModel
+from hiab_sim.study.machines.machine_model import MachineModel
+from hiab_sim.study.machines.protocol import Design, StudyMachine
 from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import DEFAULT_STUDY, Source, locate
@@ -138,26 +144,30 @@ class Bounds:
 
     xi_low: tuple[float, ...]
     xi_up: tuple[float, ...]
-    joint_velocity: tuple[float, float, float] = (0.6, 0.6, 0.5)
+    joint_velocity: tuple[float, ...] = (0.6, 0.6, 0.5)
     triangle_margin: float = math.radians(10.0)
     working_margin: float = math.radians(3.0)
     envelope_margin: float = 0.02
     working_range: str = "crane"
+    #: where each bound comes from, for messages (default: the crane's ``bounds.<chain>.low[i] (key)``)
+    xi_fields: tuple[str, ...] = field(default=(), compare=False, repr=False)
 
     def __post_init__(self) -> None:
         for i, (low, up) in enumerate(zip(self.xi_low, self.xi_up, strict=True)):
-            name, key = CHAIN_NAMES[i // 3], ("L", "Lc0", "Lc")[i % 3]
-            if not 0.0 < low < up:
-                raise InvalidInputError(
-                    f"bounds.{name}.low[{i % 3}] ({key})", low, f"must satisfy 0 < low < up = {up:.6g}", "m"
-                )
+            where = (
+                self.xi_fields[i]
+                if self.xi_fields
+                else f"bounds.{CHAIN_NAMES[i // 3]}.low[{i % 3}] ({('L', 'Lc0', 'Lc')[i % 3]})"
+            )
+            if not low < up or (not self.xi_fields and not 0.0 < low):
+                raise InvalidInputError(where, low, f"must satisfy {'' if self.xi_fields else '0 < '}low < up = {up:.6g}", "m")
         if min(self.joint_velocity) <= 0.0:
             raise InvalidInputError("bounds.joint_velocity", min(self.joint_velocity), "every limit must be > 0")
         margin = math.degrees(self.triangle_margin)
         check_range("bounds.triangle_margin_deg", margin, 0.0, 60.0, "deg", high_open=True)
         check_range("bounds.working_margin_deg", math.degrees(self.working_margin), 0.0, 30.0, "deg")
         check_range("bounds.envelope_margin", self.envelope_margin, 0.0, 0.5, high_open=True)
-        check_choice("bounds.working_range", self.working_range, ("crane", "reference"))
+        check_choice("bounds.working_range", self.working_range, ("crane", "machine", "reference"))
 
 
 @dataclass(frozen=True)
@@ -199,16 +209,18 @@ class Study:
 
     ``crane_source`` and ``emla_source`` are what the study file wrote (a preset name or a path
     relative to it), kept for reports; ``crane_file`` is where the crane was read from, for
-    copying a crane file next to a result.
+    copying a crane file next to a result. A study of a machine file (``machine:``) has no crane
+    description (``crane_description`` None, ``machine`` its :class:`~hiab_sim.machine.description.Machine`);
+    :attr:`model` is the machine as the NLP sees it either way.
     """
 
     name: str
     path: str
     crane_source: str
-    crane: Crane = field(repr=False)
+    crane_description: Crane | None = field(repr=False)
     emla_source: str
     emlas: EmlaSet = field(repr=False)
-    initial_lengths: LinkLengths
+    initial_lengths: Design
     spline: SplineSettings
     grid: GridSettings
     tasks: tuple[Task, ...]
@@ -219,25 +231,57 @@ class Study:
     mounting: MountingSpace | None = None  # optional mounting polygons of the base pivots
     crane_file: Source | None = field(default=None, repr=False, compare=False)
     #: The built crane's lengths when they lie outside the bounds and the loader moved the start into them.
-    start_moved_from: LinkLengths | None = field(default=None, repr=False, compare=False)
+    start_moved_from: Design | None = field(default=None, repr=False, compare=False)
     energy: EnergySettings = field(default_factory=EnergySettings)  # objective, duty, transmission
     structure: StructureSettings = field(default_factory=StructureSettings)  # buckling, pin and frequency rows
+    machine: Machine | None = field(default=None, repr=False)  # a machine file's description (``machine:``)
+    tracked: tuple[str, ...] = ()  # a machine's tracked coordinates beyond the TCP's x, y
 
     def __post_init__(self) -> None:
         if not self.tasks:
             raise InvalidInputError("tasks", 0, "a study needs at least one task")
+        if (self.crane_description is None) == (self.machine is None):
+            raise InvalidInputError("machine", self.crane_source, "a study needs exactly one of crane: or machine:")
         if self.energy.duty is not None:
             for task in self.tasks:  # the duty must fit each task's cycle (named error otherwise)
                 self.energy.duty.duty(task.reference.duration)
-        for name in CHAIN_NAMES:
-            for i, key in enumerate(("L", "Lc0", "Lc")):
-                k = 3 * CHAIN_NAMES.index(name) + i
-                low, up = self.bounds.xi_low[k], self.bounds.xi_up[k]
-                start = getattr(getattr(self.initial_lengths, name), key)
-                if not low <= start <= up:
-                    raise InvalidInputError(
-                        f"initial_lengths.{name}.{key}", start, f"must lie in the bounds [{low:.6g}, {up:.6g}]", "m"
-                    )
+        names = self.model.design_names
+        if len(self.bounds.xi_low) != len(names):
+            raise InvalidInputError("bounds", len(self.bounds.xi_low), f"need one per decision variable: {names}")
+        for k, (name, start) in enumerate(zip(names, self.initial_lengths.as_array(), strict=True)):
+            low, up = self.bounds.xi_low[k], self.bounds.xi_up[k]
+            if not low <= start <= up:
+                raise InvalidInputError(
+                    f"initial_lengths.{name}", float(start), f"must lie in the bounds [{low:.6g}, {up:.6g}]", "m"
+                )
+        if len(self.bounds.joint_velocity) != len(self.model.joint_names):
+            raise InvalidInputError(
+                "bounds.joint_velocity",
+                len(self.bounds.joint_velocity),
+                f"need one limit per joint: {', '.join(self.model.joint_names)}",
+            )
+
+    @property
+    def crane(self) -> Crane:
+        """The crane description (a crane-file study only; the parts of hiab-sim not yet on machine files need it)."""
+        if self.crane_description is None:
+            raise InvalidInputError(
+                "machine", self.crane_source, "this part of hiab-sim needs a crane file (crane:), not a machine file"
+            )
+        return self.crane_description
+
+    @property
+    def model(self) -> StudyMachine:
+        """The machine as the NLP sees it (:mod:`hiab_sim.study.machines`), built once."""
+        cached = self.__dict__.get("_model")
+        if cached is None:
+            if self.crane_description is not None:
+                cached = CraneModel(self.crane_description)
+            else:
+                assert self.machine is not None
+                cached = MachineModel(self.machine, self.tracked)
+            object.__setattr__(self, "_model", cached)
+        return cached
 
     @property
     def reference(self) -> TaskReference:
@@ -253,6 +297,8 @@ class Study:
 _TOP = {
     "name",
     "crane",
+    "machine",
+    "tracked",
     "emla",
     "initial_lengths",
     "spline",
@@ -268,7 +314,7 @@ _TOP = {
     "mounting",
     "structure",
 }
-_REQUIRED_TOP = {"crane", "bounds"}
+_REQUIRED_TOP = {"bounds"}
 
 
 def load_study(path: str | Path | Source | None = None) -> Study:
@@ -291,11 +337,17 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
     if not isinstance(file, Source):
         file = Source(str(file), Path(file), shipped=False)
     top = mapping(data, "study", _TOP, _REQUIRED_TOP)
+    if "machine" in top:
+        return machine_study_from_dict(top, file)
+    if "crane" not in top:
+        raise ConfigError("study: missing key 'crane' (a crane file) or 'machine' (a machine file)")
+    if "tracked" in top:
+        raise ConfigError("study: 'tracked' belongs to a machine file's study (machine:); a crane tracks x, y, xt2")
     crane_source = str(top["crane"])
     crane_file = locate(crane_source, "crane", relative_to=file)
     crane = load_crane(crane_file)
     emla_source = "default" if top.get("emla") is None else str(top["emla"])
-    emlas = load_emla_set(locate(emla_source, "emla", relative_to=file))
+    emlas = load_emla_set(locate(emla_source, "emla", relative_to=file)).renamed(CraneModel(crane).actuator_names)
     bounds = _bounds(top["bounds"])
     grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
     name = str(top.get("name", Path(str(file.file)).stem))
@@ -311,7 +363,7 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
         name=name,
         path=str(file.file),
         crane_source=crane_source,
-        crane=crane,
+        crane_description=crane,
         emla_source=emla_source,
         emlas=emlas,
         initial_lengths=initial,
@@ -364,27 +416,27 @@ def _clipped_lengths(crane: Crane, bounds: Bounds) -> LinkLengths:
     return LinkLengths.from_array(out)
 
 
-def _bounds(data: Any) -> Bounds:
-    """Bounds from YAML: per chain ``low``/``up`` triples; angles in degrees (``*_deg``)."""
+def _bounds(data: Any, chains: bool = True, joints: int = 3) -> Bounds:
+    """Bounds from YAML: per chain ``low``/``up`` triples (a crane file's; a machine file declares its own,
+    ``chains`` False); ``joint_velocity`` one per joint (required for a machine); angles in degrees (``*_deg``)."""
     keys = {
-        "lift",
-        "tilt",
         "joint_velocity",
         "triangle_margin_deg",
         "working_range",
         "working_margin_deg",
         "envelope_margin",
     }
-    d = mapping(data, "bounds", keys, {"lift", "tilt"})
+    chain_keys = set(CHAIN_NAMES) if chains else set()
+    d = mapping(data, "bounds", keys | chain_keys, chain_keys if chains else {"joint_velocity"})
     low: list[float] = []
     up: list[float] = []
-    for name in CHAIN_NAMES:
+    for name in sorted(chain_keys, key=CHAIN_NAMES.index):
         chain = mapping(d[name], f"bounds.{name}", {"low", "up"}, {"low", "up"})
         low += vector(chain["low"], f"bounds.{name}.low", 3)
         up += vector(chain["up"], f"bounds.{name}.up", 3)
     values: dict[str, Any] = {"xi_low": tuple(low), "xi_up": tuple(up)}
     if "joint_velocity" in d:
-        values["joint_velocity"] = vector(d["joint_velocity"], "bounds.joint_velocity", 3)
+        values["joint_velocity"] = vector(d["joint_velocity"], "bounds.joint_velocity", joints)
     for key in ("triangle_margin", "working_margin"):
         if f"{key}_deg" in d:
             values[key] = math.radians(number(d[f"{key}_deg"], f"bounds.{key}_deg"))
@@ -393,3 +445,82 @@ def _bounds(data: Any) -> Bounds:
     if "working_range" in d:
         values["working_range"] = str(d["working_range"])
     return Bounds(**values)
+
+
+def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
+    """A study of a machine file (``machine:``): its decision variables, their bounds and its names are the file's.
+
+    Keys as a crane study's, except: ``machine`` (a shipped machine or a path next to the study),
+    ``tracked`` (the tracked coordinates beyond the TCP's x, y: joint names or ``tcp_angle``;
+    default ``tcp_angle`` for each), ``initial_lengths`` (a mapping ``chain.variable: value``, default
+    the file's values) and ``bounds`` without per-chain bounds (the file declares them). ``build``,
+    ``mounting`` and ``structure`` need a crane file for now and are refused.
+    """
+    for key in ("crane", "mounting", "structure", "build"):
+        if key in top:
+            raise ConfigError(f"study: '{key}' is not available for a machine file (machine:) yet; remove it")
+    source = str(top["machine"])
+    path = Path(source)
+    folder = Path(str(file.file)).parent
+    if source not in MACHINE_PRESETS and not path.is_absolute() and (folder / path).is_file():
+        path = folder / path
+    machine_file = locate_machine(source if source in MACHINE_PRESETS else path)
+    machine = load_machine(machine_file)
+    n = len(machine.joint_names)
+    tracked_value = top.get("tracked", ["tcp_angle"] * (n - 2))
+    if not isinstance(tracked_value, list) or not all(isinstance(t, str) for t in tracked_value):
+        raise ConfigError(f"study: tracked: expected a list of names, got {tracked_value!r}")
+    tracked = tuple(tracked_value)
+    model = MachineModel(machine, tracked)
+    emla_source = str(top.get("emla", ""))
+    if not emla_source:
+        raise ConfigError("study: a machine file's study names its EMLA file (emla:)")
+    emlas = load_emla_set(locate(emla_source, "emla", relative_to=file)).renamed(model.actuator_names)
+    low, up = model.design_bounds()
+    bounds = _bounds(top["bounds"], chains=False, joints=n)
+    bounds = replace(
+        bounds,
+        xi_low=tuple(map(float, low)),
+        xi_up=tuple(map(float, up)),
+        xi_fields=tuple(f"{machine_file.label}: chains.{k.replace('.', '.variables.')}.bounds" for k in model.design_names),
+    )
+    grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
+    name = str(top.get("name", Path(str(file.file)).stem))
+    if "tasks" not in top and "reference" not in top:
+        raise ConfigError("study: give 'tasks:' (a list of tasks) or 'reference:' (one task)")
+    names = (tuple(model.tracked_names[2:]), model.joint_names)
+    tasks = tasks_from_mapping(top, folder, grid.duration, name, names)
+    if "tasks" not in top and isinstance(top.get("payload", 0.0), int | float):
+        tasks = (replace(tasks[0], payload=replace(tasks[0].payload, inertia=False)),)
+    for i, task in enumerate(tasks):
+        if task.reference.kind != "csv":
+            raise ConfigError(
+                f"study: tasks[{i}] ({task.name}): a machine file's study takes 'kind: csv' references "
+                f"(got '{task.reference.kind}'; the spiral and pick-and-place kinds prescribe a crane's telescope)"
+            )
+    initial = model.default_design
+    if "initial_lengths" in top:
+        given = mapping(top["initial_lengths"], "initial_lengths", set(model.design_names), set())
+        values = initial.as_array()
+        for key, value in given.items():
+            values[model.design_names.index(key)] = number(value, f"initial_lengths.{key}")
+        initial = model.design(values)
+    return Study(
+        name=name,
+        path=str(file.file),
+        crane_source=source,
+        crane_description=None,
+        emla_source=emla_source,
+        emlas=emlas,
+        initial_lengths=initial,
+        spline=SplineSettings(**section(SplineSettings, top.get("spline"), "spline")),
+        grid=grid,
+        tasks=tasks,
+        tracking=Tracking(**section(Tracking, top.get("tracking"), "tracking")),
+        bounds=bounds,
+        solver=SolverSettings(**section(SolverSettings, top.get("solver"), "solver")),
+        crane_file=machine_file,
+        energy=energy_settings(top),
+        machine=machine,
+        tracked=tracked,
+    )

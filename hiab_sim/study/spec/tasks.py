@@ -20,19 +20,23 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.crane.description import Crane
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study.motion.trajectory import TcpKinematics
+from hiab_sim.study.references.csv_file import CRANE_NAMES
 from hiab_sim.study.references.kinds import TaskReference, reference_from_mapping
 from hiab_sim.study.spec.payload import Payload
 from hiab_sim.yaml_fields import mapping, number
 
 Array = NDArray[np.float64]
+
+if TYPE_CHECKING:
+    from hiab_sim.crane.description import Crane
+    from hiab_sim.study.machines.protocol import StudyMachine
 
 
 @dataclass(frozen=True)
@@ -101,7 +105,13 @@ class Task:
         return self.tcp_force(kin, gravity, times)
 
 
-def tasks_from_mapping(top: Mapping[str, Any], folder: Path, grid_duration: float, study_name: str) -> tuple[Task, ...]:
+def tasks_from_mapping(
+    top: Mapping[str, Any],
+    folder: Path,
+    grid_duration: float,
+    study_name: str,
+    names: tuple[tuple[str, ...], tuple[str, ...]] = CRANE_NAMES,
+) -> tuple[Task, ...]:
     """The study's tasks from its top-level mapping (``tasks:`` or today's ``reference:`` + ``payload:``).
 
     Args:
@@ -109,10 +119,11 @@ def tasks_from_mapping(top: Mapping[str, Any], folder: Path, grid_duration: floa
         folder: The study file's folder (CSV paths resolve there).
         grid_duration: ``grid.duration`` [s], a spiral's default duration.
         study_name: Name of the single task of the one-reference form.
+        names: The machine's tracked coordinates beyond the TCP's x, y, and its joints (CSV columns).
 
     """
     if "tasks" not in top:
-        reference = reference_from_mapping(top["reference"], "reference", folder, grid_duration)
+        reference = reference_from_mapping(top["reference"], "reference", folder, grid_duration, names)
         return (Task(study_name, 1.0, reference, Payload.from_value(top.get("payload", 0.0))),)
     if "reference" in top or "payload" in top:
         raise ConfigError("study: give either 'tasks:' or 'reference:' (with 'payload:'), not both")
@@ -131,7 +142,7 @@ def tasks_from_mapping(top: Mapping[str, Any], folder: Path, grid_duration: floa
             task = Task(
                 name=str(d["name"]),
                 weight=number(d["weight"], f"{where}.weight"),
-                reference=reference_from_mapping(d["reference"], f"{where}.reference", folder, grid_duration),
+                reference=reference_from_mapping(d["reference"], f"{where}.reference", folder, grid_duration, names),
                 payload=Payload.from_value(d.get("payload", 0.0), f"{where}.payload"),
                 control_points=points,
             )
@@ -145,11 +156,11 @@ def tasks_from_mapping(top: Mapping[str, Any], folder: Path, grid_duration: floa
     return tuple(tasks)
 
 
-def check_tasks(tasks: tuple[Task, ...], kin: TcpKinematics, crane: Crane) -> None:
-    """Every task's reference within the crane's reach and joint ranges; the error names the task."""
+def check_tasks(tasks: tuple[Task, ...], kin: TcpKinematics, model: StudyMachine | Crane) -> None:
+    """Every task's reference within the machine's reach and joint ranges; the error names the task."""
     for i, task in enumerate(tasks):
         try:
-            task.reference.check_reach(kin, crane)
+            task.reference.check_reach(kin, model)
         except InvalidInputError as error:
             field = f"tasks[{i}] ({task.name}) {error.field}"
             raise InvalidInputError(field, error.value, error.allowed, error.unit) from None
