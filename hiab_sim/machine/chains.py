@@ -5,6 +5,8 @@ Conventions in :mod:`hiab_sim.machine.description`. Lengths in m.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -202,6 +204,10 @@ class HydraulicSystem:
         names = [c.name for c in self.cylinders]
         if len(set(names)) != len(names):
             raise InvalidInputError("hydraulic.cylinders", str(names), "names must be unique")
+
+    def __iter__(self) -> Iterator[Cylinder]:
+        """The cylinders in order (the hydraulic baseline's actuator order)."""
+        return iter(self.cylinders)
 
     def cylinder(self, name: str) -> Cylinder:
         """The cylinder of this name."""

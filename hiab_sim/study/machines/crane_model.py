@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.names import ACTUATOR_NAMES, JOINT_NAMES
+from hiab_sim.hydraulics.cylinders import HydraulicCylinders
 from hiab_sim.dynamics.interface import InverseDynamics, make_inverse_dynamics
 from hiab_sim.study.machines.protocol import Array
 from hiab_sim.study.motion import trajectory as tr
@@ -61,6 +62,11 @@ class CraneModel:
     def gravity(self) -> float:
         """[m/s^2]."""
         return self.crane.gravity
+
+    @property
+    def hydraulic_cylinders(self) -> HydraulicCylinders | None:
+        """The cylinders the EMLAs replace (the crane file's ``hydraulic_cylinders``), or None."""
+        return self.crane.hydraulic_cylinders
 
     @property
     def default_design(self) -> LinkLengths:

@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.machine.chains import HydraulicSystem
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.paths import make_machine_dynamics
 from hiab_sim.machine.kinematics.closure import joint_to_stroke
@@ -72,7 +73,9 @@ class MachineDynamics:
     """The study's inverse-dynamics callable on a machine path: joint samples in, actuator samples out."""
 
     def __init__(self, machine: Machine, design: Array, path: str) -> None:
-        self.model = make_machine_dynamics(machine, design, PATHS[path])
+        # the bounds are the NLP's (SLSQP's trial points and the finite differences may step past them
+        # by round-off); the machine is built from any design whose loops close
+        self.model = make_machine_dynamics(machine.with_design(design, check_bounds=False), None, PATHS[path])
 
     def __call__(self, joints: JointSamples, tcp_force: ArrayLike | None = None) -> ActuatorSamples:
         """[f_x, v_x, a_x] (T, n actuators) for joint samples; ``tcp_force`` [N] (3,) or (T, 3) in the world."""
@@ -148,6 +151,15 @@ class MachineModel:
     def default_design(self) -> MachineDesign:
         """The file's values."""
         return self.design(self.machine.design_values())
+
+    @property
+    def hydraulic_cylinders(self) -> HydraulicSystem | None:
+        """The hydraulic cylinders the EMLAs replace, in chain order, or None if a chain has none."""
+        hyd = self.machine.hydraulic
+        names = [c.actuator.hydraulic_cylinder for c in self.machine.chains]
+        if hyd is None or any(n is None for n in names):
+            return None
+        return replace(hyd, cylinders=tuple(hyd.cylinder(str(n)) for n in names))
 
     def design(self, values: ArrayLike) -> MachineDesign:
         """The design with these values (n_xi,)."""

@@ -82,6 +82,9 @@ class StudyMachine(Protocol):
     stroke_joints: tuple[int, ...]
     kinematics: Kinematics
     default_design: Design
+    #: the hydraulic cylinders the EMLAs replace, in actuator order (iterable, with ``supply_pressure``,
+    #: ``coulomb_friction``, ``viscous_friction``), or None
+    hydraulic_cylinders: Any
 
     def design(self, values: ArrayLike) -> Design:
         """The design with these values (n_xi,)."""

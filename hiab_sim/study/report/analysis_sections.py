@@ -22,7 +22,10 @@ def analysis_sections(
 ) -> dict[str, Any]:
     """Keyword arguments for ``dataclasses.replace(result, ...)``: buildable, feasibility, sensitivity."""
     return {
-        "buildable": buildable_section(problem, z, result.optimal, crane_label),
+        # the buildable design is the crane file's for now (a machine file's study has none yet)
+        "buildable": None
+        if problem.study.crane_description is None
+        else buildable_section(problem, z, result.optimal, crane_label),
         "feasibility": tuple(phases) if phases else None,
         "sensitivity": sensitivity(problem, z),
     }

@@ -229,7 +229,7 @@ def _variant(s: SupplyResult) -> HydraulicVariant:
 
 def hydraulic_supplies(fine: TaskProblem, state: SampleState) -> tuple[SupplyResult, SupplyResult] | None:
     """(constant pressure, load sensing) for one design's rod forces and velocities, None without cylinders."""
-    cylinders = fine.study.crane.hydraulic_cylinders
+    cylinders = fine.study.model.hydraulic_cylinders
     if cylinders is None:
         return None
     return hydraulic_baseline(state.joints.time, state.actuators.force, state.actuators.velocity, cylinders)
@@ -239,7 +239,7 @@ def hydraulic_report(
     fine: TaskProblem, initial: SampleState, optimal: SampleState, energy: EnergyReport
 ) -> HydraulicBaseline | None:
     """The ``hydraulic_baseline`` section, or None when the crane file has no ``hydraulic_cylinders``."""
-    cylinders = fine.study.crane.hydraulic_cylinders
+    cylinders = fine.study.model.hydraulic_cylinders
     designs = {}
     for name, state, e in (("initial", initial, energy.initial), ("optimal", optimal, energy.optimal)):
         supplies = hydraulic_supplies(fine, state)
@@ -271,7 +271,7 @@ def hydraulic_report(
         )
     return HydraulicBaseline(
         note=(
-            "valve-controlled cylinders of the crane file for the same rod forces and velocities (fine grid): "
+            "valve-controlled cylinders of the machine file for the same rod forces and velocities (fine grid): "
             "constant_pressure and load_sensing at the pump motor's electric input, EMLA at the battery; at_battery: "
             "every variant (also pump-controlled EHAs) at the battery over the cycle, against the EMLAs' cycle"
         ),

@@ -138,7 +138,8 @@ def study_digest(problem: StudyProblem) -> str:
     """
     study = problem.study
     content = replace(study, path="", solver=replace(study.solver, maxiter=1))  # any fixed value
-    text = "\n".join((repr(content), repr(study.crane), repr(problem.emlas)))
+    described = study.crane_description if study.crane_description is not None else study.machine
+    text = "\n".join((repr(content), repr(described), repr(problem.emlas)))
     return hashlib.sha256(text.encode()).hexdigest()
 
 
