@@ -88,12 +88,17 @@ class WorstConstraint:
 
 @dataclass(frozen=True)
 class TrackingError:
-    """Largest deviation from the reference over the grid: TCP in the plane, telescope extension xt2."""
+    """Largest deviation from the reference over the grid: TCP in the plane, and each further tracked coordinate.
+
+    ``telescope_m``: the crane's telescope extension xt2 [m] (None for a machine file, whose further
+    tracked coordinates are in ``tracked``, keyed ``<name>_<unit>``, e.g. ``tcp_angle_rad``).
+    """
 
     position_m: float
     velocity_m_per_s: float
     acceleration_m_per_s2: float
-    telescope_m: float
+    telescope_m: float | None
+    tracked: dict[str, float] | None = None
 
 
 @dataclass(frozen=True)

@@ -99,7 +99,7 @@ def sensitivity(problem: StudyProblem, z: Array, active_tolerance: float = ACTIV
             entry[1] += lam_i * per_unit * scale
             entry[2] += 1
             units[key] = unit
-    for k, name in enumerate(XI_NAMES):
+    for k, name in enumerate(problem.model.design_names):
         for side, nu in (("low", nu_low[k]), ("up", nu_up[k])):
             if nu > 0.0:
                 key = f"bound {name} {side} = {(problem.lower if side == 'low' else problem.upper)[k] * XI_SCALE:g} m"

@@ -11,6 +11,7 @@ reported separately, with the loss breakdown of :func:`hiab_sim.emla.operating_p
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -31,6 +32,7 @@ from hiab_sim.results.schema import (
     WorstConstraint,
 )
 from hiab_sim.study.nlp.objectives import costf2
+from hiab_sim.study.motion.workspace import tracked_units
 from hiab_sim.study.nlp.task_problem import Evaluation, TaskProblem
 from hiab_sim.study.spec.study_file import Study
 
@@ -48,6 +50,15 @@ class DesignCheck:
     def actuator_names(self) -> tuple[str, ...]:
         """The actuators, in the order of the evaluation's columns."""
         return tuple(self.summary.actuators)
+
+
+def _extra_errors(problem: TaskProblem, errors: Array) -> dict[str, Any]:
+    """The crane's telescope error [m], or a machine file's further tracked coordinates' by ``<name>_<unit>``."""
+    if problem.study.crane_description is not None:
+        return {"telescope_m": float(errors[0])}
+    units = tracked_units(problem.model)[2:]
+    names = problem.model.tracked_names[2:]
+    return {"telescope_m": None, "tracked": {f"{n}_{u}": float(e) for n, u, e in zip(names, units, errors, strict=True)}}
 
 
 def design_summary(problem: TaskProblem, z: Array) -> DesignCheck:
@@ -85,7 +96,7 @@ def design_summary(problem: TaskProblem, z: Array) -> DesignCheck:
         position_m=float(np.max(np.abs(ev.tcp.position[:, :2] - ref.position[:, :2]))),
         velocity_m_per_s=float(np.max(np.abs(ev.tcp.velocity[:, :2] - ref.velocity[:, :2]))),
         acceleration_m_per_s2=float(np.max(np.abs(ev.tcp.acceleration[:, :2] - ref.acceleration[:, :2]))),
-        telescope_m=float(np.max(np.abs(ev.tcp.position[:, 2] - ref.position[:, 2]))),
+        **_extra_errors(problem, np.max(np.abs(ev.tcp.position[:, 2:] - ref.position[:, 2:]), axis=0)),
     )
     summary = DesignSummary(
         lengths=ev.lengths,

@@ -27,7 +27,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.emla import battery_energy, operating_point, thermal_check
 from hiab_sim.emla.battery import rest_battery_energy
 from hiab_sim.emla.duty_energy import drive_duty
@@ -113,13 +112,14 @@ def design_energy(problem: TaskProblem, state: SampleState) -> DesignEnergy:
             c.torque_margin,
             c.temperature_margin,
         )
+    names = problem.emlas.names
     return DesignEnergy(
         battery_energy_J=duty_section.battery_energy_J if duty_section is not None else exact.energy,
         battery_energy_smooth_J=smooth_energy,
-        smoothing_bound_J=battery.smoothing_bound(len(ACTUATOR_NAMES), float(t[-1] - t[0])),
+        smoothing_bound_J=battery.smoothing_bound(len(names), float(t[-1] - t[0])),
         costf2_W2s=costf2(problem, state),
-        drawn_energy_J=dict(zip(ACTUATOR_NAMES, map(float, exact.drawn_energy), strict=True)),
-        net_energy_J=dict(zip(ACTUATOR_NAMES, map(float, exact.net_energy), strict=True)),
+        drawn_energy_J=dict(zip(names, map(float, exact.drawn_energy), strict=True)),
+        net_energy_J=dict(zip(names, map(float, exact.net_energy), strict=True)),
         thermal=thermal or None,
         drive_loss_energy_J=losses or None,
         drive_loss_smoothing_J=(
@@ -209,9 +209,9 @@ def weighted_energy_report(
     )
 
 
-def _variant(s: SupplyResult) -> HydraulicVariant:
+def _variant(s: SupplyResult, names: tuple[str, ...]) -> HydraulicVariant:
     def per(x: np.ndarray) -> dict[str, float]:
-        return dict(zip(ACTUATOR_NAMES, map(float, x), strict=True))
+        return dict(zip(names, map(float, x), strict=True))
 
     return HydraulicVariant(
         input_energy_J=s.input_energy,
@@ -261,8 +261,8 @@ def hydraulic_report(
             )
         }
         designs[name] = HydraulicDesign(
-            constant_pressure=_variant(cp),
-            load_sensing=_variant(ls),
+            constant_pressure=_variant(cp, fine.emlas.names),
+            load_sensing=_variant(ls, fine.emlas.names),
             emla_battery_energy_J=e.battery_energy_J,
             emla_saving_vs_load_sensing_percent=100.0 * (1.0 - e.battery_energy_J / ls.input_energy),
             emla_saving_vs_constant_pressure_percent=100.0 * (1.0 - e.battery_energy_J / cp.input_energy),

@@ -180,9 +180,13 @@ def build_result(
             collocation_step_s=first.dt,
             fine_grid_points=sum(len(f.times) for f in fines),
             redundancy=(
-                "xt2 prescribed by the study (third reference coordinate)"
-                if problem.n_tasks == 1
-                else f"xt2 {TELESCOPE} in every task; counts summed over the tasks"
+                (
+                    "xt2 prescribed by the study (third reference coordinate)"
+                    if problem.n_tasks == 1
+                    else f"xt2 {TELESCOPE} in every task; counts summed over the tasks"
+                )
+                if study.crane_description is not None
+                else f"tracked: {', '.join(problem.model.tracked_names)} (one per joint: the IK is square)"
             ),
             tracking_bands=tracking_bands(study),
             xi_low=tuple(study.bounds.xi_low),
