@@ -6,8 +6,8 @@ from dataclasses import replace
 
 import pytest
 
-from hiab_sim.docs_site import field_specs
 from hiab_sim.docs_site.field_specs import KEYS, Key
+from hiab_sim.docs_site.field_specs.study import study_keys
 from hiab_sim.docs_site.file_formats import discrepancies, file_formats_markdown
 from hiab_sim.docs_site.formats import FORMATS
 
@@ -30,7 +30,7 @@ def test_a_key_the_loader_rejects_or_an_undocumented_key_is_caught(monkeypatch: 
 
 def test_reference_rows_take_defaults_and_ranges_from_the_dataclasses() -> None:
     """The study's spline and tracking rows carry the dataclasses' defaults and their __post_init__ ranges."""
-    rows = {k.path: k for k in field_specs.study_keys()}
+    rows = {k.path: k for k in study_keys()}
     assert rows["spline.degree"].default == "5" and rows["spline.degree"].allowed == "[3, 7] (integer)"
     assert rows["tracking.position"].unit == "m" and rows["tracking.position"].allowed == "> 0"
     assert rows["solver.method"].allowed == "one of `slsqp`, `ipopt`"
