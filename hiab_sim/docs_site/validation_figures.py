@@ -113,11 +113,12 @@ def forces_figure(traces: list[CaseTrace], force_tolerance: float) -> Any:
     fig = new_figure((11, 7.5))
     top, bottom = fig.subplots(2, 1)
     trajectory = next((t for t in traces if t.kind == "trajectory"), traces[0])
+    every = max(1, len(trajectory.axis) // 60)  # about 60 MuJoCo markers, so the analytic line shows between
     for j, name in enumerate(ACTUATOR_NAMES):
         top.plot(trajectory.axis, trajectory.analytic[:, j] / 1e3, color=f"C{j}", label=f"{name}, analytic")
         top.plot(
-            trajectory.axis[:: max(1, len(trajectory.axis) // 60)],
-            trajectory.mujoco[:: max(1, len(trajectory.axis) // 60), j] / 1e3,
+            trajectory.axis[::every],
+            trajectory.mujoco[::every, j] / 1e3,
             color=f"C{j}",
             linestyle="none",
             marker="o",
