@@ -1,13 +1,23 @@
 #!/usr/bin/env bash
-# Re-make docs/figures/ from the tool: the default study's figures, three frames (start, middle, end)
-# of the playback and closed-loop videos, the EMLA map and the energy map. With SLOW=1 also the
-# sweeps and the Pareto front (tens of optimisations). Run after scripts/setup.sh.
+# Re-make docs/figures/ from the tool: the validation page's figures (MuJoCo vs analytic inverse
+# dynamics over the cases of `hiab-sim validate`, and the balance residuals), the default study's
+# figures, three frames (start, middle, end) of the playback and closed-loop videos, the EMLA map and
+# the energy map. With SLOW=1 also the sweeps and the Pareto front (tens of optimisations). Run after
+# scripts/setup.sh. ONLY=validation makes the validation figures only (seconds); FIGURES_DIR (default
+# docs/figures), VALIDATION_SAMPLES (default: the case file's) and PYTHON (default .venv/bin/python)
+# change where they go, how many samples per case and which interpreter runs them (the test uses all three).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 HS=.venv/bin/hiab-sim
 RUN="${RUN_DIR:-runs/docs_xs031_spiral}"
-OUT=docs/figures
+PY="${PYTHON:-.venv/bin/python}"
+OUT="${FIGURES_DIR:-docs/figures}"
 mkdir -p "$OUT"
+$PY -m hiab_sim.docs_site.validation_figures --out "$OUT" ${VALIDATION_SAMPLES:+--samples "$VALIDATION_SAMPLES"} >/dev/null
+if [ "${ONLY:-}" = "validation" ]; then
+  echo "re-made the validation figures in $OUT"
+  exit 0
+fi
 $HS optimize --starts 3 --out "$RUN" --force >/dev/null
 for name in objective decision_variables_lift decision_variables_tilt structure_initial_vs_optimal crane_spiral \
             actuators_force_velocity_power efficiency_maps energy_breakdown sensitivity energy_emla_vs_hydraulic; do

@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+import copy
+from collections.abc import Callable
 from dataclasses import replace
 
 import pytest
 
-from hiab_sim.docs_site import field_specs
 from hiab_sim.docs_site.field_specs import KEYS, Key
-from hiab_sim.docs_site.file_formats import discrepancies, file_formats_markdown
+from hiab_sim.docs_site.field_specs.study import study_keys
+from hiab_sim.docs_site.file_formats import discrepancies, file_formats_markdown, key_name
 from hiab_sim.docs_site.formats import FORMATS
+from hiab_sim.docs_site.probe import container, split
+from hiab_sim.errors import ConfigError, HiabSimError
 
 
 @pytest.mark.parametrize("name", sorted(FORMATS))
@@ -30,7 +34,7 @@ def test_a_key_the_loader_rejects_or_an_undocumented_key_is_caught(monkeypatch: 
 
 def test_reference_rows_take_defaults_and_ranges_from_the_dataclasses() -> None:
     """The study's spline and tracking rows carry the dataclasses' defaults and their __post_init__ ranges."""
-    rows = {k.path: k for k in field_specs.study_keys()}
+    rows = {k.path: k for k in study_keys()}
     assert rows["spline.degree"].default == "5" and rows["spline.degree"].allowed == "[3, 7] (integer)"
     assert rows["tracking.position"].unit == "m" and rows["tracking.position"].allowed == "> 0"
     assert rows["solver.method"].allowed == "one of `slsqp`, `ipopt`"
@@ -49,3 +53,53 @@ def test_a_free_mapping_is_reported_when_documented_as_a_section(monkeypatch: py
     rows = [replace(k, kind="section") if k.path == "bodies" else k for k in KEYS["crane"]()]
     monkeypatch.setitem(KEYS, "crane", lambda: rows)
     assert any("bodies: the loader accepts any key" in line for line in discrepancies("crane"))
+
+
+def _without(document: dict, path: str) -> dict | None:
+    """A copy of ``document`` without the key at ``path`` (None: the document has no such key)."""
+    trial = copy.deepcopy(document)
+    *above, last = split(path)
+    try:
+        node = container(trial, ".".join(above))
+    except KeyError:
+        return None
+    name = key_name(last)
+    if name.startswith("<") or name not in node:
+        return None
+    del node[name]
+    return trial
+
+
+def _missing(load: Callable[[object], object], document: dict) -> str | None:
+    """The loader's missing-key message for ``document``, or None when it names no missing key."""
+    try:
+        load(document)
+    except ConfigError as error:
+        return str(error) if "missing key" in str(error) else None
+    except HiabSimError:
+        return None  # a range or assembly failure: the key itself may be left out
+    return None
+
+
+def test_machine_keys_documented_as_required_are_the_ones_the_loader_needs() -> None:
+    """A machine key documented `required`, dropped from a shipped file, is a missing key; one with a default is not.
+
+    The loader, not the reference, decides which keys a file may leave out.
+    """
+    fmt = FORMATS["machine"]
+    checked = 0
+    for key in KEYS["machine"]():
+        if key.kind == "free" or key.default.startswith(("required for", "exactly one")):
+            continue  # conditional: required for some chains or links only
+        required = key.default in ("", "required")
+        for document in fmt.documents():
+            trial = _without(document, key.path)
+            if trial is None:
+                continue
+            message = _missing(fmt.load, trial)
+            if required:
+                assert message is not None and repr(key_name(split(key.path)[-1])) in message, key.path
+            else:
+                assert message is None, (key.path, message)
+            checked += 1
+    assert checked > 80, checked  # 110 (key, document) pairs in the shipped machines

@@ -2,8 +2,9 @@
 
 The description is the field's entry under ``Attributes:`` in the class docstring (Google style), the
 unit the first ``[...]`` in it; the allowed range is read from the ``check_range`` / ``check_positive`` /
-``check_non_negative`` / ``check_choice`` calls of ``__post_init__`` that test ``self.<field>``, so the
-reference states exactly what the dataclass enforces.
+``check_non_negative`` / ``check_choice`` calls of ``__post_init__`` that test ``self.<field>``
+(:func:`checked_ranges`), or from the field name each check reports (:func:`checked_fields`, for a
+dataclass that checks the keys of its parts), so the reference states exactly what the code enforces.
 """
 
 from __future__ import annotations
@@ -41,10 +42,13 @@ def attribute_docs(cls: type) -> dict[str, str]:
     return out
 
 
-def _literal(node: ast.expr) -> Any:
+def _literal(node: ast.expr, namespace: dict[str, Any]) -> Any:
+    """A call argument's value: a literal, a module-level constant of ``namespace`` (``JOINT_KINDS``), else its text."""
     try:
         return ast.literal_eval(node)
     except ValueError:
+        if isinstance(node, ast.Name) and isinstance(namespace.get(node.id), tuple | int | float | str):
+            return namespace[node.id]
         return ast.unparse(node)
 
 
@@ -63,35 +67,74 @@ def _interval(args: list[Any], keywords: dict[str, Any]) -> str:
     return "finite" + integer
 
 
-def checked_ranges(cls: type) -> dict[str, str]:
-    """``field -> allowed range`` from the range checks of ``cls.__post_init__`` on ``self.<field>``."""
+def _allowed(name: str, args: list[Any], keywords: dict[str, Any]) -> str | None:
+    """The range a check of :mod:`hiab_sim.checks` (or a vector/interval check) enforces, in words."""
+    if name == "check_range":
+        return _interval(args, keywords)
+    if name == "check_positive":
+        return "> 0"
+    if name == "check_non_negative":
+        return ">= 0"
+    if name == "check_choice" and args:
+        choices = args[0]
+        return "one of " + ", ".join(f"`{c}`" for c in choices) if isinstance(choices, tuple) else str(choices)
+    if name == "check_vector":
+        return "finite"
+    if name == "check_interval":
+        return "[min, max], finite, min < max"
+    return None
+
+
+def _checks(cls: type) -> list[tuple[ast.Call, str, str]]:
+    """The check calls of ``cls.__post_init__``: (call, the check's name, the range in words)."""
     method = cls.__dict__.get("__post_init__")
     if method is None:
-        return {}
+        return []
+    module = inspect.getmodule(cls)
+    namespace = vars(module) if module is not None else {}
     tree = ast.parse(textwrap.dedent(inspect.getsource(method)))
-    out: dict[str, str] = {}
+    out = []
     for call in ast.walk(tree):
         if not (isinstance(call, ast.Call) and isinstance(call.func, ast.Name) and len(call.args) >= 2):
             continue
+        args = [_literal(a, namespace) for a in call.args[2:]]
+        keywords = {k.arg: _literal(k.value, namespace) for k in call.keywords if k.arg}
+        allowed = _allowed(call.func.id, args, keywords)
+        if allowed is not None:
+            out.append((call, call.func.id, allowed))
+    return out
+
+
+def checked_ranges(cls: type) -> dict[str, str]:
+    """``field -> allowed range`` from the range checks of ``cls.__post_init__`` on ``self.<field>``."""
+    out: dict[str, str] = {}
+    for call, check, allowed in _checks(cls):
+        if check in ("check_vector", "check_interval"):
+            continue  # reported by checked_fields under the name they check
         target = call.args[1]
         if isinstance(target, ast.Call) and target.args:  # e.g. math.degrees(self.x): reported in its own key
             target = target.args[0]
-        if not (isinstance(target, ast.Attribute) and isinstance(target.value, ast.Name) and target.value.id == "self"):
-            continue
-        args = [_literal(a) for a in call.args[2:]]
-        keywords = {k.arg: _literal(k.value) for k in call.keywords if k.arg}
-        name = call.func.id
-        if name == "check_range":
-            out[target.attr] = _interval(args, keywords)
-        elif name == "check_positive":
-            out[target.attr] = "> 0"
-        elif name == "check_non_negative":
-            out[target.attr] = ">= 0"
-        elif name == "check_choice" and args:
-            choices = args[0]
-            out[target.attr] = (
-                "one of " + ", ".join(f"`{c}`" for c in choices) if isinstance(choices, tuple) else str(choices)
-            )
+        if isinstance(target, ast.Attribute) and isinstance(target.value, ast.Name) and target.value.id == "self":
+            out[target.attr] = allowed
+    return out
+
+
+def checked_fields(cls: type) -> dict[str, str]:
+    """``named field -> allowed range`` from the checks of ``cls.__post_init__``, by the name each error gives.
+
+    A check names the file key it tests (``check_positive(f"{where}.actuator.stroke", ...)``): the
+    name's text after its last ``{...}`` (leading dot dropped) is the key path below ``where``;
+    a name ending in a ``{...}`` (a loop over keys) is skipped.
+    """
+    out: dict[str, str] = {}
+    for call, _, allowed in _checks(cls):
+        name = call.args[0]
+        if isinstance(name, ast.Constant) and isinstance(name.value, str):
+            out[name.value] = allowed
+        elif isinstance(name, ast.JoinedStr) and name.values and isinstance(name.values[-1], ast.Constant):
+            tail = str(name.values[-1].value).lstrip(".")
+            if tail:
+                out[tail] = allowed
     return out
 
 

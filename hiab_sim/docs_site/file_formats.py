@@ -65,12 +65,14 @@ def file_formats_markdown() -> str:
         "# File formats",
         "",
         "Every key of every file hiab-sim reads, generated from the dataclasses and readers that own them "
-        "(`hiab_sim/docs_site/field_specs.py`: defaults, descriptions and units from the dataclasses, ranges from "
-        "their `__post_init__` checks). A test compares these keys with the keys the loaders accept: no key "
-        "is missing and none is documented that a loader rejects. An unknown or missing key is a one-line "
-        "`ConfigError`, a value out of range an `InvalidInputError` naming field, value and range (exit status 2).",
+        "(`hiab_sim/docs_site/field_specs/`, one module per format: defaults, descriptions and units from the "
+        "dataclasses, ranges from their `__post_init__` checks). A test compares these keys with the keys the "
+        "loaders accept: no key is missing and none is documented that a loader rejects. An unknown or missing "
+        "key is a one-line `ConfigError`, a value out of range an `InvalidInputError` naming field, value and "
+        "range (exit status 2).",
         "",
-        "Paths: `a.b` is key `b` of mapping `a`; `tasks[]` an element of the list `tasks`; `reference{csv}` the "
+        "Paths: `a.b` is key `b` of mapping `a`; `links.<link>` any key of the mapping `links` (a name the file "
+        "chooses); `tasks[]` an element of the list `tasks`; `reference{csv}` the "
         "mapping `reference` with `kind: csv`. A value marked `number or {value, source}` may carry its "
         'provenance: `{value: 0.268, source: "read: ..."}` with a source starting with `read`, `estimate`, '
         "`derived` or `model`. *required* keys have no default; *shared* ones default to the shared section's.",

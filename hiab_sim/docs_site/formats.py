@@ -38,6 +38,30 @@ def _load_crane(document: Any) -> object:
     return crane_from_dict(document)
 
 
+def _load_machine(document: Any) -> object:
+    from hiab_sim.machine.loader import machine_from_dict
+
+    return machine_from_dict(document)
+
+
+def _machine_documents() -> list[Any]:
+    """Both shipped machines, and the excavator with its four-bar chain first.
+
+    The probe's ``<chain>`` is a document's first chain: the reordered copy lets it reach the
+    ``linkage`` keys (and their bodies) on a chain that has a four-bar.
+    """
+    from hiab_sim.machine.loader import PRESETS, locate_machine, read_machine_yaml
+
+    documents = [read_machine_yaml(locate_machine(name)) for name in sorted(PRESETS, reverse=True)]
+    for document in list(documents):
+        chains = document["chains"]
+        linkages = [name for name, chain in chains.items() if chain.get("kind") == "linkage"]
+        if linkages:
+            first = linkages[0]
+            documents.append({**document, "chains": {first: chains[first], **chains}})
+    return documents
+
+
 def _load_emla(document: Any) -> object:
     from hiab_sim.emla.config import emla_set_from_mapping
 
@@ -94,8 +118,15 @@ FORMATS: dict[str, FileFormat] = {
     f.name: f
     for f in (
         FileFormat(
+            "machine",
+            "Machine file",
+            "hiab_sim.machine.loader.load_machine",
+            _load_machine,
+            _machine_documents,
+        ),
+        FileFormat(
             "crane",
-            "Crane (machine) file",
+            "Crane file",
             "hiab_sim.crane.loader.load_crane",
             _load_crane,
             lambda: [_parsed(shipped("crane", "xs031"))],

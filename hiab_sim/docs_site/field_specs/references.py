@@ -1,0 +1,95 @@
+"""The keys of a study's reference trajectory and payload, at top level or per task of a duty mix."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from hiab_sim.docs_site.field_specs.rows import Key, from_class, section
+
+
+def reference_keys(where: str) -> list[Key]:
+    """The reference sections at ``where`` (``reference`` or ``tasks[].reference``), one per kind."""
+    from hiab_sim.study.references.kinds import PickAndPlace
+
+    spiral = [
+        Key(
+            "kind",
+            type="text",
+            default="spiral",
+            allowed="one of `spiral`, `pick_and_place`, `csv`",
+            description="The kind of reference.",
+        ),
+        Key("duration", type="number", unit="s", default="grid.duration", allowed="> 0", description="Duration."),
+        Key(
+            "centre_joints",
+            type="[number, number]",
+            unit="rad",
+            default="none",
+            description="Spiral centre as the TCP at (theta1, theta2) with xt2 = telescope_start (or centre_tcp).",
+        ),
+        Key("centre_tcp", type="[number, number]", unit="m", default="none", description="Spiral centre in {W}."),
+        Key("start_radius", type="number", unit="m", description="Radius at the start."),
+        Key("end_radius", type="number", unit="m", description="Radius at the end."),
+        Key("turns", type="number", description="Turns (counter-clockwise)."),
+        Key("start_angle", type="number", unit="rad", default="0", description="Start angle from +x of {W}."),
+        Key("telescope_start", type="number", unit="m", description="xt2 at both ends (prescribed)."),
+        Key(
+            "telescope_amplitude",
+            type="number",
+            unit="m",
+            default="0",
+            description="xt2 goes out by this much at mid-motion and back.",
+        ),
+    ]
+    pick = [Key("kind", type="text", allowed="`pick_and_place`", description="The kind of reference.")]
+    pick += [replace(k, default="[1, 1]" if k.path == "dwell" else k.default) for k in from_class("", PickAndPlace)]
+    csv = [
+        Key("kind", type="text", allowed="`csv`", description="The kind of reference."),
+        Key(
+            "file",
+            type="path",
+            description="CSV `t, x, y[, xt2]` (TCP) or `t, theta1, theta2, xt2` (joints), "
+            "SI units, a header row, `#` comments; relative to the study file.",
+        ),
+        Key(
+            "telescope",
+            type="number",
+            unit="m",
+            default="none",
+            description="xt2 when the TCP file has no `xt2` column.",
+        ),
+        Key(
+            "control_points",
+            type="integer",
+            default="by duration",
+            allowed=">= 7",
+            description="Control points of the least-squares B-spline fit.",
+        ),
+        Key(
+            "fit_tolerance",
+            type="number",
+            unit="m",
+            default="0.005",
+            allowed="> 0",
+            description="Largest distance of the fit from any sample.",
+        ),
+    ]
+    needed = "one of `reference`, `tasks`" if where == "reference" else "required"
+    rows = [section(f"{where}{{spiral}}", "A TCP spiral in the vertical plane (kind omitted or `spiral`).", needed)]
+    rows += [replace(k, path=f"{where}{{spiral}}.{k.path.lstrip('.')}") for k in spiral]
+    rows.append(section(f"{where}{{pick_and_place}}", "Rest to rest from `pick` to `place` over a clearance.", needed))
+    rows += [replace(k, path=f"{where}{{pick_and_place}}.{k.path.lstrip('.')}") for k in pick]
+    rows.append(section(f"{where}{{csv}}", "A sampled trajectory from a CSV file, fitted by a B-spline.", needed))
+    rows += [replace(k, path=f"{where}{{csv}}.{k.path.lstrip('.')}") for k in csv]
+    return rows
+
+
+def payload_keys(where: str) -> list[Key]:
+    """The payload at ``where`` (``payload`` or ``tasks[].payload``): a number or the ``Payload`` mapping."""
+    from hiab_sim.study.spec.payload import Payload
+
+    rows = [
+        section(where, "A number (constant mass [kg]) or a mapping: the mass held from pick to release.", default="0")
+    ]
+    rows += [replace(k, path=f"{where}.{k.path}") for k in from_class("", Payload)]
+    return rows

@@ -1,0 +1,60 @@
+"""Documented-key rows: :class:`Key` and the helpers that build rows from sections, free mappings and dataclasses.
+
+Where a reader builds a dataclass from a section (:func:`hiab_sim.yaml_fields.section` and its kin),
+:func:`from_class` takes the rows from that dataclass
+(:func:`~hiab_sim.docs_site.dataclass_fields.field_rows`: its type, default, the docstring's
+description and unit, the range its ``__post_init__`` checks).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from hiab_sim.docs_site.dataclass_fields import field_rows
+
+SOURCED = "number or {value, source}"
+
+
+@dataclass(frozen=True)
+class Key:
+    """One documented key: dotted path (grammar of :mod:`hiab_sim.docs_site.probe`), kind and its facts."""
+
+    path: str
+    kind: str = "value"  # "value", "section" (a mapping of the keys below it) or "free" (any key)
+    type: str = ""
+    unit: str = ""
+    default: str = ""
+    allowed: str = ""
+    description: str = ""
+
+
+def section(path: str, description: str, default: str = "required") -> Key:
+    """A mapping whose keys are documented by the rows below it."""
+    return Key(path, "section", "mapping", default=default, description=description)
+
+
+def free(path: str, description: str, type_: str = "") -> Key:
+    """A mapping whose keys are names or dotted paths chosen by the user."""
+    return Key(path, "free", type_, description=description)
+
+
+def from_class(prefix: str, cls: type, skip: tuple[str, ...] = ("label",), **overrides: dict[str, str]) -> list[Key]:
+    """The rows of dataclass ``cls``'s fields under ``prefix``; ``overrides`` replace facts per field."""
+    out = []
+    for name, facts in field_rows(cls, skip).items():
+        row = {**facts, **overrides.get(name, {})}
+        out.append(Key(f"{prefix}.{name}" if prefix else name, "value", **row))
+    return out
+
+
+def sourced(keys: list[Key], required: bool = True) -> list[Key]:
+    """Rows of a provenance-carrying section: each value a number or ``{value, source}``."""
+    return [
+        replace(k, type=SOURCED, default=k.default if not required or k.default != "required" else "required")
+        for k in keys
+    ]
+
+
+def under(prefix: str, keys: list[Key]) -> list[Key]:
+    """``keys`` moved under the mapping ``prefix`` (``a`` -> ``prefix.a``)."""
+    return [replace(k, path=f"{prefix}.{k.path}") for k in keys]

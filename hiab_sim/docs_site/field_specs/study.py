@@ -1,0 +1,201 @@
+"""The study file's keys (:func:`hiab_sim.study.spec.study_file.study_from_dict`), from its settings dataclasses."""
+
+from __future__ import annotations
+
+from hiab_sim.docs_site.field_specs.references import payload_keys, reference_keys
+from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, section
+
+
+def _structure_keys() -> list[Key]:
+    """The study's ``structure`` section (:meth:`hiab_sim.structure.settings.StructureSettings.from_mapping`)."""
+    from hiab_sim.structure.settings import StructureSettings
+
+    rows = from_class("structure", StructureSettings, skip=("pin_load_limits_N",))
+    return [
+        section("structure", "Structural rows of the NLP: buckling, pin loads, natural frequency.", "none"),
+        *rows,
+        free(
+            "structure.pin_load_limits",
+            "Pin name (`<chain>.<pin>`, as `hiab-sim machine show` lists them) -> largest |F| [N] > 0; "
+            "one row per pin and sample.",
+            "number",
+        ),
+    ]
+
+
+def study_keys() -> list[Key]:
+    """The study file (:func:`hiab_sim.study.spec.study_file.study_from_dict`)."""
+    from hiab_sim.study.nlp.objectives import OBJECTIVES
+    from hiab_sim.study.spec.build import BuildSettings
+    from hiab_sim.study.spec.energy import DutySettings
+    from hiab_sim.study.spec.study_file import GridSettings, SolverSettings, SplineSettings, Tracking
+
+    rows = [
+        Key("name", type="text", default="the file's stem", description="Study name (result folder, reports)."),
+        Key("crane", type="text", description="Crane preset name (`xs031`) or a crane file, relative to the study."),
+        Key("emla", type="text", default="default", description="EMLA preset name or an EMLA file."),
+        section(
+            "initial_lengths",
+            "Start of the optimisation (default: the crane's own lengths, moved into the bounds).",
+            default="the crane's",
+        ),
+    ]
+    for chain in ("lift", "tilt"):
+        rows.append(section(f"initial_lengths.{chain}", f"The {chain} chain's start."))
+        rows += [
+            Key(
+                f"initial_lengths.{chain}.{k}", type="number", unit="m", allowed="> 0, within the bounds", description=d
+            )
+            for k, d in (("L", "Base pivot -> boom hinge."), ("Lc0", "Piston offset."), ("Lc", "Rod length."))
+        ]
+    rows += [
+        section("spline", "Joint-trajectory B-splines (eqs. `matrix_basis`..`matrix_basis_dd`).", "defaults"),
+        *from_class("spline", SplineSettings),
+    ]
+    rows += [section("grid", "Collocation grid.", "defaults"), *from_class("grid", GridSettings)]
+    rows += reference_keys("reference")
+    rows += payload_keys("payload")
+    rows += [
+        Key(
+            "tasks",
+            kind="value",
+            type="list",
+            default="one of `reference`, `tasks`",
+            description="Tasks of a duty mix (instead of `reference` and `payload`).",
+        ),
+        section("tasks[]", "One task."),
+        Key("tasks[].name", type="text", description="Unique task name."),
+        Key("tasks[].weight", type="number", allowed="> 0", description="Share of the work (e.g. cycles per hour)."),
+        Key(
+            "tasks[].control_points",
+            type="integer",
+            default="by duration",
+            allowed=">= 7",
+            description="The task's spline control points.",
+        ),
+        *reference_keys("tasks[].reference"),
+        *payload_keys("tasks[].payload"),
+    ]
+    rows += [section("tracking", "Tolerance bands of const_b..const_d.", "defaults"), *from_class("tracking", Tracking)]
+    rows += _structure_keys()
+    rows += [
+        section("bounds", "Box and path bounds of the NLP."),
+        *[
+            k
+            for chain in ("lift", "tilt")
+            for k in (
+                section(f"bounds.{chain}", f"Bounds of the {chain} chain's Xi (const_g)."),
+                Key(
+                    f"bounds.{chain}.low",
+                    type="[number, number, number]",
+                    unit="m",
+                    allowed="0 < low < up",
+                    description="Lower bounds of L, Lc0, Lc.",
+                ),
+                Key(
+                    f"bounds.{chain}.up",
+                    type="[number, number, number]",
+                    unit="m",
+                    description="Upper bounds of L, Lc0, Lc.",
+                ),
+            )
+        ],
+        Key(
+            "bounds.joint_velocity",
+            type="[number, number, number]",
+            unit="rad/s, rad/s, m/s",
+            default="[0.6, 0.6, 0.5]",
+            allowed="> 0",
+            description="Joint-velocity limits (const_i).",
+        ),
+        Key(
+            "bounds.triangle_margin_deg",
+            type="number",
+            unit="deg",
+            default="10",
+            allowed="[0, 60)",
+            description="Smallest interior angle at the boom hinge and its supplement (const_k).",
+        ),
+        Key(
+            "bounds.working_margin_deg",
+            type="number",
+            unit="deg",
+            default="3",
+            allowed="[0, 30]",
+            description="With `working_range: reference`, the reference's joint range widened by this.",
+        ),
+        Key(
+            "bounds.envelope_margin",
+            type="number",
+            default="0.02",
+            allowed="[0, 0.5)",
+            description="EMLA envelope margins held at the collocation points.",
+        ),
+        Key(
+            "bounds.working_range",
+            type="text",
+            default="crane",
+            allowed="one of `crane`, `reference`",
+            description="`crane`: the design serves the crane's full joint range; `reference`: only the reference's.",
+        ),
+    ]
+    rows += [section("solver", "Solver settings.", "defaults"), *from_class("solver", SolverSettings)]
+    rows += [
+        section("build", "Manufacturing tolerance and stroke margin.", "defaults"),
+        *from_class("build", BuildSettings),
+    ]
+    rows += [
+        section("mounting", "Mounting-space polygons of the base pivots and a pin clearance.", "none"),
+        Key(
+            "mounting.lift",
+            type="list of [x, y]",
+            unit="m",
+            default="none",
+            description="Convex polygon of the lift base pivot in {W}, counter-clockwise.",
+        ),
+        Key(
+            "mounting.tilt",
+            type="list of [x, y]",
+            unit="m",
+            default="none",
+            description="Convex polygon of the tilt base pivot in {B11}.",
+        ),
+        Key(
+            "mounting.clearance",
+            type="number",
+            unit="m",
+            default="0.05",
+            allowed="> 0",
+            description="Centre-to-centre clearance from other pins and the swept boom.",
+        ),
+        Key(
+            "mounting.samples",
+            type="integer",
+            default="(built in)",
+            allowed=">= 2",
+            description="Joint samples over the working range for the boom clearance.",
+        ),
+        Key(
+            "objective",
+            type="text",
+            default="costf2",
+            allowed="one of " + ", ".join(f"`{n}`" for n in OBJECTIVES),
+            description="What the optimiser minimises: the seed's eq. `costf2` or the battery energy.",
+        ),
+        section("duty", "Rest between cycles: thermal rows and report (give exactly one key).", "none"),
+        *from_class(
+            "duty",
+            DutySettings,
+            rest_time={"unit": "s", "description": "Rest after each cycle."},
+            cycles_per_hour={"unit": "1/h", "description": "Cycles per hour (rest = 3600/n - T)."},
+        ),
+        section("transmission", "Catalogue of (gear ratio, screw lead) options per actuator: co-design.", "none"),
+    ]
+    for name in ("lift", "tilt", "telescope"):
+        rows += [
+            Key(f"transmission.{name}", type="list", default="the EMLA file's", description=f"Options for {name}."),
+            section(f"transmission.{name}[]", "One option."),
+            Key(f"transmission.{name}[].gear_ratio", type="number", allowed="> 1", description="Gearbox ratio G."),
+            Key(f"transmission.{name}[].screw_lead", type="number", unit="m", allowed="> 0", description="Screw lead."),
+        ]
+    return rows
