@@ -22,7 +22,7 @@ return to the start (3.0 s), 0.5 s at rest at each end.
 The eXact's EMLAs are slower than a hydraulic mini excavator: 2250 rpm through 2444.16 rad/m is
 0.0964 m/s of rod speed (emla_exact.yaml). Each move keeps its nominal time unless one of the
 rods would then exceed 90 % of that speed; such a move is slowed (its time scaled, rounded up to
-0.1 s) until the fastest rod runs at 90 %. The printed summary and the headers give both times.
+0.1 s) until the fastest rod runs at 90 %. The CSV headers give both times.
 
 Every move is rest to rest along a straight line in (x, y, theta) with the septic timing law of
 :func:`hiab_sim.study.references.kinds.septic_law` (C3: velocity, acceleration and jerk vanish at
