@@ -7,7 +7,7 @@ wheel behave alike (pyproject.toml maps the top-level folders into the package):
 kind          folder in the source tree   shipped names
 ============  ==========================  ===================================================
 ``crane``     ``hiab_sim/presets/``       ``xs031``
-``emla``      ``hiab_sim/presets/``       ``default``, ``xs031``, ``paper`` (the seed's lossless model)
+``emla``      ``hiab_sim/presets/``       ``default``, ``xs031``, ``paper`` (the seed's), ``exact``
 ``plant``     ``hiab_sim/presets/``       ``realistic`` (the closed loop's plant effects)
 ``study``     ``optimize/``               every ``*.yaml`` by its path without the suffix,
                                           e.g. ``xs031_spiral``, ``sweeps/<name>``
@@ -46,7 +46,12 @@ _FOLDERS: dict[str, tuple[str, str]] = {
 #: Kinds whose names are given here; the other kinds name every YAML (XML) file of their folder.
 _NAMED: dict[str, dict[str, str]] = {
     "crane": {"xs031": "hiab_xs031.yaml"},
-    "emla": {"default": "emla_xs031.yaml", "xs031": "emla_xs031.yaml", "paper": "emla_paper.yaml"},
+    "emla": {
+        "default": "emla_xs031.yaml",
+        "xs031": "emla_xs031.yaml",
+        "paper": "emla_paper.yaml",
+        "exact": "emla_exact.yaml",
+    },
     "plant": {"realistic": "plant_realistic.yaml"},
 }
 _SUFFIX = {"mjcf": ".xml"}

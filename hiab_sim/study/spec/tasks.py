@@ -30,6 +30,7 @@ from hiab_sim.study.motion.trajectory import TcpKinematics
 from hiab_sim.study.references.csv_file import CRANE_NAMES
 from hiab_sim.study.references.kinds import TaskReference, reference_from_mapping
 from hiab_sim.study.spec.payload import Payload
+from hiab_sim.study.spec.soil_contact import SoilContact
 from hiab_sim.yaml_fields import mapping, number
 
 Array = NDArray[np.float64]
@@ -49,6 +50,7 @@ class Task:
         reference: What the TCP and the telescope must do.
         payload: The mass at the TCP and when it is held.
         control_points: Spline control points of the task's trajectory, or None (by duration).
+        soil: The soil the tool cuts (its force on the TCP along the reference), or None.
 
     """
 
@@ -57,6 +59,7 @@ class Task:
     reference: TaskReference
     payload: Payload
     control_points: int | None = None
+    soil: SoilContact | None = None
 
     def __post_init__(self) -> None:
         if not self.name:
@@ -89,6 +92,13 @@ class Task:
         acceleration = self.reference.sample(kin, times).acceleration[:, :2]
         return self.payload.tcp_force(times, acceleration, gravity)
 
+    def soil_force(self, kin: TcpKinematics, gravity: float, times: Array) -> Array | None:
+        """The soil's force on the TCP at ``times``, (K, 3) in {W} [N] (on the reference); None without soil."""
+        if self.soil is None:
+            return None
+        ref = self.reference.sample(kin, times)
+        return self.soil.force(tuple(getattr(kin, "names", ())), ref.position, ref.velocity, gravity)
+
     def id_force(self, kin: TcpKinematics, gravity: float, times: Array) -> Array | None:
         """The payload's force on the TCP as the inverse dynamics takes it [N] in {W}: None, (3,) or (K, 3).
 
@@ -98,11 +108,16 @@ class Task:
         depend on the NLP's variables).
         """
         payload = self.payload
+        soil = self.soil_force(kin, gravity, times)
         if payload.mass == 0.0:
-            return None
-        if payload.pick is None and payload.release is None and not payload.inertia:
+            return soil
+        if payload.pick is None and payload.release is None and not payload.inertia and soil is None:
             return np.array([0.0, -payload.mass * gravity, 0.0])
-        return self.tcp_force(kin, gravity, times)
+        carried = self.tcp_force(kin, gravity, times)
+        assert carried is not None
+        if carried.ndim == 1:
+            carried = np.broadcast_to(carried, (len(np.asarray(times)), 3))
+        return carried if soil is None else carried + soil
 
 
 def tasks_from_mapping(
@@ -133,7 +148,7 @@ def tasks_from_mapping(
     tasks = []
     for i, entry in enumerate(entries):
         where = f"tasks[{i}]"
-        keys = {"name", "weight", "reference", "payload", "control_points"}
+        keys = {"name", "weight", "reference", "payload", "control_points", "soil"}
         d = mapping(entry, where, keys, {"name", "weight", "reference"})
         points = d.get("control_points")
         if points is not None and (isinstance(points, bool) or not isinstance(points, int) or points < 7):
@@ -145,6 +160,7 @@ def tasks_from_mapping(
                 reference=reference_from_mapping(d["reference"], f"{where}.reference", folder, grid_duration, names),
                 payload=Payload.from_value(d.get("payload", 0.0), f"{where}.payload"),
                 control_points=points,
+                soil=None if d.get("soil") is None else SoilContact.from_mapping(d["soil"], f"{where}.soil"),
             )
         except InvalidInputError as error:
             raise InvalidInputError(_prefixed(where, error.field), error.value, error.allowed, error.unit) from None

@@ -1,0 +1,176 @@
+"""A study of a machine file (``machine:``): the same NLP as a crane file's, sized and named by the machine.
+
+Two independent descriptions of the XS 031 (the crane file's closed-form model and the machine file's
+generic tree, tracked kinematics and Newton-Euler) must give the same NLP; on the excavator, whose
+bucket is a four-bar the crane model cannot describe, the gradients must match finite differences.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.study.nlp.problem import StudyProblem
+from hiab_sim.study.spec.study_file import load_study, study_from_dict
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def _joint_csv(path: Path, names: tuple[str, ...], start: list[float], end: list[float], duration: float) -> None:
+    """A rest-to-rest quintic joint move (t, q...) sampled at 10 Hz."""
+    t = np.linspace(0.0, duration, int(10 * duration) + 1)
+    tau = t / duration
+    s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
+    q = np.asarray(start)[None] + s[:, None] * (np.asarray(end) - np.asarray(start))[None]
+    lines = ["# a test move", ",".join(("t", *names))]
+    lines += [",".join(f"{v:.12g}" for v in row) for row in np.column_stack([t, q])]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def _tcp_csv(path: Path, kin_study: object, joints: Path) -> None:
+    """The TCP form (t, x, y, xt2) of a joint move, through the crane's own kinematics."""
+    data = np.loadtxt(joints, delimiter=",", comments="#", skiprows=2)
+    kin = kin_study.model.kinematics  # type: ignore[attr-defined]
+    s = kin.samples(data[:, 1:], np.zeros_like(data[:, 1:]), np.zeros_like(data[:, 1:]))
+    lines = ["# the TCP of a test move", "t,x,y,xt2"]
+    lines += [",".join(f"{v:.12g}" for v in row) for row in np.column_stack([data[:, 0], s.position])]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def _study(folder: Path, top: dict[str, object]) -> object:
+    path = folder / "study.yaml"
+    path.write_text(yaml.safe_dump(top), encoding="utf-8")
+    return load_study(path)
+
+
+EXCAVATOR = {
+    "name": "excavator_move",
+    "machine": "exact",
+    "emla": "exact",
+    "tasks": [{"name": "move", "weight": 1, "reference": {"kind": "csv", "file": "move.csv"}, "payload": 50.0}],
+    "spline": {"control_points": 12, "degree": 5},
+    "grid": {"duration": 4.0, "intervals": 12, "fine_factor": 4},
+    "bounds": {"joint_velocity": [0.6, 0.6, 1.0]},
+}
+
+
+@pytest.fixture(scope="module")
+def excavator(tmp_path_factory: pytest.TempPathFactory) -> StudyProblem:
+    folder = tmp_path_factory.mktemp("excavator")
+    _joint_csv(folder / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
+    return StudyProblem(_study(folder, EXCAVATOR))  # type: ignore[arg-type]
+
+
+def test_excavator_problem_is_sized_and_named_by_its_machine_file(excavator: StudyProblem) -> None:
+    model = excavator.model
+    assert model.joint_names == ("alpha", "beta", "gamma")
+    assert model.tracked_names == ("x_tcp", "y_tcp", "tcp_angle")
+    assert excavator.n_xi == 9 and excavator.emlas.names == ("boom", "arm", "bucket")
+    names = excavator.constraint_names
+    assert any(n.startswith("stroke.bucket.x <= stroke") for n in names)  # the four-bar's stroke rows
+    assert any(n.startswith("envelope.arm.") for n in names)
+    assert any(n.startswith("tracking.position.tcp_angle") for n in names)
+    z = excavator.initial_point(excavator.study.initial_lengths)
+    assert excavator.max_violation(z) < 1e-9  # the IK fit tracks its own reference at the file's design
+
+
+def test_excavator_gradients_match_central_differences(excavator: StudyProblem) -> None:
+    """Cost and rows: the exact-structure gradient against central differences of the whole NLP in z."""
+    p = excavator
+    rng = np.random.default_rng(7)
+    z0 = p.initial_point(p.study.initial_lengths)
+    z0 = z0 + 1e-3 * rng.standard_normal(len(z0)) * (np.arange(len(z0)) >= p.n_xi)  # off the fit
+    grad, jac = p.cost_gradient(z0), p.constraints_jacobian(z0)
+    columns = [*range(p.n_xi), *rng.choice(np.arange(p.n_xi, p.n), 6, replace=False)]
+    for j in columns:
+        h = 1e-6 * max(1.0, abs(z0[j]))
+        up, down = z0.copy(), z0.copy()
+        up[j] += h
+        down[j] -= h
+        d_cost = (p.cost(up) - p.cost(down)) / (2 * h)
+        d_rows = (p.constraints(up) - p.constraints(down)) / (2 * h)
+        assert d_cost == pytest.approx(grad[j], rel=2e-4, abs=1e-6), f"cost column {j}"
+        scale = max(1.0, float(np.max(np.abs(d_rows))))
+        assert float(np.max(np.abs(d_rows - jac[:, j]))) < 2e-4 * scale, f"rows column {j}"
+
+
+def test_xs031_machine_file_and_crane_file_give_the_same_nlp(tmp_path: Path) -> None:
+    """The XS 031 through its machine file (tracking xt2) equals the crane file's NLP at a perturbed point."""
+    _joint_csv(tmp_path / "joints.csv", ("theta1", "theta2", "xt2"), [0.3, -1.5, 0.2], [0.9, -1.0, 0.6], 4.0)
+    common = {
+        "spline": {"control_points": 12, "degree": 5},
+        "grid": {"duration": 4.0, "intervals": 12, "fine_factor": 4},
+        "emla": "default",
+        "tasks": [{"name": "move", "weight": 1, "reference": {"kind": "csv", "file": "move.csv"}, "payload": 100.0}],
+    }
+    crane = _study(tmp_path, {**common, "name": "a", "crane": "xs031", "bounds": {
+        "lift": {"low": [0.80, 0.04, 0.60], "up": [1.25, 0.30, 1.00]},
+        "tilt": {"low": [0.90, 0.04, 0.60], "up": [1.35, 0.30, 1.00]},
+        "working_range": "reference",
+    }} | {"tasks": [{"name": "move", "weight": 1, "reference": {"kind": "csv", "file": "joints.csv"}}]})
+    _tcp_csv(tmp_path / "move.csv", crane, tmp_path / "joints.csv")
+    both = {}
+    for key, extra in (("crane", {"crane": "xs031", "bounds": {
+        "lift": {"low": [0.80, 0.04, 0.60], "up": [1.25, 0.30, 1.00]},
+        "tilt": {"low": [0.90, 0.04, 0.60], "up": [1.35, 0.30, 1.00]},
+        "working_range": "reference",
+    }}), ("machine", {"machine": "xs031", "tracked": ["xt2"], "bounds": {
+        "joint_velocity": [0.6, 0.6, 0.5], "working_range": "reference"}})):
+        both[key] = StudyProblem(_study(tmp_path, {**common, "name": key, **extra}))  # type: ignore[arg-type]
+    a, b = both["crane"], both["machine"]
+    assert a.n == b.n and a.model.design_names == b.model.design_names
+    z = a.initial_point(a.study.initial_lengths)
+    z = z + 1e-3 * np.random.default_rng(3).standard_normal(len(z))
+    ev_a, ev_b = a.evaluate(z), b.evaluate(z)
+    assert ev_b.cost == pytest.approx(ev_a.cost, rel=1e-10)
+    rows_a, rows_b = dict(zip(a.constraint_names, ev_a.constraints)), dict(zip(b.constraint_names, ev_b.constraints))
+    # every row of the machine file's NLP is the crane's, but the joint rows (the crane adds its triangle
+    # margin to the joint bounds) and the crane's buildable-range rows (crane files only, for now)
+    shared = [n for n in rows_b if not n.startswith("joint.")]
+    assert set(shared) <= set(rows_a)
+    assert {n.split(".")[0] for n in rows_a} - {n.split(".")[0] for n in rows_b} == {"buildable_range"}
+    assert max(abs(rows_a[n] - rows_b[n]) for n in shared) < 1e-8
+    assert np.allclose(b.cost_gradient(z), a.cost_gradient(z), rtol=1e-6, atol=1e-9)
+
+
+def test_machine_study_refuses_what_it_cannot_take_with_one_line(tmp_path: Path) -> None:
+    _joint_csv(tmp_path / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
+    base = dict(EXCAVATOR)
+    with pytest.raises(ConfigError, match="kind: csv"):
+        study_from_dict({**base, "tasks": [{"name": "s", "weight": 1, "reference": {
+            "kind": "spiral", "start_radius": 0.1, "end_radius": 0.2, "turns": 1, "telescope_start": 0.0,
+            "centre_tcp": [2.0, 0.0]}}]}, tmp_path / "s.yaml")
+    with pytest.raises(ConfigError, match="'structure' is not available for a machine file"):
+        study_from_dict({**base, "structure": {}}, tmp_path / "s.yaml")
+    with pytest.raises(ConfigError, match="names its EMLA file"):
+        study_from_dict({k: v for k, v in base.items() if k != "emla"}, tmp_path / "s.yaml")
+    with pytest.raises(ConfigError, match="bounds.joint_velocity: expected a list of 3"):
+        study_from_dict({**base, "bounds": {"joint_velocity": [0.6, 0.6]}}, tmp_path / "s.yaml")
+    with pytest.raises(InvalidInputError, match="tracked"):
+        study_from_dict({**base, "tracked": ["theta9"]}, tmp_path / "s.yaml")
+    with pytest.raises(ConfigError, match="'tracked' belongs to a machine file"):
+        study_from_dict({"crane": "xs031", "tracked": ["xt2"], "bounds": {}}, tmp_path / "s.yaml")
+
+
+def test_shipped_digging_study_cuts_soil_at_the_tip() -> None:
+    """The digging task's TCP force: the soil's resistance while the tip is below ground, the payload's weight after."""
+    study = load_study("exact_digging")
+    task = study.tasks[0]
+    model = study.model
+    times = task.times(study.grid.dt)
+    force = task.id_force(model.kinematics, model.gravity, times)
+    soil = task.soil_force(model.kinematics, model.gravity, times)
+    assert force is not None and soil is not None
+    ref = task.reference.sample(model.kinematics, times)
+    below = ref.position[:, 1] < task.soil.ground - 0.02  # type: ignore[union-attr]
+    moving = np.abs(ref.velocity[:, 0]) > 0.03
+    assert np.all(np.linalg.norm(soil[below & moving], axis=1) > 100.0)
+    assert np.all(soil[ref.position[:, 1] > task.soil.ground] == 0.0)  # type: ignore[union-attr]
+    held = (times >= task.payload.pick) & (times < task.payload.release)  # type: ignore[operator]
+    weight = force[held & ~below][:, 1] - soil[held & ~below][:, 1]
+    # the carried soil: its weight and its inertia at the reference's acceleration (< 0.05 m/s^2 x 76 kg)
+    assert np.allclose(weight, -76.0 * model.gravity, atol=76.0 * 0.5)
