@@ -75,7 +75,7 @@ def test_a_rod_side_mass_below_the_stability_bound_is_rejected() -> None:
 
 
 def test_a_plant_file_that_sets_the_stiffness_is_refused_in_one_line(tmp_path: Path) -> None:
-    """The stiffness is the EMLA file's: a plant file with drive_train.axial_stiffness_N_per_m names the key and its home."""
+    """A plant file that sets drive_train.axial_stiffness_N_per_m is refused in one line (the EMLA file owns it)."""
     text = shipped("plant", "realistic").read_text()
     bad = tmp_path / "old.yaml"
     bad.write_text(text.replace("  damping_ratio:", "  axial_stiffness_N_per_m: 1.87e8\n  damping_ratio:", 1))

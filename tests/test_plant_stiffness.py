@@ -1,4 +1,4 @@
-"""The plant's drive-train stiffness is the EMLA file's: the same number, and it follows the file when the file changes."""
+"""The plant's drive-train stiffness is the EMLA file's: the same number, and it follows the file when it changes."""
 
 from __future__ import annotations
 

@@ -31,7 +31,7 @@ def small_result(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def test_simulate_writes_the_validation_of_one_design(
     small_result: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """simulation.json holds the closed-loop and predicted energies, TCP errors, limit fractions and the bandwidth check.
+    """simulation.json holds closed-loop and predicted energies, TCP errors, limit fractions and the bandwidth check.
 
     The check's lowest natural frequency is the study's own (``result.json``'s structure section,
     computed by the optimiser on the same fine grid), the margin is 1 - f_v / (f_1 / 3) of the

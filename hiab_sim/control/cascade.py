@@ -149,7 +149,8 @@ class CascadeController:
     def settle_time(self) -> float:
         """5 time constants of the slowest pole of the cascade on a rigid mass [s] (99.3 % settled)."""
         g = self.gains
-        poles = np.roots([1.0, g.velocity, g.velocity * (g.position + g.integral), g.velocity * g.position * g.integral])
+        w = g.velocity
+        poles = np.roots([1.0, w, w * (g.position + g.integral), w * g.position * g.integral])
         return 5.0 / float(np.min(-poles.real))
 
     def hold(self, observation: dict[str, np.ndarray], dt: float) -> np.ndarray:
@@ -175,9 +176,7 @@ class CascadeController:
         self.last_time = time
         return self._command(obs, self.motion.index(time), dt)
 
-    def _command(
-        self, obs: dict[str, np.ndarray], k: int, dt: float, rate: np.ndarray | None = None
-    ) -> np.ndarray:
+    def _command(self, obs: dict[str, np.ndarray], k: int, dt: float, rate: np.ndarray | None = None) -> np.ndarray:
         """The cascade's output at plan sample k, integrating the velocity error over dt [s]."""
         g = self.gains
         v_star = (self.rate[k] if rate is None else rate) + g.position * (self.stroke[k] - obs["measured_stroke"])

@@ -95,9 +95,7 @@ def first_natural_frequency(plan: DesignPlan) -> float | None:
     if not has_stiffness(plan.emlas):
         return None
     tcp_force = None if plan.payload == 0.0 else np.array([0.0, -plan.payload * plan.crane.gravity, 0.0])
-    modes = natural_frequencies(
-        plan.crane, plan.emlas, plan.lengths, plan.position, tcp_force, payload_kg=plan.payload
-    )
+    modes = natural_frequencies(plan.crane, plan.emlas, plan.lengths, plan.position, tcp_force, payload_kg=plan.payload)
     return float(np.min(modes.lowest_Hz))
 
 

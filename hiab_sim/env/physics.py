@@ -12,8 +12,8 @@ A :class:`~hiab_sim.env.plant.config.Plant` adds what the planner leaves out (:m
 the crane and friction of the mismatch, the hinge and pin friction, a two-mass drive train per EMLA
 (the rotor's reflected inertia and the screw friction then move from the slide to the motor side,
 which the drive turns and the spring, of the EMLA file's stiffness, joins to the rod), the discrete
-current loop with its inverter losses, the sensors the controller reads, and the winding temperature that sets R_s. With every
-effect off (or no plant) the model is the one above, step for step.
+current loop with its inverter losses, the sensors the controller reads, and the winding temperature
+that sets R_s. With every effect off (or no plant) the model is the one above, step for step.
 """
 
 from __future__ import annotations

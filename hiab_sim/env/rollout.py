@@ -30,9 +30,9 @@ from hiab_sim.control.cascade import CascadeController, CascadeGains
 from hiab_sim.emla.config import ACTUATOR_NAMES
 from hiab_sim.emla.drive_sim import DriveArrays
 from hiab_sim.env import make_environment
+from hiab_sim.env.loop_design import design_loop
 from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.plan import DesignPlan
-from hiab_sim.env.loop_design import design_loop
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.errors import InvalidInputError
 
