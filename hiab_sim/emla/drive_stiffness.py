@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -26,8 +26,28 @@ from numpy.typing import ArrayLike, NDArray
 from hiab_sim.checks import check_positive, check_range
 from hiab_sim.errors import InvalidInputError
 
-if TYPE_CHECKING:
-    from hiab_sim.emla.config import EmlaParams
+
+class _Screw(Protocol):
+    """What the stiffness needs of :class:`~hiab_sim.emla.config.ScrewColumn`."""
+
+    @property
+    def root_diameter(self) -> float: ...
+
+    @property
+    def elastic_modulus(self) -> float: ...
+
+
+class _Actuator(Protocol):
+    """What the stiffness needs of :class:`~hiab_sim.emla.config.EmlaParams` (no import: config imports this)."""
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def screw(self) -> _Screw | None: ...
+
+    @property
+    def stiffness(self) -> DriveStiffness | None: ...
 
 
 @dataclass(frozen=True)
@@ -60,7 +80,7 @@ class DriveStiffness:
             raise InvalidInputError(f"{self.label}.pin_count", self.pin_count, "must be a whole number of pins")
 
 
-def axial_stiffness(params: EmlaParams, stroke: ArrayLike) -> NDArray[np.float64]:
+def axial_stiffness(params: _Actuator, stroke: ArrayLike) -> NDArray[np.float64]:
     """Axial stiffness k [N/m] of one drive train between its pins at strokes x [m] (module docstring).
 
     Raises:
