@@ -69,6 +69,7 @@ class ClosedLoopRun:
         lowest_resonance_hz: The lowest drive-train resonance the gains were designed against [Hz], or None.
         bandwidth_check: The velocity-loop bandwidth against the structure's lowest natural frequency
             (:meth:`hiab_sim.env.loop_design.LoopDesign.check`).
+        settle_time_s: Simulated hold before each cycle (:func:`settled_start`) [s], not in ``time``.
 
     """
 
@@ -100,6 +101,7 @@ class ClosedLoopRun:
     gains: CascadeGains = field(default_factory=CascadeGains)
     lowest_resonance_hz: float | None = None
     bandwidth_check: dict[str, object] = field(default_factory=dict)
+    settle_time_s: float = 0.0
 
     @property
     def net_energy(self) -> float:
@@ -153,6 +155,7 @@ class ClosedLoopRun:
             else {name: float(t) for name, t in zip(ACTUATOR_NAMES, self.winding_temperature, strict=True)},
             "cycles": list(self.cycles),
             "bandwidth_check": dict(self.bandwidth_check),
+            "settle_time_s": self.settle_time_s,
         }
 
 
@@ -234,6 +237,7 @@ def run_closed_loop(
         gains=gains,
         lowest_resonance_hz=design.lowest_resonance_hz,
         bandwidth_check=design.check(),
+        settle_time_s=round(controller.settle_time() / env.control_timestep()) * env.control_timestep(),
     )
     return run, physics
 
