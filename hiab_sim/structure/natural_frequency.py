@@ -201,9 +201,9 @@ def bandwidth_margin(bandwidth_Hz: float, lowest_Hz: ArrayLike, max_ratio: float
 
     >= 0 holds: the loop's bandwidth stays below ``max_ratio`` times the lowest natural frequency
     over the poses. The rule of servo tuning guides is that the velocity loop must stay well below
-    the first mechanical resonance (G. Ellis, Control System Design Guide, ch. on compliance and
-    resonance); ``max_ratio`` = 1/3 is our choice of "well below", the lenient end of the 1/3 to 1/5
-    of common practice. The frequencies here are the locked-rotor ones, the anti-resonances of the
+    the first mechanical resonance (G. Ellis, Control System Design Guide, the chapter on
+    mechanical resonance); ``max_ratio`` = 1/3 is our choice of "well below", the lenient end of
+    the 1/3 to 1/5 of common practice. The frequencies here are the locked-rotor ones, the anti-resonances of the
     drives' two-mass models, which lie below their resonances: 1/3 of them is the stricter reading.
     """
     check_range("bandwidth_Hz", bandwidth_Hz, 0.0, low_open=True, unit="Hz")
