@@ -19,7 +19,7 @@ def test_realistic_preset_states_a_source_for_every_number() -> None:
     """Every number of the shipped plant carries a source whose first word is read, estimate, derived or model."""
     plant = load_plant("realistic")
     assert plant.enabled == EFFECTS
-    assert len(plant.provenance) >= 30
+    assert len(plant.provenance) >= 29  # the drive-train stiffness is the EMLA file's, not the plant's
     for key, source in plant.provenance:
         assert source.split(":", 1)[0] in PROVENANCE, key
 
@@ -49,8 +49,8 @@ def test_a_users_file_loads_and_an_unknown_key_is_named(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("build", "field"),
     [
-        (lambda: DriveTrain(True, -1.0, 0.05, 0.0, 100.0), "drive_train.axial_stiffness_N_per_m"),
-        (lambda: DriveTrain(True, 1e8, 2.0, 0.0, 100.0), "drive_train.damping_ratio"),
+        (lambda: DriveTrain(True, 2.0, 0.0, 100.0), "drive_train.damping_ratio"),
+        (lambda: DriveTrain(True, 0.05, 0.0, -1.0), "drive_train.rod_side_mass_kg"),
         (lambda: CurrentLoop(True, 8e3, 3e3, 0.0, 565.0, 1.0, 0.05, 1.8, 20.0), "current_loop.bandwidth_Hz"),
         (lambda: CurrentLoop(True, 8e3, 500.0, 2e-5, 565.0, 1.0, 0.05, 1.8, 20.0), "current_loop.dead_time_s"),
         (lambda: Sensors(True, 2, 0.1, 0.2, 1e-3), "sensors.encoder_counts_per_rev"),
@@ -70,5 +70,17 @@ def test_a_rod_side_mass_below_the_stability_bound_is_rejected() -> None:
     """rod_side_mass_kg < k_s h^2 / 2 at the physics step is named, with the bound (94 kg for 1.87e8 N/m at 1 ms)."""
     train = dataclasses.replace(load_plant("realistic").drive_train, rod_side_mass_kg=50.0)
     with pytest.raises(InvalidInputError, match=r"rod_side_mass_kg.*93\.5"):
-        train.check_step(1e-3)
-    train.check_step(5e-4)  # 23 kg suffices at half the step
+        train.check_step(1e-3, 1.87e8)
+    train.check_step(5e-4, 1.87e8)  # 23 kg suffices at half the step
+
+
+def test_a_plant_file_that_sets_the_stiffness_is_refused_in_one_line(tmp_path: Path) -> None:
+    """A plant file that sets drive_train.axial_stiffness_N_per_m is refused in one line (the EMLA file owns it)."""
+    text = shipped("plant", "realistic").read_text()
+    bad = tmp_path / "old.yaml"
+    bad.write_text(text.replace("  damping_ratio:", "  axial_stiffness_N_per_m: 1.87e8\n  damping_ratio:", 1))
+    with pytest.raises(ConfigError) as error:
+        load_plant(str(bad))
+    message = str(error.value)
+    assert "drive_train.axial_stiffness_N_per_m" in message and "drive_stiffness" in message
+    assert "\n" not in message

@@ -24,8 +24,8 @@ def _rod(mass: float, h: float) -> tuple[mujoco.MjModel, mujoco.MjData]:
 def _train(
     stiffness: float, zeta: float, backlash: float, motor_mass: float, viscous: float = 0.0
 ) -> TwoMassDriveTrain:
-    data = DriveTrain(True, stiffness, zeta, backlash, 0.0)
-    return TwoMassDriveTrain(data, np.array([motor_mass]), np.array([viscous]))
+    data = DriveTrain(True, zeta, backlash, 0.0)
+    return TwoMassDriveTrain(data, np.array([stiffness]), np.array([motor_mass]), np.array([viscous]))
 
 
 def _simulate(train: TwoMassDriveTrain, rod_mass: float, force: float, h: float, steps: int):  # type: ignore[no-untyped-def]
@@ -64,8 +64,7 @@ def test_force_step_rings_at_the_two_mass_frequency() -> None:
 
 def test_locked_rod_frequency_is_the_lowest_two_mass_frequency() -> None:
     """sqrt(k/m_m) / 2 pi lies below the two-mass frequency for every load mass and is its limit for a heavy load."""
-    data = DriveTrain(True, 1.87e8, 0.05, 0.0, 100.0)
-    lock = float(locked_rod_frequency_Hz(data, np.array([30319.0]))[0])
+    lock = float(locked_rod_frequency_Hz(np.array([1.87e8]), np.array([30319.0]))[0])
     for load in (10.0, 1e3, 1e5, 1e9):
         two_mass = math.sqrt(1.87e8 * (1 / 30319.0 + 1 / load)) / (2 * math.pi)
         assert lock < two_mass

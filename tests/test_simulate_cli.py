@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import pytest
@@ -27,13 +28,28 @@ def small_result(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return run_study(study, folder / "out", progress=None, figures=False).folder
 
 
-def test_simulate_writes_the_validation_of_one_design(small_result: Path, tmp_path: Path) -> None:
-    """simulation.json holds the closed-loop and predicted energies, TCP errors and limit fractions; 4 figures."""
+def test_simulate_writes_the_validation_of_one_design(
+    small_result: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """simulation.json holds closed-loop and predicted energies, TCP errors, limit fractions and the bandwidth check.
+
+    The check's lowest natural frequency is the study's own (``result.json``'s structure section,
+    computed by the optimiser on the same fine grid), the margin is 1 - f_v / (f_1 / 3) of the
+    controller's velocity loop and it holds; the closing summary prints it.
+    """
     out = tmp_path / "sim"
     assert main(["simulate", str(small_result), "--design", "optimal", "--no-video", "--quiet", "--out", str(out)]) == 0
     report = json.loads((out / "simulation.json").read_text())
     entry = report["designs"]["optimal"]
-    predicted = json.loads((small_result / "result.json").read_text())["optimal"]["net_electrical_energy_J"]
+    result = json.loads((small_result / "result.json").read_text())
+    predicted = result["optimal"]["net_electrical_energy_J"]
+    check = entry["bandwidth_check"]
+    f_v, f_1 = check["velocity_loop_bandwidth_Hz"], check["first_natural_frequency_Hz"]
+    assert f_1 == pytest.approx(result["structure"]["optimal"]["lowest_frequency_trajectory_Hz"], rel=1e-9)
+    assert f_v == pytest.approx(report["settings"]["cascade_bandwidths_rad_per_s"]["velocity"] / (2 * math.pi))
+    assert check["bandwidth_margin"] == pytest.approx(1.0 - f_v / (f_1 / 3.0)) and check["bandwidth_margin"] >= 0.0
+    printed = capsys.readouterr().out
+    assert f"velocity loop {f_v:.2f} Hz" in printed and "bandwidth_margin" in printed and "holds" in printed
     assert entry["predicted_net_electrical_energy_J"] == predicted
     assert entry["net_electrical_energy_J"] == pytest.approx(predicted, rel=0.02)
     assert entry["tcp_error_mm"]["rms"] <= 2.0 and entry["tcp_error_mm"]["max"] <= 5.0

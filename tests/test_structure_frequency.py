@@ -103,9 +103,11 @@ def test_mode_shapes_are_mass_orthonormal(crane: Crane, emlas: EmlaSet) -> None:
 
 
 def test_bandwidth_check_uses_the_lowest_frequency_over_the_poses() -> None:
-    """Half the lowest of several frequencies is the limit: at it the margin is 0, above it negative."""
-    lowest = np.array([12.0, 4.0, 9.0])
+    """A third of the lowest of several frequencies is the limit: at it the margin is 0, above it negative."""
+    lowest = np.array([12.0, 6.0, 9.0])
     assert bandwidth_margin(2.0, lowest) == pytest.approx(0.0)
     assert bandwidth_margin(3.0, lowest) < 0.0 < bandwidth_margin(1.0, lowest)
+    assert bandwidth_margin(1.0, lowest) == pytest.approx(0.5)
+    assert bandwidth_margin(3.0, lowest, max_ratio=0.5) == pytest.approx(0.0)
     with pytest.raises(InvalidInputError, match="bandwidth_Hz"):
         bandwidth_margin(-1.0, lowest)

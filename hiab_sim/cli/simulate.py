@@ -7,7 +7,10 @@ loops and limits) under the cascade controller of :mod:`hiab_sim.control`. Writt
 
 * ``simulation.json``: per design the closed-loop net electrical energy (int 3/2 (v_d i_d + v_q i_q)
   dt, all drives), the optimiser's predicted one, the TCP error (rms, max) to the study's reference,
-  the fractions of time at the current and voltage limits; with ``--payload-error`` also the
+  the fractions of time at the current and voltage limits, and ``bandwidth_check``: the
+  controller's ``velocity_loop_bandwidth_Hz`` against the structure's ``first_natural_frequency_Hz``
+  over the plan, ``bandwidth_margin`` = 1 - f_v / (f_1 / 3) (>= 0 holds;
+  :mod:`hiab_sim.env.loop_design`), also printed at the end; with ``--payload-error`` also the
   nominal run and the extra energy the heavier end mass costs;
 * ``closed_loop_*.png`` figures (:mod:`hiab_sim.env.figures`) and ``closed_loop.mp4`` (rendered
   through dm-control's ``Physics.render``, OSMesa; side by side when both designs run).
@@ -58,6 +61,19 @@ def closing_lines(report: dict[str, object]) -> list[str]:
                 f"not a failure), tracking within {heavy['tcp_error_mm']['max']:.2f} mm"
             )
         lines.append(text + ".")
+        check = planned.get("bandwidth_check") or {}
+        if check.get("bandwidth_margin") is not None:
+            margin = check["bandwidth_margin"]
+            lines.append(
+                f"{design}: velocity loop {check['velocity_loop_bandwidth_Hz']:.2f} Hz against the structure's lowest "
+                f"natural frequency {check['first_natural_frequency_Hz']:.2f} Hz on the plan: bandwidth_margin "
+                f"{margin:+.2f} ({'holds' if margin >= 0.0 else 'FAILS'}: 1 - f_v / (f_1 / 3) >= 0)."
+            )
+        elif check:
+            lines.append(
+                f"{design}: velocity loop {check['velocity_loop_bandwidth_Hz']:.2f} Hz; no bandwidth check "
+                "(the EMLA file has no screw and drive_stiffness data for the natural frequencies)."
+            )
     boundary = report.get("energy_boundary")
     if boundary is not None:
         lines.append(f"Energy boundary: {boundary}.")

@@ -12,6 +12,7 @@ from hiab_sim.checks import check_non_negative, check_positive, check_range
 from hiab_sim.crane.names import ACTUATOR_NAMES  # noqa: F401  (the XS 031 callers still import it from here)
 from hiab_sim.emla.battery import BatteryParams
 from hiab_sim.emla.brake import HoldingBrake
+from hiab_sim.emla.drive_stiffness import DriveStiffness
 from hiab_sim.emla.electrothermal import WindingResistance
 from hiab_sim.emla.losses import DriveLosses
 from hiab_sim.emla.thermal import ThermalParams
@@ -132,40 +133,6 @@ class ScrewColumn:
 
 
 @dataclass(frozen=True)
-class DriveStiffness:
-    """Axial stiffness of an EMLA's load path between its two pins (:mod:`hiab_sim.structure.natural_frequency`).
-
-    The screw between its fixed bearing and the nut is a bar E A_r / (support_length + x) (E and
-    A_r of the actuator's :class:`ScrewColumn`), in series with the nut, the support bearing and
-    ``pin_count`` pins.
-
-    Attributes:
-        support_length: Screw length between the fixed bearing and the nut at zero stroke [m].
-        nut_stiffness: Axial stiffness of the loaded nut [N/m].
-        bearing_stiffness: Axial stiffness of the screw's fixed support bearing [N/m].
-        pin_stiffness: Radial stiffness of one pin with its eye and bearing [N/m].
-        pin_count: Pins in the load path [-] (2 for a pin-to-pin actuator).
-        label: Prefix used in error messages.
-
-    """
-
-    support_length: float
-    nut_stiffness: float
-    bearing_stiffness: float
-    pin_stiffness: float
-    pin_count: float
-    label: str = "drive_stiffness"
-
-    def __post_init__(self) -> None:
-        check_positive(f"{self.label}.support_length", self.support_length, "m")
-        for key in ("nut_stiffness", "bearing_stiffness", "pin_stiffness"):
-            check_positive(f"{self.label}.{key}", getattr(self, key), "N/m")
-        check_range(f"{self.label}.pin_count", self.pin_count, 0.0, 8.0)
-        if not float(self.pin_count).is_integer():
-            raise InvalidInputError(f"{self.label}.pin_count", self.pin_count, "must be a whole number of pins")
-
-
-@dataclass(frozen=True)
 class EmlaParams:
     """One electromechanical linear actuator: PMSM, gearbox, screw (eqs. ``torque_torque``, ``torque_force``).
 
@@ -184,7 +151,7 @@ class EmlaParams:
             (R_s constant, the seed paper's model).
         brake: The holding brake on the motor shaft (:mod:`hiab_sim.emla.brake`), or None.
         screw: The screw as a column (buckling), or None when the file gives no ``screw`` section.
-        stiffness: The drive train's axial stiffness, or None when the file gives no ``drive_stiffness``.
+        stiffness: Drive-train stiffness data (:mod:`hiab_sim.emla.drive_stiffness`), or None without it.
         provenance: (parameter key, source label) pairs, e.g.
             ``("pmsm.peak_torque", "estimate: 3 x rated torque ...")``.
 

@@ -11,9 +11,9 @@ mass at the TCP, also scaled. :class:`CranePhysics` steps the drives of
 A :class:`~hiab_sim.env.plant.config.Plant` adds what the planner leaves out (:mod:`hiab_sim.env.plant`):
 the crane and friction of the mismatch, the hinge and pin friction, a two-mass drive train per EMLA
 (the rotor's reflected inertia and the screw friction then move from the slide to the motor side,
-which the drive turns and the spring joins to the rod), the discrete current loop with its inverter
-losses, the sensors the controller reads, and the winding temperature that sets R_s. With every
-effect off (or no plant) the model is the one above, step for step.
+which the drive turns and the spring, of the EMLA file's stiffness, joins to the rod), the discrete
+current loop with its inverter losses, the sensors the controller reads, and the winding temperature
+that sets R_s. With every effect off (or no plant) the model is the one above, step for step.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator, DriveStep
 from hiab_sim.env.plan import DesignPlan
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.plant.current_loop import DiscreteCurrentLoop
-from hiab_sim.env.plant.drivetrain import TwoMassDriveTrain, coupled_step
+from hiab_sim.env.plant.drivetrain import TwoMassDriveTrain, coupled_step, drive_train_stiffness
 from hiab_sim.env.plant.friction import FrictionMeter, add_joint_friction
 from hiab_sim.env.plant.mismatch import true_crane, true_drives
 from hiab_sim.env.plant.sensors import CurrentSensorError, MotionSensor
@@ -213,8 +213,10 @@ def crane_physics(
         arrays, slides = true_drives(arrays, slides, active.mismatch)
     train_data = active.drive_train if active is not None and active.drive_train.enabled else None
     compliant = train_data is not None
+    stiffness = None
     if train_data is not None:  # the rotor and the screw friction move to the motor side of the spring
-        train_data.check_step(timestep)
+        stiffness = drive_train_stiffness(plan.emlas, motion.stroke)  # the EMLA file's k_s
+        train_data.check_step(timestep, float(stiffness.max()))
         rod_side = train_data.rod_side_mass_kg
         slides = replace(slides, armature=(rod_side, rod_side, rod_side), damping=(0.0, 0.0, 0.0))
     spec = build_spec(crane, plan.lengths, slides)
@@ -245,8 +247,8 @@ def crane_physics(
         drives,
         plant,
         drive_train=None
-        if train_data is None
-        else TwoMassDriveTrain(train_data, arrays.reflected_inertia, arrays.viscous),
+        if train_data is None or stiffness is None
+        else TwoMassDriveTrain(train_data, stiffness, arrays.reflected_inertia, arrays.viscous),
         thermal=WindingTemperature(active.thermal, plan.emlas.as_tuple())
         if active and active.thermal.enabled
         else None,

@@ -5,9 +5,12 @@ electrical energy is int 3/2 (v_d i_d + v_q i_q) dt over the cycle, summed over 
 bus credits regeneration of one drive to the others). The predicted energy is the optimiser's number
 for the design (``result.json``); the predicted power is the plan's P_elec on its fine grid.
 
-With a plant (:mod:`hiab_sim.env.plant`) the DC bus also pays the inverters' losses (the DC-bus
-energy is the electrical energy plus them), the gains follow the design rules of
-:mod:`hiab_sim.control.cascade` for the plant's lowest drive-train resonance, and ``cycles`` > 1
+The gains follow the design rules of :mod:`hiab_sim.control.cascade` for the plan's crane and the
+plant (:mod:`hiab_sim.env.loop_design`: the structure's lowest natural frequency, a compliant
+drive train's lowest resonance), and every run carries the check of its velocity-loop bandwidth
+against the structure's lowest natural frequency (``bandwidth_check``). With a plant
+(:mod:`hiab_sim.env.plant`) the DC bus also pays the inverters' losses (the DC-bus
+energy is the electrical energy plus them), and ``cycles`` > 1
 runs the cycle repeatedly with the winding temperature carried over (cooling over the plant's rest
 between cycles); the log is the last cycle's, the per-cycle energies and temperatures are kept.
 """
@@ -18,6 +21,7 @@ import time as _time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
+import dm_env
 import numpy as np
 from dm_control.rl import control
 from numpy.typing import NDArray
@@ -26,10 +30,10 @@ from hiab_sim.control.cascade import CascadeController, CascadeGains
 from hiab_sim.emla.config import ACTUATOR_NAMES
 from hiab_sim.emla.drive_sim import DriveArrays
 from hiab_sim.env import make_environment
+from hiab_sim.env.loop_design import design_loop
 from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.plan import DesignPlan
 from hiab_sim.env.plant.config import Plant
-from hiab_sim.env.plant.drivetrain import locked_rod_frequency_Hz
 from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
@@ -63,6 +67,9 @@ class ClosedLoopRun:
         cycles: Per cycle: DC-bus energy [J] and end winding temperatures [deg C].
         gains: The controller's loop bandwidths.
         lowest_resonance_hz: The lowest drive-train resonance the gains were designed against [Hz], or None.
+        bandwidth_check: The velocity-loop bandwidth against the structure's lowest natural frequency
+            (:meth:`hiab_sim.env.loop_design.LoopDesign.check`).
+        settle_time_s: Simulated hold before each cycle (:func:`settled_start`) [s], not in ``time``.
 
     """
 
@@ -93,6 +100,8 @@ class ClosedLoopRun:
     cycles: tuple[dict[str, object], ...] = ()
     gains: CascadeGains = field(default_factory=CascadeGains)
     lowest_resonance_hz: float | None = None
+    bandwidth_check: dict[str, object] = field(default_factory=dict)
+    settle_time_s: float = 0.0
 
     @property
     def net_energy(self) -> float:
@@ -145,20 +154,13 @@ class ClosedLoopRun:
             if self.winding_temperature is None
             else {name: float(t) for name, t in zip(ACTUATOR_NAMES, self.winding_temperature, strict=True)},
             "cycles": list(self.cycles),
+            "bandwidth_check": dict(self.bandwidth_check),
+            "settle_time_s": self.settle_time_s,
         }
 
 
 def _trapezoid(y: Array, t: Array) -> float:
     return float(0.5 * np.sum((y[1:] + y[:-1]) * np.diff(t)))
-
-
-def design_gains(plan: DesignPlan, plant: Plant | None) -> tuple[CascadeGains, float | None]:
-    """The design-rule gains for the plant's lowest drive-train resonance [Hz] (None when rigid)."""
-    if plant is None or not plant.drive_train.enabled:
-        return CascadeGains.design(None), None
-    masses = np.array([p.motor.rotor_inertia * p.transmission_ratio**2 + p.screw_moving_mass for p in plan.emlas])
-    lowest = float(locked_rod_frequency_Hz(plant.drive_train, masses).min())
-    return CascadeGains.design(lowest), lowest
 
 
 def run_closed_loop(
@@ -176,14 +178,14 @@ def run_closed_loop(
     """
     if isinstance(cycles, bool) or not isinstance(cycles, int) or cycles < 1:
         raise InvalidInputError("cycles", cycles, "must be an integer >= 1")
-    designed, lowest = design_gains(plan, plant)
-    gains = gains or designed
     env = make_environment(plan, payload_error=payload_error, plant=plant)
     physics: CranePhysics = env.physics
     task = env.task
-    compliant = plant is not None and plant.drive_train.enabled
-    stiffness = plant.drive_train.axial_stiffness_N_per_m if plant is not None and compliant else None
-    controller = CascadeController(task.motion, DriveArrays.from_params(plan.emlas), gains, stiffness)
+    design = design_loop(plan, task.motion, plant)
+    design = replace(design, gains=gains or design.gains)
+    gains = design.gains
+    drives = DriveArrays.from_params(plan.emlas)
+    controller = CascadeController(task.motion, drives, gains, design.stiffness, design.load_mass)
     steps = round(task.motion.time[-1] / env.control_timestep())
     history: list[dict[str, object]] = []
     for cycle in range(cycles):
@@ -233,9 +235,42 @@ def run_closed_loop(
         winding_temperature=None if physics.thermal is None else physics.thermal.temperature.copy(),
         cycles=tuple(history),
         gains=gains,
-        lowest_resonance_hz=lowest,
+        lowest_resonance_hz=design.lowest_resonance_hz,
+        bandwidth_check=design.check(),
+        settle_time_s=round(controller.settle_time() / env.control_timestep()) * env.control_timestep(),
     )
     return run, physics
+
+
+def settled_start(env: control.Environment, controller: CascadeController) -> dm_env.TimeStep:
+    """Reset, hold the plan's first pose under the controller until it has settled, restart the clock.
+
+    A crane starts a cycle from standing under its loops, not from a loop switched on at the first
+    sample: for :meth:`~hiab_sim.control.cascade.CascadeController.settle_time` (5 time constants of
+    the cascade's slowest pole) the controller holds the first sample
+    (:meth:`~hiab_sim.control.cascade.CascadeController.hold`), so its integrator carries what the
+    feedforward misses of the plant's true static load; then the physics clock and the energy
+    counters restart at zero and the cycle's first time step is returned. On a plant the planner
+    models exactly, nothing moves during the hold. Without it a load heavier than planned sags at the
+    start before the integrator catches up, the largest TCP error of a run at the bandwidth the
+    structure allows (docs/plant.md).
+    """
+    physics: CranePhysics = env.physics
+    task = env.task
+    step = env.reset()
+    controller.reset()
+    dt = env.control_timestep()
+    substeps = round(dt / physics.timestep())
+    observation = step.observation
+    for _ in range(round(controller.settle_time() / dt)):
+        task.before_step(controller.hold(observation, dt), physics)
+        physics.step(substeps)
+        task.after_step(physics)
+        observation = task.get_observation(physics)
+    controller.settled = True
+    physics.data.time = 0.0
+    physics.reset_counters()
+    return dm_env.restart(task.get_observation(physics))
 
 
 def _one_cycle(
@@ -256,7 +291,7 @@ def _one_cycle(
     energy = np.empty((steps + 1, 3))
     qpos = np.empty((steps + 1, nq))
     start = _time.perf_counter()
-    step = env.reset()
+    step = settled_start(env, controller)
     k = 0
     while True:
         obs = step.observation

@@ -6,7 +6,8 @@ Rigidity": the feed screw system's 1/K = 1/K_s + 1/K_N + 1/K_B, here with the pi
     1/k = (l_0 + x) / (E A_r) + 1/k_nut + 1/k_bearing + n_pin / k_pin        [m/N],
 
 with the screw a bar of root section A_r = pi d_r^2 / 4 between its fixed bearing and the nut,
-l_0 at zero stroke and growing with the stroke x (data of :class:`hiab_sim.emla.config.DriveStiffness`).
+l_0 at zero stroke and growing with the stroke x (:func:`hiab_sim.emla.drive_stiffness.axial_stiffness`,
+the one formula the closed loop's drive train reads too).
 The motor side is held (the brake or a stiff position loop): the frequencies are the locked-rotor
 ones, the anti-resonances of each drive's two-mass model and the lowest resonance the load can
 show a velocity loop.
@@ -45,7 +46,8 @@ from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.dynamics.analytic_id import link_inertias
 from hiab_sim.dynamics.analytic_kinematics import crane_motion
-from hiab_sim.emla.config import EmlaParams, EmlaSet
+from hiab_sim.emla.config import EmlaSet
+from hiab_sim.emla.drive_stiffness import axial_stiffness
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.structure.actuators import actuators
 
@@ -53,18 +55,6 @@ Array = NDArray[np.float64]
 
 #: Central-difference step of the geometric stiffness [rad or m].
 GEOMETRIC_STEP = 1e-6
-
-
-def axial_stiffness(params: EmlaParams, stroke: ArrayLike) -> Array:
-    """Axial stiffness k [N/m] of one drive train between its pins at strokes x [m] (module docstring)."""
-    if params.screw is None or params.stiffness is None:
-        raise InvalidInputError(f"{params.name}", "no screw or drive_stiffness data", "both sections are needed")
-    x = np.asarray(stroke, dtype=float)
-    s, t = params.screw, params.stiffness
-    area = math.pi * s.root_diameter**2 / 4.0
-    compliance = (t.support_length + np.maximum(x, 0.0)) / (s.elastic_modulus * area)
-    compliance = compliance + 1.0 / t.nut_stiffness + 1.0 / t.bearing_stiffness + t.pin_count / t.pin_stiffness
-    return 1.0 / compliance
 
 
 def _unit_motions(crane: Crane, lengths: LinkLengths, position: Array) -> list:
@@ -202,14 +192,19 @@ def generalized_eigh(K: Array, M: Array) -> tuple[Array, Array]:
     return w, np.swapaxes(Ci, 1, 2) @ v
 
 
-def bandwidth_margin(bandwidth_Hz: float, lowest_Hz: ArrayLike, max_ratio: float = 0.5) -> float:
+#: Largest velocity-loop bandwidth per unit lowest natural frequency the check accepts [-].
+MAX_BANDWIDTH_RATIO = 1.0 / 3.0
+
+
+def bandwidth_margin(bandwidth_Hz: float, lowest_Hz: ArrayLike, max_ratio: float = MAX_BANDWIDTH_RATIO) -> float:
     """Margin 1 - f_bw / (max_ratio f_1,min) [-] of a velocity-loop bandwidth against the lowest frequency.
 
     >= 0 holds: the loop's bandwidth stays below ``max_ratio`` times the lowest natural frequency
-    over the poses. ``max_ratio`` = 0.5 is our choice: a loop crossing at half a lightly damped
-    resonance keeps the resonance peak (Q ~ 1 / (2 zeta), zeta a few percent) under the loop's
-    roll-off; the rule of thumb of servo tuning guides that the velocity loop must stay well below
-    the first mechanical resonance (G. Ellis, Control System Design Guide, ch. on resonance).
+    over the poses. The rule of servo tuning guides is that the velocity loop must stay well below
+    the first mechanical resonance (G. Ellis, Control System Design Guide, the chapter on
+    mechanical resonance); ``max_ratio`` = 1/3 is our choice of "well below", the lenient end of
+    the 1/3 to 1/5 of common practice. The frequencies here are the locked-rotor ones, the anti-resonances of the
+    drives' two-mass models, which lie below their resonances: 1/3 of them is the stricter reading.
     """
     check_range("bandwidth_Hz", bandwidth_Hz, 0.0, low_open=True, unit="Hz")
     check_range("max_ratio", max_ratio, 0.0, 1.0, low_open=True)

@@ -61,7 +61,7 @@ def structure_table(summary: StructureSummary, velocity_bandwidth_Hz: float | No
             for d in designs
         ]
         lines.append(
-            f"| velocity loop {velocity_bandwidth_Hz:g} Hz vs half the lowest frequency: margin (>= 0 holds) "
+            f"| velocity loop {velocity_bandwidth_Hz:g} Hz vs a third of the lowest frequency: margin (>= 0 holds) "
             f"| {margins[0]} | {margins[1]} |"
         )
     most = [d.most_loaded_pin for d in designs]

@@ -32,9 +32,11 @@ def _check(section: Any, where: str, ranges: dict[str, tuple[float | None, float
 class DriveTrain:
     """Two-mass drive train per EMLA: the motor side (rotor reflected to the rod) on a spring to the rod.
 
+    The spring's stiffness k_s is not plant data: it is the EMLA file's ``drive_stiffness``
+    (:func:`hiab_sim.env.plant.drivetrain.drive_train_stiffness`), the one owner of the number.
+
     Attributes:
         enabled: Model the compliance (off: the rotor inertia is rigid with the rod, as the planner has it).
-        axial_stiffness_N_per_m: k_s of screw, nut, bearings and pins in series, at the rod [N/m] > 0.
         damping_ratio: zeta of the locked-rod mode, c_s = 2 zeta sqrt(k_s m_m) [-], in [0, 1].
         backlash_m: Total free play 2 b between the motor side and the rod [m], >= 0.
         rod_side_mass_kg: Mass moving with the rod on the load side of the spring (nut, push tube, rod
@@ -44,7 +46,6 @@ class DriveTrain:
     """
 
     enabled: bool
-    axial_stiffness_N_per_m: float
     damping_ratio: float
     backlash_m: float
     rod_side_mass_kg: float
@@ -54,17 +55,16 @@ class DriveTrain:
             self,
             "drive_train",
             {
-                "axial_stiffness_N_per_m": (1e3, None, "N/m"),
                 "damping_ratio": (0.0, 1.0, ""),
                 "backlash_m": (0.0, 0.01, "m"),
                 "rod_side_mass_kg": (0.0, 1e4, "kg"),
             },
         )
 
-    def check_step(self, h: float) -> None:
-        """Raise unless the rod-side mass keeps the spring's local modes stable at the physics step h [s]."""
+    def check_step(self, h: float, stiffness: float) -> None:
+        """Raise unless the rod-side mass keeps the local modes of a spring k_s [N/m] stable at the step h [s]."""
         if self.enabled:
-            low = 0.5 * self.axial_stiffness_N_per_m * h * h
+            low = 0.5 * stiffness * h * h
             check_range("drive_train.rod_side_mass_kg", self.rod_side_mass_kg, low, None, "kg (k_s h^2 / 2)")
 
 
@@ -307,7 +307,7 @@ class Plant:
         return self.with_effects((name,), name)
 
     def source_of(self, key: str) -> str:
-        """Provenance of a dotted field such as ``drive_train.axial_stiffness_N_per_m``."""
+        """Provenance of a dotted field such as ``drive_train.damping_ratio``."""
         return dict(self.provenance).get(key, "unspecified")
 
 

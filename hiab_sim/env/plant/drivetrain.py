@@ -24,8 +24,15 @@ is kept to (omega h)^2 / 8. The motor side then takes the force the rod received
 - c_c v' (action and reaction), in a symplectic Euler step with the screw friction implicit.
 
 Two-mass frequency with the rod on a load m_L: omega^2 = k_s (1/m_m + 1/m_L); its lowest value,
-the rod locked (m_L -> infinity), is omega_lock = sqrt(k_s / m_m), the bound the controller's
+the rod locked (m_L -> infinity), is omega_lock = sqrt(k_s / m_m), one of the bounds the controller's
 bandwidth is designed against (:func:`locked_rod_frequency_Hz`).
+
+Stiffness. k_s is the EMLA file's (``drive_stiffness``, :func:`hiab_sim.emla.drive_stiffness.axial_stiffness`,
+the series of screw, nut, bearing and pins that the structure's natural frequencies use), one value
+per drive, taken at the planned motion's mean stroke (:func:`drive_train_stiffness`): the screw's
+share grows with the stroke, so along the default study's motion k_s varies by about +-7 % (lift,
+tilt) and -14 % to +11 % (telescope) around it; a spring that changes with the stroke would need the
+force -1/2 dk/dx e^2 to stay conservative, a constant one per cycle is the choice here.
 """
 
 from __future__ import annotations
@@ -36,30 +43,51 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.emla.config import EmlaSet
+from hiab_sim.emla.drive_stiffness import axial_stiffness
 from hiab_sim.env.plant.config import DriveTrain
+from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
 
 
-def locked_rod_frequency_Hz(train: DriveTrain, motor_mass: Array) -> Array:
-    """sqrt(k_s / m_m) / 2 pi [Hz] per drive: the lowest two-mass frequency (module docstring)."""
-    return np.sqrt(train.axial_stiffness_N_per_m / np.asarray(motor_mass, dtype=float)) / (2.0 * math.pi)
+def drive_train_stiffness(emlas: EmlaSet, stroke: Array) -> Array:
+    """k_s [N/m] per drive: the EMLA file's axial stiffness at the mean of the planned strokes (N, n_a) [m].
+
+    Raises:
+        InvalidInputError: an EMLA of the set has no ``screw`` or ``drive_stiffness`` data.
+
+    """
+    params = emlas.as_tuple()
+    missing = [p.name for p in params if p.screw is None or p.stiffness is None]
+    if missing:
+        raise InvalidInputError(
+            "drive_train", ", ".join(missing), "needs the EMLA file's screw and drive_stiffness sections (its k_s)"
+        )
+    mean = np.mean(np.atleast_2d(np.asarray(stroke, dtype=float)), axis=0)
+    return np.array([float(axial_stiffness(p, x)) for p, x in zip(params, mean, strict=True)])
+
+
+def locked_rod_frequency_Hz(stiffness: Array, motor_mass: Array) -> Array:
+    """sqrt(k_s / m_m) / 2 pi [Hz] per drive for k_s [N/m] and m_m [kg]: the lowest two-mass frequency."""
+    return np.sqrt(np.asarray(stiffness, dtype=float) / np.asarray(motor_mass, dtype=float)) / (2.0 * math.pi)
 
 
 class TwoMassDriveTrain:
     """Motor-side states of n drives and their springs with free play (module docstring).
 
     Args:
-        train: Stiffness, damping ratio and free play.
+        train: Damping ratio and free play.
+        stiffness: k_s per drive [N/m] (:func:`drive_train_stiffness`).
         motor_mass: m_m per drive [kg].
         viscous: b_f per drive [N s/m], acting on the motor side.
 
     """
 
-    def __init__(self, train: DriveTrain, motor_mass: Array, viscous: Array) -> None:
-        self.stiffness = train.axial_stiffness_N_per_m
-        self.half_play = 0.5 * train.backlash_m
+    def __init__(self, train: DriveTrain, stiffness: Array, motor_mass: Array, viscous: Array) -> None:
         self.mass = np.asarray(motor_mass, dtype=float)
+        self.stiffness = np.broadcast_to(np.asarray(stiffness, dtype=float), self.mass.shape).copy()
+        self.half_play = 0.5 * train.backlash_m
         self.damping = 2.0 * train.damping_ratio * np.sqrt(self.stiffness * self.mass)
         self.viscous = np.asarray(viscous, dtype=float)
         self.position = np.zeros_like(self.mass)

@@ -4,6 +4,9 @@ The file has one mapping per effect of :data:`~hiab_sim.env.plant.config.EFFECTS
 ``enabled: true|false`` and the section's fields, every number either bare or ``{value, source}``
 with a source whose first word is ``read``, ``estimate``, ``derived`` or ``model``. Structure and
 types raise :class:`~hiab_sim.errors.ConfigError`; ranges are checked by the dataclasses.
+
+The drive train's stiffness is the EMLA file's (``drive_stiffness``, its one owner): a plant file
+that still sets ``drive_train.axial_stiffness_N_per_m`` is refused with a one-line error saying so.
 """
 
 from __future__ import annotations
@@ -40,8 +43,18 @@ def _value_and_source(raw: Any, key: str) -> tuple[Any, str]:
     return raw["value"], source
 
 
+#: Keys that moved out of the plant file, with where they live now.
+_MOVED: dict[str, str] = {
+    "drive_train.axial_stiffness_N_per_m": "the EMLA file's drive_stiffness section (hiab_sim.emla.drive_stiffness)",
+}
+
+
 def _read_section(cls: type, node: Any, where: str, provenance: list[tuple[str, str]]) -> Any:
     """One effect's section as its dataclass; appends (field, source) of every value to ``provenance``."""
+    for key, home in _MOVED.items():
+        section, name = key.split(".")
+        if where == section and isinstance(node, Mapping) and name in node:
+            raise ConfigError(f"{key}: the drive train's stiffness is read from {home}; remove it from the plant file")
     hints = typing.get_type_hints(cls)
     data = mapping(node, where, set(hints), {n for n in hints if n != "seed"})
     values: dict[str, Any] = {}
