@@ -152,7 +152,9 @@ def test_set_missing_a_machine_actuator_is_refused_naming_the_actuators() -> Non
     document["actuators"].pop("telescope")
     emlas = emla_set_from_mapping(document)
     assert emlas.names == ("lift", "tilt")
-    with pytest.raises(InvalidInputError, match=r"actuators = 'lift, tilt' .*must be the machine's actuators: lift, tilt, telescope"):
+    with pytest.raises(
+        InvalidInputError, match=r"actuators = 'lift, tilt' .*must be the machine's actuators: lift, tilt, telescope"
+    ):
         emlas.renamed(("lift", "tilt", "telescope"))
     full = emla_set_from_mapping(_preset_document())
     assert full.renamed(("telescope", "lift", "tilt")).names == ("telescope", "lift", "tilt")

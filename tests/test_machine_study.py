@@ -107,19 +107,43 @@ def test_xs031_machine_file_and_crane_file_give_the_same_nlp(tmp_path: Path) -> 
         "emla": "default",
         "tasks": [{"name": "move", "weight": 1, "reference": {"kind": "csv", "file": "move.csv"}, "payload": 100.0}],
     }
-    crane = _study(tmp_path, {**common, "name": "a", "crane": "xs031", "bounds": {
-        "lift": {"low": [0.80, 0.04, 0.60], "up": [1.25, 0.30, 1.00]},
-        "tilt": {"low": [0.90, 0.04, 0.60], "up": [1.35, 0.30, 1.00]},
-        "working_range": "reference",
-    }} | {"tasks": [{"name": "move", "weight": 1, "reference": {"kind": "csv", "file": "joints.csv"}}]})
+    crane = _study(
+        tmp_path,
+        {
+            **common,
+            "name": "a",
+            "crane": "xs031",
+            "bounds": {
+                "lift": {"low": [0.80, 0.04, 0.60], "up": [1.25, 0.30, 1.00]},
+                "tilt": {"low": [0.90, 0.04, 0.60], "up": [1.35, 0.30, 1.00]},
+                "working_range": "reference",
+            },
+        }
+        | {"tasks": [{"name": "move", "weight": 1, "reference": {"kind": "csv", "file": "joints.csv"}}]},
+    )
     _tcp_csv(tmp_path / "move.csv", crane, tmp_path / "joints.csv")
     both = {}
-    for key, extra in (("crane", {"crane": "xs031", "bounds": {
-        "lift": {"low": [0.80, 0.04, 0.60], "up": [1.25, 0.30, 1.00]},
-        "tilt": {"low": [0.90, 0.04, 0.60], "up": [1.35, 0.30, 1.00]},
-        "working_range": "reference",
-    }}), ("machine", {"machine": "xs031", "tracked": ["xt2"], "bounds": {
-        "joint_velocity": [0.6, 0.6, 0.5], "working_range": "reference"}})):
+    for key, extra in (
+        (
+            "crane",
+            {
+                "crane": "xs031",
+                "bounds": {
+                    "lift": {"low": [0.80, 0.04, 0.60], "up": [1.25, 0.30, 1.00]},
+                    "tilt": {"low": [0.90, 0.04, 0.60], "up": [1.35, 0.30, 1.00]},
+                    "working_range": "reference",
+                },
+            },
+        ),
+        (
+            "machine",
+            {
+                "machine": "xs031",
+                "tracked": ["xt2"],
+                "bounds": {"joint_velocity": [0.6, 0.6, 0.5], "working_range": "reference"},
+            },
+        ),
+    ):
         both[key] = StudyProblem(_study(tmp_path, {**common, "name": key, **extra}))  # type: ignore[arg-type]
     a, b = both["crane"], both["machine"]
     assert a.n == b.n and a.model.design_names == b.model.design_names
@@ -127,7 +151,10 @@ def test_xs031_machine_file_and_crane_file_give_the_same_nlp(tmp_path: Path) -> 
     z = z + 1e-3 * np.random.default_rng(3).standard_normal(len(z))
     ev_a, ev_b = a.evaluate(z), b.evaluate(z)
     assert ev_b.cost == pytest.approx(ev_a.cost, rel=1e-10)
-    rows_a, rows_b = dict(zip(a.constraint_names, ev_a.constraints)), dict(zip(b.constraint_names, ev_b.constraints))
+    rows_a, rows_b = (
+        dict(zip(a.constraint_names, ev_a.constraints, strict=True)),
+        dict(zip(b.constraint_names, ev_b.constraints, strict=True)),
+    )
     # every row of the machine file's NLP is the crane's, but the joint rows (the crane adds its triangle
     # margin to the joint bounds) and the crane's buildable-range rows (crane files only, for now)
     shared = [n for n in rows_b if not n.startswith("joint.")]
@@ -141,14 +168,31 @@ def test_machine_study_refuses_what_it_cannot_take_with_one_line(tmp_path: Path)
     _joint_csv(tmp_path / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
     base = dict(EXCAVATOR)
     with pytest.raises(ConfigError, match="kind: csv"):
-        study_from_dict({**base, "tasks": [{"name": "s", "weight": 1, "reference": {
-            "kind": "spiral", "start_radius": 0.1, "end_radius": 0.2, "turns": 1, "telescope_start": 0.0,
-            "centre_tcp": [2.0, 0.0]}}]}, tmp_path / "s.yaml")
+        study_from_dict(
+            {
+                **base,
+                "tasks": [
+                    {
+                        "name": "s",
+                        "weight": 1,
+                        "reference": {
+                            "kind": "spiral",
+                            "start_radius": 0.1,
+                            "end_radius": 0.2,
+                            "turns": 1,
+                            "telescope_start": 0.0,
+                            "centre_tcp": [2.0, 0.0],
+                        },
+                    }
+                ],
+            },
+            tmp_path / "s.yaml",
+        )
     with pytest.raises(ConfigError, match="'structure' is not available for a machine file"):
         study_from_dict({**base, "structure": {}}, tmp_path / "s.yaml")
     with pytest.raises(ConfigError, match="names its EMLA file"):
         study_from_dict({k: v for k, v in base.items() if k != "emla"}, tmp_path / "s.yaml")
-    with pytest.raises(ConfigError, match="bounds.joint_velocity: expected a list of 3"):
+    with pytest.raises(ConfigError, match=r"bounds\.joint_velocity: expected a list of 3"):
         study_from_dict({**base, "bounds": {"joint_velocity": [0.6, 0.6]}}, tmp_path / "s.yaml")
     with pytest.raises(InvalidInputError, match="tracked"):
         study_from_dict({**base, "tracked": ["theta9"]}, tmp_path / "s.yaml")

@@ -85,7 +85,7 @@ def test_plant_stiffness_follows_the_emla_file(tmp_path: Path, crane: Crane) -> 
 def test_a_drive_train_without_emla_stiffness_data_is_named() -> None:
     """An EMLA set without drive_stiffness data cannot give the plant its spring: the error names the drives."""
     emlas = load_emla_set("xs031")
-    bare = dataclasses.replace(emlas, lift=dataclasses.replace(emlas.lift, stiffness=None))
+    bare = emlas.replaced(lift=dataclasses.replace(emlas.lift, stiffness=None))
     with pytest.raises(InvalidInputError, match="lift") as error:
         drive_train_stiffness(bare, _strokes())
     assert error.value.field == "drive_train"

@@ -27,6 +27,7 @@ from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.errors import ConfigError, HiabSimError, InvalidInputError
+from hiab_sim.results.design_values import crane_lengths
 
 #: Natural frequency of the viewer file's stroke servos [Hz].
 SERVO_FREQUENCY_HZ = 1.0
@@ -182,7 +183,9 @@ def _crane_and_lengths(args: argparse.Namespace) -> tuple[Crane, LinkLengths]:
     from hiab_sim.results.read import design_lengths, read_result, result_crane
 
     result = read_result(args.from_result)
-    return result_crane(args.from_result, result.crane), design_lengths(result, args.design)
+    return result_crane(args.from_result, result.crane), crane_lengths(
+        design_lengths(result, args.design), "--from-result"
+    )
 
 
 def run(args: argparse.Namespace) -> int:

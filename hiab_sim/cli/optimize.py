@@ -21,6 +21,8 @@ from typing import TYPE_CHECKING
 
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.errors import BackendUnavailableError
+from hiab_sim.machine.design import MachineDesign
+from hiab_sim.results.design_values import DesignValues
 from hiab_sim.study.report.summary import SUMMARY_FILE, summary_text
 
 if TYPE_CHECKING:
@@ -87,14 +89,23 @@ def decomposition_line(d: Decomposition) -> str:
     )
 
 
+def design_words(lengths: DesignValues) -> str:
+    """A design in one line: a crane's ``lift L=.. Lc0=.. Lc=..  tilt ... m``, a machine's ``boom.L=.. ... m``."""
+    if isinstance(lengths, MachineDesign):
+        return "  ".join(f"{n}={v:.4f}" for n, v in zip(lengths.names, lengths.values, strict=True)) + " m"
+    lift, tilt = lengths.lift, lengths.tilt
+    return (
+        f"lift L={lift.L:.4f} Lc0={lift.Lc0:.4f} Lc={lift.Lc:.4f}  "
+        f"tilt L={tilt.L:.4f} Lc0={tilt.Lc0:.4f} Lc={tilt.Lc:.4f} m"
+    )
+
+
 def summary_lines(r: Result) -> list[str]:
     """The run's summary as printed to stdout: designs, solver, decomposition, re-check, multi-start."""
     lines = []
     for name, entry in (("initial", r.initial), ("optimal", r.optimal)):
-        lift, tilt = entry.lengths.lift, entry.lengths.tilt
         lines.append(
-            f"{name:8s} lift L={lift.L:.4f} Lc0={lift.Lc0:.4f} Lc={lift.Lc:.4f}  "
-            f"tilt L={tilt.L:.4f} Lc0={tilt.Lc0:.4f} Lc={tilt.Lc:.4f} m  "
+            f"{name:8s} {design_words(entry.lengths)}  "
             f"net motor energy {entry.net_electrical_energy_J / 1e3:.3f} kJ  "
             f"drawn {entry.drawn_energy_summed_drives_J / 1e3:.3f} kJ (motor side; battery below)"
         )

@@ -6,6 +6,7 @@ from pathlib import Path
 
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.design_report.page import esc, figure, num, paragraph, section, table
+from hiab_sim.results.design_values import crane_lengths
 from hiab_sim.results.schema import Result
 
 
@@ -19,7 +20,7 @@ def _lengths_text(lengths: LinkLengths, crane: Crane) -> str:
 
 def built_lengths(result: Result) -> LinkLengths:
     """The design to build: the rounded (buildable) design when the result has one, else the optimum."""
-    return result.optimal.lengths if result.buildable is None else result.buildable.lengths
+    return crane_lengths(result.optimal.lengths if result.buildable is None else result.buildable.lengths)
 
 
 def question(result: Result, crane: Crane) -> str:

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.results.design_values import crane_lengths
 from hiab_sim.results.read import open_run, result_crane
 from hiab_sim.results.schema import Result
 from hiab_sim.study.spec.study_file import load_study
@@ -82,7 +83,7 @@ def read_plan(result_dir: str | Path, design: str) -> DesignPlan:
         design=design,
         crane=result_crane(run.folder, result.crane),
         emlas=_study_emlas(result.study),
-        lengths=summary.lengths,
+        lengths=crane_lengths(summary.lengths, "result"),
         time=trajectory.time(),
         position=trajectory.design(design, "position"),
         velocity=trajectory.design(design, "velocity"),

@@ -6,7 +6,6 @@ Conventions in :mod:`hiab_sim.machine.description`. Lengths in m.
 from __future__ import annotations
 
 from collections.abc import Iterator
-
 from dataclasses import dataclass
 
 import numpy as np

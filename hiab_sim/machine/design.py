@@ -8,7 +8,7 @@ Lc, the rod length takes x0 - Lc0). Values in m.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any, Protocol, TypeVar
 
 import numpy as np
@@ -113,3 +113,15 @@ def _chain_with(machine: Designable, chain: Chain, assigned: list[tuple[Decision
         if act.rod_body is not None and rod is not None and act.rod_length is not None:
             new = replace(new, rod_body=act.rod_body.scaled_slender(rod / act.rod_length))
     return replace(chain, actuator=new, pivots=tuple(pivots[p.role] for p in chain.pivots))
+
+
+@dataclass(frozen=True)
+class MachineDesign:
+    """A machine's decision-variable values (``names`` in order) [m or rad by kind]."""
+
+    names: tuple[str, ...]
+    values: tuple[float, ...]
+
+    def as_array(self) -> np.ndarray:
+        """The values, (n_xi,)."""
+        return np.asarray(self.values, dtype=float)

@@ -7,8 +7,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from hiab_sim.crane.description import LinkLengths
 from hiab_sim.results.codec import optional
+from hiab_sim.results.design_values import DesignValues
 
 
 @dataclass(frozen=True)
@@ -36,7 +36,7 @@ class Buildable:
     tolerance_m: float
     stroke_margin_m: float
     range_given_up_deg: dict[str, tuple[float, ...]]
-    lengths: LinkLengths
+    lengths: DesignValues
     crane_check: RoundedCheck
     tolerance_check: RoundedCheck
     recheck: RoundedCheck
@@ -59,8 +59,8 @@ class FeasibilityPhase:
     initial_max_violation: float
     initial_worst: str
     final_max_violation: float
-    lengths_before: LinkLengths
-    lengths_after: LinkLengths
+    lengths_before: DesignValues
+    lengths_after: DesignValues
     changes: tuple[str, ...]
     iterations: int
 
@@ -116,7 +116,7 @@ class CrossEvaluation:
     tasks: tuple[str, ...]
     weights: tuple[float, ...]
     designs: tuple[str, ...]
-    lengths: tuple[LinkLengths, ...]
+    lengths: tuple[DesignValues, ...]
     net_energy_J: tuple[tuple[float | None, ...], ...]
     drawn_energy_J: tuple[tuple[float | None, ...], ...]
     cost_W2s: tuple[tuple[float | None, ...], ...]

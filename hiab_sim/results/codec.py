@@ -4,7 +4,8 @@
 builds the tree back, checking every value against its field's type and naming the dotted path of
 the first missing or mistyped key (:class:`~hiab_sim.errors.ConfigError`). Supported field
 types: ``bool``, ``int``, ``float`` (an int is accepted), ``str``, ``Any`` (kept as read), ``X |
-None``, ``tuple[X, ...]``, ``list[X]``, ``dict[str, X]`` and nested dataclasses.
+None``, a union of dataclasses (told apart by their keys), ``tuple[X, ...]``, ``list[X]``,
+``dict[str, X]`` and nested dataclasses.
 
 Two conventions let a format grow without breaking files written before:
 
@@ -91,7 +92,7 @@ def _decode(kind: Any, value: Any, path: str) -> Any:
             return None
         options = [a for a in args if a is not type(None)]
         if len(options) != 1:
-            raise TypeError(f"{path}: only 'X | None' unions are supported, got {kind}")
+            return _decode(_dataclass_by_keys(options, value, path), value, path)
         return _decode(options[0], value, path)
     if dataclasses.is_dataclass(kind):
         return from_json(kind, value, path)  # type: ignore[arg-type]
@@ -122,6 +123,19 @@ def _decode(kind: Any, value: Any, path: str) -> Any:
             raise ConfigError(f"'{path}' must be a string, got {_kind(value)}")
         return value
     raise TypeError(f"{path}: unsupported field type {kind}")
+
+
+def _dataclass_by_keys(options: list[Any], value: Any, path: str) -> Any:
+    """The one dataclass of a union whose field names are the mapping's keys (``A | B | None`` of dataclasses)."""
+    if not all(dataclasses.is_dataclass(o) for o in options):
+        raise TypeError(f"{path}: a union must be 'X | None' or of dataclasses, got {options}")
+    if not isinstance(value, dict):
+        raise ConfigError(f"'{path}' must be a mapping, got {_kind(value)}")
+    for option in options:
+        if {f.name for f in dataclasses.fields(option)} == set(value):
+            return option
+    names = " or ".join(str(sorted(f.name for f in dataclasses.fields(o))) for o in options)
+    raise ConfigError(f"'{path}' must have the keys {names}, got {sorted(value)}")
 
 
 def _kind(value: Any) -> str:

@@ -17,8 +17,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from hiab_sim.crane.description import LinkLengths
 from hiab_sim.results.codec import optional
+from hiab_sim.results.design_values import DesignValues
 
 
 @dataclass(frozen=True)
@@ -188,7 +188,7 @@ class CodesignRow:
     costf2_W2s: float | None = optional()
     objective_value: float | None = optional()  # the study's objective on the fine grid [objective_unit]
     objective_unit: str | None = optional()
-    lengths: LinkLengths | None = optional()
+    lengths: DesignValues | None = optional()
     max_violation: float | None = optional()
     min_thermal_margin: float | None = optional()
     iterations: int | None = optional()

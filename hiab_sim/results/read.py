@@ -14,10 +14,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Generic, TypeVar
 
-from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.crane.description import Crane
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import Source
+from hiab_sim.results.design_values import DesignValues
 from hiab_sim.results.schema import RESULT_FILE, Result, read_json_as
 from hiab_sim.results.trajectory_file import TRAJECTORY_FILE, Trajectory, read_trajectory
 
@@ -34,7 +35,7 @@ _HINT = "write one with 'hiab-sim optimize'"
 class DesignSummary:
     """One design of a run: lengths [m], energies [J], per-actuator peaks and envelope margins."""
 
-    lengths: LinkLengths
+    lengths: DesignValues
     net_energy_J: float
     drawn_energy_J: float
     battery_energy_J: float | None  # the energy the battery delivers (results with an energy section)
@@ -103,7 +104,7 @@ def result_crane(run_dir: str | Path, crane: str) -> Crane:
     return load_crane(crane, relative_to=Source(str(path), path, False))
 
 
-def design_lengths(result: Result, design: str) -> LinkLengths:
+def design_lengths(result: Result, design: str) -> DesignValues:
     """The link lengths of ``design`` (``initial`` or ``optimal``) of a result [m]."""
     if design not in DESIGNS:
         raise InvalidInputError("--design", design, f"must be one of {list(DESIGNS)}")

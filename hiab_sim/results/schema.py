@@ -20,10 +20,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar, cast
 
-from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import ConfigError
 from hiab_sim.results.analysis_sections import Buildable, CrossEvaluation, FeasibilityPhase, Sensitivity
 from hiab_sim.results.codec import from_json, optional, to_json
+from hiab_sim.results.design_values import DesignValues
 from hiab_sim.results.energy_sections import Codesign, EnergyReport, HydraulicBaseline
 from hiab_sim.structure.summary import StructureSummary
 
@@ -98,7 +98,7 @@ class TrackingError:
     velocity_m_per_s: float
     acceleration_m_per_s2: float
     telescope_m: float | None
-    tracked: dict[str, float] | None = None
+    tracked: dict[str, float] | None = optional()
 
 
 @dataclass(frozen=True)
@@ -109,7 +109,7 @@ class DesignSummary:
     optimal designs (the optimiser's grid), not on the other fine-grid checks.
     """
 
-    lengths: LinkLengths
+    lengths: DesignValues
     id_path: str
     grid_points: int
     cost_W2s: float
@@ -210,8 +210,8 @@ class StartRow:
     """One start of a multi-start run; a failed start has no optimal lengths or cost."""
 
     start: int
-    initial_lengths: LinkLengths
-    optimal_lengths: LinkLengths | None
+    initial_lengths: DesignValues
+    optimal_lengths: DesignValues | None
     cost_W2s: float | None
     success: bool
     message: str
@@ -411,7 +411,7 @@ def _renamed(data: Any) -> Any:
 class DesignLengths:
     """The part of a design the renderer needs: its link lengths."""
 
-    lengths: LinkLengths
+    lengths: DesignValues
 
 
 @dataclass(frozen=True)

@@ -121,7 +121,7 @@ def run_study(
         from hiab_sim.study.figures.cross_evaluation import cross_figure
         from hiab_sim.study.figures.optimisation import write_figures
 
-        paths = write_figures(folder, problem.study.crane, problem.emlas, result, arrays, checks)
+        paths = write_figures(folder, problem.study.crane_description, problem.emlas, result, arrays, checks)
         if result.cross_evaluation is not None:
             paths.append(folder / "cross_evaluation.png")
             cross_figure(result.cross_evaluation, paths[-1])

@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
+from hiab_sim.crane.names import ACTUATOR_NAMES as ACTUATORS
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.dynamics.samples import ActuatorSamples
 from hiab_sim.emla import ENVELOPE_LIMIT_NAMES, electrical_power, energy_summary, envelope_margins
@@ -48,7 +49,7 @@ from hiab_sim.results.schema import Result
 from hiab_sim.study.analysis.buildable import RobustXi, replace_lengths
 from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.nlp.interface import SampleState
-from hiab_sim.study.nlp.task_problem import ACTUATORS, STROKE_SCALE, TaskProblem
+from hiab_sim.study.nlp.task_problem import STROKE_SCALE, TaskProblem
 
 Array = NDArray[np.float64]
 

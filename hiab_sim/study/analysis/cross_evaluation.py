@@ -19,9 +19,9 @@ from __future__ import annotations
 import copy
 from dataclasses import replace
 
-from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.results.analysis_sections import CrossEvaluation
+from hiab_sim.results.design_values import DesignValues
 from hiab_sim.study.nlp.interface import N_XI, Array
 from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.problem import StudyProblem
@@ -41,7 +41,7 @@ def task_alone(study: Study, k: int) -> StudyProblem:
 
 
 def fixed_lengths_optimum(
-    problem: StudyProblem, lengths: LinkLengths, coefficients: Array | None = None
+    problem: StudyProblem, lengths: DesignValues, coefficients: Array | None = None
 ) -> tuple[Array, bool, str]:
     """The task's best trajectory for fixed link lengths: IPOPT on the task's NLP with Xi fixed.
 
@@ -69,7 +69,7 @@ def fixed_lengths_optimum(
     return outcome.z, outcome.success, outcome.message
 
 
-def single_task_optima(alone: list[StudyProblem]) -> list[LinkLengths]:
+def single_task_optima(alone: list[StudyProblem]) -> list[DesignValues]:
     """Each task's optimum alone, from the study's start (its own NLP, the study's solver settings)."""
     out = []
     for p in alone:
@@ -78,7 +78,7 @@ def single_task_optima(alone: list[StudyProblem]) -> list[LinkLengths]:
     return out
 
 
-def cross_evaluation(mix: StudyProblem, z_mix: Array, alone: list[LinkLengths] | None = None) -> CrossEvaluation:
+def cross_evaluation(mix: StudyProblem, z_mix: Array, alone: list[DesignValues] | None = None) -> CrossEvaluation:
     """Rows: each task's optimum alone, then the mix optimum ``z_mix``; columns: the tasks (module docstring)."""
     tasks = [task_alone(mix.study, k) for k in range(mix.n_tasks)]
     alone = single_task_optima(tasks) if alone is None else alone

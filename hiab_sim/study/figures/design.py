@@ -12,6 +12,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -127,11 +128,12 @@ def _mark_pin(ax: Axes, crane: Crane, lengths: LinkLengths, pose: Array, pin: st
     )
 
 
-def decision_panels(axes: Any, history: tuple[HistoryRow, ...], chain: int, low: Array, up: Array) -> None:
-    """L, Lc0, Lc of one chain per iteration, one panel each, outside the bounds shaded grey."""
+def decision_panels(
+    axes: Any, history: tuple[HistoryRow, ...], indices: Sequence[int], labels: Sequence[str], low: Array, up: Array
+) -> None:
+    """One chain's decision variables (Xi entries ``indices``) per iteration, one panel each, out of bounds grey."""
     it = [h.iteration for h in history]
-    for j, (ax, label) in enumerate(zip(axes, ("L", "Lc0", "Lc"), strict=True)):
-        k = 3 * chain + j
+    for ax, k, label in zip(axes, indices, labels, strict=True):
         values = [h.xi[k] for h in history]
         span = max(up[k] - low[k], 1e-3)
         lo_view, hi_view = low[k] - 0.08 * span, up[k] + 0.08 * span

@@ -9,6 +9,7 @@ breakdown, initial vs optimal.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +17,9 @@ import numpy as np
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.emla import EmlaSet
 from hiab_sim.figure_io import new_figure, save_png
+from hiab_sim.machine.design import MachineDesign
 from hiab_sim.results.analysis_sections import Sensitivity
+from hiab_sim.results.design_values import DesignValues, crane_lengths
 from hiab_sim.results.schema import HistoryRow, Result
 from hiab_sim.study.figures.design import (
     cumulative_energy,
@@ -66,12 +69,18 @@ def objective_figure(history: tuple[HistoryRow, ...], path: Path, objective: str
 
 
 def decision_figure(
-    history: tuple[HistoryRow, ...], chain: int, name: str, path: Path, low: np.ndarray, up: np.ndarray
+    history: tuple[HistoryRow, ...],
+    indices: Sequence[int],
+    labels: Sequence[str],
+    name: str,
+    path: Path,
+    low: np.ndarray,
+    up: np.ndarray,
 ) -> None:
-    """L, Lc0, Lc of one chain per iteration with the bounds shaded (seed Figs. Decision_variables_1/2)."""
-    fig = new_figure((6.5, 6.0))
-    axes = fig.subplots(3, 1, sharex=True)
-    decision_panels(axes, history, chain, low, up)
+    """One chain's decision variables per iteration with the bounds shaded (seed Figs. Decision_variables_1/2)."""
+    fig = new_figure((6.5, 2.0 * len(indices)))
+    axes = fig.subplots(len(indices), 1, sharex=True, squeeze=False)[:, 0]
+    decision_panels(axes, history, indices, labels, low, up)
     axes[0].legend(fontsize=8)
     fig.suptitle(f"Decision variables of the {name} chain (grey: outside the bounds)")
     save_png(fig, path)
@@ -171,8 +180,8 @@ def efficiency_figure(emlas: EmlaSet, checks: dict[str, DesignCheck], path: Path
     """Operating points (initial, optimal) over each actuator's efficiency map."""
     from hiab_sim.emla.maps import efficiency_map, plot_efficiency_map
 
-    fig = new_figure((19.0, 6.0))
-    axes = fig.subplots(1, 3)
+    fig = new_figure((6.3 * len(emlas), 6.0))
+    axes = fig.subplots(1, len(emlas), squeeze=False)[0]
     for i, (ax, params) in enumerate(zip(axes, emlas, strict=True)):
         emap = efficiency_map(params, n_force=81, n_velocity=81)
         ini = checks["initial"].evaluation.actuators
@@ -205,9 +214,22 @@ def sensitivity_figure(sensitivity: Sensitivity, path: Path) -> None:
     save_png(fig, path)
 
 
+def chain_variables(lengths: DesignValues) -> list[tuple[str, list[int], list[str]]]:
+    """Per chain: its name, the indices of its decision variables in Xi and their labels."""
+    if not isinstance(lengths, MachineDesign):
+        return [(c, [3 * j, 3 * j + 1, 3 * j + 2], ["L", "Lc0", "Lc"]) for j, c in enumerate(("lift", "tilt"))]
+    out: dict[str, tuple[list[int], list[str]]] = {}
+    for k, name in enumerate(lengths.names):
+        chain, variable = name.split(".", 1)
+        out.setdefault(chain, ([], []))
+        out[chain][0].append(k)
+        out[chain][1].append(variable)
+    return [(c, idx, labels) for c, (idx, labels) in out.items()]
+
+
 def write_figures(
     out: Path,
-    crane: Crane,
+    crane: Crane | None,
     emlas: EmlaSet,
     result: Result,
     arrays: dict[str, np.ndarray],
@@ -216,10 +238,10 @@ def write_figures(
     """Write every figure into ``out``; return their paths."""
     designs = {"initial": result.initial.lengths, "optimal": result.optimal.lengths}
     history = result.history
+    chains = chain_variables(result.optimal.lengths)
     paths = {
         "objective": out / "objective.png",
-        "lift": out / "decision_variables_lift.png",
-        "tilt": out / "decision_variables_tilt.png",
+        **{c: out / f"decision_variables_{c}.png" for c, _, _ in chains},
         "structure": out / "structure_initial_vs_optimal.png",
         "spiral": out / "crane_spiral.png",
         "actuators": out / "actuators_force_velocity_power.png",
@@ -228,8 +250,17 @@ def write_figures(
     }
     objective_figure(history, paths["objective"], result.energy.objective if result.energy is not None else "costf2")
     low, up = np.asarray(result.settings.xi_low), np.asarray(result.settings.xi_up)
-    decision_figure(history, 0, "lift", paths["lift"], low, up)
-    decision_figure(history, 1, "tilt", paths["tilt"], low, up)
+    for c, indices, labels in chains:
+        decision_figure(history, indices, labels, c, paths[c], low, up)
+    if crane is None:  # a machine file's study: the crane's structure and spiral drawings do not apply
+        del paths["structure"], paths["spiral"]
+        actuator_figure(arrays["time"], checks, paths["actuators"])
+        efficiency_figure(emlas, checks, paths["maps"])
+        energy_figure(arrays["time"], checks, paths["energy"])
+        if result.sensitivity is not None:
+            paths["sensitivity"] = out / "sensitivity.png"
+            sensitivity_figure(result.sensitivity, paths["sensitivity"])
+        return list(paths.values()) + hydraulic_figure(out / "energy_emla_vs_hydraulic.png", result)
     joints = arrays["optimal_position"]
     mid = len(joints) // 2
     label = f"t = {arrays['time'][mid]:.2f} s of the optimal motion"
@@ -238,10 +269,12 @@ def write_figures(
     if loads is not None:
         pin = loads.optimal.most_loaded_pin
         most = (pin, loads.optimal.pins[pin].peak_N)
-    structure_figure(crane, designs, joints[mid], paths["structure"], label, most)
+    structure_figure(
+        crane, {k: crane_lengths(v) for k, v in designs.items()}, joints[mid], paths["structure"], label, most
+    )
     spiral_figure(
         crane,
-        designs["optimal"],
+        crane_lengths(designs["optimal"]),
         joints,
         arrays["reference_tcp"],
         arrays["optimal_tcp"],

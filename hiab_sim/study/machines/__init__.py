@@ -6,7 +6,7 @@ machine file (``machine:``, :mod:`hiab_sim.machine`: any planar parallel-serial 
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, cast
 
 from hiab_sim.crane.description import Crane
 from hiab_sim.study.machines.crane_model import CraneModel
@@ -16,8 +16,8 @@ from hiab_sim.study.machines.protocol import StudyMachine
 def as_study_machine(source: Any) -> StudyMachine:
     """A :class:`StudyMachine` as it is, a :class:`~hiab_sim.crane.description.Crane` as its :class:`CraneModel`."""
     if isinstance(source, Crane):
-        return CraneModel(source)
-    return source  # type: ignore[no-any-return]
+        return cast(StudyMachine, CraneModel(source))
+    return cast(StudyMachine, source)
 
 
 __all__ = ["CraneModel", "StudyMachine", "as_study_machine"]

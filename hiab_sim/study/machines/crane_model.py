@@ -19,20 +19,11 @@ from numpy.typing import ArrayLike
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.names import ACTUATOR_NAMES, JOINT_NAMES
-from hiab_sim.hydraulics.cylinders import HydraulicCylinders
 from hiab_sim.dynamics.interface import InverseDynamics, make_inverse_dynamics
-from hiab_sim.study.machines.protocol import Array
+from hiab_sim.hydraulics.cylinders import HydraulicCylinders
+from hiab_sim.study.machines.crane_reach import REASONS, planar_ik
+from hiab_sim.study.machines.protocol import Array, PointReach
 from hiab_sim.study.motion import trajectory as tr
-from hiab_sim.study.motion.workspace import REASONS, planar_ik
-
-
-@dataclass(frozen=True)
-class PointReach:
-    """Joints (R, n) of points, a status per point (0: reachable) and what each status means."""
-
-    joints: Array
-    status: np.ndarray
-    reasons: tuple[str, ...]
 
 
 @dataclass(frozen=True)

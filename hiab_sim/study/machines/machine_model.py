@@ -32,12 +32,13 @@ from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.chains import HydraulicSystem
 from hiab_sim.machine.description import Machine
+from hiab_sim.machine.design import MachineDesign
 from hiab_sim.machine.dynamics.paths import make_machine_dynamics
 from hiab_sim.machine.kinematics.closure import joint_to_stroke
 from hiab_sim.machine.kinematics.design_partials import stroke_design_partials
 from hiab_sim.machine.kinematics.tracked import TrackedKinematics
 from hiab_sim.machine.kinematics.tracked import inverse_kinematics as tracked_ik
-from hiab_sim.study.machines.crane_model import PointReach
+from hiab_sim.study.machines.protocol import PointReach
 from hiab_sim.study.motion import trajectory as tr
 
 Array = NDArray[np.float64]
@@ -55,18 +56,6 @@ REASONS = (
 GUESSES_PER_JOINT = 5
 #: Slack on the stroke and range checks of reachable points [m or rad]: round-off of the IK.
 REACH_TOLERANCE = 1e-9
-
-
-@dataclass(frozen=True)
-class MachineDesign:
-    """A machine's decision-variable values (``names`` in order) [m or rad by kind]."""
-
-    names: tuple[str, ...]
-    values: tuple[float, ...]
-
-    def as_array(self) -> Array:
-        """The values, (n_xi,)."""
-        return np.asarray(self.values, dtype=float)
 
 
 class MachineDynamics:
@@ -175,7 +164,11 @@ class MachineModel:
 
     def joint_ranges(self) -> tuple[tuple[float, float], ...]:
         """Every joint's working range [rad or m]."""
-        return tuple(tuple(map(float, self.machine.joint_link(j).joint_range)) for j in self.joint_names)  # type: ignore[misc]
+        out = []
+        for j in self.joint_names:
+            low, high = self.machine.joint_link(j).joint_range or (-np.inf, np.inf)
+            out.append((float(low), float(high)))
+        return tuple(out)
 
     def joint_bounds(self, triangle_margin: float) -> tuple[Array, Array]:
         """The joints' working ranges (the file's usable ranges; no triangle margin)."""
@@ -183,10 +176,10 @@ class MachineModel:
         return ranges[:, 0].copy(), ranges[:, 1].copy()
 
     def with_stroke_ranges(self, ranges: Sequence[tuple[float, float]]) -> MachineModel:
-        """This machine with the stroke chains' joints' ranges replaced."""
+        """The machine with the stroke chains' joints' ranges replaced."""
         new = dict(zip((self.joint_names[j] for j in self.stroke_joints), ranges, strict=True))
         links = tuple(
-            replace(link, joint_range=tuple(map(float, new[link.joint])))
+            replace(link, joint_range=(float(new[link.joint][0]), float(new[link.joint][1])))
             if link.joint in new
             else link
             for link in self.machine.links

@@ -16,26 +16,24 @@ closed-form crane, bit for bit today's numbers) and
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.dynamics.interface import InverseDynamics
+from hiab_sim.results.design_values import DesignValues
 
 Array = NDArray[np.float64]
 
 
-class Design(Protocol):
-    """A design Xi: its values as an array [m or rad per the variable's kind]."""
-
-    def as_array(self) -> Array:
-        """The decision variables' values, (n_xi,)."""
-        ...
+#: A design Xi (the crane's LinkLengths or a machine file's MachineDesign; ``as_array()`` gives its values).
+Design = DesignValues
 
 
 class TrackedSamplesLike(Protocol):
-    """Tracked coordinates r, their rates, and their partials w.r.t. q9 (see :mod:`hiab_sim.study.motion.trajectory`)."""
+    """Tracked coordinates r, their rates and partials w.r.t. q9 (:mod:`hiab_sim.study.motion.trajectory`)."""
 
     position: Array
     velocity: Array
@@ -59,32 +57,77 @@ class Kinematics(Protocol):
         ...
 
 
-class Reach(Protocol):
-    """Inverse kinematics of points of tracked coordinates: joints and a status per point."""
+@dataclass(frozen=True)
+class PointReach:
+    """Joints (R, n) of points, a status per point (0: reachable) and what each status means."""
 
-    joints: Array  # (R, n)
-    status: NDArray[np.int_]  # (R,) 0 reachable, else an index into ``reasons``
+    joints: Array
+    status: np.ndarray
     reasons: tuple[str, ...]
 
 
 class StudyMachine(Protocol):
     """A machine as the study sees it (module docstring); every length in m, angle in rad, force in N."""
 
-    name: str
-    gravity: float  # [m/s^2], along -y
-    joint_names: tuple[str, ...]
-    joint_units: tuple[str, ...]  # "rad" or "m" per joint
-    actuator_names: tuple[str, ...]
-    tracked_names: tuple[str, ...]  # e.g. ("x_tcp", "y_tcp", "xt2")
-    design_names: tuple[str, ...]
-    #: the chains with a stroke row (their stroke depends on their joint), and each one's joint index
-    stroke_chains: tuple[str, ...]
-    stroke_joints: tuple[int, ...]
-    kinematics: Kinematics
-    default_design: Design
-    #: the hydraulic cylinders the EMLAs replace, in actuator order (iterable, with ``supply_pressure``,
-    #: ``coulomb_friction``, ``viscous_friction``), or None
-    hydraulic_cylinders: Any
+    @property
+    def name(self) -> str:
+        """The machine's name."""
+        ...
+
+    @property
+    def gravity(self) -> float:
+        """Gravity [m/s^2], along -y."""
+        ...
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """The joints, in the column order of joint samples."""
+        ...
+
+    @property
+    def joint_units(self) -> tuple[str, ...]:
+        """``rad`` or ``m`` per joint."""
+        ...
+
+    @property
+    def actuator_names(self) -> tuple[str, ...]:
+        """The actuators, in the order of actuator samples and of the EMLA set."""
+        ...
+
+    @property
+    def tracked_names(self) -> tuple[str, ...]:
+        """The tracked coordinates, e.g. (x_tcp, y_tcp, xt2)."""
+        ...
+
+    @property
+    def design_names(self) -> tuple[str, ...]:
+        """The decision variables, in the order of Xi."""
+        ...
+
+    @property
+    def stroke_chains(self) -> tuple[str, ...]:
+        """The chains with stroke rows (their stroke depends on their joint)."""
+        ...
+
+    @property
+    def stroke_joints(self) -> tuple[int, ...]:
+        """Each stroke chain's joint index."""
+        ...
+
+    @property
+    def kinematics(self) -> Kinematics:
+        """The tracked kinematics."""
+        ...
+
+    @property
+    def default_design(self) -> Design:
+        """The design the file describes."""
+        ...
+
+    @property
+    def hydraulic_cylinders(self) -> Any:
+        """The cylinders the EMLAs replace in actuator order (iterable; ``supply_pressure``, friction), or None."""
+        ...
 
     def design(self, values: ArrayLike) -> Design:
         """The design with these values (n_xi,)."""
@@ -103,7 +146,7 @@ class StudyMachine(Protocol):
         ...
 
     def with_stroke_ranges(self, ranges: Sequence[tuple[float, float]]) -> StudyMachine:
-        """This machine with the stroke chains' joint ranges replaced (the inverse dynamics' input check)."""
+        """The machine with the stroke chains' joint ranges replaced (the inverse dynamics' input check)."""
         ...
 
     def inverse_dynamics(self, design: Design, path: str) -> InverseDynamics:
@@ -124,7 +167,7 @@ class StudyMachine(Protocol):
         """Partials of :meth:`stroke_margins` w.r.t. q (K, 3 m, n) and Xi (K, 3 m, n_xi)."""
         ...
 
-    def reach(self, points: Array) -> Reach:
+    def reach(self, points: Array) -> PointReach:
         """Joints of points of tracked coordinates (R, n) within the joint ranges and strokes, with a status."""
         ...
 

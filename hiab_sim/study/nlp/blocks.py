@@ -50,8 +50,11 @@ _TRACKING_UNITS = {"position": "mm", "velocity": "mm/s", "acceleration": "mm/s^2
 
 
 def opposite_rows(n: int) -> tuple[tuple[int, int], ...]:
-    """Per-sample row pairs (i, i + n) of a block whose first n rows bound n quantities from one side
-    and last n from the other (:attr:`hiab_sim.study.nlp.interface.PerSampleBlock.pairs`)."""
+    """Per-sample row pairs (i, i + n) of a block bounding n quantities from both sides.
+
+    The first n rows bound them from one side, the last n from the other
+    (:attr:`hiab_sim.study.nlp.interface.PerSampleBlock.pairs`).
+    """
     return tuple((i, i + n) for i in range(n))
 
 
@@ -191,9 +194,7 @@ class JointLimits(PerSampleBlock):
 
     """
 
-    def __init__(
-        self, times: Array, low: Array, up: Array, joints: tuple[str, ...], units: tuple[str, ...]
-    ) -> None:
+    def __init__(self, times: Array, low: Array, up: Array, joints: tuple[str, ...], units: tuple[str, ...]) -> None:
         self.name = "joint"
         self.times = times
         self.low = low

@@ -48,7 +48,9 @@ register_block("brake", lambda p: brake_blocks(p.emlas, p.study.energy.duty))
 register_block("buildable", lambda p: buildable_blocks(p.study, p.working, p.tightened))
 register_block(
     "structure",
-    lambda p: []
-    if p.study.crane_description is None  # a machine file's study: structure rows not yet available for it
-    else structure_blocks(p.study.structure, p.times, p.crane, p.emlas, p.tcp_force, p.fd_step, p.task.payload.mass),
+    lambda p: (
+        []
+        if p.study.crane_description is None  # a machine file's study: structure rows not yet available for it
+        else structure_blocks(p.study.structure, p.times, p.crane, p.emlas, p.tcp_force, p.fd_step, p.task.payload.mass)
+    ),
 )

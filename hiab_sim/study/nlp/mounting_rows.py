@@ -12,6 +12,7 @@ from collections.abc import Hashable
 
 from hiab_sim.crane.description import Crane
 from hiab_sim.crane.mounting import MountingSpace, mounting_margins
+from hiab_sim.results.design_values import crane_lengths
 from hiab_sim.study.nlp.interface import Array, ConstraintBlock, DenseRows, Relaxation, SamplePartials, SampleState
 
 #: Scale of the mounting rows [m per unit].
@@ -41,11 +42,16 @@ class MountingRows(ConstraintBlock):
 
     def values(self, state: SampleState) -> Array:
         """Margins [m] / MOUNTING_SCALE."""
-        return mounting_margins(self.space, self.crane, state.lengths).values / MOUNTING_SCALE - self._clearance
+        return (
+            mounting_margins(self.space, self.crane, crane_lengths(state.lengths)).values / MOUNTING_SCALE
+            - self._clearance
+        )
 
     def jacobian(self, state: SampleState, partials: SamplePartials) -> DenseRows:
         """Exact dg/dXi [per m] / MOUNTING_SCALE (rows of Xi only)."""
-        return DenseRows(dxi=mounting_margins(self.space, self.crane, state.lengths).jacobian / MOUNTING_SCALE)
+        return DenseRows(
+            dxi=mounting_margins(self.space, self.crane, crane_lengths(state.lengths)).jacobian / MOUNTING_SCALE
+        )
 
     def clearance(self) -> float:
         """The optimiser's clearance (scaled)."""

@@ -142,7 +142,9 @@ class StudyProblem:
             for i in rows
         ]
         self.clearance = np.concatenate([p.clearance[rows] for p, rows in zip(self.problems, self.rows, strict=True)])
-        self.equality_names = [self.row_name(k, f"rest {i}") for k in range(len(self.tasks)) for i in range(first.n_equalities)]
+        self.equality_names = [
+            self.row_name(k, f"rest {i}") for k in range(len(self.tasks)) for i in range(first.n_equalities)
+        ]
         self.cost_scale = 1.0
         self.cost_scale = max(self.evaluate(self.initial_point(study.initial_lengths)).cost, 1e-300)
 

@@ -22,6 +22,7 @@ import numpy as np
 
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.emla import EmlaSet
+from hiab_sim.results.design_values import crane_lengths
 from hiab_sim.structure.buckling import buckled_actuators, buckling_samples, utilisation_partials
 from hiab_sim.structure.natural_frequency import natural_frequencies
 from hiab_sim.structure.pin_loads import pin_forces, pins
@@ -52,7 +53,12 @@ class BucklingRows(PerSampleBlock):
     def values(self, state: SampleState) -> Array:
         """1 - u per sample, sample-major (K * r,)."""
         u = buckling_samples(
-            self.crane, self.emlas, state.lengths, state.joints.position, state.actuators.force, self.safety_factor
+            self.crane,
+            self.emlas,
+            crane_lengths(state.lengths),
+            state.joints.position,
+            state.actuators.force,
+            self.safety_factor,
         ).utilisation
         return (1.0 - u).ravel()
 
@@ -66,7 +72,7 @@ class BucklingRows(PerSampleBlock):
         du_dq, du_dxi = utilisation_partials(
             self.crane,
             self.emlas,
-            state.lengths,
+            crane_lengths(state.lengths),
             state.joints.position,
             state.actuators.force,
             partials.id_q[:, 0:3, :],
@@ -99,7 +105,7 @@ class PinLoadRows(PerSampleBlock):
     def values(self, state: SampleState) -> Array:
         """1 - |F| / F_max per sample, sample-major."""
         j = state.joints
-        return self._rows(state.lengths, j.position, j.velocity, j.acceleration).ravel()
+        return self._rows(crane_lengths(state.lengths), j.position, j.velocity, j.acceleration).ravel()
 
     def relaxation(self, values: Array) -> Relaxation:
         """Per kN of a pin's rating: d(1 - |F| / F_max)/dF_max = (1 - g) / F_max, times 1e3 N."""
@@ -118,8 +124,8 @@ class PinLoadRows(PerSampleBlock):
             up, down = q9.copy(), q9.copy()
             up[:, k] += h
             down[:, k] -= h
-            rows_up = self._rows(state.lengths, up[:, 0:3], up[:, 3:6], up[:, 6:9])
-            rows_down = self._rows(state.lengths, down[:, 0:3], down[:, 3:6], down[:, 6:9])
+            rows_up = self._rows(crane_lengths(state.lengths), up[:, 0:3], up[:, 3:6], up[:, 6:9])
+            rows_down = self._rows(crane_lengths(state.lengths), down[:, 0:3], down[:, 3:6], down[:, 6:9])
             dq[:, :, k] = (rows_up - rows_down) / (2.0 * h[:, None])
         xi = state.lengths.as_array()
         dxi = np.zeros((K, r, N_XI))
@@ -165,7 +171,7 @@ class NaturalFrequencyRows(PerSampleBlock):
 
     def values(self, state: SampleState) -> Array:
         """f_1 / f_min - 1 per sample."""
-        return self._rows(state.lengths, state.joints.position)
+        return self._rows(crane_lengths(state.lengths), state.joints.position)
 
     def relaxation(self, values: Array) -> Relaxation:
         """Per Hz of the minimum lowered: d(f / f_min - 1)/d(-f_min) = (1 + g) / f_min."""
@@ -182,7 +188,9 @@ class NaturalFrequencyRows(PerSampleBlock):
             up, down = q.copy(), q.copy()
             up[:, k] += h
             down[:, k] -= h
-            dq[:, 0, k] = (self._rows(state.lengths, up) - self._rows(state.lengths, down)) / (2.0 * h)
+            dq[:, 0, k] = (
+                self._rows(crane_lengths(state.lengths), up) - self._rows(crane_lengths(state.lengths), down)
+            ) / (2.0 * h)
         xi = state.lengths.as_array()
         dxi = np.zeros((K, 1, N_XI))
         for k in range(N_XI):

@@ -6,7 +6,8 @@ one :class:`TaskProblem` per task over the shared Xi (a single task is its own s
 Decision variables z = [z_xi (n_xi), z_c (n N)] (scaled): Xi = ``XI_SCALE`` z_xi (the machine's
 decision variables: for the crane lift L, Lc0, Lc, then tilt [m]) and c = c_ref + ``C_SCALE`` z_c,
 the B-spline coefficients of the n joints (the crane's theta1, theta2, xt2) around the study's
-initial fit. The machine is seen through :class:`hiab_sim.study.machines.protocol.StudyMachine`. The cost f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 [W^2 s] uses the EMLA
+initial fit. The machine is seen through :class:`hiab_sim.study.machines.protocol.StudyMachine`.
+The cost f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 [W^2 s] uses the EMLA
 electrical power P_i of :mod:`hiab_sim.emla` (never f v / eta); it is a squared-power integral,
 not an energy, and is scaled by its value at the study's start.
 
@@ -51,11 +52,11 @@ from hiab_sim.emla import (
 )
 from hiab_sim.emla.duty_energy import DutyOptions, drive_duty
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.study.machines.protocol import Design, StudyMachine
 from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.nlp import blocks as bl
 from hiab_sim.study.nlp import builtin_blocks  # noqa: F401  (registers the built-in blocks, in row order)
 from hiab_sim.study.nlp.block_registry import build_blocks
-from hiab_sim.study.machines.protocol import Design, StudyMachine
 from hiab_sim.study.nlp.id_partials import id_joint_partials
 from hiab_sim.study.nlp.interface import (
     Array,

@@ -35,14 +35,14 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.crane.description import Crane
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study.motion.trajectory import JointTrajectory, Reference, SplineBasis, TcpKinematics, fit_coefficients
+from hiab_sim.study.motion.trajectory import JointTrajectory, Reference, SplineBasis, fit_coefficients
 from hiab_sim.study.motion.workspace import check_workspace, dense_times, describe_point
 from hiab_sim.yaml_fields import mapping, number, positive
 
 if TYPE_CHECKING:
-    from hiab_sim.crane.description import Crane
-    from hiab_sim.study.machines.protocol import StudyMachine
+    from hiab_sim.study.machines.protocol import Kinematics, StudyMachine
 
 Array = NDArray[np.float64]
 #: The crane's tracked coordinates beyond the TCP's x, y and its joints: the default columns.
@@ -55,6 +55,8 @@ def forms(extra: tuple[str, ...], joints: tuple[str, ...]) -> dict[frozenset[str
     if len(extra) == 1:
         out[frozenset({"t", "x", "y"})] = "tcp"  # the one further coordinate held at the task's value
     return out
+
+
 DEGREE = 5
 #: Default knot spacing of the fit [s]: the seed's 22 control points over 6.25 s space knots ~0.37 s.
 KNOT_SPACING = 0.25
@@ -209,7 +211,7 @@ class CsvReference:
             cols.append(np.full(len(tab.values), self.telescope))
         return np.column_stack(cols)
 
-    def sample(self, kin: TcpKinematics, times: Array) -> Reference:
+    def sample(self, kin: Kinematics, times: Array) -> Reference:
         """Reference r = (x, y, xt2) and its rates from the fit at ``times`` [s] (0 = the first row)."""
         t = np.asarray(times, dtype=float)
         B, dB, ddB = self.basis().matrices(t)
@@ -220,11 +222,12 @@ class CsvReference:
             q, dq, ddq = s.position, s.velocity, s.acceleration
         return Reference(time=t, position=q, velocity=dq, acceleration=ddq, z=kin.z, centre=(q[0, 0], q[0, 1]))
 
-    def check_reach(self, kin: TcpKinematics, model: StudyMachine | Crane) -> None:
+    def check_reach(self, kin: Kinematics, model: StudyMachine | Crane) -> None:
         """Every row, then the fit every 10 ms, within the machine's reach and joint ranges."""
-        from hiab_sim.study.machines import as_study_machine  # the study's machines import this module
+        if isinstance(model, Crane):
+            from hiab_sim.study.machines.crane_model import CraneModel
 
-        model = as_study_machine(model)
+            model = CraneModel(model)
         tab, data = self.table, self._data()
         t = tab.values[:, tab.columns.index("t")]
         if self.form == "tcp":

@@ -42,12 +42,12 @@ from numpy.typing import NDArray
 from scipy.optimize import brentq
 
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study.motion.trajectory import Reference, TcpKinematics, timing_law
+from hiab_sim.study.motion.trajectory import Reference, timing_law
 from hiab_sim.study.motion.workspace import check_workspace, dense_times, initial_joints
 
 if TYPE_CHECKING:
     from hiab_sim.crane.description import Crane
-    from hiab_sim.study.machines.protocol import StudyMachine
+    from hiab_sim.study.machines.protocol import Kinematics, StudyMachine
 from hiab_sim.study.references.csv_file import CRANE_NAMES, CsvReference
 from hiab_sim.yaml_fields import mapping, number, positive
 
@@ -64,10 +64,10 @@ class TaskReference(Protocol):
     def duration(self) -> float:
         """Length of the task [s]; the task's grid spans [0, duration]."""
 
-    def sample(self, kin: TcpKinematics, times: Array) -> Reference:
+    def sample(self, kin: Kinematics, times: Array) -> Reference:
         """Reference r = (x_tcp, y_tcp, xt2) and its rates at ``times`` [s], each (T, 3)."""
 
-    def check_reach(self, kin: TcpKinematics, model: StudyMachine | Crane) -> None:
+    def check_reach(self, kin: Kinematics, model: StudyMachine | Crane) -> None:
         """Raise :class:`InvalidInputError` naming the first time (or file row) the machine cannot reach."""
 
 
@@ -128,7 +128,7 @@ class Spiral:
         )
         _check(self.telescope_start >= 0.0, "reference.telescope_start", self.telescope_start, "must be >= 0", "m")
 
-    def centre(self, kin: TcpKinematics) -> tuple[float, float]:
+    def centre(self, kin: Kinematics) -> tuple[float, float]:
         """Spiral centre in {W} (x, y) [m]: given, or the TCP at the given centre joints."""
         if self.centre_tcp is not None:
             return self.centre_tcp
@@ -136,7 +136,7 @@ class Spiral:
         p = kin.position(np.array([[*self.centre_joints, self.telescope_start]]))[0]
         return float(p[0]), float(p[1])
 
-    def sample(self, kin: TcpKinematics, times: Array) -> Reference:
+    def sample(self, kin: Kinematics, times: Array) -> Reference:
         """Reference r = (x, y, xt2) of the spiral and its rates at ``times`` [s]."""
         s, ds, dds = timing_law(times, self.duration)
         cx, cy = self.centre(kin)
@@ -164,7 +164,7 @@ class Spiral:
             centre=(cx, cy),
         )
 
-    def check_reach(self, kin: TcpKinematics, model: StudyMachine | Crane) -> None:
+    def check_reach(self, kin: Kinematics, model: StudyMachine | Crane) -> None:
         """The machine's IK of the reference every <= 10 ms; raises naming the first unreachable time."""
         check_workspace(model, self.sample(kin, dense_times(self.duration)))
 
@@ -252,7 +252,7 @@ class PickAndPlace:
         curvature = 6.0 * (r * (p2 - 2.0 * p1 + p0) + s * (p3 - 2.0 * p2 + p1))
         return point, tangent, curvature
 
-    def sample(self, kin: TcpKinematics, times: Array) -> Reference:
+    def sample(self, kin: Kinematics, times: Array) -> Reference:
         """Reference r = (x, y, xt2) and its rates: P(s(t)), P' ds, P'' ds^2 + P' dds; xt2 with the same s(t)."""
         t = np.asarray(times, dtype=float)
         s, ds, dds = septic_law(t, self.dwell[0], self.move_time)
@@ -269,7 +269,7 @@ class PickAndPlace:
             centre=self.pick,
         )
 
-    def check_reach(self, kin: TcpKinematics, model: StudyMachine | Crane) -> None:
+    def check_reach(self, kin: Kinematics, model: StudyMachine | Crane) -> None:
         """The machine's IK of the reference every <= 10 ms; raises naming the first unreachable time."""
         check_workspace(model, self.sample(kin, dense_times(self.duration)))
 

@@ -22,6 +22,7 @@ from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.tolerance import buildable_crane, check_tolerance, design_margins, range_cost_deg
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.results.analysis_sections import Buildable, RoundedCheck
+from hiab_sim.results.design_values import crane_lengths
 from hiab_sim.results.schema import DesignSummary
 from hiab_sim.study.analysis.buildable import rounded_design
 from hiab_sim.study.nlp.problem import StudyProblem
@@ -36,7 +37,7 @@ def rounded_point(problem: StudyProblem, z: Array) -> tuple[LinkLengths, Array]:
     lengths, _ = problem.unpack(z)
     study = problem.study
     rounded = rounded_design(
-        lengths, study.build.tolerance, np.asarray(study.bounds.xi_low), np.asarray(study.bounds.xi_up)
+        crane_lengths(lengths), study.build.tolerance, np.asarray(study.bounds.xi_low), np.asarray(study.bounds.xi_up)
     )
     return rounded, problem.with_lengths(z, rounded)
 
@@ -58,7 +59,7 @@ def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, c
         crane_check = RoundedCheck(True, "check_lengths over the buildable working range", 0.0, "m")
     except InvalidInputError as error:
         crane_check = RoundedCheck(False, str(error), float("nan"), "m")
-    lengths, _ = problem.unpack(z)
+    lengths = crane_lengths(problem.unpack(z)[0])
     tol = check_tolerance(design_margins(short, study.mounting), lengths, t)
     label, row, value = tol.worst()
     tolerance_check = RoundedCheck(tol.ok, f"{row} at the {label} design", value, "m")
@@ -99,7 +100,8 @@ def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, c
 
 def buildable_line(b: Buildable) -> str:
     """One stdout line: the rounded design, its checks and energy."""
-    lift, tilt = b.lengths.lift, b.lengths.tilt
+    lengths = crane_lengths(b.lengths, "buildable.lengths")
+    lift, tilt = lengths.lift, lengths.tilt
     ok = all(c.passed for c in (b.crane_check, b.tolerance_check, b.recheck))
     return (
         f"buildable (rounded to {b.tolerance_m * 1e3:g} mm, stroke margin {b.stroke_margin_m * 1e3:g} mm): "

@@ -31,8 +31,8 @@ from hiab_sim.results.schema import (
     TrackingError,
     WorstConstraint,
 )
-from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.motion.workspace import tracked_units
+from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.task_problem import Evaluation, TaskProblem
 from hiab_sim.study.spec.study_file import Study
 
@@ -58,7 +58,10 @@ def _extra_errors(problem: TaskProblem, errors: Array) -> dict[str, Any]:
         return {"telescope_m": float(errors[0])}
     units = tracked_units(problem.model)[2:]
     names = problem.model.tracked_names[2:]
-    return {"telescope_m": None, "tracked": {f"{n}_{u}": float(e) for n, u, e in zip(names, units, errors, strict=True)}}
+    return {
+        "telescope_m": None,
+        "tracked": {f"{n}_{u}": float(e) for n, u, e in zip(names, units, errors, strict=True)},
+    }
 
 
 def design_summary(problem: TaskProblem, z: Array) -> DesignCheck:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from hiab_sim.dynamics.samples import JointSamples
+from hiab_sim.results.design_values import crane_lengths
 from hiab_sim.structure.summary import StructureSummary, design_structure
 from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.report.design_check import DesignCheck
@@ -17,7 +18,7 @@ def structure_section(fine: TaskProblem, checks: dict[str, DesignCheck]) -> Stru
         out[name] = design_structure(
             fine.crane,
             fine.emlas,
-            ev.lengths,
+            crane_lengths(ev.lengths),
             joints,
             ev.actuators.force,
             fine.tcp_force,

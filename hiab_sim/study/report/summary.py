@@ -17,6 +17,8 @@ from dataclasses import fields
 from pathlib import Path
 
 from hiab_sim.crane.description import LinkLengths
+from hiab_sim.machine.design import MachineDesign
+from hiab_sim.results.design_values import DesignValues
 from hiab_sim.results.schema import Result
 
 #: File name of the summary inside a run folder.
@@ -80,9 +82,15 @@ def limit_in_words(name: str, detail: bool = True) -> str:
     return name.replace("_", " ")
 
 
-def _design_lines(built: LinkLengths, initial: LinkLengths, tolerance_mm: float | None) -> list[str]:
+def _design_lines(built: DesignValues, initial: DesignValues, tolerance_mm: float | None) -> list[str]:
     rounding = f", rounded to {tolerance_mm:g} mm" if tolerance_mm is not None else ""
     lines = [f"What to build (link lengths in mm, change from the initial design in brackets{rounding}):"]
+    if isinstance(built, MachineDesign) or isinstance(initial, MachineDesign):
+        old = dict(zip(initial.names, initial.values, strict=True)) if isinstance(initial, MachineDesign) else {}
+        assert isinstance(built, MachineDesign)
+        for name, value in zip(built.names, built.values, strict=True):
+            lines.append(f"- {name}: {value * 1e3:.0f} ({(value - old.get(name, value)) * 1e3:+.0f})")
+        return lines
     for chain in (f.name for f in fields(LinkLengths)):
         new, old = getattr(built, chain), getattr(initial, chain)
         parts = []

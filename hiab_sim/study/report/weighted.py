@@ -10,6 +10,8 @@ returns that task's own section unchanged.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from hiab_sim.results.schema import (
     ENERGY_PARTS,
     ActuatorSummary,
@@ -29,6 +31,26 @@ TELESCOPE = "prescribed by the reference (third tracked coordinate xt2)"
 def is_one_task(weights: list[float]) -> bool:
     """A study of one task of weight 1: its sections are the task's own."""
     return len(weights) == 1 and weights[0] == 1.0
+
+
+def worst_tracking(errors: Sequence[TrackingError]) -> TrackingError:
+    """The largest of each tracking error over the tasks (None where every task has none)."""
+
+    def worst(values: list[float | None]) -> float | None:
+        given = [v for v in values if v is not None]
+        return max(given) if given else None
+
+    tracked: dict[str, float] = {}
+    for e in errors:
+        for key, value in (e.tracked or {}).items():
+            tracked[key] = max(tracked.get(key, value), value)
+    return TrackingError(
+        position_m=max(e.position_m for e in errors),
+        velocity_m_per_s=max(e.velocity_m_per_s for e in errors),
+        acceleration_m_per_s2=max(e.acceleration_m_per_s2 for e in errors),
+        telescope_m=worst([e.telescope_m for e in errors]),
+        tracked=tracked or None,
+    )
 
 
 def weighted_summary(summaries: list[DesignSummary], weights: Array, names: list[str]) -> DesignSummary:
@@ -72,9 +94,7 @@ def weighted_summary(summaries: list[DesignSummary], weights: Array, names: list
         worst_constraint=WorstConstraint(
             f"{names[worst]}: {summaries[worst].worst_constraint.name}", summaries[worst].worst_constraint.scaled_margin
         ),
-        tracking_error=TrackingError(
-            *(max(getattr(s.tracking_error, k) for s in summaries) for k in vars(summaries[0].tracking_error))
-        ),
+        tracking_error=worst_tracking([s.tracking_error for s in summaries]),
         collocation_cost_W2s=None if None in colloc else total([float(c or 0.0) for c in colloc]),
         collocation_max_violation=None if None in colloc_viol else max(float(v or 0.0) for v in colloc_viol),
     )
@@ -93,9 +113,7 @@ def weighted_recheck(rechecks: list[Recheck], weights: Array, names: list[str]) 
         worst_constraint=WorstConstraint(
             f"{names[worst]}: {rechecks[worst].worst_constraint.name}", rechecks[worst].worst_constraint.scaled_margin
         ),
-        tracking_error=TrackingError(
-            *(max(getattr(r.tracking_error, k) for r in rechecks) for k in vars(rechecks[0].tracking_error))
-        ),
+        tracking_error=worst_tracking([r.tracking_error for r in rechecks]),
         net_electrical_energy_J=float(
             sum(w * r.net_electrical_energy_J for w, r in zip(weights, rechecks, strict=True))
         ),

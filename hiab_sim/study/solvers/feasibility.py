@@ -31,7 +31,6 @@ import math
 import numpy as np
 from scipy.optimize import minimize
 
-from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import InfeasibleStudyError, InvalidInputError
 from hiab_sim.results.analysis_sections import FeasibilityPhase
 from hiab_sim.study.analysis.sensitivity import XI_NAMES
@@ -282,7 +281,8 @@ def feasible_start(
         final_max_violation=problem.max_violation(z),
         lengths_before=before,
         lengths_after=after,
-        changes=changes(before, after, problem.model.design_names) or ("only the trajectory (spline coefficients) changed",),
+        changes=changes(before, after, problem.model.design_names)
+        or ("only the trajectory (spline coefficients) changed",),
         iterations=int(res.nit),
     )
 
@@ -310,7 +310,7 @@ def feasible_starts(problem: StudyProblem, count: int, seed: int = 6) -> tuple[l
             break
         xi = rng.uniform(low, up)
         try:
-            z, phase = feasible_start(problem, problem.initial_point(LinkLengths.from_array(xi)), len(points))
+            z, phase = feasible_start(problem, problem.initial_point(problem.model.design(xi)), len(points))
         except InvalidInputError:
             continue
         points.append(z)
@@ -347,7 +347,10 @@ def moved_start_phase(problem: StudyProblem, z: Array) -> FeasibilityPhase | Non
     return FeasibilityPhase(
         start=0,
         initial_max_violation=float(excess[k]),
-        initial_worst=f"bounds: the built machine's {problem.model.design_names[k]} lies {excess[k] * 1e3:.1f} mm outside its bounds",
+        initial_worst=(
+            f"bounds: the built machine's {problem.model.design_names[k]} lies "
+            f"{excess[k] * 1e3:.1f} mm outside its bounds"
+        ),
         final_max_violation=problem.max_violation(z),
         lengths_before=before,
         lengths_after=problem.study.initial_lengths,

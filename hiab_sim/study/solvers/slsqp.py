@@ -27,6 +27,8 @@ from scipy.optimize import OptimizeResult, minimize
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
 from hiab_sim.errors import InvalidInputError, SolverError
+from hiab_sim.machine.design import MachineDesign
+from hiab_sim.results.design_values import DesignValues
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.solvers.ipopt import solve_ipopt
 
@@ -53,7 +55,7 @@ class SolveResult:
     """Outcome of one start."""
 
     start: int
-    initial_lengths: LinkLengths
+    initial_lengths: DesignValues
     z0: Array
     z: Array
     history: list[Iterate] = field(default_factory=list)
@@ -84,16 +86,23 @@ def check_start(problem: StudyProblem, z: Array, label: str = "initial_lengths")
         )
 
 
-def start_points(problem: StudyProblem, count: int, seed: int = 6) -> list[LinkLengths]:
+def start_points(problem: StudyProblem, count: int, seed: int = 6) -> list[DesignValues]:
     """The study's start and ``count - 1`` other feasible starts, drawn in the Xi bounds.
 
     Per chain: L uniform in its bounds, the retracted length x0 = Lc0 + Lc so that the stroke is
     >= 0 at the low end of the working range and within the stroke at its high end, Lc just
     above the largest stroke; kept when every constraint holds with the inverse-kinematics
-    coefficients.
+    coefficients. A crane file's draw (its triangle trigonometry); a machine file's study has none
+    (:func:`hiab_sim.study.solvers.feasibility.feasible_points` draws its starts uniformly).
+
+    Raises:
+        InvalidInputError: too few feasible starts, or a machine file's study (field ``starts``).
+
     """
     from hiab_sim.crane import mechanism
 
+    if problem.study.crane_description is None:
+        raise InvalidInputError("starts", count, "the solver's own draw of starts needs a crane file")
     low, up = np.asarray(problem.study.bounds.xi_low), np.asarray(problem.study.bounds.xi_up)
     starts = [problem.study.initial_lengths]
     rng = np.random.default_rng(seed)
@@ -101,7 +110,7 @@ def start_points(problem: StudyProblem, count: int, seed: int = 6) -> list[LinkL
         if len(starts) >= count:
             break
         xi = np.zeros(6)
-        for j, chain in enumerate(problem.crane.chains):
+        for j, chain in enumerate(problem.problems[0].crane.chains):
             L = rng.uniform(low[3 * j], up[3 * j])
             lo, hi = problem.working[j]
             q = mechanism.hinge_angle(chain, np.array([lo, hi]))
@@ -143,7 +152,7 @@ def study_digest(problem: StudyProblem) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def checkpoint_identity(problem: StudyProblem, initial: LinkLengths) -> dict[str, Any]:
+def checkpoint_identity(problem: StudyProblem, initial: DesignValues) -> dict[str, Any]:
     """What a checkpoint belongs to: study path and content hash, ID path, start Xi [m]."""
     return {
         "study": str(Path(problem.study.path).resolve()),
@@ -153,7 +162,7 @@ def checkpoint_identity(problem: StudyProblem, initial: LinkLengths) -> dict[str
     }
 
 
-def check_checkpoint(problem: StudyProblem, initial: LinkLengths, out: Path, start: int) -> dict[str, Any] | None:
+def check_checkpoint(problem: StudyProblem, initial: DesignValues, out: Path, start: int) -> dict[str, Any] | None:
     """The checkpoint of a start if it belongs to this run, None if there is none.
 
     Raises:
@@ -216,7 +225,7 @@ def load_checkpoint(out: Path, start: int) -> dict[str, Any] | None:
 
 def solve(
     problem: StudyProblem,
-    initial: LinkLengths,
+    initial: DesignValues,
     start: int = 0,
     out: Path | None = None,
     resume: bool = False,
@@ -360,6 +369,8 @@ def _ipopt(problem: StudyProblem, z: Array, limit: int, record: Callable[[Array]
     return OptimizeResult(x=outcome.z, success=outcome.success, status=status, message=outcome.message)
 
 
-def xi_table(lengths: LinkLengths) -> dict[str, dict[str, float]]:
-    """{"lift": {"L":..,"Lc0":..,"Lc":..}, "tilt": {...}} [m]."""
+def xi_table(lengths: DesignValues) -> dict[str, Any]:
+    """A crane's {"lift": {"L":..,"Lc0":..,"Lc":..}, "tilt": {...}}, a machine file's {"chain.variable": value} [m]."""
+    if isinstance(lengths, MachineDesign):
+        return dict(zip(lengths.names, map(float, lengths.values), strict=True))
     return {name: {k: float(getattr(getattr(lengths, name), k)) for k in ("L", "Lc0", "Lc")} for name in CHAIN_NAMES}

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -28,16 +28,16 @@ from hiab_sim.checks import check_choice, check_range
 from hiab_sim.crane.description import CHAIN_NAMES, ChainLengths, Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.crane.mounting import MountingSpace
+from hiab_sim.emla.config import EmlaSet, load_emla_set
+from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.loader import PRESETS as MACHINE_PRESETS
 from hiab_sim.machine.loader import load_machine, locate_machine
+from hiab_sim.resources import DEFAULT_STUDY, Source, locate
+from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.machines.crane_model import CraneModel
 from hiab_sim.study.machines.machine_model import MachineModel
 from hiab_sim.study.machines.protocol import Design, StudyMachine
-from hiab_sim.emla.config import EmlaSet, load_emla_set
-from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.resources import DEFAULT_STUDY, Source, locate
-from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.references.kinds import TaskReference
 from hiab_sim.study.spec.build import BuildSettings
 from hiab_sim.study.spec.energy import ENERGY_KEYS, EnergySettings, energy_settings
@@ -160,7 +160,9 @@ class Bounds:
                 else f"bounds.{CHAIN_NAMES[i // 3]}.low[{i % 3}] ({('L', 'Lc0', 'Lc')[i % 3]})"
             )
             if not low < up or (not self.xi_fields and not 0.0 < low):
-                raise InvalidInputError(where, low, f"must satisfy {'' if self.xi_fields else '0 < '}low < up = {up:.6g}", "m")
+                raise InvalidInputError(
+                    where, low, f"must satisfy {'' if self.xi_fields else '0 < '}low < up = {up:.6g}", "m"
+                )
         if min(self.joint_velocity) <= 0.0:
             raise InvalidInputError("bounds.joint_velocity", min(self.joint_velocity), "every limit must be > 0")
         margin = math.degrees(self.triangle_margin)
@@ -281,7 +283,7 @@ class Study:
                 assert self.machine is not None
                 cached = MachineModel(self.machine, self.tracked)
             object.__setattr__(self, "_model", cached)
-        return cached
+        return cast("StudyMachine", cached)
 
     @property
     def reference(self) -> TaskReference:
@@ -338,7 +340,7 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
         file = Source(str(file), Path(file), shipped=False)
     top = mapping(data, "study", _TOP, _REQUIRED_TOP)
     if "machine" in top:
-        return machine_study_from_dict(top, file)
+        return machine_study_from_dict(dict(top), file)
     if "crane" not in top:
         raise ConfigError("study: missing key 'crane' (a crane file) or 'machine' (a machine file)")
     if "tracked" in top:
@@ -417,8 +419,11 @@ def _clipped_lengths(crane: Crane, bounds: Bounds) -> LinkLengths:
 
 
 def _bounds(data: Any, chains: bool = True, joints: int = 3) -> Bounds:
-    """Bounds from YAML: per chain ``low``/``up`` triples (a crane file's; a machine file declares its own,
-    ``chains`` False); ``joint_velocity`` one per joint (required for a machine); angles in degrees (``*_deg``)."""
+    """Bounds from YAML: per chain ``low``/``up`` triples, ``joint_velocity`` one per joint, angles in degrees.
+
+    A crane file's study gives the chains' bounds; a machine file declares its own (``chains`` False)
+    and its study must give ``joint_velocity`` (``joints`` limits).
+    """
     keys = {
         "joint_velocity",
         "triangle_margin_deg",
@@ -482,7 +487,9 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
         bounds,
         xi_low=tuple(map(float, low)),
         xi_up=tuple(map(float, up)),
-        xi_fields=tuple(f"{machine_file.label}: chains.{k.replace('.', '.variables.')}.bounds" for k in model.design_names),
+        xi_fields=tuple(
+            f"{machine_file.label}: chains.{k.replace('.', '.variables.')}.bounds" for k in model.design_names
+        ),
     )
     grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
     name = str(top.get("name", Path(str(file.file)).stem))

@@ -26,7 +26,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study.motion.trajectory import TcpKinematics
 from hiab_sim.study.references.csv_file import CRANE_NAMES
 from hiab_sim.study.references.kinds import TaskReference, reference_from_mapping
 from hiab_sim.study.spec.payload import Payload
@@ -37,7 +36,7 @@ Array = NDArray[np.float64]
 
 if TYPE_CHECKING:
     from hiab_sim.crane.description import Crane
-    from hiab_sim.study.machines.protocol import StudyMachine
+    from hiab_sim.study.machines.protocol import Kinematics, StudyMachine
 
 
 @dataclass(frozen=True)
@@ -85,21 +84,21 @@ class Task:
         duration = self.reference.duration
         return np.linspace(0.0, duration, max(2, math.ceil(duration / step - 1e-9)) + 1)
 
-    def tcp_force(self, kin: TcpKinematics, gravity: float, times: Array) -> Array | None:
+    def tcp_force(self, kin: Kinematics, gravity: float, times: Array) -> Array | None:
         """Payload force on the TCP at ``times``, (K, 3) in {W} [N] (reference's acceleration); None without mass."""
         if self.payload.mass == 0.0:
             return None
         acceleration = self.reference.sample(kin, times).acceleration[:, :2]
         return self.payload.tcp_force(times, acceleration, gravity)
 
-    def soil_force(self, kin: TcpKinematics, gravity: float, times: Array) -> Array | None:
+    def soil_force(self, kin: Kinematics, gravity: float, times: Array) -> Array | None:
         """The soil's force on the TCP at ``times``, (K, 3) in {W} [N] (on the reference); None without soil."""
         if self.soil is None:
             return None
         ref = self.reference.sample(kin, times)
         return self.soil.force(tuple(getattr(kin, "names", ())), ref.position, ref.velocity, gravity)
 
-    def id_force(self, kin: TcpKinematics, gravity: float, times: Array) -> Array | None:
+    def id_force(self, kin: Kinematics, gravity: float, times: Array) -> Array | None:
         """The payload's force on the TCP as the inverse dynamics takes it [N] in {W}: None, (3,) or (K, 3).
 
         A constant weight without inertia (a single-reference study's plain ``payload: <kg>``) is
@@ -165,14 +164,14 @@ def tasks_from_mapping(
         except InvalidInputError as error:
             raise InvalidInputError(_prefixed(where, error.field), error.value, error.allowed, error.unit) from None
         tasks.append(task)
-    names = [t.name for t in tasks]
-    duplicate = next((n for n in names if names.count(n) > 1), None)
+    task_names = [t.name for t in tasks]
+    duplicate = next((n for n in task_names if task_names.count(n) > 1), None)
     if duplicate is not None:
         raise ConfigError(f"tasks: the name {duplicate!r} is used twice; task names must be unique")
     return tuple(tasks)
 
 
-def check_tasks(tasks: tuple[Task, ...], kin: TcpKinematics, model: StudyMachine | Crane) -> None:
+def check_tasks(tasks: tuple[Task, ...], kin: Kinematics, model: StudyMachine | Crane) -> None:
     """Every task's reference within the machine's reach and joint ranges; the error names the task."""
     for i, task in enumerate(tasks):
         try:

@@ -1,0 +1,23 @@
+"""The values of a design's decision variables as a result stores them: a crane file's or a machine file's.
+
+A crane file's study stores the seed's Xi as :class:`~hiab_sim.crane.description.LinkLengths`
+(``{"lift": {"L", "Lc0", "Lc"}, "tilt": {...}}`` [m]); a machine file's as
+:class:`~hiab_sim.machine.design.MachineDesign` (``{"names": [...], "values": [...]}``, each value in
+its variable's unit, m). The result codec tells them apart by their keys.
+"""
+
+from __future__ import annotations
+
+from hiab_sim.crane.description import LinkLengths
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.machine.design import MachineDesign
+
+#: A design's decision-variable values.
+DesignValues = LinkLengths | MachineDesign
+
+
+def crane_lengths(design: DesignValues, where: str = "design") -> LinkLengths:
+    """The crane's link lengths of a design (a crane file's study); a machine file's design is refused by name."""
+    if not isinstance(design, LinkLengths):
+        raise InvalidInputError(where, type(design).__name__, "this part of hiab-sim needs a crane file's link lengths")
+    return design
