@@ -254,7 +254,7 @@ class NeLayout:
     ``parent``, ``revolute`` and ``unturn`` e^{-i offset} per body; ``n_links``: the machine's links are bodies 0 ..
     n_links - 1 (no link hangs on a chain body); ``below`` (nbody, nbody) 0/1, ``below[j, b]``:
     body j is in body b's subtree; ``axis`` (nbody,) unit slide directions (0 for hinges) and ``offset`` (nbody,) [rad] of
-    :class:`PlanarBody`; ``fixed`` (nbody, 3, 3); ``massive``: bodies with inertia; ``actuated``
+    :class:`PlanarBody`; ``fixed`` (nbody, 3, 3); ``massive``/``massless``: bodies with inertia and the rest (the root included); ``actuated``
     and ``act_parent``: actuated bodies and their parents; ``pins_on``: the body each reported force
     acts on (:func:`pin_layout` order); joint ranges ``low``, ``high`` of the independent joints;
     ``file``: the planar numbers of the machine itself (its design).
@@ -273,6 +273,7 @@ class NeLayout:
     offset: Array
     fixed: Array
     massive: Index
+    massless: Index
     independent: Index
     actuated: Index
     act_parent: Index
@@ -318,6 +319,7 @@ def build_layout(machine: Machine) -> NeLayout:
         offset=np.asarray([p.offset for p in planar], dtype=float),
         fixed=np.stack([p.fixed for p in planar]),
         massive=_index([b for b in range(1, n) if tree.bodies[b].inertia is not None]),
+        massless=_index([b for b in range(n) if b == 0 or tree.bodies[b].inertia is None]),
         independent=_index(tree.independent),
         actuated=_index(tree.actuated),
         act_parent=_index([tree.bodies[b].parent for b in tree.actuated]),

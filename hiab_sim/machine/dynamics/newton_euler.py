@@ -45,13 +45,8 @@ from numpy.typing import ArrayLike, NDArray
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.ne_design import design_constants
-from hiab_sim.machine.dynamics.ne_kernel import (
-    actuator_forces,
-    frames_of_full,
-    full_state,
-    joint_forces,
-    pin_arrays,
-)
+from hiab_sim.machine.dynamics.ne_forces import actuator_forces, joint_forces, pin_arrays
+from hiab_sim.machine.dynamics.ne_kernel import frames_of_full, full_state
 from hiab_sim.machine.dynamics.ne_layout import NeConstants, NeLayout, layout_of
 from hiab_sim.machine.dynamics.planar import PlanarBody, planar_bodies
 from hiab_sim.machine.dynamics.tree import (
@@ -111,8 +106,8 @@ class NewtonEulerInverseDynamics:
     def state(self, q: Any, dq: Any, ddq: Any) -> tuple[Array, Array, Array]:
         """Loop-consistent full coordinates, rates, accelerations (T, nbody); inputs checked."""
         q, dq, ddq = joint_arrays(self.layout.tree, q, dq, ddq)
-        full = full_state(self.layout, self.constants, q.T[:, None], dq.T[:, None], ddq.T[:, None], angles=True)
-        return full[0][:, 0].T, full[1][:, 0].T, full[2][:, 0].T
+        ws = full_state(self.layout, self.constants, q.T[:, None], dq.T[:, None], ddq.T[:, None], angles=True)
+        return ws.q[:, 0].T.copy(), ws.dq[:, 0].T.copy(), ws.ddq[:, 0].T.copy()
 
     def __call__(self, q: Any, dq: Any, ddq: Any, tcp_force: Any = None) -> MachineActuatorSamples:
         """Actuator forces, velocities, accelerations, strokes (T, n_chains) and pin forces.
@@ -131,11 +126,12 @@ class NewtonEulerInverseDynamics:
         layout = self.layout
         q, dq, ddq = joint_arrays(layout.tree, q, dq, ddq)
         external = tcp_force_complex(tcp_force, q.shape[0])
-        qf, dqf, ddqf, fr = full_state(layout, self.constants, q.T[:, None], dq.T[:, None], ddq.T[:, None])
-        transmitted, lam = joint_forces(layout, self.constants, fr, external)
+        ws = full_state(layout, self.constants, q.T[:, None], dq.T[:, None], ddq.T[:, None])
+        transmitted, lam = joint_forces(ws, self.constants, external)
         act = layout.actuated
-        force = _with_extras(actuator_forces(layout, fr, transmitted), self.extras, dqf[act], ddqf[act])
-        world, local = pin_arrays(layout, fr, transmitted, lam)
+        qf, dqf, ddqf = ws.q, ws.dq, ws.ddq
+        force = _with_extras(actuator_forces(ws, transmitted), self.extras, dqf[act], ddqf[act])
+        world, local = pin_arrays(ws, transmitted, lam)
         names, kinds, on, by = layout.pins
         return MachineActuatorSamples(
             names=tuple(layout.tree.machine.actuator_names),
@@ -158,19 +154,20 @@ class NewtonEulerInverseDynamics:
         """Kinetic and potential energy [J] of full coordinates (T, nbody) with no range checks."""
         layout, c = self.layout, self.constants
         qf, dqf = np.asarray(qf, dtype=float).T[:, None], np.asarray(dqf, dtype=float).T[:, None]
-        fr = frames_of_full(layout, c, qf, dqf, np.zeros_like(qf))
+        ws = frames_of_full(layout, c, qf, dqf, np.zeros_like(qf))
         mb = layout.massive
-        com, velocity, _ = fr.points(mb, c.com[mb][:, :, None])
+        com, velocity, _ = ws.points(mb, c.com[mb][:, :, None], tuple(ws.c("energy", 3 * len(mb)).reshape(3, len(mb), *ws.shape)), tuple(ws.c("energy-spare", 2 * len(mb)).reshape(2, len(mb), *ws.shape)))  # type: ignore[arg-type]
         mass, izz = c.mass[mb], c.izz[mb]  # (bodies, 1)
-        kinetic = 0.5 * (mass * np.abs(velocity[:, 0]) ** 2 + izz * fr.omega[mb, 0] ** 2)
+        kinetic = 0.5 * (mass * np.abs(velocity[:, 0]) ** 2 + izz * ws.omega[mb, 0] ** 2)
         potential = mass * layout.tree.gravity * com[:, 0].imag
         return kinetic.sum(axis=0), potential.sum(axis=0)
 
     def tcp_velocity(self, q: Any, dq: Any) -> Array:
         """Velocity of the TCP point in the world plane (T, 2) [m/s] (the power of a TCP force)."""
         q, dq, zero = joint_arrays(self.layout.tree, q, dq, np.zeros_like(np.atleast_2d(np.asarray(q, dtype=float))))
-        _, _, _, fr = full_state(self.layout, self.constants, q.T[:, None], dq.T[:, None], zero.T[:, None])
-        v = fr.points(self.layout.tree.tcp_body, np.asarray(self.layout.tcp_point))[1][0]
+        ws = full_state(self.layout, self.constants, q.T[:, None], dq.T[:, None], zero.T[:, None])
+        b = self.layout.tree.tcp_body
+        v = ws.dz[b, 0] + ws.spin[b, 0] * ws.rot[b, 0] * self.layout.tcp_point
         return np.stack([v.real, v.imag], axis=1)
 
 
@@ -222,11 +219,12 @@ def batched_inverse_dynamics(
     else:
         q, dq, ddq = (x.T[:, None] for x in joint_arrays(layout.tree, *joints))
     external = tcp_force_complex(tcp_force, q.shape[2])
-    qf, dqf, ddqf, fr = full_state(layout, c, q, dq, ddq)
-    transmitted, _ = joint_forces(layout, c, fr, external)
+    ws = full_state(layout, c, q, dq, ddq)
+    transmitted, _ = joint_forces(ws, c, external)
     act = layout.actuated
-    force = _with_extras(actuator_forces(layout, fr, transmitted), extras, dqf[act], ddqf[act])
-    return tuple(x.transpose(1, 2, 0) for x in (force, dqf[act], ddqf[act], qf[act]))  # type: ignore[return-value]
+    qf, dqf, ddqf = ws.q[act], ws.dq[act], ws.ddq[act]  # copies: the workspace is reused
+    force = _with_extras(actuator_forces(ws, transmitted), extras, dqf, ddqf)
+    return tuple(np.ascontiguousarray(x.transpose(1, 2, 0)) for x in (force, dqf, ddqf, qf))  # type: ignore[return-value]
 
 
 def _check_extras(machine: Machine, extras: SimulationExtras | None) -> None:

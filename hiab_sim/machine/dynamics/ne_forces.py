@@ -1,0 +1,188 @@
+"""The force half of the Newton-Euler solve: joint, pin and actuator forces from the frames of a workspace.
+
+Step 3 of the solve (:mod:`hiab_sim.machine.dynamics.newton_euler` states the equations): per
+body the Newton-Euler force and moment about O, (F, M_O) = (m (a_c - g), I_zz alpha + c x F),
+summed tip to base over subtrees; the hinge equations M_O - o_b x F = 0 in the loop-pin forces
+lambda, solved block by block in the order of
+:class:`~hiab_sim.machine.dynamics.ne_layout.PinSystem` (a 2 x 2 block cross(d_1, lambda) = a_1,
+cross(d_2, lambda) = a_2 gives lambda = (a_1 d_2 - a_2 d_1) / cross(d_1, d_2)); then each joint's
+transmitted force is its subtree's plus the pin forces entering it. Arrays (n, D, T) as in
+:mod:`hiab_sim.machine.dynamics.ne_kernel`, written in place in the workspace.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hiab_sim.machine.dynamics.ne_kernel import Workspace, cross
+from hiab_sim.machine.dynamics.ne_layout import NeConstants
+
+Array = NDArray[np.float64]
+Complex = NDArray[np.complex128]
+
+
+def _cross_into(out: Array, spare: Array, a: Complex, b: Complex) -> Array:
+    """cross(a, b) = a_x b_y - a_y b_x into ``out`` (``spare``: scratch of its shape)."""
+    np.multiply(a.real, b.imag, out=out)
+    np.multiply(a.imag, b.real, out=spare)
+    out -= spare
+    return out
+
+
+def joint_forces(ws: Workspace, c: NeConstants, external: Complex | complex | None) -> tuple[Complex, Complex]:
+    """Force each joint transmits from parent to body (nbody, D, T) and the loop-pin forces lambda (n_pins, D, T).
+
+    ``external``: the TCP force of the environment (complex) [N], (T,), a scalar or None. Both
+    results are workspace arrays (overwritten by the next call).
+    """
+    layout = ws.layout
+    mb, n, take = layout.massive, layout.n_bodies, {"axis": 0, "mode": "clip"}
+    force, moment = ws.c("force", n), ws.r("moment", n)
+    arm, net, at = ws.c("arm", len(mb)), ws.c("net", len(mb)), ws.c("at", len(mb))
+    turning, spare = ws.r("turning", len(mb)), ws.r("spare", len(mb))
+    np.take(ws.rot, mb, out=arm, **take)
+    arm *= c.com[mb][:, :, None]
+    np.take(ws.turn, mb, out=net, **take)
+    net *= arm
+    np.take(ws.ddz, mb, out=at, **take)
+    net += at
+    net += 1j * layout.tree.gravity  # a_c - g, g = (0, -g)
+    net *= c.mass[mb][:, :, None]
+    np.take(ws.z, mb, out=at, **take)
+    at += arm  # centre of mass
+    _cross_into(turning, spare, at, net)
+    np.take(ws.alpha, mb, out=spare, **take)
+    spare *= c.izz[mb][:, :, None]
+    turning += spare
+    force[layout.massless], moment[layout.massless] = 0.0, 0.0
+    force[mb], moment[mb] = net, turning
+    if external is not None:
+        tb = layout.tree.tcp_body
+        tcp, lever = ws.c("tcp", 1)[0], ws.r("tcp", 2)
+        np.multiply(ws.rot[tb], layout.tcp_point, out=tcp)
+        tcp += ws.z[tb]
+        force[tb] -= external
+        moment[tb] -= _cross_into(lever[0], lever[1], tcp, np.broadcast_to(np.asarray(external, complex), tcp.shape))
+    for b in range(n - 1, 1, -1):  # parents precede children: add each subtree into its parent's
+        p = layout.parent[b]
+        if p > 0:
+            force[p] += force[b]
+            moment[p] += moment[b]
+    lam = ws.c("lambda", len(layout.tree.loops))
+    s = layout.system
+    if len(s.pin):
+        _pin_forces(ws, c, force, moment, lam)
+    for k, b, sign in s.transmit:
+        if sign > 0.0:
+            force[b] += lam[k]
+        else:
+            force[b] -= lam[k]
+    return force, lam
+
+
+def _pin_forces(ws: Workspace, c: NeConstants, force: Complex, moment: Array, lam: Complex) -> None:
+    """lambda from the hinge equations, level by level (2 x 2 blocks), then the dense rest."""
+    s = ws.layout.system
+    take = {"axis": 0, "mode": "clip"}
+    n_entries, n_hinges = len(s.pin), len(s.hinge)
+    d, tmp = ws.c("d", n_entries), ws.c("d-spare", n_entries)
+    np.take(ws.rot, s.side_body, out=d, **take)
+    d *= np.concatenate([c.point_a, c.point_b])[s.pin + len(ws.layout.tree.loops) * s.side][:, :, None]
+    np.take(ws.z, s.side_body, out=tmp, **take)
+    d += tmp
+    np.take(ws.z, s.hinge[s.row], out=tmp, **take)
+    d -= tmp  # arm from the hinge to the pin
+    at, pull = ws.c("hinge-z", n_hinges), ws.c("hinge-f", n_hinges)
+    rhs, spare = ws.r("rhs", n_hinges), ws.r("rhs-spare", n_hinges)
+    np.take(ws.z, s.hinge, out=at, **take)
+    np.take(force, s.hinge, out=pull, **take)
+    _cross_into(rhs, spare, at, pull)
+    np.take(moment, s.hinge, out=spare, **take)
+    rhs -= spare  # o_b x F - M_O
+    for level, (pins, e1, e2, earlier, feed) in enumerate(s.levels):
+        k = len(pins)
+        r1, r2, den, den_spare = ws.r(f"level-{level}", 4 * k).reshape(4, k, *ws.shape)
+        d1, d2, num, num_spare = ws.c(f"level-{level}", 4 * k).reshape(4, k, *ws.shape)
+        np.take(rhs, s.row[e1], out=r1, **take)
+        np.take(rhs, s.row[e2], out=r2, **take)
+        if len(earlier):
+            known = s.sign[earlier][:, None, None] * cross(d[earlier], lam[s.pin[earlier]])
+            r1 -= np.tensordot(feed[:, :k], known, axes=(0, 0))
+            r2 -= np.tensordot(feed[:, k:], known, axes=(0, 0))
+        r1 *= s.sign[e1][:, None, None]
+        r2 *= s.sign[e2][:, None, None]
+        np.take(d, e1, out=d1, **take)
+        np.take(d, e2, out=d2, **take)
+        np.multiply(d2, r1, out=num)
+        np.multiply(d1, r2, out=num_spare)
+        num -= num_spare
+        _cross_into(den, den_spare, d1, d2)
+        np.divide(1.0, den, out=den)
+        num *= den
+        lam[pins] = num
+    if s.dense is not None:
+        _dense_pins(ws, d, rhs, lam)
+
+
+def _dense_pins(ws: Workspace, d: Complex, rhs: Array, lam: Complex) -> None:
+    """The pins no 2 x 2 block determines, in one dense solve (real unknowns lambda_x, lambda_y per pin)."""
+    s = ws.layout.system
+    if s.dense is None:
+        return
+    pins, rows = s.dense
+    col = {int(k): i for i, k in enumerate(pins)}
+    at = {int(r): i for i, r in enumerate(rows)}
+    matrix = np.zeros((*rhs.shape[1:], 2 * len(pins), 2 * len(pins)))
+    right = np.moveaxis(rhs[rows], 0, -1).copy()
+    for e in range(len(s.pin)):
+        r, k = int(s.row[e]), int(s.pin[e])
+        if r not in at:
+            continue
+        if k in col:
+            matrix[..., at[r], 2 * col[k]] += -s.sign[e] * d[e].imag
+            matrix[..., at[r], 2 * col[k] + 1] += s.sign[e] * d[e].real
+        else:
+            right[..., at[r]] -= s.sign[e] * cross(d[e], lam[k])
+    x = np.moveaxis(np.linalg.solve(matrix, right[..., None])[..., 0], -1, 0)
+    lam[pins] = x[0::2] + 1j * x[1::2]
+
+
+def actuator_forces(ws: Workspace, transmitted: Complex) -> Array:
+    """Axial force f_x of each actuated slide (n_chains, D, T) [N], u . F of its joint's transmitted force (new array)."""
+    layout = ws.layout
+    n = len(layout.actuated)
+    u, pull = ws.c("axis", n), ws.c("pull", n)
+    np.take(ws.rot, layout.act_parent, out=u, axis=0, mode="clip")
+    u *= layout.axis[layout.actuated][:, None, None]
+    np.take(transmitted, layout.actuated, out=pull, axis=0, mode="clip")
+    out = np.multiply(u.real, pull.real)
+    spare = ws.r("axis", n)
+    np.multiply(u.imag, pull.imag, out=spare)
+    out += spare
+    return out
+
+
+def pin_arrays(ws: Workspace, transmitted: Complex, lam: Complex) -> tuple[Array, Array]:
+    """World (D, T, P, 2) and body-frame (D, T, P, 3) forces of the joints and pins of :func:`pin_layout` [N].
+
+    In the frame Rz(theta) F of the body acted on: [Re, Im, 0](e^{-i theta} f) F (the row-vector
+    form of :mod:`hiab_sim.machine.dynamics.newton_euler`). Both are new arrays.
+    """
+    layout = ws.layout
+    n, on = layout.n_bodies - 1, layout.pins_on
+    P = n + lam.shape[0]
+    world = np.empty((*ws.shape, P), dtype=complex)
+    world[..., :n] = np.moveaxis(transmitted[1:], 0, -1)
+    world[..., n:] = np.moveaxis(lam, 0, -1)
+    unturn = ws.c("pin-frame", P)
+    np.take(ws.rot, on, out=unturn, axis=0, mode="clip")
+    np.conjugate(unturn, out=unturn)
+    turned = ws.buffer("pin-turned", world.shape, complex)
+    np.multiply(world, np.moveaxis(unturn, 0, -1), out=turned)
+    fixed = layout.fixed[on]
+    local = np.multiply(turned.real[..., None], fixed[:, 0, :])
+    spare = ws.buffer("pin-local", local.shape, float)
+    np.multiply(turned.imag[..., None], fixed[:, 1, :], out=spare)
+    local += spare
+    return world.view(np.float64).reshape(*world.shape, 2), local
