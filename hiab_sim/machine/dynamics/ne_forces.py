@@ -37,22 +37,15 @@ def joint_forces(ws: Workspace, c: NeConstants, external: Complex | complex | No
     results are workspace arrays (overwritten by the next call).
     """
     layout = ws.layout
-    mb, n, take = layout.massive, layout.n_bodies, {"axis": 0, "mode": "clip"}
+    mb, n = layout.massive, layout.n_bodies
     force, moment = ws.c("force", n), ws.r("moment", n)
-    arm, net, at = ws.c("arm", len(mb)), ws.c("net", len(mb)), ws.c("at", len(mb))
-    turning, spare = ws.r("turning", len(mb)), ws.r("spare", len(mb))
-    np.take(ws.rot, mb, out=arm, **take)
-    arm *= c.com[mb][:, :, None]
-    np.take(ws.turn, mb, out=net, **take)
-    net *= arm
-    np.take(ws.ddz, mb, out=at, **take)
-    net += at
+    com = ws.points(mb, c.com[mb][:, :, None], ws.c("com", 3, len(mb)), (ws.c("com arm", len(mb)), ws.c("com spare", 3, len(mb))))
+    net = com[2]
     net += 1j * layout.tree.gravity  # a_c - g, g = (0, -g)
     net *= c.mass[mb][:, :, None]
-    np.take(ws.z, mb, out=at, **take)
-    at += arm  # centre of mass
-    _cross_into(turning, spare, at, net)
-    np.take(ws.alpha, mb, out=spare, **take)
+    turning, spare = ws.r("turning", len(mb)), ws.r("spare", len(mb))
+    _cross_into(turning, spare, com[0], net)
+    ws.alpha.take(mb, axis=0, out=spare, mode="clip")
     spare *= c.izz[mb][:, :, None]
     turning += spare
     force[layout.massless], moment[layout.massless] = 0.0, 0.0
@@ -61,9 +54,13 @@ def joint_forces(ws: Workspace, c: NeConstants, external: Complex | complex | No
         tb = layout.tree.tcp_body
         tcp, lever = ws.c("tcp", 1)[0], ws.r("tcp", 2)
         np.multiply(ws.rot[tb], layout.tcp_point, out=tcp)
-        tcp += ws.z[tb]
+        tcp += ws.motion[0, tb]
         force[tb] -= external
-        moment[tb] -= _cross_into(lever[0], lever[1], tcp, np.broadcast_to(np.asarray(external, complex), tcp.shape))
+        ext = np.asarray(external)
+        np.multiply(tcp.real, ext.imag, out=lever[0])
+        np.multiply(tcp.imag, ext.real, out=lever[1])
+        lever[0] -= lever[1]
+        moment[tb] -= lever[0]  # tcp x F
     for b in range(n - 1, 1, -1):  # parents precede children: add each subtree into its parent's
         p = layout.parent[b]
         if p > 0:
@@ -85,35 +82,36 @@ def _pin_forces(ws: Workspace, c: NeConstants, force: Complex, moment: Array, la
     """lambda from the hinge equations, level by level (2 x 2 blocks), then the dense rest."""
     s = ws.layout.system
     take = {"axis": 0, "mode": "clip"}
+    z = ws.motion[0]
     n_entries, n_hinges = len(s.pin), len(s.hinge)
     d, tmp = ws.c("d", n_entries), ws.c("d-spare", n_entries)
-    np.take(ws.rot, s.side_body, out=d, **take)
+    ws.rot.take(s.side_body, out=d, **take)
     d *= np.concatenate([c.point_a, c.point_b])[s.pin + len(ws.layout.tree.loops) * s.side][:, :, None]
-    np.take(ws.z, s.side_body, out=tmp, **take)
+    z.take(s.side_body, out=tmp, **take)
     d += tmp
-    np.take(ws.z, s.hinge[s.row], out=tmp, **take)
+    z.take(s.hinge[s.row], out=tmp, **take)
     d -= tmp  # arm from the hinge to the pin
     at, pull = ws.c("hinge-z", n_hinges), ws.c("hinge-f", n_hinges)
     rhs, spare = ws.r("rhs", n_hinges), ws.r("rhs-spare", n_hinges)
-    np.take(ws.z, s.hinge, out=at, **take)
-    np.take(force, s.hinge, out=pull, **take)
+    z.take(s.hinge, out=at, **take)
+    force.take(s.hinge, out=pull, **take)
     _cross_into(rhs, spare, at, pull)
-    np.take(moment, s.hinge, out=spare, **take)
+    moment.take(s.hinge, out=spare, **take)
     rhs -= spare  # o_b x F - M_O
     for level, (pins, e1, e2, earlier, feed) in enumerate(s.levels):
         k = len(pins)
-        r1, r2, den, den_spare = ws.r(f"level-{level}", 4 * k).reshape(4, k, *ws.shape)
-        d1, d2, num, num_spare = ws.c(f"level-{level}", 4 * k).reshape(4, k, *ws.shape)
-        np.take(rhs, s.row[e1], out=r1, **take)
-        np.take(rhs, s.row[e2], out=r2, **take)
+        r1, r2, den, den_spare = ws.r(f"level-{level}", 4, k)
+        d1, d2, num, num_spare = ws.c(f"level-{level}", 4, k)
+        rhs.take(s.row[e1], out=r1, **take)
+        rhs.take(s.row[e2], out=r2, **take)
         if len(earlier):
             known = s.sign[earlier][:, None, None] * cross(d[earlier], lam[s.pin[earlier]])
             r1 -= np.tensordot(feed[:, :k], known, axes=(0, 0))
             r2 -= np.tensordot(feed[:, k:], known, axes=(0, 0))
         r1 *= s.sign[e1][:, None, None]
         r2 *= s.sign[e2][:, None, None]
-        np.take(d, e1, out=d1, **take)
-        np.take(d, e2, out=d2, **take)
+        d.take(e1, out=d1, **take)
+        d.take(e2, out=d2, **take)
         np.multiply(d2, r1, out=num)
         np.multiply(d1, r2, out=num_spare)
         num -= num_spare
@@ -153,9 +151,9 @@ def actuator_forces(ws: Workspace, transmitted: Complex) -> Array:
     layout = ws.layout
     n = len(layout.actuated)
     u, pull = ws.c("axis", n), ws.c("pull", n)
-    np.take(ws.rot, layout.act_parent, out=u, axis=0, mode="clip")
+    ws.rot.take(layout.act_parent, out=u, axis=0, mode="clip")
     u *= layout.axis[layout.actuated][:, None, None]
-    np.take(transmitted, layout.actuated, out=pull, axis=0, mode="clip")
+    transmitted.take(layout.actuated, out=pull, axis=0, mode="clip")
     out = np.multiply(u.real, pull.real)
     spare = ws.r("axis", n)
     np.multiply(u.imag, pull.imag, out=spare)
@@ -173,13 +171,13 @@ def pin_arrays(ws: Workspace, transmitted: Complex, lam: Complex) -> tuple[Array
     n, on = layout.n_bodies - 1, layout.pins_on
     P = n + lam.shape[0]
     world = np.empty((*ws.shape, P), dtype=complex)
-    world[..., :n] = np.moveaxis(transmitted[1:], 0, -1)
-    world[..., n:] = np.moveaxis(lam, 0, -1)
+    world[..., :n] = transmitted[1:].transpose(1, 2, 0)
+    world[..., n:] = lam.transpose(1, 2, 0)
     unturn = ws.c("pin-frame", P)
-    np.take(ws.rot, on, out=unturn, axis=0, mode="clip")
+    ws.rot.take(on, out=unturn, axis=0, mode="clip")
     np.conjugate(unturn, out=unturn)
     turned = ws.buffer("pin-turned", world.shape, complex)
-    np.multiply(world, np.moveaxis(unturn, 0, -1), out=turned)
+    np.multiply(world, unturn.transpose(1, 2, 0), out=turned)
     fixed = layout.fixed[on]
     local = np.multiply(turned.real[..., None], fixed[:, 0, :])
     spare = ws.buffer("pin-local", local.shape, float)

@@ -57,72 +57,69 @@ def dot(a: Complex, b: Complex) -> Array:
 class Workspace:
     """Frames, coordinates and scratch arrays of one evaluation of D designs x T samples.
 
-    Frames, (nbody, D, T): ``rot`` e^{i theta}, origins ``z``, ``dz``, ``ddz`` (complex) [m, m/s,
-    m/s^2], ``omega``, ``alpha`` [rad/s, rad/s^2], ``spin`` = i omega and ``turn`` = i alpha -
-    omega^2 (a point's velocity and acceleration relative to the origin are spin and turn times
-    its arm); full coordinates ``q``, ``dq``, ``ddq``; scratch arrays by name (:meth:`c`, :meth:`r`).
-    The root's row is set once: at the root's origin, unrotated, at rest.
+    Frames: ``rot`` (nbody, D, T) e^{i theta}; ``motion`` (3, nbody, D, T) the origin's position,
+    velocity and acceleration (complex) [m, m/s, m/s^2]; ``factor`` (3, nbody, D, T) = (1, i omega,
+    i alpha - omega^2), so that a point at arm r e^{i theta} from the origin moves with
+    motion + factor r e^{i theta}; ``omega``, ``alpha`` [rad/s, rad/s^2]; full coordinates ``q``,
+    ``dq``, ``ddq``; scratch arrays by name (:meth:`c`, :meth:`r`, :meth:`buffer`). The root's row
+    is set once: at the root's origin, unrotated, at rest.
     """
 
     def __init__(self, layout: NeLayout, designs: int, samples: int) -> None:
         self.layout, self.shape = layout, (designs, samples)
         shape = (layout.n_bodies, designs, samples)
-        self.rot, self.z, self.dz, self.ddz, self.spin, self.turn = (np.zeros(shape, complex) for _ in range(6))
+        self.rot = np.zeros(shape, complex)
+        self.motion, self.factor = np.zeros((3, *shape), complex), np.zeros((3, *shape), complex)
         self.omega, self.alpha, self.q, self.dq, self.ddq = (np.zeros(shape) for _ in range(5))
         self.rot[0] = 1.0
-        self.z[0] = layout.file.origin[0, 0]  # the root carries no decision variable
-        self._scratch: dict[tuple[str, tuple[int, ...], type], np.ndarray] = {}
+        self.factor[0] = 1.0
+        self.motion[0, 0] = layout.file.origin[0, 0]  # the root carries no decision variable
+        self._scratch: dict[str, np.ndarray] = {}
 
     @property
     def nbytes(self) -> int:
         """Memory held [bytes]."""
-        arrays = (self.rot, self.z, self.dz, self.ddz, self.spin, self.turn, self.omega, self.alpha)
-        return sum(a.nbytes for a in arrays) + 3 * self.q.nbytes + sum(a.nbytes for a in self._scratch.values())
+        arrays = (self.rot, self.motion, self.factor, self.omega, self.alpha, self.q, self.dq, self.ddq)
+        return sum(a.nbytes for a in arrays) + sum(a.nbytes for a in self._scratch.values())
 
-    def c(self, name: str, rows: int) -> Complex:
-        """Complex scratch array (rows, D, T) of this name (contents left from its last use)."""
-        return self.buffer(name, (rows, *self.shape), complex)
+    def c(self, name: str, *rows: int) -> Complex:
+        """Complex scratch array (*rows, D, T) of this name (contents left from its last use)."""
+        return self.buffer(f"{name} (complex)", (*rows, *self.shape), complex)
 
-    def r(self, name: str, rows: int) -> Array:
-        """Real scratch array (rows, D, T) of this name."""
-        return self.buffer(name, (rows, *self.shape), float)
+    def r(self, name: str, *rows: int) -> Array:
+        """Real scratch array (*rows, D, T) of this name."""
+        return self.buffer(f"{name} (real)", (*rows, *self.shape), float)
 
     def buffer(self, name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
-        """Scratch array of this name, shape and type (zeros when new)."""
-        key = (name, shape, dtype)
-        out = self._scratch.get(key)
+        """Scratch array of this name (one shape and type per name; zeros when new)."""
+        out = self._scratch.get(name)
         if out is None:
             out = np.zeros(shape, dtype)
-            self._scratch[key] = out
+            self._scratch[name] = out
         return out
 
-    def orient(self, bodies: Index, rot: Complex, omega: Array, alpha: Array, spare: tuple[Complex, Array]) -> None:
-        """Set e^{i theta}, omega, alpha (and spin, turn) of ``bodies``; ``spare``: scratch of their shape."""
-        tmp, square = spare
+    def orient(self, bodies: Index, rot: Complex, omega: Array, alpha: Array, factor: Complex) -> Complex:
+        """Set e^{i theta}, omega, alpha of ``bodies``; ``factor`` (3, k, D, T) gets (1, i omega, i alpha - omega^2)."""
         self.rot[bodies], self.omega[bodies], self.alpha[bodies] = rot, omega, alpha
-        np.multiply(omega, 1j, out=tmp)
-        self.spin[bodies] = tmp
-        np.multiply(alpha, 1j, out=tmp)
-        np.multiply(omega, omega, out=square)
-        tmp -= square
-        self.turn[bodies] = tmp
+        factor[0] = 1.0
+        np.multiply(omega, 1j, out=factor[1])
+        np.multiply(alpha, 1j, out=factor[2])
+        factor[2] -= omega * omega
+        self.factor[1:, bodies] = factor[1:]
+        return factor
 
-    def points(self, bodies: Index, r: Complex, out: Motion, spare: tuple[Complex, Complex]) -> Motion:
-        """Position, velocity, acceleration of planar points r ((k, D, 1) or (k, 1, 1)) of ``bodies`` into ``out``."""
+    def points(self, bodies: Index, r: Complex, out: Complex, spare: tuple[Complex, Complex]) -> Complex:
+        """Motion (3, k, D, T) of planar points r ((k, D, 1) or (k, 1, 1)) of ``bodies`` into ``out``.
+
+        ``spare``: scratch (k, D, T) and (3, k, D, T).
+        """
         arm, tmp = spare
-        p, v, a = out
-        np.take(self.rot, bodies, axis=0, out=arm, mode="clip")
+        self.rot.take(bodies, axis=0, out=arm, mode="clip")
         arm *= r
-        np.take(self.z, bodies, axis=0, out=p, mode="clip")
-        p += arm
-        np.take(self.spin, bodies, axis=0, out=tmp, mode="clip")
+        self.motion.take(bodies, axis=1, out=out, mode="clip")
+        self.factor.take(bodies, axis=1, out=tmp, mode="clip")
         tmp *= arm
-        np.take(self.dz, bodies, axis=0, out=v, mode="clip")
-        v += tmp
-        np.take(self.turn, bodies, axis=0, out=tmp, mode="clip")
-        tmp *= arm
-        np.take(self.ddz, bodies, axis=0, out=a, mode="clip")
-        a += tmp
+        out += tmp
         return out
 
 
@@ -156,9 +153,10 @@ def workspace(layout: NeLayout, designs: int, samples: int) -> Workspace:
 def forward(ws: Workspace, c: NeConstants, bodies: range) -> None:
     """Frames of ``bodies`` (parents first, each parent's frame known) from ``ws.q``, ``dq``, ``ddq`` (step 1)."""
     layout = ws.layout
-    q, dq, ddq = ws.q, ws.dq, ws.ddq
-    w, u, tmp = ws.c("fw", 3)
-    square = ws.r("fw", 1)[0]
+    q, dq, ddq, motion, factor = ws.q, ws.dq, ws.ddq, ws.motion, ws.factor
+    w, u, tmp = ws.c("forward", 3)
+    moved = ws.c("forward-motion", 3)
+    square = ws.r("forward")
     for b in bodies:
         p = layout.parent[b]
         origin = c.origin[b][:, None]
@@ -168,36 +166,30 @@ def forward(ws: Workspace, c: NeConstants, bodies: range) -> None:
             np.multiply(ws.rot[p], tmp, out=ws.rot[b])
             np.add(ws.omega[p], dq[b], out=ws.omega[b])
             np.add(ws.alpha[p], ddq[b], out=ws.alpha[b])
-            np.multiply(ws.omega[b], 1j, out=ws.spin[b])
-            np.multiply(ws.alpha[b], 1j, out=ws.turn[b])
+            np.multiply(ws.omega[b], 1j, out=factor[1, b])
+            np.multiply(ws.alpha[b], 1j, out=factor[2, b])
             np.multiply(ws.omega[b], ws.omega[b], out=square)
-            ws.turn[b] -= square
+            factor[2, b] -= square
             np.multiply(ws.rot[p], origin, out=w)
-            np.add(ws.z[p], w, out=ws.z[b])
-            np.multiply(ws.spin[p], w, out=tmp)
-            np.add(ws.dz[p], tmp, out=ws.dz[b])
-            np.multiply(ws.turn[p], w, out=tmp)
-            np.add(ws.ddz[p], tmp, out=ws.ddz[b])
+            np.multiply(factor[:, p], w, out=moved)
+            np.add(motion[:, p], moved, out=motion[:, b])
             continue
-        for series in (ws.rot, ws.omega, ws.alpha, ws.spin, ws.turn):  # a slide turns with its parent
+        for series in (ws.rot, ws.omega, ws.alpha):  # a slide turns with its parent
             series[b] = series[p]
+        factor[1:, b] = factor[1:, p]
         np.multiply(ws.rot[p], layout.axis[b], out=u)
         np.multiply(ws.rot[p], origin, out=w)
         np.multiply(u, q[b], out=tmp)
         w += tmp
-        np.add(ws.z[p], w, out=ws.z[b])
-        np.multiply(ws.spin[p], w, out=tmp)
-        np.add(ws.dz[p], tmp, out=ws.dz[b])
+        np.multiply(factor[:, p], w, out=moved)
+        np.add(motion[:, p], moved, out=motion[:, b])
         np.multiply(u, dq[b], out=tmp)
-        ws.dz[b] += tmp
-        np.multiply(ws.turn[p], w, out=tmp)
-        np.add(ws.ddz[p], tmp, out=ws.ddz[b])
-        np.multiply(ws.spin[p], u, out=tmp)
-        tmp *= dq[b]
+        motion[1, b] += tmp  # u dq
+        np.multiply(factor[1, p], dq[b], out=tmp)
         tmp *= 2.0
-        ws.ddz[b] += tmp
-        np.multiply(u, ddq[b], out=tmp)
-        ws.ddz[b] += tmp
+        tmp += ddq[b]
+        tmp *= u
+        motion[2, b] += tmp  # 2 i omega_p u dq + u ddq
 
 
 def close_chains(ws: Workspace, c: NeConstants, angles: bool = False) -> None:
@@ -215,83 +207,70 @@ def close_chains(ws: Workspace, c: NeConstants, angles: bool = False) -> None:
     n_tri, k = len(g.tri_chain), len(g.tri_chain) + len(g.bar_chain)
     if k == 0:
         return
-    end = ws.c("end", 3 * k).reshape(3, k, *ws.shape)
-    pivot = ws.c("pivot", 3 * k).reshape(3, k, *ws.shape)
-    spare = ws.c("spare", 2 * k).reshape(2, k, *ws.shape)
-    ends = (end[0, :n_tri], end[1, :n_tri], end[2, :n_tri])
-    ws.points(g.tri_end, c.point_b[g.tri_loop][:, :, None], ends, (spare[0, :n_tri], spare[1, :n_tri]))
+    end, pivot, spare = ws.c("end", 3, k), ws.c("pivot", 3, k), ws.c("spare", 3, k)
+    e, arm = ws.c("e", k), ws.c("arm", k)
+    ws.points(g.tri_end, c.point_b[g.tri_loop][:, :, None], end[:, :n_tri], (arm[:n_tri], spare[:, :n_tri]))
     cyl, rod, base, x0 = g.tri_cyl, g.tri_rod, g.tri_base, c.x0[g.tri_chain]
     if k > n_tri:
-        H = _four_bar(ws, c, angles)
-        for series, h in zip(end, H, strict=True):
-            series[n_tri:] = h
+        end[:, n_tri:] = _four_bar(ws, c, angles)
         cyl, rod, base = np.concatenate([cyl, g.bar_cyl]), np.concatenate([rod, g.bar_rod]), np.concatenate([base, g.bar_base])
         x0 = np.concatenate([x0, c.x0[g.bar_chain]])
-    ws.points(base, c.origin[cyl][:, :, None], (pivot[0], pivot[1], pivot[2]), (spare[0], spare[1]))
-    d, v, a = end[0], end[1], end[2]
-    d -= pivot[0]
-    v -= pivot[1]
-    a -= pivot[2]
-    s, inv, omega, alpha, ddx, tmp = ws.r("triangle", 6 * k).reshape(6, k, *ws.shape)
-    e, ev, ea = spare[0], spare[1], ws.c("ea", k)
-    np.abs(d, out=s)
+    ws.points(base, c.origin[cyl][:, :, None], pivot, (arm, spare))
+    end -= pivot  # d, v_d, a_d
+    s, inv, omega, alpha, ddx = ws.r("triangle", 5, k)
+    np.abs(end[0], out=s)
     np.divide(1.0, s, out=inv)
-    np.multiply(d, inv, out=e)  # e = d / s
-    np.conjugate(e, out=ea)
-    np.multiply(ea, v, out=ev)  # e* v_d
-    ea *= a  # e* a_d
-    dx = ev.real
-    np.multiply(ev.imag, inv, out=omega)
+    np.multiply(end[0], inv, out=e)  # e = d / s
+    np.conjugate(e, out=arm)
+    rel = spare[1:]
+    np.multiply(arm, end[1:], out=rel)  # e* v_d, e* a_d
+    dx, ev_imag, ea_real, ea_imag = rel[0].real, rel[0].imag, rel[1].real, rel[1].imag
+    np.multiply(ev_imag, inv, out=omega)
     np.multiply(omega, omega, out=ddx)
     ddx *= s
-    ddx += ea.real
+    ddx += ea_real
     np.multiply(dx, omega, out=alpha)
     alpha *= -2.0
-    alpha += ea.imag
+    alpha += ea_imag
     alpha *= inv
-    rot, u, w, t = ws.c("cylinder", 4 * k).reshape(4, k, *ws.shape)
-    np.multiply(e, layout.unturn[cyl][:, None, None], out=rot)
-    ws.orient(cyl, rot, omega, alpha, (t, tmp))
-    ws.z[cyl], ws.dz[cyl], ws.ddz[cyl] = pivot
-    ws.orient(rod, rot, omega, alpha, (t, tmp))
+    e *= layout.unturn[cyl][:, None, None]  # the cylinder's e^{i theta}
+    turning = ws.orient(cyl, e, omega, alpha, ws.c("turning", 3, k))
+    ws.rot[rod], ws.omega[rod], ws.alpha[rod] = e, omega, alpha  # a slide turns with its cylinder
+    ws.factor[1:, rod] = turning[1:]
+    ws.motion[:, cyl] = pivot
     x = s
-    x -= x0[:, :, None]  # stroke: s - x0 (s is no longer needed)
+    x -= x0[:, :, None]  # stroke s - x0 (s is not needed any more)
     ws.q[rod], ws.dq[rod], ws.ddq[rod] = x, dx, ddx
-    np.multiply(rot, layout.axis[rod][:, None, None], out=u)
-    np.multiply(rot, c.origin[rod][:, :, None], out=w)
-    np.multiply(u, x, out=t)
-    w += t
-    spin, turn = ws.spin[cyl], ws.turn[cyl]
-    np.add(pivot[0], w, out=t)
-    ws.z[rod] = t
-    np.multiply(spin, w, out=t)
-    t += pivot[1]
-    ea[...] = u
-    ea *= dx
-    t += ea
-    ws.dz[rod] = t
-    np.multiply(turn, w, out=t)
-    t += pivot[2]
-    np.multiply(spin, u, out=ea)
-    ea *= dx
-    ea *= 2.0
-    t += ea
-    np.multiply(u, ddx, out=ea)
-    t += ea
-    ws.ddz[rod] = t
+    u, w = end[0], end[1]  # d, v_d are not needed any more either
+    np.multiply(e, layout.axis[rod][:, None, None], out=u)
+    np.multiply(e, c.origin[rod][:, :, None], out=w)
+    np.multiply(u, x, out=arm)
+    w += arm
+    moved = ws.c("rod motion", 3, k)
+    np.multiply(turning, w, out=moved)
+    moved += pivot
+    np.multiply(u, dx, out=arm)
+    moved[1] += arm  # u dx
+    np.multiply(turning[1], dx, out=arm)
+    arm *= 2.0
+    arm += ddx
+    arm *= u
+    moved[2] += arm  # 2 i omega u dx + u ddx
+    ws.motion[:, rod] = moved
     if angles:
-        ws.q[cyl] = np.angle(rot * ws.rot[base].conj())
+        ws.q[cyl] = np.angle(ws.rot[cyl] * ws.rot[base].conj())
         ws.dq[cyl], ws.ddq[cyl] = omega - ws.omega[base], alpha - ws.alpha[base]
 
 
-def _four_bar(ws: Workspace, c: NeConstants, angles: bool) -> Motion:
-    """Rocker and coupler frames (and coordinates); return the rod pin H's position, velocity, acceleration."""
+def _four_bar(ws: Workspace, c: NeConstants, angles: bool) -> Complex:
+    """Rocker and coupler frames (and coordinates); return the rod pin H's motion (3, n, D, T)."""
     layout = ws.layout
     g = layout.groups
     n = len(g.bar_chain)
-    buffers = ws.c("four-bar", 8 * n).reshape(8, n, *ws.shape)
-    J = ws.points(g.bar_j, c.origin[g.bar_rocker][:, :, None], tuple(buffers[:3]), (buffers[6], buffers[7]))  # type: ignore[arg-type]
-    K = ws.points(g.bar_k, c.point_b[g.bar_loop][:, :, None], tuple(buffers[3:6]), (buffers[6], buffers[7]))  # type: ignore[arg-type]
+    J, K = ws.c("four-bar J", 3, n), ws.c("four-bar K", 3, n)
+    spare = (ws.c("four-bar arm", n), ws.c("four-bar spare", 3, n))
+    ws.points(g.bar_j, c.origin[g.bar_rocker][:, :, None], J, spare)
+    ws.points(g.bar_k, c.point_b[g.bar_loop][:, :, None], K, spare)
     r1, r2, side = (x[:, None, None] for x in (g.bar_r1, g.bar_r2, g.bar_side))
     span = np.abs(K[0] - J[0])
     along = (span * span + r1 * r1 - r2 * r2) / (2.0 * span)
@@ -311,12 +290,12 @@ def _four_bar(ws: Workspace, c: NeConstants, angles: bool) -> Motion:
     rest = a + w_r * w_r * arm + w_c * w_c * reach
     a_r, a_c = dot(reach, rest) / turn, -dot(arm, rest) / turn
     rocker, coupler, link = g.bar_rocker, g.bar_coupler, g.bar_j
-    H_motion = (H, J[1] + 1j * w_r * arm, J[2] + (1j * a_r - w_r * w_r) * arm)
-    spare = (buffers[6], ws.r("four-bar", n))
-    ws.orient(rocker, arm / r1 * layout.unturn[rocker][:, None, None], w_r, a_r, spare)
-    ws.z[rocker], ws.dz[rocker], ws.ddz[rocker] = J
-    ws.orient(coupler, reach / r2 * layout.unturn[coupler][:, None, None], w_c, a_c, spare)
-    ws.z[coupler], ws.dz[coupler], ws.ddz[coupler] = H_motion
+    factor = ws.c("four-bar factor", 3, n)
+    ws.orient(rocker, arm / r1 * layout.unturn[rocker][:, None, None], w_r, a_r, factor)
+    ws.motion[:, rocker] = J
+    ws.orient(coupler, reach / r2 * layout.unturn[coupler][:, None, None], w_c, a_c, factor)
+    H_motion = np.stack([H, J[1] + 1j * w_r * arm, J[2] + (1j * a_r - w_r * w_r) * arm])
+    ws.motion[:, coupler] = H_motion
     if angles:
         ws.q[rocker] = np.angle(ws.rot[rocker] * ws.rot[link].conj())
         ws.dq[rocker], ws.ddq[rocker] = w_r - ws.omega[link], a_r - ws.alpha[link]

@@ -44,6 +44,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
+from hiab_sim.machine.dynamics.deferred_pins import DeferredPinForces
 from hiab_sim.machine.dynamics.ne_design import design_constants
 from hiab_sim.machine.dynamics.ne_forces import actuator_forces, joint_forces, pin_arrays
 from hiab_sim.machine.dynamics.ne_kernel import frames_of_full, full_state
@@ -52,7 +53,6 @@ from hiab_sim.machine.dynamics.planar import PlanarBody, planar_bodies
 from hiab_sim.machine.dynamics.tree import (
     MachineActuatorSamples,
     MachineTree,
-    PinForces,
     SimulationExtras,
     joint_arrays,
     machine_tree,
@@ -127,20 +127,31 @@ class NewtonEulerInverseDynamics:
         q, dq, ddq = joint_arrays(layout.tree, q, dq, ddq)
         external = tcp_force_complex(tcp_force, q.shape[0])
         ws = full_state(layout, self.constants, q.T[:, None], dq.T[:, None], ddq.T[:, None])
-        transmitted, lam = joint_forces(ws, self.constants, external)
+        transmitted, _ = joint_forces(ws, self.constants, external)
         act = layout.actuated
-        qf, dqf, ddqf = ws.q, ws.dq, ws.ddq
-        force = _with_extras(actuator_forces(ws, transmitted), self.extras, dqf[act], ddqf[act])
-        world, local = pin_arrays(ws, transmitted, lam)
+        dqf, ddqf = ws.dq[act], ws.ddq[act]
+        force = _with_extras(actuator_forces(ws, transmitted), self.extras, dqf, ddqf)
+        out = np.empty((4, q.shape[0], len(act)))
+        for k, series in enumerate((force, dqf, ddqf, ws.q[act])):
+            out[k] = series[:, 0].T
+        snapshot = np.stack([q, dq, ddq])  # the pins are computed from these when first read
         names, kinds, on, by = layout.pins
         return MachineActuatorSamples(
             names=tuple(layout.tree.machine.actuator_names),
-            force=force[:, 0].T,
-            velocity=dqf[act, 0].T,
-            acceleration=ddqf[act, 0].T,
-            stroke=qf[act, 0].T,
-            pins=PinForces(names=names, kinds=kinds, on=on, by=by, world=world[0], local=local[0]),
+            force=out[0],
+            velocity=out[1],
+            acceleration=out[2],
+            stroke=out[3],
+            pins=DeferredPinForces(names, kinds, on, by, lambda: self._pin_forces(snapshot, external)),
         )
+
+    def _pin_forces(self, joints: Array, external: complex | NDArray[np.complex128] | None) -> tuple[Array, Array]:
+        """World (T, P, 2) and body-frame (T, P, 3) pin forces [N] at checked joints (3, T, n) (q, dq, ddq)."""
+        q, dq, ddq = (x.T[:, None] for x in joints)
+        ws = full_state(self.layout, self.constants, q, dq, ddq)
+        transmitted, lam = joint_forces(ws, self.constants, external)
+        world, local = pin_arrays(ws, transmitted, lam)
+        return world[0], local[0]
 
     # ------------------------------------------------------------------------------------------
 
@@ -156,7 +167,8 @@ class NewtonEulerInverseDynamics:
         qf, dqf = np.asarray(qf, dtype=float).T[:, None], np.asarray(dqf, dtype=float).T[:, None]
         ws = frames_of_full(layout, c, qf, dqf, np.zeros_like(qf))
         mb = layout.massive
-        com, velocity, _ = ws.points(mb, c.com[mb][:, :, None], tuple(ws.c("energy", 3 * len(mb)).reshape(3, len(mb), *ws.shape)), tuple(ws.c("energy-spare", 2 * len(mb)).reshape(2, len(mb), *ws.shape)))  # type: ignore[arg-type]
+        spare = (ws.c("energy arm", len(mb)), ws.c("energy spare", 3, len(mb)))
+        com, velocity, _ = ws.points(mb, c.com[mb][:, :, None], ws.c("energy", 3, len(mb)), spare)
         mass, izz = c.mass[mb], c.izz[mb]  # (bodies, 1)
         kinetic = 0.5 * (mass * np.abs(velocity[:, 0]) ** 2 + izz * ws.omega[mb, 0] ** 2)
         potential = mass * layout.tree.gravity * com[:, 0].imag
@@ -167,7 +179,7 @@ class NewtonEulerInverseDynamics:
         q, dq, zero = joint_arrays(self.layout.tree, q, dq, np.zeros_like(np.atleast_2d(np.asarray(q, dtype=float))))
         ws = full_state(self.layout, self.constants, q.T[:, None], dq.T[:, None], zero.T[:, None])
         b = self.layout.tree.tcp_body
-        v = ws.dz[b, 0] + ws.spin[b, 0] * ws.rot[b, 0] * self.layout.tcp_point
+        v = ws.motion[1, b, 0] + ws.factor[1, b, 0] * ws.rot[b, 0] * self.layout.tcp_point
         return np.stack([v.real, v.imag], axis=1)
 
 
