@@ -22,6 +22,8 @@ with the pivots. Tests hold these numbers to those of the designed machine's tre
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -37,6 +39,94 @@ Complex = NDArray[np.complex128]
 def _xy(fixed: Array, r: Array) -> Complex:
     """Planar coordinates (F r)_xy of points r (D, 3) [m], complex (D,)."""
     out: Complex = (r @ fixed[0]) + 1j * (r @ fixed[1])
+    return out
+
+
+@dataclass(frozen=True)
+class _Body:
+    """A slender actuator body: its index, file mass [kg], planar centre of mass [m], I_zz and I_xx F_zx^2 [kg m^2]."""
+
+    index: int
+    mass: float
+    com: complex
+    izz: float
+    axial: float
+
+
+@dataclass(frozen=True)
+class _ChainPlan:
+    """What a design changes of one chain, and where it goes (built once per machine).
+
+    ``columns``: (design column, kind, pivot role, the chain's hinge in the pivot's link frame);
+    per pivot role its file position, its link's planar frame F and (world z of the link origin,
+    third row of its rotation) at zero coordinates; body and pin indices; the slender bodies.
+    """
+
+    chain: int
+    name: str
+    kind: str
+    columns: tuple[tuple[int, str, str, Array | None], ...]
+    position: dict[str, Array]
+    frame: dict[str, Array]
+    height: dict[str, tuple[float, Array]]
+    piston: float
+    rod: float
+    cyl: int
+    end_pin: int
+    rocker: int
+    coupler_pin: int
+    coupler_length: float
+    scaled: tuple[tuple[_Body | None, _Body | None], ...]  # ((cylinder, rod),) when the bodies are slender
+
+
+def _plans(machine: Machine, layout: NeLayout) -> tuple[_ChainPlan, ...]:
+    """The chains with decision variables, compiled (cached in the layout)."""
+    cached = layout.memo.get("design plans")
+    if cached is not None:
+        return cached  # type: ignore[no-any-return]
+    tree, planar = layout.tree, layout.planar
+    heights = world_z(machine)
+    plans = []
+    for c, chain in enumerate(machine.chains):
+        columns = tuple(
+            (k, v.kind, str(v.pivot), machine.hinge_xy(chain, chain.pivot(str(v.pivot)).link) if v.pivot else None)
+            for k, v in enumerate(machine.decision_variables)
+            if v.chain == chain.name
+        )
+        if not columns or chain.kind == "direct":
+            continue
+        act = chain.actuator
+        cyl = tree.index(f"{chain.name}.cylinder")
+        loops = {p.body_a: k for k, p in enumerate(tree.loops)}
+        scaled: tuple[tuple[_Body | None, _Body | None], ...] = ()
+        if act.body_scaling == "slender":
+            pair = []
+            for b, body in ((cyl, act.cylinder_body), (cyl + 1, act.rod_body)):
+                axial = 0.0 if body is None else float(body.inertia[0][0]) * float(layout.fixed[b][2, 0]) ** 2
+                p = planar[b]
+                pair.append(None if body is None else _Body(b, p.mass, p.com, p.inertia_zz, axial))
+            scaled = ((pair[0], pair[1]),)
+        linkage = chain.linkage
+        plans.append(
+            _ChainPlan(
+                chain=c,
+                name=chain.name,
+                kind=chain.kind,
+                columns=columns,
+                position={p.role: np.asarray(p.position, dtype=float) for p in chain.pivots},
+                frame={p.role: layout.fixed[tree.index(p.link)] for p in chain.pivots},
+                height={p.role: (heights[p.link][0], heights[p.link][1][2]) for p in chain.pivots},
+                piston=float(act.piston_offset),  # type: ignore[arg-type]
+                rod=float(act.rod_length),  # type: ignore[arg-type]
+                cyl=cyl,
+                end_pin=loops[cyl + 1],
+                rocker=cyl + 2 if linkage is not None else -1,
+                coupler_pin=loops[cyl + 3] if linkage is not None else -1,
+                coupler_length=linkage.coupler_length if linkage is not None else 0.0,
+                scaled=scaled,
+            )
+        )
+    layout.memo["design plans"] = out = tuple(plans)
     return out
 
 
@@ -62,33 +152,19 @@ def design_constants(machine: Machine, layout: NeLayout, designs: Array) -> NeCo
     base = layout.file
     D = designs.shape[0]
     out = {name: np.repeat(getattr(base, name).T, D, axis=0) for name in NeConstants.__dataclass_fields__}
-    z_of_link = world_z(machine)
-    for c, chain in enumerate(machine.chains):
-        columns = [(v, designs[:, k]) for k, v in enumerate(variables) if v.chain == chain.name]
-        if columns:
-            _chain_numbers(machine, layout, z_of_link, c, columns, out)
+    for plan in _plans(machine, layout):
+        _chain_numbers(plan, designs, out)
     return NeConstants(**{name: np.ascontiguousarray(value.T) for name, value in out.items()})
 
 
-def _chain_numbers(
-    machine: Machine,
-    layout: NeLayout,
-    z_of_link: dict[str, tuple[float, Array]],
-    c: int,
-    columns: list[tuple[object, Array]],
-    out: dict[str, Array],
-) -> None:
-    """Write chain c's numbers for its variable columns into ``out`` (arrays (D, ...))."""
-    chain = machine.chains[c]
-    tree, planar = layout.tree, layout.planar
-    act = chain.actuator
-    D = columns[0][1].shape[0]
-    piston = np.full(D, np.nan if act.piston_offset is None else act.piston_offset)
-    rod = np.full(D, np.nan if act.rod_length is None else act.rod_length)
-    pos = {p.role: np.tile(np.asarray(p.position, dtype=float), (D, 1)) for p in chain.pivots}
+def _chain_numbers(plan: _ChainPlan, designs: Array, out: dict[str, Array]) -> None:
+    """Write one chain's numbers for D designs into ``out`` (arrays (D, ...))."""
+    D = designs.shape[0]
+    piston, rod = np.full(D, plan.piston), np.full(D, plan.rod)
+    pos = dict(plan.position)
     retracted = None
-    for v, value in columns:
-        kind = v.kind  # type: ignore[attr-defined]
+    for k, kind, role, hinge in plan.columns:
+        value = designs[:, k]
         if kind == "piston_offset":
             piston = value
         elif kind == "rod_length":
@@ -96,62 +172,47 @@ def _chain_numbers(
         elif kind == "retracted_length":
             retracted = value
         else:
-            role = str(v.pivot)  # type: ignore[attr-defined]
-            p = pos[role].copy()
+            p = np.array(np.broadcast_to(pos[role], (D, 3)))
             if kind == "pivot_x":
                 p[:, 0] = value
             elif kind == "pivot_y":
                 p[:, 1] = value
             else:
-                hinge = machine.hinge_xy(chain, chain.pivot(role).link)
                 d = p[:, :2] - hinge
                 p[:, :2] = hinge + value[:, None] * d / np.linalg.norm(d, axis=1)[:, None]
             pos[role] = p
     if retracted is not None:
         rod = retracted - piston
-    if chain.kind == "direct":
-        return
-    for label, values in (("piston offset", piston), ("rod length", rod), ("retracted length", piston + rod)):
+    x0 = piston + rod
+    for label, values in (("piston offset", piston), ("rod length", rod), ("retracted length", x0)):
         if np.any(values <= 0.0):
-            raise InvalidInputError("designs", f"chain {chain.name}: a {label} <= 0", "must be > 0", "m")
-    frame = {role: layout.fixed[tree.index(chain.pivot(role).link)] for role in pos}
+            raise InvalidInputError("designs", f"chain {plan.name}: a {label} <= 0", "must be > 0", "m")
 
     def height(role: str) -> Array:  # world z of a pivot at zero coordinates [m]
-        origin, rotation = z_of_link[chain.pivot(role).link]
-        return origin + pos[role] @ rotation[2]
+        origin, row = plan.height[role]
+        return origin + pos[role] @ row
 
-    cyl = tree.index(f"{chain.name}.cylinder")
-    rod_body = cyl + 1
-    F = frame["base"]  # the cylinder's and the rod's frame
+    cyl, rod_body = plan.cyl, plan.cyl + 1
+    F = plan.frame["base"]  # the cylinder's and the rod's frame
     ax, az = complex(F[0, 0], F[1, 0]), complex(F[0, 2], F[1, 2])
-    out["origin"][:, cyl] = _xy(F, pos["base"])
+    out["origin"][:, cyl] = _xy(F, np.atleast_2d(pos["base"]))
     out["origin"][:, rod_body] = piston * ax
-    out["x0"][:, c] = piston + rod
-    if chain.kind == "triangle":
-        k = next(k for k, p in enumerate(tree.loops) if p.body_a == rod_body)
-        out["point_a"][:, k] = rod * ax + (height("end") - height("base")) * az
-        out["point_b"][:, k] = _xy(frame["end"], pos["end"])
+    out["x0"][:, plan.chain] = x0
+    if plan.kind == "triangle":
+        out["point_a"][:, plan.end_pin] = rod * ax + (height("end") - height("base")) * az
+        out["point_b"][:, plan.end_pin] = _xy(plan.frame["end"], np.atleast_2d(pos["end"]))
     else:
-        linkage = chain.linkage
-        if linkage is None:
-            raise AssertionError("a linkage chain carries its four-bar")
-        rocker = cyl + 2
-        out["origin"][:, rocker] = _xy(frame["rocker"], pos["rocker"])
-        k_rod = next(k for k, p in enumerate(tree.loops) if p.body_a == rod_body)
-        out["point_a"][:, k_rod] = rod * ax + (height("rocker") - height("base")) * az
-        R = frame["rocker"]  # the rocker's and the coupler's frame
-        k = next(k for k, p in enumerate(tree.loops) if p.body_a == rocker + 1)
-        reach = linkage.coupler_length * complex(R[0, 0], R[1, 0])
-        out["point_a"][:, k] = reach + (height("coupler") - height("rocker")) * complex(R[0, 2], R[1, 2])
-        out["point_b"][:, k] = _xy(frame["coupler"], pos["coupler"])
-    x0_file, rod_file = act.retracted_length, act.rod_length
-    if act.body_scaling != "slender" or x0_file is None or rod_file is None:
-        return
-    for b, body, factor in ((cyl, act.cylinder_body, (piston + rod) / x0_file), (rod_body, act.rod_body, rod / rod_file)):
-        if body is None:
-            continue
-        axial = float(body.inertia[0][0]) * float(layout.fixed[b][2, 0]) ** 2
-        p = planar[b]
-        out["mass"][:, b] = p.mass * factor
-        out["com"][:, b] = p.com * factor
-        out["izz"][:, b] = factor**3 * (p.inertia_zz - axial) + factor * axial
+        out["origin"][:, plan.rocker] = _xy(plan.frame["rocker"], np.atleast_2d(pos["rocker"]))
+        out["point_a"][:, plan.end_pin] = rod * ax + (height("rocker") - height("base")) * az
+        R = plan.frame["rocker"]  # the rocker's and the coupler's frame
+        reach = plan.coupler_length * complex(R[0, 0], R[1, 0])
+        lift = (height("coupler") - height("rocker")) * complex(R[0, 2], R[1, 2])
+        out["point_a"][:, plan.coupler_pin] = reach + lift
+        out["point_b"][:, plan.coupler_pin] = _xy(plan.frame["coupler"], np.atleast_2d(pos["coupler"]))
+    for cylinder, rod_part in plan.scaled:
+        for body, factor in ((cylinder, x0 / (plan.piston + plan.rod)), (rod_part, rod / plan.rod)):
+            if body is None:
+                continue
+            out["mass"][:, body.index] = body.mass * factor
+            out["com"][:, body.index] = body.com * factor
+            out["izz"][:, body.index] = factor**3 * (body.izz - body.axial) + factor * body.axial

@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.machine.dynamics.ne_kernel import Workspace, cross
-from hiab_sim.machine.dynamics.ne_layout import NeConstants
+from hiab_sim.machine.dynamics.ne_kernel import cross
+from hiab_sim.machine.dynamics.ne_workspace import Prepared, Workspace
 
 Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
@@ -30,7 +30,7 @@ def _cross_into(out: Array, spare: Array, a: Complex, b: Complex) -> Array:
     return out
 
 
-def joint_forces(ws: Workspace, c: NeConstants, external: Complex | complex | None) -> tuple[Complex, Complex]:
+def joint_forces(ws: Workspace, pc: Prepared, external: Complex | complex | None) -> tuple[Complex, Complex]:
     """Force each joint transmits from parent to body (nbody, D, T) and the loop-pin forces lambda (n_pins, D, T).
 
     ``external``: the TCP force of the environment (complex) [N], (T,), a scalar or None. Both
@@ -39,14 +39,14 @@ def joint_forces(ws: Workspace, c: NeConstants, external: Complex | complex | No
     layout = ws.layout
     mb, n = layout.massive, layout.n_bodies
     force, moment = ws.c("force", n), ws.r("moment", n)
-    com = ws.points(mb, c.com[mb][:, :, None], ws.c("com", 3, len(mb)), (ws.c("com arm", len(mb)), ws.c("com spare", 3, len(mb))))
+    com = ws.points(mb, pc.com, ws.c("com", 3, len(mb)), (ws.c("com arm", len(mb)), ws.c("com spare", 3, len(mb))))
     net = com[2]
     net += 1j * layout.tree.gravity  # a_c - g, g = (0, -g)
-    net *= c.mass[mb][:, :, None]
+    net *= pc.mass
     turning, spare = ws.r("turning", len(mb)), ws.r("spare", len(mb))
     _cross_into(turning, spare, com[0], net)
     ws.alpha.take(mb, axis=0, out=spare, mode="clip")
-    spare *= c.izz[mb][:, :, None]
+    spare *= pc.izz
     turning += spare
     force[layout.massless], moment[layout.massless] = 0.0, 0.0
     force[mb], moment[mb] = net, turning
@@ -61,15 +61,13 @@ def joint_forces(ws: Workspace, c: NeConstants, external: Complex | complex | No
         np.multiply(tcp.imag, ext.real, out=lever[1])
         lever[0] -= lever[1]
         moment[tb] -= lever[0]  # tcp x F
-    for b in range(n - 1, 1, -1):  # parents precede children: add each subtree into its parent's
-        p = layout.parent[b]
-        if p > 0:
-            force[p] += force[b]
-            moment[p] += moment[b]
+    for b, p in layout.accumulate:  # tip to base: add each body's subtree into its parent's
+        force[p] += force[b]
+        moment[p] += moment[b]
     lam = ws.c("lambda", len(layout.tree.loops))
     s = layout.system
     if len(s.pin):
-        _pin_forces(ws, c, force, moment, lam)
+        _pin_forces(ws, pc, force, moment, lam)
     for k, b, sign in s.transmit:
         if sign > 0.0:
             force[b] += lam[k]
@@ -78,7 +76,7 @@ def joint_forces(ws: Workspace, c: NeConstants, external: Complex | complex | No
     return force, lam
 
 
-def _pin_forces(ws: Workspace, c: NeConstants, force: Complex, moment: Array, lam: Complex) -> None:
+def _pin_forces(ws: Workspace, pc: Prepared, force: Complex, moment: Array, lam: Complex) -> None:
     """lambda from the hinge equations, level by level (2 x 2 blocks), then the dense rest."""
     s = ws.layout.system
     take = {"axis": 0, "mode": "clip"}
@@ -86,7 +84,7 @@ def _pin_forces(ws: Workspace, c: NeConstants, force: Complex, moment: Array, la
     n_entries, n_hinges = len(s.pin), len(s.hinge)
     d, tmp = ws.c("d", n_entries), ws.c("d-spare", n_entries)
     ws.rot.take(s.side_body, out=d, **take)
-    d *= np.concatenate([c.point_a, c.point_b])[s.pin + len(ws.layout.tree.loops) * s.side][:, :, None]
+    d *= pc.side_point
     z.take(s.side_body, out=tmp, **take)
     d += tmp
     z.take(s.hinge[s.row], out=tmp, **take)
@@ -98,7 +96,7 @@ def _pin_forces(ws: Workspace, c: NeConstants, force: Complex, moment: Array, la
     _cross_into(rhs, spare, at, pull)
     moment.take(s.hinge, out=spare, **take)
     rhs -= spare  # o_b x F - M_O
-    for level, (pins, e1, e2, earlier, feed) in enumerate(s.levels):
+    for level, ((pins, e1, e2, earlier, feed), (sign1, sign2)) in enumerate(zip(s.levels, pc.signs, strict=True)):
         k = len(pins)
         r1, r2, den, den_spare = ws.r(f"level-{level}", 4, k)
         d1, d2, num, num_spare = ws.c(f"level-{level}", 4, k)
@@ -108,8 +106,8 @@ def _pin_forces(ws: Workspace, c: NeConstants, force: Complex, moment: Array, la
             known = s.sign[earlier][:, None, None] * cross(d[earlier], lam[s.pin[earlier]])
             r1 -= np.tensordot(feed[:, :k], known, axes=(0, 0))
             r2 -= np.tensordot(feed[:, k:], known, axes=(0, 0))
-        r1 *= s.sign[e1][:, None, None]
-        r2 *= s.sign[e2][:, None, None]
+        r1 *= sign1
+        r2 *= sign2
         d.take(e1, out=d1, **take)
         d.take(e2, out=d2, **take)
         np.multiply(d2, r1, out=num)
@@ -146,13 +144,13 @@ def _dense_pins(ws: Workspace, d: Complex, rhs: Array, lam: Complex) -> None:
     lam[pins] = x[0::2] + 1j * x[1::2]
 
 
-def actuator_forces(ws: Workspace, transmitted: Complex) -> Array:
+def actuator_forces(ws: Workspace, pc: Prepared, transmitted: Complex) -> Array:
     """Axial force f_x of each actuated slide (n_chains, D, T) [N], u . F of its joint's transmitted force (new array)."""
     layout = ws.layout
     n = len(layout.actuated)
     u, pull = ws.c("axis", n), ws.c("pull", n)
     ws.rot.take(layout.act_parent, out=u, axis=0, mode="clip")
-    u *= layout.axis[layout.actuated][:, None, None]
+    u *= pc.act_axis
     transmitted.take(layout.actuated, out=pull, axis=0, mode="clip")
     out = np.multiply(u.real, pull.real)
     spare = ws.r("axis", n)

@@ -17,7 +17,7 @@ Built once per :class:`~hiab_sim.machine.description.Machine` object (:func:`lay
 from __future__ import annotations
 
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -252,12 +252,13 @@ class NeLayout:
     """Everything design-independent of the Newton-Euler solve of one machine (see the module docstring).
 
     ``parent``, ``revolute`` and ``unturn`` e^{-i offset} per body; ``n_links``: the machine's links are bodies 0 ..
-    n_links - 1 (no link hangs on a chain body); ``below`` (nbody, nbody) 0/1, ``below[j, b]``:
+    n_links - 1 (no link hangs on a chain body); ``accumulate``: (body, parent) tip to base, root excluded; ``below`` (nbody, nbody) 0/1, ``below[j, b]``:
     body j is in body b's subtree; ``axis`` (nbody,) unit slide directions (0 for hinges) and ``offset`` (nbody,) [rad] of
     :class:`PlanarBody`; ``fixed`` (nbody, 3, 3); ``massive``/``massless``: bodies with inertia and the rest (the root included); ``actuated``
     and ``act_parent``: actuated bodies and their parents; ``pins_on``: the body each reported force
     acts on (:func:`pin_layout` order); joint ranges ``low``, ``high`` of the independent joints;
-    ``file``: the planar numbers of the machine itself (its design).
+    ``file``: the planar numbers of the machine itself (its design); ``memo``: what other modules
+    derive from the layout once (kept here, so it goes with the layout).
     """
 
     tree: MachineTree
@@ -266,6 +267,7 @@ class NeLayout:
     revolute: tuple[bool, ...]
     unturn: Complex
     n_links: int
+    accumulate: tuple[tuple[int, int], ...]
     below: Array
     groups: ChainGroups
     system: PinSystem
@@ -283,6 +285,7 @@ class NeLayout:
     low: Array
     high: Array
     file: NeConstants
+    memo: dict[str, object] = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def n_bodies(self) -> int:
@@ -312,6 +315,7 @@ def build_layout(machine: Machine) -> NeLayout:
         revolute=tuple(body.kind == "revolute" for body in tree.bodies),
         unturn=np.exp(-1j * np.asarray([p.offset for p in planar], dtype=float)),
         n_links=n_links,
+        accumulate=tuple((b, tree.bodies[b].parent) for b in range(n - 1, 0, -1) if tree.bodies[b].parent > 0),
         below=below,
         groups=chain_groups(tree),
         system=pin_system(tree, below),

@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hiab_sim.checks import check_range
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.deferred_pins import DeferredPinForces
@@ -49,6 +50,7 @@ from hiab_sim.machine.dynamics.ne_design import design_constants
 from hiab_sim.machine.dynamics.ne_forces import actuator_forces, joint_forces, pin_arrays
 from hiab_sim.machine.dynamics.ne_kernel import frames_of_full, full_state
 from hiab_sim.machine.dynamics.ne_layout import NeConstants, NeLayout, layout_of
+from hiab_sim.machine.dynamics.ne_workspace import Prepared, prepare
 from hiab_sim.machine.dynamics.planar import PlanarBody, planar_bodies
 from hiab_sim.machine.dynamics.tree import (
     MachineActuatorSamples,
@@ -65,8 +67,10 @@ Array = NDArray[np.float64]
 class NewtonEulerInverseDynamics:
     """Inverse dynamics of one machine design by per-body Newton-Euler (see the module docstring).
 
-    Building one for a new design of the same machine object costs the design's checks
-    (:meth:`Machine.with_design`) and one vectorised pass of :func:`design_constants`.
+    Building one for a new design of the same machine object costs the design's bounds check
+    and one vectorised pass of :func:`design_constants`; the designed machine itself
+    (:attr:`machine`, with the rest of :meth:`Machine.with_design`'s checks) is built when first
+    asked for.
 
     Args:
         machine: The machine description.
@@ -86,12 +90,17 @@ class NewtonEulerInverseDynamics:
     ) -> None:
         _check_extras(machine, extras)
         self.layout: NeLayout = layout_of(machine)
-        self.machine = machine
+        self._file_machine, self._design = machine, None if design is None else _checked_design(machine, design)
         self.constants: NeConstants = self.layout.file
-        if design is not None:
-            self.machine = machine.with_design(design)  # the design's checks
-            self.constants = design_constants(machine, self.layout, np.asarray(design, dtype=float)[None])
+        if self._design is not None:
+            self.constants = design_constants(machine, self.layout, self._design[None])
+        self.prepared: Prepared = prepare(self.layout, self.constants)
         self.extras = extras
+
+    @functools.cached_property
+    def machine(self) -> Machine:
+        """The designed machine, :meth:`Machine.with_design` (built on first use: the solve needs only its numbers)."""
+        return self._file_machine if self._design is None else self._file_machine.with_design(self._design)
 
     @functools.cached_property
     def tree(self) -> MachineTree:
@@ -106,7 +115,7 @@ class NewtonEulerInverseDynamics:
     def state(self, q: Any, dq: Any, ddq: Any) -> tuple[Array, Array, Array]:
         """Loop-consistent full coordinates, rates, accelerations (T, nbody); inputs checked."""
         q, dq, ddq = joint_arrays(self.layout.tree, q, dq, ddq)
-        ws = full_state(self.layout, self.constants, q.T[:, None], dq.T[:, None], ddq.T[:, None], angles=True)
+        ws = full_state(self.layout, self.prepared, q.T[:, None], dq.T[:, None], ddq.T[:, None], angles=True)
         return ws.q[:, 0].T.copy(), ws.dq[:, 0].T.copy(), ws.ddq[:, 0].T.copy()
 
     def __call__(self, q: Any, dq: Any, ddq: Any, tcp_force: Any = None) -> MachineActuatorSamples:
@@ -126,11 +135,11 @@ class NewtonEulerInverseDynamics:
         layout = self.layout
         q, dq, ddq = joint_arrays(layout.tree, q, dq, ddq)
         external = tcp_force_complex(tcp_force, q.shape[0])
-        ws = full_state(layout, self.constants, q.T[:, None], dq.T[:, None], ddq.T[:, None])
-        transmitted, _ = joint_forces(ws, self.constants, external)
+        ws = full_state(layout, self.prepared, q.T[:, None], dq.T[:, None], ddq.T[:, None])
+        transmitted, _ = joint_forces(ws, self.prepared, external)
         act = layout.actuated
         dqf, ddqf = ws.dq[act], ws.ddq[act]
-        force = _with_extras(actuator_forces(ws, transmitted), self.extras, dqf, ddqf)
+        force = _with_extras(actuator_forces(ws, self.prepared, transmitted), self.extras, dqf, ddqf)
         out = np.empty((4, q.shape[0], len(act)))
         for k, series in enumerate((force, dqf, ddqf, ws.q[act])):
             out[k] = series[:, 0].T
@@ -148,8 +157,8 @@ class NewtonEulerInverseDynamics:
     def _pin_forces(self, joints: Array, external: complex | NDArray[np.complex128] | None) -> tuple[Array, Array]:
         """World (T, P, 2) and body-frame (T, P, 3) pin forces [N] at checked joints (3, T, n) (q, dq, ddq)."""
         q, dq, ddq = (x.T[:, None] for x in joints)
-        ws = full_state(self.layout, self.constants, q, dq, ddq)
-        transmitted, lam = joint_forces(ws, self.constants, external)
+        ws = full_state(self.layout, self.prepared, q, dq, ddq)
+        transmitted, lam = joint_forces(ws, self.prepared, external)
         world, local = pin_arrays(ws, transmitted, lam)
         return world[0], local[0]
 
@@ -165,7 +174,7 @@ class NewtonEulerInverseDynamics:
         """Kinetic and potential energy [J] of full coordinates (T, nbody) with no range checks."""
         layout, c = self.layout, self.constants
         qf, dqf = np.asarray(qf, dtype=float).T[:, None], np.asarray(dqf, dtype=float).T[:, None]
-        ws = frames_of_full(layout, c, qf, dqf, np.zeros_like(qf))
+        ws = frames_of_full(layout, self.prepared, qf, dqf, np.zeros_like(qf))
         mb = layout.massive
         spare = (ws.c("energy arm", len(mb)), ws.c("energy spare", 3, len(mb)))
         com, velocity, _ = ws.points(mb, c.com[mb][:, :, None], ws.c("energy", 3, len(mb)), spare)
@@ -177,7 +186,7 @@ class NewtonEulerInverseDynamics:
     def tcp_velocity(self, q: Any, dq: Any) -> Array:
         """Velocity of the TCP point in the world plane (T, 2) [m/s] (the power of a TCP force)."""
         q, dq, zero = joint_arrays(self.layout.tree, q, dq, np.zeros_like(np.atleast_2d(np.asarray(q, dtype=float))))
-        ws = full_state(self.layout, self.constants, q.T[:, None], dq.T[:, None], zero.T[:, None])
+        ws = full_state(self.layout, self.prepared, q.T[:, None], dq.T[:, None], zero.T[:, None])
         b = self.layout.tree.tcp_body
         v = ws.motion[1, b, 0] + ws.factor[1, b, 0] * ws.rot[b, 0] * self.layout.tcp_point
         return np.stack([v.real, v.imag], axis=1)
@@ -231,12 +240,24 @@ def batched_inverse_dynamics(
     else:
         q, dq, ddq = (x.T[:, None] for x in joint_arrays(layout.tree, *joints))
     external = tcp_force_complex(tcp_force, q.shape[2])
-    ws = full_state(layout, c, q, dq, ddq)
-    transmitted, _ = joint_forces(ws, c, external)
+    pc = prepare(layout, c)
+    ws = full_state(layout, pc, q, dq, ddq)
+    transmitted, _ = joint_forces(ws, pc, external)
     act = layout.actuated
     qf, dqf, ddqf = ws.q[act], ws.dq[act], ws.ddq[act]  # copies: the workspace is reused
-    force = _with_extras(actuator_forces(ws, transmitted), extras, dqf, ddqf)
+    force = _with_extras(actuator_forces(ws, pc, transmitted), extras, dqf, ddqf)
     return tuple(np.ascontiguousarray(x.transpose(1, 2, 0)) for x in (force, dqf, ddqf, qf))  # type: ignore[return-value]
+
+
+def _checked_design(machine: Machine, design: Sequence[float]) -> Array:
+    """Design values (n_xi,) checked as :meth:`Machine.with_design` checks them: their number and bounds."""
+    values = np.asarray(design, dtype=float).reshape(-1)
+    variables = machine.decision_variables
+    if values.shape != (len(variables),):
+        raise InvalidInputError("design", f"{values.size} values", f"need {len(variables)}: {machine.variable_keys}")
+    for v, value in zip(variables, values, strict=True):
+        check_range(v.key, float(value), v.low, v.high, "m")
+    return values
 
 
 def _check_extras(machine: Machine, extras: SimulationExtras | None) -> None:
