@@ -38,12 +38,14 @@ from hiab_sim.machine.loader import load_machine
 from hiab_sim.validation import random_states
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from lengths_helper import feasible_lengths  # noqa: E402  (the tests' sampler of feasible designs)
+from lengths_helper import feasible_lengths
 
 PAYLOAD = np.array([0.0, -250.0 * 9.81, 0.0])  # N, 250 kg at the TCP
 
 
-def alternate(rounds: int, repeats: int, crane: Callable[[], object], machine: Callable[[], object]) -> tuple[float, float]:
+def alternate(
+    rounds: int, repeats: int, crane: Callable[[], object], machine: Callable[[], object]
+) -> tuple[float, float]:
     """Best wall-clock seconds of each function, timed in alternation."""
     best_crane = best_machine = float("inf")
     for _ in range(rounds):

@@ -46,12 +46,12 @@ class DeferredPinForces(PinForces):
             object.__setattr__(self, "_compute", None)  # let go of what it held
         return arrays
 
-    @property  # type: ignore[override]
+    @property
     def world(self) -> Array:
         """World force (T, P, 2) [N] (see :class:`PinForces`)."""
         return self._computed()[0]
 
-    @property  # type: ignore[override]
+    @property
     def local(self) -> Array:
         """Body-frame force (T, P, 3) [N] (see :class:`PinForces`)."""
         return self._computed()[1]

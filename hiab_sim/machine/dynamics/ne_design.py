@@ -82,8 +82,8 @@ class _ChainPlan:
 def _plans(machine: Machine, layout: NeLayout) -> tuple[_ChainPlan, ...]:
     """The chains with decision variables, compiled (cached in the layout)."""
     cached = layout.memo.get("design plans")
-    if cached is not None:
-        return cached  # type: ignore[no-any-return]
+    if isinstance(cached, tuple):
+        return cached
     tree, planar = layout.tree, layout.planar
     heights = world_z(machine)
     plans = []
@@ -177,7 +177,7 @@ def _chain_numbers(plan: _ChainPlan, designs: Array, out: dict[str, Array]) -> N
                 p[:, 0] = value
             elif kind == "pivot_y":
                 p[:, 1] = value
-            else:
+            elif hinge is not None:  # hinge_distance
                 d = p[:, :2] - hinge
                 p[:, :2] = hinge + value[:, None] * d / np.linalg.norm(d, axis=1)[:, None]
             pos[role] = p

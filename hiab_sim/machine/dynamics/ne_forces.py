@@ -77,39 +77,38 @@ def joint_forces(ws: Workspace, pc: Prepared, external: Complex | complex | None
 
 
 def _pin_forces(ws: Workspace, pc: Prepared, force: Complex, moment: Array, lam: Complex) -> None:
-    """lambda from the hinge equations, level by level (2 x 2 blocks), then the dense rest."""
+    """Lambda from the hinge equations, level by level (2 x 2 blocks), then the dense rest."""
     s = ws.layout.system
-    take = {"axis": 0, "mode": "clip"}
     z = ws.motion[0]
     n_entries, n_hinges = len(s.pin), len(s.hinge)
     d, tmp = ws.c("d", n_entries), ws.c("d-spare", n_entries)
-    ws.rot.take(s.side_body, out=d, **take)
+    ws.rot.take(s.side_body, axis=0, out=d, mode="clip")
     d *= pc.side_point
-    z.take(s.side_body, out=tmp, **take)
+    z.take(s.side_body, axis=0, out=tmp, mode="clip")
     d += tmp
-    z.take(s.hinge[s.row], out=tmp, **take)
+    z.take(s.hinge[s.row], axis=0, out=tmp, mode="clip")
     d -= tmp  # arm from the hinge to the pin
     at, pull = ws.c("hinge-z", n_hinges), ws.c("hinge-f", n_hinges)
     rhs, spare = ws.r("rhs", n_hinges), ws.r("rhs-spare", n_hinges)
-    z.take(s.hinge, out=at, **take)
-    force.take(s.hinge, out=pull, **take)
+    z.take(s.hinge, axis=0, out=at, mode="clip")
+    force.take(s.hinge, axis=0, out=pull, mode="clip")
     _cross_into(rhs, spare, at, pull)
-    moment.take(s.hinge, out=spare, **take)
+    moment.take(s.hinge, axis=0, out=spare, mode="clip")
     rhs -= spare  # o_b x F - M_O
     for level, ((pins, e1, e2, earlier, feed), (sign1, sign2)) in enumerate(zip(s.levels, pc.signs, strict=True)):
         k = len(pins)
         r1, r2, den, den_spare = ws.r(f"level-{level}", 4, k)
         d1, d2, num, num_spare = ws.c(f"level-{level}", 4, k)
-        rhs.take(s.row[e1], out=r1, **take)
-        rhs.take(s.row[e2], out=r2, **take)
+        rhs.take(s.row[e1], axis=0, out=r1, mode="clip")
+        rhs.take(s.row[e2], axis=0, out=r2, mode="clip")
         if len(earlier):
             known = s.sign[earlier][:, None, None] * cross(d[earlier], lam[s.pin[earlier]])
             r1 -= np.tensordot(feed[:, :k], known, axes=(0, 0))
             r2 -= np.tensordot(feed[:, k:], known, axes=(0, 0))
         r1 *= sign1
         r2 *= sign2
-        d.take(e1, out=d1, **take)
-        d.take(e2, out=d2, **take)
+        d.take(e1, axis=0, out=d1, mode="clip")
+        d.take(e2, axis=0, out=d2, mode="clip")
         np.multiply(d2, r1, out=num)
         np.multiply(d1, r2, out=num_spare)
         num -= num_spare
@@ -145,7 +144,7 @@ def _dense_pins(ws: Workspace, d: Complex, rhs: Array, lam: Complex) -> None:
 
 
 def actuator_forces(ws: Workspace, pc: Prepared, transmitted: Complex) -> Array:
-    """Axial force f_x of each actuated slide (n_chains, D, T) [N], u . F of its joint's transmitted force (new array)."""
+    """Axial force f_x (n_chains, D, T) [N] of each actuated slide: u . F of its joint's force (a new array)."""
     layout = ws.layout
     n = len(layout.actuated)
     u, pull = ws.c("axis", n), ws.c("pull", n)

@@ -1,6 +1,7 @@
 """What the Newton-Euler solve of a machine needs that no design changes: its tree as index arrays.
 
-Built once per :class:`~hiab_sim.machine.description.Machine` object (:func:`layout_of`) from :func:`hiab_sim.machine.dynamics.tree.machine_tree` and
+Built once per :class:`~hiab_sim.machine.description.Machine` object (:func:`layout_of`) from
+:func:`hiab_sim.machine.dynamics.tree.machine_tree` and
 :func:`hiab_sim.machine.dynamics.planar.planar_bodies`; the solve itself is in
 :mod:`hiab_sim.machine.dynamics.ne_kernel`, the design-dependent numbers in
 :mod:`hiab_sim.machine.dynamics.ne_design`.
@@ -94,14 +95,14 @@ def chain_groups(tree: MachineTree) -> ChainGroups:
         r2.append(linkage.coupler_length)
         side.append(float(linkage.pin_side))
         names.append(chain.name)
+    t, f = [_index(column) for column in tri], [_index(column) for column in bar]
     return ChainGroups(
-        *(_index(column) for column in tri),
-        *(_index(column) for column in bar),
-        np.asarray(r1, dtype=float),
-        np.asarray(r2, dtype=float),
-        np.asarray(side, dtype=float),
-        tuple(names),
-    )
+        tri_chain=t[0], tri_cyl=t[1], tri_rod=t[2], tri_base=t[3], tri_end=t[4], tri_loop=t[5],
+        bar_chain=f[0], bar_cyl=f[1], bar_rod=f[2], bar_rocker=f[3], bar_coupler=f[4], bar_base=f[5],
+        bar_j=f[6], bar_k=f[7], bar_loop=f[8],
+        bar_r1=np.asarray(r1, dtype=float), bar_r2=np.asarray(r2, dtype=float),
+        bar_side=np.asarray(side, dtype=float), bar_names=tuple(names),
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -109,10 +110,11 @@ class PinSystem:
     """The hinge-moment equations in the loop-pin forces (see the module docstring).
 
     Entry e couples hinge row ``row[e]`` (body ``hinge[row[e]]``) to pin ``pin[e]`` through the
-    pin's point on its body a (``side[e]`` 0) or b (1), body ``side_body[e]``, with sign ``sign[e]`` (-1 for a: lambda acts
-    on a with -lambda in the tree's bookkeeping; +1 for b). ``levels``: per level, the closed-form
-    2 x 2 blocks as (pins, first entries, second entries, earlier entries and the block slot they
-    feed, as a 0/1 map from those entries to [first row of each block, second row]).
+    pin's point on its body a (``side[e]`` 0) or b (1), body ``side_body[e]``, with sign
+    ``sign[e]`` (-1 for a: lambda acts on a with -lambda in the tree's bookkeeping; +1 for b).
+    ``levels``: per level, the closed-form 2 x 2 blocks as (pins, first entries, second entries,
+    earlier entries and the block slot they feed, as a 0/1 map from those entries to [first row of
+    each block, second row]).
     ``dense``: pins and rows left for one dense solve, or None. ``transmit``: (pin, body, sign)
     for every joint whose transmitted force contains the pin's force (not internal to its subtree).
     """
@@ -197,7 +199,9 @@ def pin_system(tree: MachineTree, below: Array) -> PinSystem:
         row=_index(rows),
         pin=_index(pins),
         side=_index(sides),
-        side_body=_index([tree.loops[k].body_b if side else tree.loops[k].body_a for k, side in zip(pins, sides, strict=True)]),
+        side_body=_index(
+            [tree.loops[k].body_b if side else tree.loops[k].body_a for k, side in zip(pins, sides, strict=True)]
+        ),
         sign=np.asarray(signs, dtype=float),
         levels=tuple(compiled),
         dense=dense,
@@ -251,12 +255,14 @@ def file_constants(tree: MachineTree, planar: tuple[PlanarBody, ...]) -> NeConst
 class NeLayout:
     """Everything design-independent of the Newton-Euler solve of one machine (see the module docstring).
 
-    ``parent``, ``revolute`` and ``unturn`` e^{-i offset} per body; ``n_links``: the machine's links are bodies 0 ..
-    n_links - 1 (no link hangs on a chain body); ``accumulate``: (body, parent) tip to base, root excluded; ``below`` (nbody, nbody) 0/1, ``below[j, b]``:
-    body j is in body b's subtree; ``axis`` (nbody,) unit slide directions (0 for hinges) and ``offset`` (nbody,) [rad] of
-    :class:`PlanarBody`; ``fixed`` (nbody, 3, 3); ``massive``/``massless``: bodies with inertia and the rest (the root included); ``actuated``
-    and ``act_parent``: actuated bodies and their parents; ``pins_on``: the body each reported force
-    acts on (:func:`pin_layout` order); joint ranges ``low``, ``high`` of the independent joints;
+    ``parent``, ``revolute`` and ``unturn`` e^{-i offset} per body; ``n_links``: the machine's links
+    are bodies 0 .. n_links - 1 (no link hangs on a chain body); ``accumulate``: (body, parent) tip
+    to base, root excluded; ``below`` (nbody, nbody) 0/1, ``below[j, b]``: body j is in body b's
+    subtree; ``axis`` (nbody,) unit slide directions (0 for hinges) and ``offset`` (nbody,) [rad]
+    of :class:`PlanarBody`; ``fixed`` (nbody, 3, 3); ``massive``/``massless``: bodies with inertia
+    and the rest (the root included); ``actuated`` and ``act_parent``: actuated bodies and their
+    parents; ``pins_on``: the body each reported force acts on (:func:`pin_layout` order); joint
+    ranges ``low``, ``high`` of the independent joints;
     ``file``: the planar numbers of the machine itself (its design); ``memo``: what other modules
     derive from the layout once (kept here, so it goes with the layout).
     """
@@ -305,7 +311,7 @@ def build_layout(machine: Machine) -> NeLayout:
             below[j, b] = 1.0
             b = tree.bodies[b].parent
     ranges = [machine.joint_link(name).joint_range for name in machine.joint_names]
-    names, kinds, on, by = pins = pin_layout(tree)
+    names, kinds, on, by = pin_layout(tree)
     on_index = [*range(1, n), *(loop.body_a for loop in tree.loops)]
     tcp_body = planar[tree.tcp_body]
     return NeLayout(
@@ -330,8 +336,8 @@ def build_layout(machine: Machine) -> NeLayout:
         tcp_point=tcp_body.point(np.asarray(tree.tcp.position)),
         pins=(names, kinds, on, by),
         pins_on=_index(on_index),
-        low=np.asarray([r[0] for r in ranges], dtype=float),  # type: ignore[index]
-        high=np.asarray([r[1] for r in ranges], dtype=float),  # type: ignore[index]
+        low=np.array([r[0] for r in ranges if r is not None], dtype=np.float64),
+        high=np.array([r[1] for r in ranges if r is not None], dtype=np.float64),
         file=file_constants(tree, planar),
     )
 

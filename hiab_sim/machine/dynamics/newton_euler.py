@@ -270,5 +270,7 @@ def _with_extras(force: Array, extras: SimulationExtras | None, velocity: Array,
     """The motor-side force f_x + (J_m k^2 + M_sm) a_x + b_f v_x, or f_x without extras [N]."""
     if extras is None:
         return force
-    armature, damping = (np.asarray(x, dtype=float)[:, None, None] for x in (extras.armature_kg, extras.damping_Ns_per_m))
+    armature, damping = (
+        np.asarray(x, dtype=float)[:, None, None] for x in (extras.armature_kg, extras.damping_Ns_per_m)
+    )
     return force + armature * acceleration + damping * velocity

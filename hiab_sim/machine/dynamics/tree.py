@@ -352,7 +352,10 @@ def joint_arrays(tree: MachineTree, q: object, dq: object, ddq: object) -> tuple
         k = int(np.argmax(np.any(outside, axis=0)))  # the first joint (file order) with a sample outside
         column = out[0][:, k]
         raise InvalidInputError(
-            names[k], float(column[np.argmax(outside[:, k])]), f"must lie in [{low[k]:.6g}, {high[k]:.6g}]", links[k].unit
+            names[k],
+            float(column[np.argmax(outside[:, k])]),
+            f"must lie in [{low[k]:.6g}, {high[k]:.6g}]",
+            links[k].unit,
         )
     return out[0], out[1], out[2]
 
