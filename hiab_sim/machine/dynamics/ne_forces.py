@@ -144,15 +144,15 @@ def _dense_pins(ws: Workspace, d: Complex, rhs: Array, lam: Complex) -> None:
 
 
 def actuator_forces(ws: Workspace, pc: Prepared, transmitted: Complex) -> Array:
-    """Axial force f_x (n_chains, D, T) [N] of each actuated slide: u . F of its joint's force (a new array)."""
+    """Axial force f_x (n_chains, D, T) [N] of each actuated slide: u . F of its joint's force (a workspace array)."""
     layout = ws.layout
     n = len(layout.actuated)
     u, pull = ws.c("axis", n), ws.c("pull", n)
     ws.rot.take(layout.act_parent, out=u, axis=0, mode="clip")
     u *= pc.act_axis
     transmitted.take(layout.actuated, out=pull, axis=0, mode="clip")
-    out = np.multiply(u.real, pull.real)
-    spare = ws.r("axis", n)
+    out, spare = ws.r("actuator force", n), ws.r("axis", n)
+    np.multiply(u.real, pull.real, out=out)
     np.multiply(u.imag, pull.imag, out=spare)
     out += spare
     return out

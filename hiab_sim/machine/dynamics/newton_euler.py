@@ -137,25 +137,35 @@ class NewtonEulerInverseDynamics:
         external = tcp_force_complex(tcp_force, q.shape[0])
         ws = full_state(layout, self.prepared, q.T[:, None], dq.T[:, None], ddq.T[:, None])
         transmitted, _ = joint_forces(ws, self.prepared, external)
-        act = layout.actuated
-        dqf, ddqf = ws.dq[act], ws.ddq[act]
-        force = _with_extras(actuator_forces(ws, self.prepared, transmitted), self.extras, dqf, ddqf)
-        out = np.empty((4, q.shape[0], len(act)))
-        for k, series in enumerate((force, dqf, ddqf, ws.q[act])):
-            out[k] = series[:, 0].T
-        snapshot = np.stack([q, dq, ddq])  # the pins are computed from these when first read
+        pull = actuator_forces(ws, self.prepared, transmitted)
+        # one (T, n) array each, filled row by row from the workspace (big blocks come fresh from the system)
+        force, velocity, acceleration, stroke = (np.empty((q.shape[0], len(layout.actuated))) for _ in range(4))
+        for k, b in enumerate(layout.actuated):
+            force[:, k], velocity[:, k], acceleration[:, k], stroke[:, k] = (
+                pull[k, 0],
+                ws.dq[b, 0],
+                ws.ddq[b, 0],
+                ws.q[b, 0],
+            )
+        if self.extras is not None:
+            force += (
+                np.asarray(self.extras.armature_kg) * acceleration + np.asarray(self.extras.damping_Ns_per_m) * velocity
+            )
+        snapshot = (q.copy(), dq.copy(), ddq.copy())  # the pins are computed from these when first read
         names, kinds, on, by = layout.pins
         return MachineActuatorSamples(
             names=tuple(layout.tree.machine.actuator_names),
-            force=out[0],
-            velocity=out[1],
-            acceleration=out[2],
-            stroke=out[3],
+            force=force,
+            velocity=velocity,
+            acceleration=acceleration,
+            stroke=stroke,
             pins=DeferredPinForces(names, kinds, on, by, lambda: self._pin_forces(snapshot, external)),
         )
 
-    def _pin_forces(self, joints: Array, external: complex | NDArray[np.complex128] | None) -> tuple[Array, Array]:
-        """World (T, P, 2) and body-frame (T, P, 3) pin forces [N] at checked joints (3, T, n) (q, dq, ddq)."""
+    def _pin_forces(
+        self, joints: tuple[Array, Array, Array], external: complex | NDArray[np.complex128] | None
+    ) -> tuple[Array, Array]:
+        """World (T, P, 2) and body-frame (T, P, 3) pin forces [N] at checked joints q, dq, ddq (T, n) each."""
         q, dq, ddq = (x.T[:, None] for x in joints)
         ws = full_state(self.layout, self.prepared, q, dq, ddq)
         transmitted, lam = joint_forces(ws, self.prepared, external)
@@ -245,7 +255,7 @@ def batched_inverse_dynamics(
     transmitted, _ = joint_forces(ws, pc, external)
     act = layout.actuated
     qf, dqf, ddqf = ws.q[act], ws.dq[act], ws.ddq[act]  # copies: the workspace is reused
-    force = _with_extras(actuator_forces(ws, pc, transmitted), extras, dqf, ddqf)
+    force = _with_extras(actuator_forces(ws, pc, transmitted).copy(), extras, dqf, ddqf)
     return tuple(np.ascontiguousarray(x.transpose(1, 2, 0)) for x in (force, dqf, ddqf, qf))  # type: ignore[return-value]
 
 
