@@ -77,6 +77,7 @@ class _ChainPlan:
     coupler_pin: int
     coupler_length: float
     scaled: tuple[tuple[_Body | None, _Body | None], ...]  # ((cylinder, rod),) when the bodies are slender
+    affine: bool  # no pivot is set both by a hinge distance and by a coordinate
 
 
 def _plans(machine: Machine, layout: NeLayout) -> tuple[_ChainPlan, ...]:
@@ -124,6 +125,10 @@ def _plans(machine: Machine, layout: NeLayout) -> tuple[_ChainPlan, ...]:
                 coupler_pin=loops[cyl + 3] if linkage is not None else -1,
                 coupler_length=linkage.coupler_length if linkage is not None else 0.0,
                 scaled=scaled,
+                affine=not (
+                    {role for _, kind, role, _ in columns if kind == "hinge_distance"}
+                    & {role for _, kind, role, _ in columns if kind in ("pivot_x", "pivot_y")}
+                ),
             )
         )
     layout.memo["design plans"] = out = tuple(plans)
@@ -149,16 +154,92 @@ def design_constants(machine: Machine, layout: NeLayout, designs: Array) -> NeCo
         raise InvalidInputError("designs", f"shape {designs.shape}", need, "m")
     if not np.all(np.isfinite(designs)):
         raise InvalidInputError("designs", "NaN or inf", "must be finite", "m")
+    fit = _affine(machine, layout)
+    if fit is None:
+        out = _direct(machine, layout, designs)
+    else:
+        step = designs - fit.at
+        out = {name: fit.base[name] + step @ fit.slope[name] for name in fit.base}
+        lengths = fit.lengths[0] + step @ fit.lengths[1]  # (D, 2 per chain): piston offset, rod length
+        for k, plan in enumerate(_plans(machine, layout)):
+            piston, rod = lengths[:, 2 * k], lengths[:, 2 * k + 1]
+            _check_lengths(plan, piston, rod)
+            _scale_inertia(plan, piston, rod, out)
+    return NeConstants(**{name: np.ascontiguousarray(value.T) for name, value in out.items()})  # type: ignore[arg-type]
+
+
+@dataclass(frozen=True)
+class _Fit:
+    """Design numbers as base + (x - at) @ slope: exact, since each is affine in the variables.
+
+    Pivots move along lines or on coordinates, Lc0 and Lc are variables or differences of
+    them, masses and centres of mass scale with factors affine in them. Only the slender bodies'
+    I_zz (cubic in its factor) is not: it is computed from the fitted lengths. A pivot set by
+    both a hinge distance and a coordinate would not be affine (the description refuses such a
+    pair); a plan with one would take :func:`_direct`.
+    """
+
+    at: Array
+    base: dict[str, Array]
+    slope: dict[str, Array]
+    lengths: tuple[Array, Array]
+
+
+def _affine(machine: Machine, layout: NeLayout) -> _Fit | None:
+    """The affine fit of the design numbers (cached in the layout), or None where it is not exact."""
+    if "design fit" in layout.memo:
+        cached = layout.memo["design fit"]
+        return cached if isinstance(cached, _Fit) else None
+    plans = _plans(machine, layout)
+    fit = None
+    if all(plan.affine for plan in plans):
+        at = machine.design_values()
+        n = at.shape[0]
+        probe = at + np.vstack([np.zeros((1, n)), np.eye(n)])  # the file design and a unit step in each variable
+        lengths: list[Array] = []
+        out = _direct(machine, layout, probe, lengths)
+        table = np.stack(lengths, axis=1) if lengths else np.zeros((n + 1, 0))
+        fit = _Fit(
+            at=at,
+            base={name: value[:1] for name, value in out.items()},
+            slope={name: value[1:] - value[:1] for name, value in out.items()},
+            lengths=(table[:1], table[1:] - table[:1]),
+        )
+    layout.memo["design fit"] = fit
+    return fit
+
+
+def _direct(machine: Machine, layout: NeLayout, designs: Array, lengths: list[Array] | None = None) -> dict[str, Array]:
+    """The numbers (D, n) of each field, chain by chain by the rules of the module docstring."""
     base = layout.file
     D = designs.shape[0]
     out = {name: np.repeat(getattr(base, name).T, D, axis=0) for name in NeConstants.__dataclass_fields__}
     for plan in _plans(machine, layout):
-        _chain_numbers(plan, designs, out)
-    return NeConstants(**{name: np.ascontiguousarray(value.T) for name, value in out.items()})
+        piston, rod = _chain_numbers(plan, designs, out)
+        if lengths is not None:
+            lengths.extend((piston, rod))
+    return out
 
 
-def _chain_numbers(plan: _ChainPlan, designs: Array, out: dict[str, Array]) -> None:
-    """Write one chain's numbers for D designs into ``out`` (arrays (D, ...))."""
+def _check_lengths(plan: _ChainPlan, piston: Array, rod: Array) -> None:
+    for label, values in (("piston offset", piston), ("rod length", rod), ("retracted length", piston + rod)):
+        if np.any(values <= 0.0):
+            raise InvalidInputError("designs", f"chain {plan.name}: a {label} <= 0", "must be > 0", "m")
+
+
+def _scale_inertia(plan: _ChainPlan, piston: Array, rod: Array, out: dict[str, Array]) -> None:
+    """Slender bodies: m and the centre of mass scale with f, I_zz(f) = f^3 (I_zz - I_xx F_zx^2) + f I_xx F_zx^2."""
+    for cylinder, rod_part in plan.scaled:
+        for body, factor in ((cylinder, (piston + rod) / (plan.piston + plan.rod)), (rod_part, rod / plan.rod)):
+            if body is None:
+                continue
+            out["mass"][:, body.index] = body.mass * factor
+            out["com"][:, body.index] = body.com * factor
+            out["izz"][:, body.index] = factor**3 * (body.izz - body.axial) + factor * body.axial
+
+
+def _chain_numbers(plan: _ChainPlan, designs: Array, out: dict[str, Array]) -> tuple[Array, Array]:
+    """Write one chain's numbers for D designs into ``out`` (arrays (D, ...)); return its Lc0 and Lc (D,) [m]."""
     D = designs.shape[0]
     piston, rod = np.full(D, plan.piston), np.full(D, plan.rod)
     pos = dict(plan.position)
@@ -184,9 +265,7 @@ def _chain_numbers(plan: _ChainPlan, designs: Array, out: dict[str, Array]) -> N
     if retracted is not None:
         rod = retracted - piston
     x0 = piston + rod
-    for label, values in (("piston offset", piston), ("rod length", rod), ("retracted length", x0)):
-        if np.any(values <= 0.0):
-            raise InvalidInputError("designs", f"chain {plan.name}: a {label} <= 0", "must be > 0", "m")
+    _check_lengths(plan, piston, rod)
 
     def height(role: str) -> Array:  # world z of a pivot at zero coordinates [m]
         origin, row = plan.height[role]
@@ -209,10 +288,5 @@ def _chain_numbers(plan: _ChainPlan, designs: Array, out: dict[str, Array]) -> N
         lift = (height("coupler") - height("rocker")) * complex(R[0, 2], R[1, 2])
         out["point_a"][:, plan.coupler_pin] = reach + lift
         out["point_b"][:, plan.coupler_pin] = _xy(plan.frame["coupler"], np.atleast_2d(pos["coupler"]))
-    for cylinder, rod_part in plan.scaled:
-        for body, factor in ((cylinder, x0 / (plan.piston + plan.rod)), (rod_part, rod / plan.rod)):
-            if body is None:
-                continue
-            out["mass"][:, body.index] = body.mass * factor
-            out["com"][:, body.index] = body.com * factor
-            out["izz"][:, body.index] = factor**3 * (body.izz - body.axial) + factor * body.axial
+    _scale_inertia(plan, piston, rod, out)
+    return piston, rod
