@@ -160,11 +160,13 @@ def design_constants(machine: Machine, layout: NeLayout, designs: Array) -> NeCo
     else:
         step = designs - fit.at
         out = {name: fit.base[name] + step @ fit.slope[name] for name in fit.base}
-        lengths = fit.lengths[0] + step @ fit.lengths[1]  # (D, 2 per chain): piston offset, rod length
-        for k, plan in enumerate(_plans(machine, layout)):
-            piston, rod = lengths[:, 2 * k], lengths[:, 2 * k + 1]
-            _check_lengths(plan, piston, rod)
-            _scale_inertia(plan, piston, rod, out)
+        lengths = fit.lengths[0] + step @ fit.lengths[1]  # (D, 3 per chain): Lc0, Lc, x0
+        if np.any(lengths <= 0.0):
+            for k, plan in enumerate(_plans(machine, layout)):
+                _check_lengths(plan, lengths[:, 3 * k], lengths[:, 3 * k + 1])
+        if fit.slender.size:  # I_zz(f) = f^3 (I_zz - I_xx F_zx^2) + f I_xx F_zx^2, f affine in the variables
+            factor = fit.factor[0] + step @ fit.factor[1]
+            out["izz"][:, fit.slender] = factor**3 * fit.cubic + factor * fit.linear
     return NeConstants(**{name: np.ascontiguousarray(value.T) for name, value in out.items()})  # type: ignore[arg-type]
 
 
@@ -183,6 +185,10 @@ class _Fit:
     base: dict[str, Array]
     slope: dict[str, Array]
     lengths: tuple[Array, Array]
+    slender: NDArray[np.intp]
+    factor: tuple[Array, Array]
+    cubic: Array
+    linear: Array
 
 
 def _affine(machine: Machine, layout: NeLayout) -> _Fit | None:
@@ -199,11 +205,24 @@ def _affine(machine: Machine, layout: NeLayout) -> _Fit | None:
         lengths: list[Array] = []
         out = _direct(machine, layout, probe, lengths)
         table = np.stack(lengths, axis=1) if lengths else np.zeros((n + 1, 0))
+        bodies, factors = [], []
+        for k, plan in enumerate(plans):
+            piston, rod = table[:, 3 * k], table[:, 3 * k + 1]
+            for cylinder, rod_part in plan.scaled:
+                for body, factor in ((cylinder, (piston + rod) / (plan.piston + plan.rod)), (rod_part, rod / plan.rod)):
+                    if body is not None:
+                        bodies.append(body)
+                        factors.append(factor)
+        scale = np.stack(factors, axis=1) if factors else np.zeros((n + 1, 0))
         fit = _Fit(
             at=at,
             base={name: value[:1] for name, value in out.items()},
             slope={name: value[1:] - value[:1] for name, value in out.items()},
             lengths=(table[:1], table[1:] - table[:1]),
+            slender=np.asarray([b.index for b in bodies], dtype=np.intp),
+            factor=(scale[:1], scale[1:] - scale[:1]),
+            cubic=np.asarray([b.izz - b.axial for b in bodies]),
+            linear=np.asarray([b.axial for b in bodies]),
         )
     layout.memo["design fit"] = fit
     return fit
@@ -217,7 +236,7 @@ def _direct(machine: Machine, layout: NeLayout, designs: Array, lengths: list[Ar
     for plan in _plans(machine, layout):
         piston, rod = _chain_numbers(plan, designs, out)
         if lengths is not None:
-            lengths.extend((piston, rod))
+            lengths.extend((piston, rod, piston + rod))
     return out
 
 
