@@ -39,12 +39,18 @@ def joint_forces(ws: Workspace, pc: Prepared, external: Complex | complex | None
     layout = ws.layout
     mb, n = layout.massive, layout.n_bodies
     force, moment = ws.c("force", n), ws.r("moment", n)
-    com = ws.points(mb, pc.com, ws.c("com", 3, len(mb)), (ws.c("com arm", len(mb)), ws.c("com spare", 3, len(mb))))
-    net = com[2]
+    arm, at, net = ws.c("com arm", len(mb)), ws.c("com", len(mb)), ws.c("net", len(mb))
+    ws.rot.take(mb, axis=0, out=arm, mode="clip")
+    arm *= pc.com
+    ws.motion[0].take(mb, axis=0, out=at, mode="clip")
+    at += arm  # centre of mass
+    ws.factor[2].take(mb, axis=0, out=net, mode="clip")
+    net *= arm
+    net += ws.motion[2].take(mb, axis=0, out=ws.c("com acceleration", len(mb)), mode="clip")
     net += 1j * layout.tree.gravity  # a_c - g, g = (0, -g)
     net *= pc.mass
     turning, spare = ws.r("turning", len(mb)), ws.r("spare", len(mb))
-    _cross_into(turning, spare, com[0], net)
+    _cross_into(turning, spare, at, net)
     ws.alpha.take(mb, axis=0, out=spare, mode="clip")
     spare *= pc.izz
     turning += spare
