@@ -23,44 +23,54 @@ one equation each. With every moving joint driven by one chain (all prismatic jo
 actuators) there are exactly as many hinges as loop-pin force components, so this system
 (2 n_pins square, per sample) gives lambda; then every T_b is known: a hinge's T_b is its pin
 force, a slide's axial component u . F(T_b) is the actuator force f_x (> 0 extends). It is
-regular away from a flat triangle or a four-bar at its toggle. The MuJoCo path
+regular away from a flat triangle or a four-bar at its toggle.
+
+The solve is vectorised over samples and designs (:mod:`hiab_sim.machine.dynamics.ne_kernel`):
+what no design changes is built once per machine (:mod:`hiab_sim.machine.dynamics.ne_layout`),
+a design's numbers come from :mod:`hiab_sim.machine.dynamics.ne_design` without building its
+tree, and :func:`batched_inverse_dynamics` evaluates D designs in one call. The MuJoCo path
 (:mod:`hiab_sim.machine.dynamics.mujoco_path`) instead projects MuJoCo's generalised forces on the
 loops' admissible motions.
 """
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
+from hiab_sim.checks import check_range
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.dynamics.planar import Frames, PlanarBody, frames, loop_state, planar_bodies
+from hiab_sim.machine.dynamics.deferred_pins import DeferredPinForces
+from hiab_sim.machine.dynamics.ne_design import design_constants
+from hiab_sim.machine.dynamics.ne_forces import actuator_forces, joint_forces, pin_arrays
+from hiab_sim.machine.dynamics.ne_kernel import frames_of_full, full_state
+from hiab_sim.machine.dynamics.ne_layout import NeConstants, NeLayout, layout_of
+from hiab_sim.machine.dynamics.ne_workspace import Prepared, prepare
+from hiab_sim.machine.dynamics.planar import PlanarBody, planar_bodies
 from hiab_sim.machine.dynamics.tree import (
     MachineActuatorSamples,
     MachineTree,
-    PinForces,
     SimulationExtras,
     joint_arrays,
     machine_tree,
-    pin_layout,
-    tcp_force_array,
+    tcp_force_complex,
 )
 
 Array = NDArray[np.float64]
-Complex = NDArray[np.complex128]
-
-
-def _cross(a: Complex | complex, b: Complex | complex) -> Array:
-    """The z component of the cross product of in-plane vectors (complex)."""
-    return (np.conj(a) * b).imag
 
 
 class NewtonEulerInverseDynamics:
     """Inverse dynamics of one machine design by per-body Newton-Euler (see the module docstring).
+
+    Building one for a new design of the same machine object costs the design's bounds check
+    and one vectorised pass of :func:`design_constants`; the designed machine itself
+    (:attr:`machine`, with the rest of :meth:`Machine.with_design`'s checks) is built when first
+    asked for.
 
     Args:
         machine: The machine description.
@@ -78,23 +88,35 @@ class NewtonEulerInverseDynamics:
     def __init__(
         self, machine: Machine, design: Sequence[float] | None = None, extras: SimulationExtras | None = None
     ) -> None:
-        if design is not None:
-            machine = machine.with_design(design)
-        if extras is not None and len(extras.armature_kg) != len(machine.chains):
-            need = f"need one per actuator: {machine.actuator_names}"
-            raise InvalidInputError("extras.armature_kg", f"{len(extras.armature_kg)} values", need)
+        _check_extras(machine, extras)
+        self.layout: NeLayout = layout_of(machine)
+        self._file_machine, self._design = machine, None if design is None else _checked_design(machine, design)
+        self.constants: NeConstants = self.layout.file
+        if self._design is not None:
+            self.constants = design_constants(machine, self.layout, self._design[None])
+        self.prepared: Prepared = prepare(self.layout, self.constants)
         self.extras = extras
-        self.tree: MachineTree = machine_tree(machine)
-        self.planar: tuple[PlanarBody, ...] = planar_bodies(self.tree)
-        self._pins = pin_layout(self.tree)
-        self._hinges = [b for b, body in enumerate(self.tree.bodies) if body.kind == "revolute"]
-        if len(self._hinges) != 2 * len(self.tree.loops):
-            raise AssertionError("a fully driven tree has one hinge per loop-pin force component")
+
+    @functools.cached_property
+    def machine(self) -> Machine:
+        """The designed machine, :meth:`Machine.with_design` (built on first use: the solve needs only its numbers)."""
+        return self._file_machine if self._design is None else self._file_machine.with_design(self._design)
+
+    @functools.cached_property
+    def tree(self) -> MachineTree:
+        """The designed machine's tree (built on first use)."""
+        return self.layout.tree if self.machine is self.layout.tree.machine else machine_tree(self.machine)
+
+    @functools.cached_property
+    def planar(self) -> tuple[PlanarBody, ...]:
+        """Planar data of the designed machine's bodies (built on first use)."""
+        return planar_bodies(self.tree)
 
     def state(self, q: Any, dq: Any, ddq: Any) -> tuple[Array, Array, Array]:
         """Loop-consistent full coordinates, rates, accelerations (T, nbody); inputs checked."""
-        q, dq, ddq = joint_arrays(self.tree, q, dq, ddq)
-        return loop_state(self.tree, self.planar, q, dq, ddq)
+        q, dq, ddq = joint_arrays(self.layout.tree, q, dq, ddq)
+        ws = full_state(self.layout, self.prepared, q.T[:, None], dq.T[:, None], ddq.T[:, None], angles=True)
+        return ws.q[:, 0].T.copy(), ws.dq[:, 0].T.copy(), ws.ddq[:, 0].T.copy()
 
     def __call__(self, q: Any, dq: Any, ddq: Any, tcp_force: Any = None) -> MachineActuatorSamples:
         """Actuator forces, velocities, accelerations, strokes (T, n_chains) and pin forces.
@@ -110,83 +132,45 @@ class NewtonEulerInverseDynamics:
             InvalidInputError: malformed or out-of-range joint samples or tcp_force (named field).
 
         """
-        qf, dqf, ddqf = self.state(q, dq, ddq)
-        T = qf.shape[0]
-        external = tcp_force_array(tcp_force, T)
-        fk = frames(self.tree, self.planar, qf, dqf, ddqf)
-        transmitted, lam = self._joint_forces(fk, external[:, 0] + 1j * external[:, 1])
-        act = list(self.tree.actuated)
-        force = np.stack([(np.conj(self._axis(fk, b)) * transmitted[b]).real for b in act], axis=1)
+        layout = self.layout
+        q, dq, ddq = joint_arrays(layout.tree, q, dq, ddq)
+        external = tcp_force_complex(tcp_force, q.shape[0])
+        ws = full_state(layout, self.prepared, q.T[:, None], dq.T[:, None], ddq.T[:, None])
+        transmitted, _ = joint_forces(ws, self.prepared, external)
+        pull = actuator_forces(ws, self.prepared, transmitted)
+        # one (T, n) array each, filled row by row from the workspace (big blocks come fresh from the system)
+        force, velocity, acceleration, stroke = (np.empty((q.shape[0], len(layout.actuated))) for _ in range(4))
+        for k, b in enumerate(layout.actuated):
+            force[:, k], velocity[:, k], acceleration[:, k], stroke[:, k] = (
+                pull[k, 0],
+                ws.dq[b, 0],
+                ws.ddq[b, 0],
+                ws.q[b, 0],
+            )
         if self.extras is not None:
-            force = force + np.asarray(self.extras.armature_kg) * ddqf[:, act]
-            force = force + np.asarray(self.extras.damping_Ns_per_m) * dqf[:, act]
+            force += (
+                np.asarray(self.extras.armature_kg) * acceleration + np.asarray(self.extras.damping_Ns_per_m) * velocity
+            )
+        snapshot = (q.copy(), dq.copy(), ddq.copy())  # the pins are computed from these when first read
+        names, kinds, on, by = layout.pins
         return MachineActuatorSamples(
-            names=tuple(self.tree.machine.actuator_names),
+            names=tuple(layout.tree.machine.actuator_names),
             force=force,
-            velocity=dqf[:, act],
-            acceleration=ddqf[:, act],
-            stroke=qf[:, act],
-            pins=self._pin_forces(fk, transmitted, lam),
+            velocity=velocity,
+            acceleration=acceleration,
+            stroke=stroke,
+            pins=DeferredPinForces(names, kinds, on, by, lambda: self._pin_forces(snapshot, external)),
         )
 
-    # ------------------------------------------------------------------------------------------
-
-    def _axis(self, fk: Frames, b: int) -> Complex:
-        """World direction of body b's slide (T,)."""
-        return fk.rot[self.tree.bodies[b].parent] * self.planar[b].axis
-
-    def _joint_forces(self, fk: Frames, external: Complex) -> tuple[list[Complex], Array]:
-        """Force each joint transmits from parent to body (complex (T,), index = body) and lambda (T, 2 n_pins)."""
-        tree, planar = self.tree, self.planar
-        T, n, pins = fk.z[0].shape[0], len(tree.bodies), 2 * len(tree.loops)
-        # T_b = base + coefficient @ lambda, force (complex) and moment about O, per body
-        force = [np.zeros(T, dtype=complex) for _ in range(n)]
-        moment = [np.zeros(T) for _ in range(n)]
-        force_per = [np.zeros((T, pins), dtype=complex) for _ in range(n)]
-        moment_per = [np.zeros((T, pins)) for _ in range(n)]
-        for b in range(1, n):
-            p = planar[b]
-            if p.mass > 0.0 or p.inertia_zz > 0.0:
-                com, _, acc = fk.point(b, p.com)
-                net = p.mass * (acc + 1j * tree.gravity)
-                force[b] += net
-                moment[b] += p.inertia_zz * fk.alpha[b] + _cross(com, net)
-        tcp = fk.point(tree.tcp_body, planar[tree.tcp_body].point(np.asarray(tree.tcp.position)))[0]
-        force[tree.tcp_body] -= external
-        moment[tree.tcp_body] -= _cross(tcp, external)
-        for k, loop in enumerate(tree.loops):
-            on_a = fk.point(loop.body_a, planar[loop.body_a].point(loop.point_a))[0]
-            on_b = fk.point(loop.body_b, planar[loop.body_b].point(loop.point_b))[0]
-            for j, unit in enumerate((1.0 + 0j, 1j)):  # lambda_x, lambda_y
-                force_per[loop.body_a][:, 2 * k + j] -= unit
-                moment_per[loop.body_a][:, 2 * k + j] -= _cross(on_a, unit)
-                force_per[loop.body_b][:, 2 * k + j] += unit
-                moment_per[loop.body_b][:, 2 * k + j] += _cross(on_b, unit)
-        for b in range(n - 1, 0, -1):  # parents precede children: add each body's joint into its parent's
-            parent = tree.bodies[b].parent
-            if parent > 0:
-                force[parent] += force[b]
-                moment[parent] += moment[b]
-                force_per[parent] += force_per[b]
-                moment_per[parent] += moment_per[b]
-        rows = np.stack([moment_per[b] - _cross(fk.z[b][:, None], force_per[b]) for b in self._hinges], axis=1)
-        rhs = np.stack([_cross(fk.z[b], force[b]) - moment[b] for b in self._hinges], axis=1)
-        lam = np.asarray(np.linalg.solve(rows, rhs[..., None])[..., 0], dtype=float)
-        transmitted = [force[b] + np.einsum("tl,tl->t", force_per[b], lam) for b in range(n)]
-        return transmitted, lam
-
-    def _pin_forces(self, fk: Frames, transmitted: list[Complex], lam: Array) -> PinForces:
-        """World and body-frame forces of every joint and loop pin."""
-        tree = self.tree
-        world = [np.stack([transmitted[b].real, transmitted[b].imag], axis=1) for b in range(1, len(tree.bodies))]
-        world.extend(lam[:, 2 * k : 2 * k + 2] for k in range(len(tree.loops)))
-        on_body = [*range(1, len(tree.bodies)), *(loop.body_a for loop in tree.loops)]
-        world_array = np.stack(world, axis=1)
-        local = np.empty((*world_array.shape[:2], 3))
-        for k, b in enumerate(on_body):
-            local[:, k] = _to_body_frame(self.planar[b].fixed, fk.theta[b], world_array[:, k])
-        names, kinds, on, by = self._pins
-        return PinForces(names=names, kinds=kinds, on=on, by=by, world=world_array, local=local)
+    def _pin_forces(
+        self, joints: tuple[Array, Array, Array], external: complex | NDArray[np.complex128] | None
+    ) -> tuple[Array, Array]:
+        """World (T, P, 2) and body-frame (T, P, 3) pin forces [N] at checked joints q, dq, ddq (T, n) each."""
+        q, dq, ddq = (x.T[:, None] for x in joints)
+        ws = full_state(self.layout, self.prepared, q, dq, ddq)
+        transmitted, lam = joint_forces(ws, self.prepared, external)
+        world, local = pin_arrays(ws, transmitted, lam)
+        return world[0], local[0]
 
     # ------------------------------------------------------------------------------------------
 
@@ -198,29 +182,105 @@ class NewtonEulerInverseDynamics:
 
     def energy_of_full(self, qf: Array, dqf: Array) -> tuple[Array, Array]:
         """Kinetic and potential energy [J] of full coordinates (T, nbody) with no range checks."""
-        fk = frames(self.tree, self.planar, qf, dqf, np.zeros_like(qf))
-        kinetic = np.zeros(qf.shape[0])
-        potential = np.zeros(qf.shape[0])
-        for b, p in enumerate(self.planar):
-            if b == 0:
-                continue
-            com, velocity, _ = fk.point(b, p.com)
-            kinetic += 0.5 * (p.mass * np.abs(velocity) ** 2 + p.inertia_zz * fk.omega[b] ** 2)
-            potential += p.mass * self.tree.gravity * com.imag
-        return kinetic, potential
+        layout, c = self.layout, self.constants
+        qf, dqf = np.asarray(qf, dtype=float).T[:, None], np.asarray(dqf, dtype=float).T[:, None]
+        ws = frames_of_full(layout, self.prepared, qf, dqf, np.zeros_like(qf))
+        mb = layout.massive
+        spare = (ws.c("energy arm", len(mb)), ws.c("energy spare", 3, len(mb)))
+        com, velocity, _ = ws.points(mb, c.com[mb][:, :, None], ws.c("energy", 3, len(mb)), spare)
+        mass, izz = c.mass[mb], c.izz[mb]  # (bodies, 1)
+        kinetic = 0.5 * (mass * np.abs(velocity[:, 0]) ** 2 + izz * ws.omega[mb, 0] ** 2)
+        potential = mass * layout.tree.gravity * com[:, 0].imag
+        return kinetic.sum(axis=0), potential.sum(axis=0)
 
     def tcp_velocity(self, q: Any, dq: Any) -> Array:
         """Velocity of the TCP point in the world plane (T, 2) [m/s] (the power of a TCP force)."""
-        zero = np.zeros_like(np.atleast_2d(np.asarray(q, dtype=float)))
-        qf, dqf, ddqf = self.state(q, dq, zero)
-        fk = frames(self.tree, self.planar, qf, dqf, ddqf)
-        b = self.tree.tcp_body
-        v = fk.point(b, self.planar[b].point(np.asarray(self.tree.tcp.position)))[1]
+        q, dq, zero = joint_arrays(self.layout.tree, q, dq, np.zeros_like(np.atleast_2d(np.asarray(q, dtype=float))))
+        ws = full_state(self.layout, self.prepared, q.T[:, None], dq.T[:, None], zero.T[:, None])
+        b = self.layout.tree.tcp_body
+        v = ws.motion[1, b, 0] + ws.factor[1, b, 0] * ws.rot[b, 0] * self.layout.tcp_point
         return np.stack([v.real, v.imag], axis=1)
 
 
-def _to_body_frame(fixed: Array, theta: Array, force: Array) -> Array:
-    """World in-plane force (T, 2) in the axes of a body frame Rz(theta) F: F^T Rz(-theta) [f; 0], (T, 3)."""
-    c, s = np.cos(theta), np.sin(theta)
-    rotated = np.stack([c * force[:, 0] + s * force[:, 1], -s * force[:, 0] + c * force[:, 1], np.zeros_like(c)], 1)
-    return rotated @ fixed
+def batched_inverse_dynamics(
+    machine: Machine,
+    designs: ArrayLike,
+    position: ArrayLike,
+    velocity: ArrayLike,
+    acceleration: ArrayLike,
+    tcp_force: ArrayLike | None = None,
+    extras: SimulationExtras | None = None,
+) -> tuple[Array, Array, Array, Array]:
+    """Actuator forces [N], velocities, accelerations and strokes of D designs of one machine in one pass.
+
+    The machine path's counterpart of :func:`hiab_sim.dynamics.analytic_batch.batched_inverse_dynamics`
+    (e.g. the perturbed designs of a finite-difference gradient): design d gives what
+    ``NewtonEulerInverseDynamics(machine, designs[d], extras)`` gives, to round-off.
+
+    Args:
+        machine: The machine.
+        designs: Decision variable values (D, n_xi) in ``machine.decision_variables`` order; no
+            bounds are checked (:func:`design_constants`).
+        position: Independent joint samples (T, n) shared by every design, or (D, T, n).
+        velocity: Their rates, same shape.
+        acceleration: Their accelerations, same shape.
+        tcp_force: Force of the environment on the TCP in the world plane [N], (2,), (T, 2) (the
+            same for every design) or None.
+        extras: Armature and damping per actuator, as :class:`NewtonEulerInverseDynamics`.
+
+    Returns:
+        Four arrays (D, T, n_chains): force, velocity, acceleration and stroke, in chain order.
+
+    Raises:
+        InvalidInputError: malformed designs, joint samples, tcp_force or extras (named field).
+
+    """
+    _check_extras(machine, extras)
+    layout = layout_of(machine)
+    c = design_constants(machine, layout, np.asarray(designs, dtype=float))
+    D = c.designs
+    joints = [np.asarray(x, dtype=float) for x in (position, velocity, acceleration)]
+    if joints[0].ndim == 3:
+        if joints[0].shape[0] != D or any(x.shape != joints[0].shape for x in joints):
+            need = f"must be ({D}, T, n) like velocity and acceleration, or (T, n)"
+            raise InvalidInputError("position", f"shape {joints[0].shape}", need)
+        T = joints[0].shape[1]
+        flat = joint_arrays(layout.tree, *(x.reshape(D * T, -1) for x in joints))
+        q, dq, ddq = (x.reshape(D, T, -1).transpose(2, 0, 1) for x in flat)
+    else:
+        q, dq, ddq = (x.T[:, None] for x in joint_arrays(layout.tree, *joints))
+    external = tcp_force_complex(tcp_force, q.shape[2])
+    pc = prepare(layout, c)
+    ws = full_state(layout, pc, q, dq, ddq)
+    transmitted, _ = joint_forces(ws, pc, external)
+    act = layout.actuated
+    qf, dqf, ddqf = ws.q[act], ws.dq[act], ws.ddq[act]  # copies: the workspace is reused
+    force = _with_extras(actuator_forces(ws, pc, transmitted).copy(), extras, dqf, ddqf)
+    return tuple(np.ascontiguousarray(x.transpose(1, 2, 0)) for x in (force, dqf, ddqf, qf))  # type: ignore[return-value]
+
+
+def _checked_design(machine: Machine, design: Sequence[float]) -> Array:
+    """Design values (n_xi,) checked as :meth:`Machine.with_design` checks them: their number and bounds."""
+    values = np.asarray(design, dtype=float).reshape(-1)
+    variables = machine.decision_variables
+    if values.shape != (len(variables),):
+        raise InvalidInputError("design", f"{values.size} values", f"need {len(variables)}: {machine.variable_keys}")
+    for v, value in zip(variables, values, strict=True):
+        check_range(v.key, float(value), v.low, v.high, "m")
+    return values
+
+
+def _check_extras(machine: Machine, extras: SimulationExtras | None) -> None:
+    if extras is not None and len(extras.armature_kg) != len(machine.chains):
+        need = f"need one per actuator: {machine.actuator_names}"
+        raise InvalidInputError("extras.armature_kg", f"{len(extras.armature_kg)} values", need)
+
+
+def _with_extras(force: Array, extras: SimulationExtras | None, velocity: Array, acceleration: Array) -> Array:
+    """The motor-side force f_x + (J_m k^2 + M_sm) a_x + b_f v_x, or f_x without extras [N]."""
+    if extras is None:
+        return force
+    armature, damping = (
+        np.asarray(x, dtype=float)[:, None, None] for x in (extras.armature_kg, extras.damping_Ns_per_m)
+    )
+    return force + armature * acceleration + damping * velocity

@@ -126,7 +126,7 @@ def actuator_lengths(chain: Chain) -> tuple[float, float]:
     return float(piston), float(rod)
 
 
-def _world_z(machine: Machine) -> dict[str, tuple[float, Array]]:
+def world_z(machine: Machine) -> dict[str, tuple[float, Array]]:
     """Per link: world z of its origin and its world rotation at zero coordinates (z is constant in planar motion)."""
     out: dict[str, tuple[float, Array]] = {}
     for link in machine.links:
@@ -167,7 +167,7 @@ def machine_tree(machine: Machine) -> MachineTree:
             raise InvalidInputError(
                 f"links.{link.name}.joint", link.joint, "every moving joint needs a chain driving it"
             )
-    z = _world_z(machine)
+    z = world_z(machine)
     loops: list[LoopPin] = []
 
     def pivot_z(link: str, point: Array) -> float:
@@ -345,15 +345,18 @@ def joint_arrays(tree: MachineTree, q: object, dq: object, ddq: object) -> tuple
         out.append(array)
     if not out[0].shape == out[1].shape == out[2].shape:
         raise InvalidInputError("joints", "mismatched shapes", "position, velocity, acceleration must match")
-    for k, name in enumerate(names):
-        link = tree.machine.joint_link(name)
-        low, high = link.joint_range  # type: ignore[misc]
+    links = [tree.machine.joint_link(name) for name in names]
+    low, high = np.array([link.joint_range for link in links], dtype=float).reshape(len(names), 2).T
+    outside = (out[0] < low) | (out[0] > high)
+    if np.any(outside):
+        k = int(np.argmax(np.any(outside, axis=0)))  # the first joint (file order) with a sample outside
         column = out[0][:, k]
-        outside = (column < low) | (column > high)
-        if np.any(outside):
-            raise InvalidInputError(
-                name, float(column[np.argmax(outside)]), f"must lie in [{low:.6g}, {high:.6g}]", link.unit
-            )
+        raise InvalidInputError(
+            names[k],
+            float(column[np.argmax(outside[:, k])]),
+            f"must lie in [{low[k]:.6g}, {high[k]:.6g}]",
+            links[k].unit,
+        )
     return out[0], out[1], out[2]
 
 
@@ -366,9 +369,24 @@ def tcp_force_array(tcp_force: object, samples: int) -> Array:
     """
     if tcp_force is None:
         return np.zeros((samples, 2))
+    return np.array(np.broadcast_to(_checked_tcp_force(tcp_force, samples), (samples, 2)), dtype=float)
+
+
+def tcp_force_complex(tcp_force: object, samples: int) -> complex | NDArray[np.complex128] | None:
+    """The same force as :func:`tcp_force_array`, as x + i y [N]: None, one number for (2,), or (T,) for (T, 2)."""
+    if tcp_force is None:
+        return None
+    force = _checked_tcp_force(tcp_force, samples)
+    if force.ndim == 1:
+        return complex(force[0], force[1])
+    out: NDArray[np.complex128] = force[:, 0] + 1j * force[:, 1]
+    return out
+
+
+def _checked_tcp_force(tcp_force: object, samples: int) -> Array:
     force = np.asarray(tcp_force, dtype=float)
     if force.shape not in ((2,), (samples, 2)):
         raise InvalidInputError("tcp_force", f"shape {force.shape}", f"must be (2,) or ({samples}, 2)", "N")
     if not np.all(np.isfinite(force)):
         raise InvalidInputError("tcp_force", "NaN or inf", "must be finite", "N")
-    return np.array(np.broadcast_to(force, (samples, 2)), dtype=float)
+    return force
