@@ -30,6 +30,9 @@ def summary(m: EnergyMap) -> dict[str, Any]:
             "objective": float(v.objective[k]),
             "cost_W2s": float(v.cost[k]),
             "net_electrical_energy_J": float(v.net_energy[k]),
+            "battery_energy_J": float(v.battery_energy[k]),
+            "binding_constraint": v.names[int(v.binding[k])],
+            "smallest_margin": float(v.margins[k].min()),
         }
     counts: dict[str, int] = {}
     for cell in np.flatnonzero(~feasible):
