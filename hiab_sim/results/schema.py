@@ -410,12 +410,29 @@ class DesignLengths:
 
 
 @dataclass(frozen=True)
+class BatteryFigure:
+    """The part of a design's energy section a video shows: the battery energy [J], and the duty model if any."""
+
+    battery_energy_J: float  # :class:`~hiab_sim.results.energy_sections.DesignEnergy`'s, cycle (+ rest with a duty)
+    duty: Any = optional()  # present when the study's duty model adds the rest (the figure is per duty period)
+
+
+@dataclass(frozen=True)
+class PlaybackEnergy:
+    """Both designs' battery figures of ``result.json``'s ``energy`` section."""
+
+    initial: BatteryFigure
+    optimal: BatteryFigure
+
+
+@dataclass(frozen=True)
 class PlaybackView:
-    """The renderer's contract with a result: the crane and both designs' lengths."""
+    """The renderer's contract with a result: the crane, both designs' lengths and, if any, their battery energy."""
 
     crane: str
     initial: DesignLengths
     optimal: DesignLengths
+    energy: PlaybackEnergy | None = optional()  # absent in a result without a battery model
 
     @classmethod
     def from_json(cls, data: Any) -> PlaybackView:
