@@ -39,13 +39,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Compute and write the map, print its answer first and save it as ``summary.txt``; return the exit status."""
-    from hiab_sim.cli.answer_output import ANSWER_FILE, StatusLine, publish_answer
+    from hiab_sim.cli.answer_output import ANSWER_FILE, publish_answer
     from hiab_sim.study.nlp.task_problem import TaskProblem
     from hiab_sim.study.report.summary import limit_in_words
     from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
     from hiab_sim.sweep.answers import map_answer
     from hiab_sim.sweep.energy_map import energy_map, optimum_design, parse_variables, result_study, start_design
     from hiab_sim.sweep.map_output import TRAJECTORY_NOTE, summary, write_map
+    from hiab_sim.terminal import StatusLine
 
     variables = parse_variables(args.vars)
     study = load_study(args.study or (result_study(args.result) if args.result else DEFAULT_STUDY))

@@ -33,12 +33,13 @@ def run(args: argparse.Namespace) -> int:
     import pandas as pd
 
     from hiab_sim.atomic_io import write_atomic
-    from hiab_sim.cli.answer_output import ANSWER_FILE, StatusLine, publish_answer
+    from hiab_sim.cli.answer_output import ANSWER_FILE, publish_answer
     from hiab_sim.study.nlp.problem import make_problem
     from hiab_sim.study.solvers.slsqp import check_start, solve
     from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
     from hiab_sim.sweep.answers import front_answer
     from hiab_sim.sweep.pareto import CRITERIA, front_figure_png, pareto_front
+    from hiab_sim.terminal import StatusLine
 
     if args.points < 2:
         from hiab_sim.errors import InvalidInputError

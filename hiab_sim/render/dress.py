@@ -203,8 +203,8 @@ def dress_scene(
     _add(scene, mujoco.mjtGeom.mjGEOM_CYLINDER, (0.012, 0.012, 0.09), tool - [0, 0, 0.09], eye, (*HOOK_RGBA[:3], alpha))
     _add(scene, mujoco.mjtGeom.mjGEOM_ELLIPSOID, (0.05, 0.02, 0.05), tool - [0, 0, 0.22], eye, (*HOOK_RGBA[:3], alpha))
     if payload_kg > 0.0:
-        centre, half = payload_box(data, dress, payload_kg)
-        _add(scene, mujoco.mjtGeom.mjGEOM_BOX, half, centre, eye, (*PAYLOAD_RGBA[:3], alpha))
+        load_centre, load_half = payload_box(data, dress, payload_kg)
+        _add(scene, mujoco.mjtGeom.mjGEOM_BOX, load_half, load_centre, eye, (*PAYLOAD_RGBA[:3], alpha))
     if ground:
         _ground(scene, model, data, dress)
 

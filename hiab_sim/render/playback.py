@@ -30,8 +30,8 @@ from numpy.typing import NDArray
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.results.playback_view import PlaybackView
 from hiab_sim.results.read import open_run, result_crane
-from hiab_sim.results.schema import PlaybackView
 from hiab_sim.results.trajectory_file import Trajectory
 
 Array = NDArray[np.float64]

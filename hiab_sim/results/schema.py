@@ -25,6 +25,7 @@ from hiab_sim.errors import ConfigError
 from hiab_sim.results.analysis_sections import Buildable, CrossEvaluation, FeasibilityPhase, Sensitivity
 from hiab_sim.results.codec import from_json, optional, to_json
 from hiab_sim.results.energy_sections import Codesign, EnergyReport, HydraulicBaseline
+from hiab_sim.results.playback_view import PlaybackView as PlaybackView  # re-exported: the renderer's contract
 from hiab_sim.structure.summary import StructureSummary
 
 #: Version of the result.json layout; files without the key are version 1. Version 2 renames the
@@ -400,44 +401,6 @@ def _renamed(data: Any) -> Any:
     if isinstance(data, list):
         return [_renamed(v) for v in data]
     return data
-
-
-@dataclass(frozen=True)
-class DesignLengths:
-    """The part of a design the renderer needs: its link lengths."""
-
-    lengths: LinkLengths
-
-
-@dataclass(frozen=True)
-class BatteryFigure:
-    """The part of a design's energy section a video shows: the battery energy [J], and the duty model if any."""
-
-    battery_energy_J: float  # :class:`~hiab_sim.results.energy_sections.DesignEnergy`'s, cycle (+ rest with a duty)
-    duty: Any = optional()  # present when the study's duty model adds the rest (the figure is per duty period)
-
-
-@dataclass(frozen=True)
-class PlaybackEnergy:
-    """Both designs' battery figures of ``result.json``'s ``energy`` section."""
-
-    initial: BatteryFigure
-    optimal: BatteryFigure
-
-
-@dataclass(frozen=True)
-class PlaybackView:
-    """The renderer's contract with a result: the crane, both designs' lengths and, if any, their battery energy."""
-
-    crane: str
-    initial: DesignLengths
-    optimal: DesignLengths
-    energy: PlaybackEnergy | None = optional()  # absent in a result without a battery model
-
-    @classmethod
-    def from_json(cls, data: Any) -> PlaybackView:
-        """Build from a parsed result.json (other keys are ignored)."""
-        return from_json(cls, data)
 
 
 def parse_json(path: Path) -> Any:

@@ -105,7 +105,7 @@ def _ordered(rows: dict[str, dict[str, Any]], order: dict[str, int]) -> list[dic
 
 
 def _bar(total: int, initial: int, enabled: bool) -> Any:
-    from hiab_sim.cli.answer_output import progress_wanted
+    from hiab_sim.terminal import progress_wanted
 
     if not enabled or not progress_wanted(sys.stderr):  # redirected to a file, a bar would dump every update
         return None
