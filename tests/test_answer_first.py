@@ -13,6 +13,7 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 from test_study_small import TINY, small_study, write_study
@@ -62,6 +63,13 @@ def test_energy_map_opens_with_the_best_mounting_and_its_battery_energy(
         value = best["xi_m"][["lift.L", "lift.Lc0", "lift.Lc", "tilt.L", "tilt.Lc0", "tilt.Lc"].index(name)]
         assert f"{name} = {value * 1e3:.0f} mm" in answer
     assert answer.index("Best feasible mounting") < answer.index("Files in")  # the answer before the files
+    arrays = np.load(folder / "energy_map.npz")
+    least = float(arrays["battery_energy_J"][arrays["feasible"]].min())  # the map's own grid, not the summary
+    if least < best["battery_energy_J"]:
+        assert "Least battery energy of a feasible mounting on the map: " in answer
+        assert f"{least / 1e3:.3f} kJ" in answer
+    else:
+        assert "Least battery energy" not in answer
 
 
 def test_pareto_opens_with_the_ends_and_the_knee(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

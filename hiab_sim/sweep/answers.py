@@ -56,12 +56,16 @@ def map_answer(m: EnergyMap, s: dict[str, Any], title: str, per: str, folder: Pa
     if best is None:
         lines.append(f"No feasible mounting on the map ({s['cells']} cells).")
     else:
-        moves = []
-        for name in names:
-            value, before = best["xi_m"][VARIABLES.index(name)], m.base.xi[VARIABLES.index(name)]
-            moves.append(f"{name} = {value * 1e3:.0f} mm ({(value - before) * 1e3:+.0f})")
+
+        def moves(cell: dict[str, Any]) -> str:
+            parts = []
+            for name in names:
+                value, before = cell["xi_m"][VARIABLES.index(name)], m.base.xi[VARIABLES.index(name)]
+                parts.append(f"{name} = {value * 1e3:.0f} mm ({(value - before) * 1e3:+.0f})")
+            return ", ".join(parts)
+
         lines.append(
-            f"Best feasible mounting on the map (least study objective, {m.objective}): " + ", ".join(moves) + "; "
+            f"Best feasible mounting on the map (least study objective, {m.objective}): {moves(best)}; "
             f"change from the {base_words} in brackets."
         )
         lines.append(
@@ -69,6 +73,13 @@ def map_answer(m: EnergyMap, s: dict[str, Any], title: str, per: str, folder: Pa
             + before_after(base["battery_energy_J"], best["battery_energy_J"], ("at the base design", "at the best"))
             + "."
         )
+        least = s["least_battery_energy_cell"]
+        if least is not None and least["xi_m"] != best["xi_m"]:
+            lines.append(
+                f"Least battery energy of a feasible mounting on the map: {moves(least)}, "
+                f"{least['battery_energy_J'] / 1e3:.3f} kJ "
+                f"({_change(least['battery_energy_J'], base['battery_energy_J'])} against the base design)."
+            )
         lines.append(
             f"Binding at the best mounting: {limit_in_words(best['binding_constraint'])} "
             f"(scaled margin {best['smallest_margin']:.1e})."
@@ -79,15 +90,19 @@ def map_answer(m: EnergyMap, s: dict[str, Any], title: str, per: str, folder: Pa
         )
     note = infeasible_note(m)
     # the note (where most cells are infeasible) says how many are feasible and why the rest are not
-    lines.append(
-        f"{s['feasible_cells']} of {s['cells']} cells feasible." if note is None else note.replace("\n", "; ") + "."
-    )
+    lines.append(f"{s['feasible_cells']} of {s['cells']} cells feasible." if note is None else _sentence(note))
     lines.append(
         f"The other four lengths and the joint trajectory stay at the {base_words}; "
         f"binding there: {limit_in_words(base['binding_constraint'])}."
     )
     lines += ["", files_line(folder, files)]
     return lines
+
+
+def _sentence(note: str) -> str:
+    """A note of several lines (:func:`hiab_sim.sweep.map_output.infeasible_note`) as one sentence."""
+    text = note.replace(";\n", "; ").replace("\n", " ")
+    return text[:1].upper() + text[1:] + "."
 
 
 def knee_index(front: Sequence[FrontPoint]) -> int | None:
