@@ -72,6 +72,19 @@ def test_energy_map_opens_with_the_best_mounting_and_its_battery_energy(
         assert "Least battery energy" not in answer
 
 
+def test_energy_map_without_a_feasible_cell_says_why(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """lift.L x tilt.L, the rest at the start: no feasible cell; the answer says why and gives the base's energy."""
+    study = write_study(tmp_path, small_study(**TINY))
+    folder = tmp_path / "map"
+    assert main(["energy-map", str(study), "--vars", "lift.L,tilt.L", "--grid", "6", "--out", str(folder)]) == 0
+    answer = _head_is_the_saved_answer(capsys.readouterr().out, folder)
+    s = json.loads((folder / "energy_map.json").read_text())
+    assert s["best_feasible_cell"] is None  # the case of the issue: a map over lengths that keep no stroke feasible
+    assert answer.splitlines()[2].startswith("No feasible cell of 36: ")
+    assert f"{s['at_base']['battery_energy_J'] / 1e3:.3f} kJ" in answer
+    assert "instead" in answer  # the hint which variables to map
+
+
 def test_pareto_opens_with_the_ends_and_the_knee(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """The answer names the plain optimum and the least peak force of pareto.csv, and a knee."""
     study = write_study(tmp_path, small_study(**TINY))

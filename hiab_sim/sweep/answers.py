@@ -53,8 +53,12 @@ def map_answer(m: EnergyMap, s: dict[str, Any], title: str, per: str, folder: Pa
     base_words = f"base design ({_short(m.base.source)})"
     lines = [f"# {title}: energy map over {names[0]} x {names[1]}, the answer", ""]
     best = s["best_feasible_cell"]
-    if best is None:
-        lines.append(f"No feasible mounting on the map ({s['cells']} cells).")
+    note = infeasible_note(m)  # where most cells are infeasible: how many are feasible and why the rest are not
+    if best is None:  # then the note opens the answer: "No feasible cell of N: ... map ... instead"
+        lines.append(_sentence(note) if note is not None else f"No feasible mounting on the map ({s['cells']} cells).")
+        lines.append(
+            f"Battery energy per {per} {BATTERY_BOUNDARY} at the {base_words}: {base['battery_energy_J'] / 1e3:.3f} kJ."
+        )
     else:
 
         def moves(cell: dict[str, Any]) -> str:
@@ -84,13 +88,8 @@ def map_answer(m: EnergyMap, s: dict[str, Any], title: str, per: str, folder: Pa
             f"Binding at the best mounting: {limit_in_words(best['binding_constraint'])} "
             f"(scaled margin {best['smallest_margin']:.1e})."
         )
-    if best is None:
-        lines.append(
-            f"Battery energy per {per} {BATTERY_BOUNDARY} at the {base_words}: {base['battery_energy_J'] / 1e3:.3f} kJ."
-        )
-    note = infeasible_note(m)
-    # the note (where most cells are infeasible) says how many are feasible and why the rest are not
-    lines.append(f"{s['feasible_cells']} of {s['cells']} cells feasible." if note is None else _sentence(note))
+    if best is not None:
+        lines.append(f"{s['feasible_cells']} of {s['cells']} cells feasible." if note is None else _sentence(note))
     lines.append(
         f"The other four lengths and the joint trajectory stay at the {base_words}; "
         f"binding there: {limit_in_words(base['binding_constraint'])}."
