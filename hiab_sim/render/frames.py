@@ -4,7 +4,7 @@ A :class:`PlaybackRenderer` draws each :class:`Design` either side by side or st
 viewport each; stacked suits a crane whose motion is wider than tall) or overlaid in one
 viewport (the later designs as translucent ghosts showing only the parts that differ), with the
 reference TCP curve and each design's TCP trail as line geoms, the design's name as a caption
-and, if given, a per-frame note under it (time, cumulative energy). One free camera, fitted once
+and, if given, a per-frame note under it (time, battery energy). One free camera, fitted once
 to the whole motion of all designs (:func:`~hiab_sim.render.camera.fit_camera`), looks onto the
 crane's x-z plane of motion.
 
