@@ -28,7 +28,7 @@ def summary(m: EnergyMap) -> dict[str, Any]:
     v = m.values
     feasible = v.feasible
 
-    def cell(k: int) -> dict[str, Any]:
+    def cell_values(k: int) -> dict[str, Any]:
         return {
             "xi_m": v.xi[k].tolist(),
             "objective": float(v.objective[k]),
@@ -42,8 +42,8 @@ def summary(m: EnergyMap) -> dict[str, Any]:
     best: dict[str, Any] | None = None
     least: dict[str, Any] | None = None
     if feasible.any():
-        best = cell(int(np.flatnonzero(feasible)[np.argmin(v.objective[feasible])]))
-        least = cell(int(np.flatnonzero(feasible)[np.argmin(v.battery_energy[feasible])]))
+        best = cell_values(int(np.flatnonzero(feasible)[np.argmin(v.objective[feasible])]))
+        least = cell_values(int(np.flatnonzero(feasible)[np.argmin(v.battery_energy[feasible])]))
     counts: dict[str, int] = {}
     for cell in np.flatnonzero(~feasible):
         name = v.names[int(v.binding[cell])]
