@@ -31,6 +31,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run the sweep, print its answer first (also ``summary.txt``), then the details; return the exit status."""
     from hiab_sim.cli.answer_output import ANSWER_FILE, publish_answer
+    from hiab_sim.results.read import read_result
     from hiab_sim.sweep.answers import sweep_answer
     from hiab_sim.sweep.executors import make_executor
     from hiab_sim.sweep.figures import summary_figures
@@ -56,5 +57,10 @@ def run(args: argparse.Namespace) -> int:
         details.append(f"net energy saved: {saving.min():.2f} .. {saving.max():.2f} % over the ok points")
     details += [f"  failed {row['key']}: {row['message']}" for _, row in frame[~ok].iterrows()]
     files = [outcome.table.name, "points/<key>/result.json", *(p.name for p in figures), ANSWER_FILE]
-    publish_answer(sweep_answer(frame, list(sweep.axes), sweep.name, out, files), out, details)
+    per = "cycle"
+    if ok.any():  # every point runs the same study's duty model: a finished point's result says which period
+        energy = read_result(out / "points" / str(frame.loc[ok, "key"].iloc[0])).energy
+        if energy is not None and energy.optimal.duty is not None:
+            per = "duty period (the cycle and the rest's hold)"
+    publish_answer(sweep_answer(frame, list(sweep.axes), sweep.name, out, files, per), out, details)
     return 0

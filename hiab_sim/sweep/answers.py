@@ -165,7 +165,7 @@ def front_answer(
     lines.append(point(f"plain optimum (no limit on the {words})", plain))
     least = min(ok, key=lambda p: p.criterion) if ok else None
     if least is not None and least is not plain:
-        lines.append(point(f"least {words} the limits allow", least))
+        lines.append(point(f"least {words} reached on the front", least))
     knee = knee_index(front)
     if knee is None:
         lines.append("- knee: none (fewer than three converged points, or the front is straight)")
@@ -191,8 +191,14 @@ def _energy_column(frame: pd.DataFrame, ok: pd.Series) -> tuple[str, str, str]:
     return "opt_net_energy_J", "start_net_energy_J", NET_BOUNDARY
 
 
-def sweep_answer(frame: pd.DataFrame, axes: Sequence[str], title: str, folder: Path, files: Sequence[str]) -> list[str]:
-    """The sweep's answer: the point of least energy at its optimum and the spread over the finished points."""
+def sweep_answer(
+    frame: pd.DataFrame, axes: Sequence[str], title: str, folder: Path, files: Sequence[str], per: str = "cycle"
+) -> list[str]:
+    """The sweep's answer: the point of least energy at its optimum and the spread over the finished points.
+
+    ``per`` names the period the battery energy covers (``"cycle"``, or ``"duty period"`` when the
+    study's duty model adds the rest's hold); the net electrical energy is always per cycle.
+    """
     ok = frame["status"] == "ok"
     lines = [f"# {title}: sweep of {len(frame)} points over {', '.join(axes)}, the answer", ""]
     if not ok.any():
@@ -204,15 +210,16 @@ def sweep_answer(frame: pd.DataFrame, axes: Sequence[str], title: str, folder: P
     best = done.loc[done[column].astype(float).idxmin()]
     values = ", ".join(f"{a} = {best[a]}" for a in axes)
     lines.append(f"Least energy at the optimum: point {best['key']} ({values}).")
+    period = per if boundary == BATTERY_BOUNDARY else "cycle"
     lines.append(
-        f"Energy per cycle {boundary}: "
+        f"Energy per {period} {boundary}: "
         + before_after(float(best[start_column]), float(best[column]), ("at its start", "at its optimum"))
         + "."
     )
     energy = done[column].astype(float) / 1e3
     saving = done["net_energy_saved_percent"].astype(float)
     lines.append(
-        f"Spread over the {int(ok.sum())} finished points: energy at the optimum {energy.min():.3f} .. "
+        f"Spread over the {int(ok.sum())} finished point(s): energy at the optimum {energy.min():.3f} .. "
         f"{energy.max():.3f} kJ; net energy saved by the optimisation {saving.min():.2f} .. {saving.max():.2f} %."
     )
     failed = int((~ok).sum())
