@@ -76,7 +76,7 @@ def test_an_all_infeasible_energy_map_says_which_limit_binds_and_what_to_map(
     printed = capsys.readouterr().out
     summary = json.loads((tmp_path / "energy_map.json").read_text())
     assert summary["best_feasible_cell"] is None
-    note = next(line for line in printed.splitlines() if line.startswith("no feasible cell of 100"))
+    note = next(line for line in printed.splitlines() if line.startswith("No feasible cell of 100"))
     chain = note.split(" cells break ")[1].split()[0]
     assert f"map {chain}.Lc0 and {chain}.Lc instead" in note
     assert "_" not in note.split(" cells break ")[1].split(" with ")[0]  # the limit in words, not a row name

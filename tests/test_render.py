@@ -205,14 +205,14 @@ def test_dressed_frame_spans_the_machine_and_its_captions_read(result_dir: Path)
 
 
 def test_energy_notes_integrate_the_power_in_time() -> None:
-    """Constant 1 kW for 2 s: the notes read 0, 1 and 2 kJ of 2 kJ at 0, 1 and 2 s; without power only the time."""
+    """Constant 1 kW for 2 s, no battery figure: the notes read 0, 1 and 2 kJ of 2 kJ at 0, 1 and 2 s."""
     from hiab_sim.render.video import energy_notes
 
     time = np.linspace(0.0, 2.0, 9)
     notes = energy_notes(time, np.array([0.0, 1.0, 2.0]), np.full(9, 1000.0))
-    assert [n.split("net energy")[1].split()[0] for n in notes] == ["0.000", "1.000", "2.000"]
-    assert all(n.endswith("of 2.000 kJ") for n in notes)
-    assert energy_notes(time, np.array([0.5]), None) == ("t =  0.50 s",)
+    assert [n.split("net electrical energy")[1].split()[0] for n in notes] == ["0.000", "1.000", "2.000"]
+    assert all(n.endswith("of 2.000 kJ (no battery figure)") for n in notes)
+    assert energy_notes(time, np.array([0.5]), None)[0].startswith("t =  0.50 s")
 
 
 def test_caption_bitmap_is_transparent_around_the_glyphs() -> None:

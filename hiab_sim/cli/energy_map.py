@@ -38,39 +38,44 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Compute and write the map; return the exit status."""
+    """Compute and write the map, print its answer first and save it as ``summary.txt``; return the exit status."""
+    from hiab_sim.cli.answer_output import ANSWER_FILE, publish_answer
     from hiab_sim.study.nlp.task_problem import TaskProblem
     from hiab_sim.study.report.summary import limit_in_words
     from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
+    from hiab_sim.sweep.answers import map_answer
     from hiab_sim.sweep.energy_map import energy_map, optimum_design, parse_variables, result_study, start_design
-    from hiab_sim.sweep.map_output import TRAJECTORY_NOTE, infeasible_note, summary, write_map
+    from hiab_sim.sweep.map_output import TRAJECTORY_NOTE, summary, write_map
+    from hiab_sim.terminal import StatusLine
 
     variables = parse_variables(args.vars)
     study = load_study(args.study or (result_study(args.result) if args.result else DEFAULT_STUDY))
     problem = TaskProblem(study, id_path="analytic")
     base = optimum_design(args.result) if args.result else start_design(problem)
-    m = energy_map(problem, base, variables, args.grid)
+    with StatusLine(f"evaluating {args.grid} x {args.grid} mountings ..."):
+        m = energy_map(problem, base, variables, args.grid)
     out = Path(args.out) if args.out else Path("runs") / study.name / "energy_map"
     paths = write_map(m, out)
     s = summary(m)
-    print(f"energy map {m.variables[0]} x {m.variables[1]}, {args.grid} x {args.grid} cells; base: {m.base.source}")
-    print(f"fixed: {', '.join(f'{k} = {v:.4f} m' for k, v in s['fixed'].items())}; {TRAJECTORY_NOTE}")
+    per = "cycle" if problem.duty_options is None else "duty period (the cycle and the rest's hold)"
+    answer = map_answer(m, s, study.name, per, out, [*(p.name for p in paths), ANSWER_FILE])
     at = s["at_base"]
-    print(
+    details = [
+        f"energy map {m.variables[0]} x {m.variables[1]}, {args.grid} x {args.grid} cells; base: {m.base.source}",
+        f"fixed: {', '.join(f'{k} = {v:.4f} m' for k, v in s['fixed'].items())}; {TRAJECTORY_NOTE}",
         f"at the base: objective {at['objective']:.6f}, net energy {at['net_electrical_energy_J'] / 1e3:.3f} kJ, "
-        f"binding: {limit_in_words(at['binding_constraint'])} (margin {at['smallest_margin']:.2e})"
-    )
+        f"battery energy {at['battery_energy_J'] / 1e3:.3f} kJ, binding: {limit_in_words(at['binding_constraint'])} "
+        f"(margin {at['smallest_margin']:.2e})",
+    ]
     best = s["best_feasible_cell"]
-    note = infeasible_note(m)
-    if best is None or note is not None:
-        print(note.replace("\n", " ") if note is not None else f"no feasible cell (of {s['cells']})")
     if best is not None:
         xi = best["xi_m"]
         i0, i1 = variables
-        print(
+        details.append(
             f"{s['feasible_cells']} of {s['cells']} cells feasible; best: {m.variables[0]} = {xi[i0]:.4f} m, "
             f"{m.variables[1]} = {xi[i1]:.4f} m, objective {best['objective']:.6f}, "
-            f"net energy {best['net_electrical_energy_J'] / 1e3:.3f} kJ"
+            f"net energy {best['net_electrical_energy_J'] / 1e3:.3f} kJ, battery energy "
+            f"{best['battery_energy_J'] / 1e3:.3f} kJ"
         )
-    print(f"wrote {', '.join(str(p) for p in paths)}")
+    publish_answer(answer, out, details)
     return 0

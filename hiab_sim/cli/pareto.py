@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from pathlib import Path
 
 
@@ -30,14 +29,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Compute the front, write the table and figure; return the exit status."""
+    """Compute the front, write the table and figure, print the answer first (``summary.txt``); return the status."""
     import pandas as pd
 
     from hiab_sim.atomic_io import write_atomic
+    from hiab_sim.cli.answer_output import ANSWER_FILE, publish_answer
     from hiab_sim.study.nlp.problem import make_problem
     from hiab_sim.study.solvers.slsqp import check_start, solve
     from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
+    from hiab_sim.sweep.answers import front_answer
     from hiab_sim.sweep.pareto import CRITERIA, front_figure_png, pareto_front
+    from hiab_sim.terminal import StatusLine
 
     if args.points < 2:
         from hiab_sim.errors import InvalidInputError
@@ -52,9 +54,9 @@ def run(args: argparse.Namespace) -> int:
     problem = study_problem.problems[0]
     check_start(study_problem, study_problem.initial_point(study.initial_lengths))
     out = Path(args.out) if args.out else Path("runs") / study.name / f"pareto_{args.against}"
-    print(f"optimising {study.name} (the front's end at an inactive epsilon) ...", file=sys.stderr)
-    optimum = solve(study_problem, study.initial_lengths, progress=None)
-    front = pareto_front(problem, optimum.z, args.against, args.points)
+    with StatusLine(f"optimising {study.name} and {args.points - 1} limits on the {args.against} ..."):
+        optimum = solve(study_problem, study.initial_lengths, progress=None)
+        front = pareto_front(problem, optimum.z, args.against, args.points)
     frame = pd.DataFrame([p.as_row() for p in front])
     out.mkdir(parents=True, exist_ok=True)
     write_atomic(out / "pareto.csv", frame.to_csv(index=False))
@@ -62,11 +64,13 @@ def run(args: argparse.Namespace) -> int:
     summary = {"study": study.path, "criterion": args.against, "unit": unit, "points": frame.to_dict("records")}
     write_atomic(out / "pareto.json", json.dumps(summary, indent=2) + "\n")
     write_atomic(out / "pareto.png", front_figure_png(front, args.against, study.name))
+    details = []
     for p in front:
         status = "ok" if p.accepted else f"not converged: {p.message}"
-        print(
+        details.append(
             f"epsilon {p.epsilon:12.6g} {unit}  criterion {p.criterion:12.6g}  objective {p.objective:.6f}  "
             f"({p.iterations} iterations, {status})"
         )
-    print(f"wrote {out}/pareto.csv, pareto.json, pareto.png")
+    files = ["pareto.csv", "pareto.json", "pareto.png", ANSWER_FILE]
+    publish_answer(front_answer(front, args.against, problem.objective.name, study.name, out, files), out, details)
     return 0

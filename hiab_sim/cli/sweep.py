@@ -29,7 +29,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the sweep and print a summary; return the exit status."""
+    """Run the sweep, print its answer first (also ``summary.txt``), then the details; return the exit status."""
+    from hiab_sim.cli.answer_output import ANSWER_FILE, publish_answer
+    from hiab_sim.results.read import read_result
+    from hiab_sim.sweep.answers import sweep_answer
     from hiab_sim.sweep.executors import make_executor
     from hiab_sim.sweep.figures import summary_figures
     from hiab_sim.sweep.runner import run_sweep
@@ -39,20 +42,25 @@ def run(args: argparse.Namespace) -> int:
     sweep = load_sweep(args.sweep)
     out = Path(args.out) if args.out else Path("runs") / "sweeps" / sweep.name
     where = f"Dask at {args.dask}" if args.dask else f"{args.workers or 1} local process(es)"
-    print(f"sweep {sweep.name}: {len(sweep.points)} points of {sweep.study_file.name} on {where}")
     with make_executor(args.workers, args.dask) as executor:
         outcome = run_sweep(sweep, out, executor, resume=args.resume, progress=not args.quiet)
     frame, _ = read_table(outcome.table)
     figures = summary_figures(frame, list(sweep.axes), out, sweep.name)
     ok = frame["status"] == "ok"
-    print(
+    details = [
+        f"sweep {sweep.name}: {len(sweep.points)} points of {sweep.study_file.name} on {where}",
         f"ran {len(outcome.ran)} point(s), skipped {len(outcome.skipped)} finished, {len(outcome.failed)} failed now; "
-        f"table: {int(ok.sum())} ok of {len(frame)}"
-    )
+        f"table: {int(ok.sum())} ok of {len(frame)}",
+    ]
     if ok.any():
         saving = frame.loc[ok, "net_energy_saved_percent"]
-        print(f"net energy saved: {saving.min():.2f} .. {saving.max():.2f} % over the ok points")
-    for _, row in frame[~ok].iterrows():
-        print(f"  failed {row['key']}: {row['message']}")
-    print(f"wrote {outcome.table} and {len(figures)} figure(s)")
+        details.append(f"net energy saved: {saving.min():.2f} .. {saving.max():.2f} % over the ok points")
+    details += [f"  failed {row['key']}: {row['message']}" for _, row in frame[~ok].iterrows()]
+    files = [outcome.table.name, "points/<key>/result.json", *(p.name for p in figures), ANSWER_FILE]
+    per = "cycle"
+    if ok.any():  # every point runs the same study's duty model: a finished point's result says which period
+        energy = read_result(out / "points" / str(frame.loc[ok, "key"].iloc[0])).energy
+        if energy is not None and energy.optimal.duty is not None:
+            per = "duty period (the cycle and the rest's hold)"
+    publish_answer(sweep_answer(frame, list(sweep.axes), sweep.name, out, files, per), out, details)
     return 0

@@ -13,7 +13,9 @@ is restyled from the crane description, never from hard-coded part names:
 * every hinge -> a pin across the plane (:data:`PIN_DIAMETER_M`), near black;
 * the rigid bodies carried by the tool's link other than the link's own part (the end mass)
   -> steel blocks of their mass (side (m / rho_steel)^(1/3)) at their centre of mass;
-* a hook under the tool point, a column foot and a truck bed standing on the model's floor.
+* a hook under the tool point, a column foot and a truck bed standing on the model's floor;
+* the task's payload, while it is held, as a steel cube of its mass (side (m / rho_steel)^(1/3))
+  hanging under the hook (:func:`payload_box`).
 
 Sizes the data does not give are chosen here, each with its reason next to it. Without
 ``hydraulic_cylinders`` the barrels and rods keep the model's capsule radii.
@@ -53,6 +55,11 @@ PIN_RGBA = (0.08, 0.08, 0.09, 1.0)
 BLOCK_RGBA = (0.36, 0.37, 0.39, 1.0)
 BED_RGBA = (0.30, 0.31, 0.33, 1.0)
 HOOK_RGBA = (0.95, 0.72, 0.1, 1.0)  # safety yellow
+PAYLOAD_RGBA = (0.55, 0.36, 0.2, 1.0)  # crate brown: apart from the end mass's steel grey and the hook
+#: Hook drawn under the tool point: its lowest point below the tool [m] (the ellipsoid's bottom), a choice.
+HOOK_DROP_M = 0.27
+#: Sling between the hook and the top of the payload [m]: a choice, so the two read as separate parts.
+SLING_M = 0.03
 
 
 @dataclass(frozen=True)
@@ -153,11 +160,13 @@ def dress_scene(
     colour: Sequence[float],
     alpha: float = 1.0,
     ground: bool = True,
+    payload_kg: float = 0.0,
 ) -> None:
     """Restyle the model's geoms of scene indices ``span`` = [start, stop) and add pins, blocks, hook, bed.
 
     ``colour`` (RGB(A) in [0, 1]) paints the structure; ``alpha`` < 1 draws everything as a ghost
-    (and ``ground`` False leaves the bed to the opaque design).
+    (and ``ground`` False leaves the bed to the opaque design). A ``payload_kg`` > 0 (the mass
+    held at this frame) hangs under the hook (:func:`payload_box`); 0 draws none.
     """
     structure = (*colour[:3], alpha)
     for i in range(*span):
@@ -193,6 +202,9 @@ def dress_scene(
     tool = data.site_xpos[dress.tcp_site]
     _add(scene, mujoco.mjtGeom.mjGEOM_CYLINDER, (0.012, 0.012, 0.09), tool - [0, 0, 0.09], eye, (*HOOK_RGBA[:3], alpha))
     _add(scene, mujoco.mjtGeom.mjGEOM_ELLIPSOID, (0.05, 0.02, 0.05), tool - [0, 0, 0.22], eye, (*HOOK_RGBA[:3], alpha))
+    if payload_kg > 0.0:
+        load_centre, load_half = payload_box(data, dress, payload_kg)
+        _add(scene, mujoco.mjtGeom.mjGEOM_BOX, load_half, load_centre, eye, (*PAYLOAD_RGBA[:3], alpha))
     if ground:
         _ground(scene, model, data, dress)
 
@@ -226,10 +238,25 @@ def bed_box(model: mujoco.MjModel, data: mujoco.MjData, dress: MachineDress) -> 
     return np.array([foot[0] - 0.25 * length, foot[1], floor + 0.5 * height]), 0.5 * np.array(BED_SIZE_M)
 
 
-def dress_points(model: mujoco.MjModel, data: mujoco.MjData, dress: MachineDress) -> Array:
-    """World points [m] the dressing adds beyond the model's geoms (blocks, hook, bed), for camera framing."""
+def payload_box(data: mujoco.MjData, dress: MachineDress, mass: float) -> tuple[Array, Array]:
+    """Centre and half sizes [m] of the payload of ``mass`` [kg]: a steel cube hanging under the hook.
+
+    The study gives the payload's mass only (a point mass at the TCP, :mod:`hiab_sim.study.spec.payload`);
+    its drawn size is a choice: a cube of steel (:data:`STEEL_DENSITY`) of that mass, side
+    (m / rho)^(1/3) (150 kg: 0.27 m). It is drawn, not simulated: the dynamics carry the point mass.
+    """
+    side = float((mass / STEEL_DENSITY) ** (1.0 / 3.0))
+    tool = data.site_xpos[dress.tcp_site]
+    return tool - [0.0, 0.0, HOOK_DROP_M + SLING_M + 0.5 * side], np.full(3, 0.5 * side)
+
+
+def dress_points(model: mujoco.MjModel, data: mujoco.MjData, dress: MachineDress, payload_kg: float = 0.0) -> Array:
+    """World points [m] the dressing adds beyond the model's geoms (blocks, hook, payload, bed), for camera framing."""
     points = [data.site_xpos[dress.tcp_site] - [0.0, 0.0, 0.3]]
     signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, 8).T
+    if payload_kg > 0.0:
+        centre, half = payload_box(data, dress, payload_kg)
+        points.extend(centre + signs * half)
     for block in dress.blocks:
         rotation = data.xmat[block.body].reshape(3, 3)
         centre = data.xpos[block.body] + rotation @ block.com

@@ -4,7 +4,7 @@ A :class:`PlaybackRenderer` draws each :class:`Design` either side by side or st
 viewport each; stacked suits a crane whose motion is wider than tall) or overlaid in one
 viewport (the later designs as translucent ghosts showing only the parts that differ), with the
 reference TCP curve and each design's TCP trail as line geoms, the design's name as a caption
-and, if given, a per-frame note under it (time, cumulative energy). One free camera, fitted once
+and, if given, a per-frame note under it (time, battery energy). One free camera, fitted once
 to the whole motion of all designs (:func:`~hiab_sim.render.camera.fit_camera`), looks onto the
 crane's x-z plane of motion.
 
@@ -65,6 +65,8 @@ class Design:
     dress: MachineDress | None = None
     #: Sites marked with a ball of the design's colour (pivots that move between designs).
     marks: tuple[str, ...] = ()
+    #: Payload mass held at the TCP per frame [kg] (0 while not held), drawn with the dressing; () for none.
+    payload: tuple[float, ...] = ()
     #: TCP position per frame (N, 3) in the MuJoCo world [m], computed from ``qpos``.
     tcp: Array = field(init=False, repr=False)
 
@@ -87,11 +89,19 @@ class Design:
             raise InvalidInputError(
                 f"{self.name}.notes", len(self.notes), f"must hold one text per frame ({len(qpos)})"
             )
+        if self.payload and len(self.payload) != len(qpos):
+            raise InvalidInputError(
+                f"{self.name}.payload", len(self.payload), f"must hold one mass per frame ({len(qpos)})"
+            )
         object.__setattr__(self, "qpos", qpos)
         object.__setattr__(self, "tcp", tcp)
 
     def __len__(self) -> int:
         return int(self.qpos.shape[0])
+
+    def payload_at(self, index: int) -> float:
+        """Payload mass held at frame ``index`` [kg] (0 without a payload)."""
+        return float(self.payload[index]) if self.payload else 0.0
 
 
 class PlaybackRenderer:
@@ -136,7 +146,7 @@ class PlaybackRenderer:
         self._perturb = mujoco.MjvPerturb()
         panel_width = width // panels if layout == "side-by-side" else width
         panel_height = height // panels if layout == "stacked" else height
-        extra = sum(d.model.njnt + 8 + len(d.marks) for d in self.designs)  # pins, blocks, hook, bed, marks
+        extra = sum(d.model.njnt + 9 + len(d.marks) for d in self.designs)  # pins, blocks, hook, payload, bed, marks
         max_geom = sum(d.model.ngeom for d in self.designs) + decor.MAX_SEGMENTS * (len(self.designs) + 1) + 16 + extra
         self._renderers: list[mujoco.Renderer] = []
         try:
@@ -173,7 +183,7 @@ class PlaybackRenderer:
                 mujoco.mj_kinematics(design.model, data)
                 points.append(geom_corners(design.model, data))
                 if design.dress is not None:
-                    points.append(dress_points(design.model, data, design.dress))
+                    points.append(dress_points(design.model, data, design.dress, max(design.payload, default=0.0)))
             points.append(design.tcp)
         return np.concatenate(points)
 
@@ -216,7 +226,10 @@ class PlaybackRenderer:
         ):
             renderer.update_scene(data, camera=self.camera, scene_option=self._option)
             if design.dress is not None:
-                dress_scene(renderer.scene, (0, renderer.scene.ngeom), design.model, data, design.dress, design.rgba)
+                dress_scene(
+                    renderer.scene, (0, renderer.scene.ngeom), design.model, data, design.dress, design.rgba,
+                    payload_kg=design.payload_at(index),
+                )  # fmt: skip
             else:
                 decor.tint_geoms(renderer.scene, 0, design.rgba)
             self._decorate(renderer.scene, [design], index)
@@ -250,7 +263,10 @@ class PlaybackRenderer:
         for k, (design, data, span) in enumerate(zip(self.designs, self._data, spans, strict=True)):
             if design.dress is not None:
                 alpha = 1.0 if k == 0 else GHOST_ALPHA
-                dress_scene(scene, span, design.model, data, design.dress, design.rgba, alpha, ground=k == 0)
+                dress_scene(
+                    scene, span, design.model, data, design.dress, design.rgba, alpha, ground=k == 0,
+                    payload_kg=design.payload_at(index),
+                )  # fmt: skip
             elif k > 0:
                 decor.tint_geoms(scene, span[0], (*design.rgba[:3], GHOST_ALPHA), weight=0.8)
         self._decorate(scene, self.designs, index)

@@ -1,10 +1,11 @@
 """Playback of an optimisation result: read the result folder, build the states, render the video.
 
 A result folder (written by ``hiab-sim optimize``) holds ``result.json`` with the crane
-(``crane``: preset name or YAML path) and the link lengths of the ``initial`` and ``optimal``
-designs, and ``trajectory.npz`` with ``time`` (K,), ``reference_tcp`` (K, 3) in the source world
-{W} (y up) and, per design d, ``{d}_position``, ``{d}_velocity``, ``{d}_acceleration`` (K, 3) of
-(theta1, theta2, xt2).
+(``crane``: preset name or YAML path), the link lengths of the ``initial`` and ``optimal``
+designs and, where the study has a battery model, their battery energy (``energy``), and
+``trajectory.npz`` with ``time`` (K,), ``reference_tcp`` (K, 3) in the source world {W} (y up),
+per design d ``{d}_position``, ``{d}_velocity``, ``{d}_acceleration`` (K, 3) of (theta1, theta2,
+xt2) and, in results that have it, ``payload_mass`` (K,), the payload held at the TCP.
 
 Two playback modes:
 
@@ -29,8 +30,8 @@ from numpy.typing import NDArray
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.results.playback_view import PlaybackView
 from hiab_sim.results.read import open_run, result_crane
-from hiab_sim.results.schema import PlaybackView
 from hiab_sim.results.trajectory_file import Trajectory
 
 Array = NDArray[np.float64]
@@ -58,6 +59,12 @@ class PlaybackData:
     time: Array  # (K,) [s], increasing
     reference_tcp: Array  # (K, 3) in the source world {W} [m]
     designs: tuple[DesignMotion, ...]
+    #: Payload mass carried at the TCP at ``time`` (K,) [kg], 0 while not held; None: the result has no schedule.
+    payload_mass: Array | None = None
+    #: Each design's battery energy of ``result.json`` [J]; None: the result has no battery model.
+    battery_energy_J: dict[str, float] | None = None
+    #: The period that battery energy covers: "cycle", or "duty period" with the study's duty model (cycle + rest).
+    battery_period: str = "cycle"
 
 
 def load_playback(result_dir: str | Path) -> PlaybackData:
@@ -79,7 +86,14 @@ def load_playback(result_dir: str | Path) -> PlaybackData:
             *(_columns(trajectory, trajectory.design(name, kind), f"{name}_{kind}") for kind in _KINDS)
         )
         designs.append(DesignMotion(name, getattr(view, name).lengths, joints))
-    return PlaybackData(crane, time, reference, tuple(designs))
+    payload = trajectory.get("payload_mass") if "payload_mass" in trajectory.arrays else None
+    if payload is not None and (payload.ndim != 1 or np.any(payload < 0.0)):
+        raise ConfigError(f"{trajectory.path}: array 'payload_mass' must be (K,) masses >= 0 kg")
+    battery, period = None, "cycle"
+    if view.energy is not None:
+        battery = {name: getattr(view.energy, name).battery_energy_J for name in DESIGNS}
+        period = "duty period" if view.energy.optimal.duty is not None else "cycle"
+    return PlaybackData(crane, time, reference, tuple(designs), payload, battery, period)
 
 
 def _columns(trajectory: Trajectory, value: Array, key: str) -> Array:

@@ -1,10 +1,14 @@
 """``render_result``: a playback video (or a still frame) of an optimisation result folder.
 
-Each design is named and shows, per frame, the time and its cumulative net electrical energy
-of the drives E(t) = integral of sum_i P_elec,i dt [kJ] (trapezoidal on the result's fine grid,
-whose total is the result's ``net_electrical_energy_J``; the battery's own number is in
-``summary.md``) next to its total. The machine is dressed from its description
-(:mod:`hiab_sim.render.dress`) in the colours of :mod:`hiab_sim.style`. The default layout overlays
+Each design is named and shows, per frame, the time and its battery energy per cycle (per duty
+period with the study's duty model) [kJ], the quantity the answer is stated in, read from
+``result.json``'s ``energy`` section: the energy the battery delivers through the shared DC bus,
+regeneration credited (:mod:`hiab_sim.emla.battery`). A result without a battery figure shows
+instead, named as such, the drives' cumulative net electrical energy E(t) = integral of sum_i
+P_elec,i dt [kJ] (trapezoidal on the result's fine grid, whose total is the result's
+``net_electrical_energy_J``) next to its total. The machine is dressed from its description
+(:mod:`hiab_sim.render.dress`) in the colours of :mod:`hiab_sim.style`, with the task's payload
+under the hook while it is held (``trajectory.npz``'s ``payload_mass``). The default layout overlays
 the initial design as a ghost on the optimal one, with the cylinder base pivots that the link
 lengths move marked by balls of each design's colour and joined by a line.
 """
@@ -56,9 +60,11 @@ def playback_renderer(
     """A :class:`~hiab_sim.render.scene.PlaybackRenderer` of both designs of ``data`` at ``fps``.
 
     Side by side, the initial design is on the left (stacked: on top); overlaid, the initial
-    design is drawn translucent over the optimal one. ``energy`` maps a design name to its net
-    electrical power summed over the actuators at ``data.time`` [W]: its frames then show the
-    cumulative energy (:func:`energy_notes`); every design's frames show the time.
+    design is drawn translucent over the optimal one. Each design's frames show the time and its
+    battery energy of the result (``data.battery_energy_J``); without one, ``energy`` (a design
+    name -> its net electrical power summed over the actuators at ``data.time`` [W]) gives the
+    drives' cumulative net energy instead (:func:`energy_notes`). ``data.payload_mass`` is drawn
+    while held (:func:`held_payload`).
     """
     if mode not in MODES:
         raise InvalidInputError("mode", mode, f"must be one of {', '.join(MODES)}")
@@ -77,11 +83,12 @@ def playback_renderer(
         if layout == "overlay" and motion.name == "initial":
             caption += ", ghost"
         power = None if energy is None else energy.get(motion.name)
-        notes = energy_notes(data.time, at, power)
+        battery = None if data.battery_energy_J is None else data.battery_energy_J.get(motion.name)
+        notes = energy_notes(data.time, at, power, battery, data.battery_period)
         designs.append(
             Design(
                 motion.name, model, qpos, _COLOURS.get(motion.name, OPTIMAL_RGBA), caption, notes,
-                dress=machine_dress(model, data.crane), marks=marks,
+                dress=machine_dress(model, data.crane), marks=marks, payload=held_payload(data, at),
             )
         )  # fmt: skip
     if layout == "overlay":
@@ -89,15 +96,37 @@ def playback_renderer(
     return PlaybackRenderer(designs, source_to_world(data.reference_tcp), size, layout=layout, shadows=shadows)
 
 
-def energy_notes(time: Array, at: Array, power: Array | None) -> tuple[str, ...]:
-    """Per-frame texts: time [s] and, with ``power`` (W at ``time``), cumulative energy and its total [kJ]."""
+def held_payload(data: PlaybackData, at: Array) -> tuple[float, ...]:
+    """The payload mass held at each frame instant ``at`` [kg]; () when the result has none.
+
+    The schedule is a step (:class:`hiab_sim.study.spec.payload.Payload`: held for pick <= t <
+    release), so each frame takes the value of the last sample at or before it, never a blend; the
+    pick and release show to within one step of the result's fine grid.
+    """
+    if data.payload_mass is None or not np.any(data.payload_mass > 0.0):
+        return ()
+    index = np.clip(np.searchsorted(data.time, at, side="right") - 1, 0, len(data.time) - 1)
+    return tuple(float(m) for m in data.payload_mass[index])
+
+
+def energy_notes(
+    time: Array, at: Array, power: Array | None, battery_J: float | None = None, period: str = "cycle"
+) -> tuple[str, ...]:
+    """Per-frame texts: time [s] and the energy, named with its boundary.
+
+    With ``battery_J`` (the result's battery energy [J] per ``period``) that figure; else, with
+    ``power`` (W at ``time``), the drives' cumulative net electrical energy and its total [kJ],
+    saying that no battery figure exists; else the time alone.
+    """
+    if battery_J is not None:
+        return tuple(f"t = {t:5.2f} s   battery energy {battery_J / 1e3:.3f} kJ per {period} (DC bus)" for t in at)
     if power is None:
-        return tuple(f"t = {t:5.2f} s" for t in at)
+        return tuple(f"t = {t:5.2f} s   (no energy figure in this result)" for t in at)
     steps = 0.5 * (power[1:] + power[:-1]) * np.diff(time)
     cumulative = np.concatenate([[0.0], np.cumsum(steps)])
     total = cumulative[-1] / 1e3
     return tuple(
-        f"t = {t:5.2f} s   drives' net energy {e / 1e3:.3f} of {total:.3f} kJ"
+        f"t = {t:5.2f} s   drives' net electrical energy {e / 1e3:.3f} of {total:.3f} kJ (no battery figure)"
         for t, e in zip(at, np.interp(at, time, cumulative), strict=True)
     )
 

@@ -4,7 +4,7 @@ Every command that reads a run (``mjcf --from-result``, ``compare``, ``render``,
 ``energy-map --result``, the Python API) opens it with :func:`open_run` or :func:`read_result`: the
 folder's checks and their one-line messages live here. ``result.json`` is read as a typed
 :class:`~hiab_sim.results.schema.Result` (or a smaller view such as the renderer's
-:class:`~hiab_sim.results.schema.PlaybackView`); ``trajectory.npz`` through the declared schema of
+:class:`~hiab_sim.results.playback_view.PlaybackView`); ``trajectory.npz`` through the declared schema of
 :mod:`hiab_sim.results.trajectory_file`. Tools that need a digest use :class:`RunSummary`.
 """
 

@@ -25,6 +25,7 @@ from hiab_sim.results.analysis_sections import Buildable, CrossEvaluation, Feasi
 from hiab_sim.results.codec import from_json, optional, to_json
 from hiab_sim.results.design_values import DesignValues
 from hiab_sim.results.energy_sections import Codesign, EnergyReport, HydraulicBaseline
+from hiab_sim.results.playback_view import PlaybackView as PlaybackView  # re-exported: the renderer's contract
 from hiab_sim.structure.summary import StructureSummary
 
 #: Version of the result.json layout; files without the key are version 1. Version 2 renames the
@@ -405,27 +406,6 @@ def _renamed(data: Any) -> Any:
     if isinstance(data, list):
         return [_renamed(v) for v in data]
     return data
-
-
-@dataclass(frozen=True)
-class DesignLengths:
-    """The part of a design the renderer needs: its link lengths."""
-
-    lengths: DesignValues
-
-
-@dataclass(frozen=True)
-class PlaybackView:
-    """The renderer's contract with a result: the crane and both designs' lengths."""
-
-    crane: str
-    initial: DesignLengths
-    optimal: DesignLengths
-
-    @classmethod
-    def from_json(cls, data: Any) -> PlaybackView:
-        """Build from a parsed result.json (other keys are ignored)."""
-        return from_json(cls, data)
 
 
 def parse_json(path: Path) -> Any:

@@ -77,6 +77,7 @@ ARRAYS: tuple[ArraySpec, ...] = (
         "W",
         "electrical power of each EMLA drive at its DC-bus terminals (per drive, > 0 drawn from the bus)",
     ),
+    ArraySpec("payload_mass", "K", "kg", "payload carried at the TCP, m(t) of the task's schedule (0 while not held)"),
 )
 
 

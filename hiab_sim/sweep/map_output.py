@@ -19,18 +19,31 @@ TRAJECTORY_NOTE = (
 
 
 def summary(m: EnergyMap) -> dict[str, Any]:
-    """JSON-ready summary: variables, base design, trajectory note, value at the base, best feasible cell."""
+    """JSON-ready summary: variables, base design, trajectory note, value at the base, best feasible cells.
+
+    ``best_feasible_cell`` has the least study objective, ``least_battery_energy_cell`` the least
+    battery energy (the same cell for a study whose objective is the battery energy, up to its
+    smoothing); None without a feasible cell.
+    """
     v = m.values
     feasible = v.feasible
-    best: dict[str, Any] | None = None
-    if feasible.any():
-        k = int(np.flatnonzero(feasible)[np.argmin(v.objective[feasible])])
-        best = {
+
+    def cell_values(k: int) -> dict[str, Any]:
+        return {
             "xi_m": v.xi[k].tolist(),
             "objective": float(v.objective[k]),
             "cost_W2s": float(v.cost[k]),
             "net_electrical_energy_J": float(v.net_energy[k]),
+            "battery_energy_J": float(v.battery_energy[k]),
+            "binding_constraint": v.names[int(v.binding[k])],
+            "smallest_margin": float(v.margins[k].min()),
         }
+
+    best: dict[str, Any] | None = None
+    least: dict[str, Any] | None = None
+    if feasible.any():
+        best = cell_values(int(np.flatnonzero(feasible)[np.argmin(v.objective[feasible])]))
+        least = cell_values(int(np.flatnonzero(feasible)[np.argmin(v.battery_energy[feasible])]))
     counts: dict[str, int] = {}
     for cell in np.flatnonzero(~feasible):
         name = v.names[int(v.binding[cell])]
@@ -59,6 +72,7 @@ def summary(m: EnergyMap) -> dict[str, Any]:
         "cells": len(feasible),
         "feasibility_tolerance": FEASIBILITY_TOLERANCE,
         "best_feasible_cell": best,
+        "least_battery_energy_cell": least,
         "infeasible_cells_by_binding_constraint": counts,
         "battery_energy_note": "energy the battery delivers through the shared DC bus (hiab_sim.emla.battery)",
     }

@@ -32,6 +32,8 @@ RESULT_COLUMNS = (
     "opt_net_energy_J",
     "start_drawn_energy_J",
     "opt_drawn_energy_J",
+    "start_battery_energy_J",
+    "opt_battery_energy_J",
     "start_cost_W2s",
     "opt_cost_W2s",
     "net_energy_saved_percent",
@@ -67,6 +69,7 @@ class PointOutcome:
 def row_from_result(result: Result) -> dict[str, Any]:
     """The result columns of one finished run (the one place a sweep reads a run's result)."""
     start, opt, solver = result.initial, result.optimal, result.solver
+    energy = result.energy  # the battery's energy at the study's duty; NaN where the result has no battery model
     row: dict[str, Any] = {
         "status": "ok",
         "message": solver.message,
@@ -82,6 +85,8 @@ def row_from_result(result: Result) -> dict[str, Any]:
         opt_net_energy_J=opt.net_electrical_energy_J,
         start_drawn_energy_J=start.drawn_energy_summed_drives_J,
         opt_drawn_energy_J=opt.drawn_energy_summed_drives_J,
+        start_battery_energy_J=math.nan if energy is None else energy.initial.battery_energy_J,
+        opt_battery_energy_J=math.nan if energy is None else energy.optimal.battery_energy_J,
         start_cost_W2s=start.collocation_cost_W2s,
         opt_cost_W2s=opt.collocation_cost_W2s,
         net_energy_saved_percent=result.improvement.net_energy_saved_percent,

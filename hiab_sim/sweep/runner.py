@@ -105,8 +105,11 @@ def _ordered(rows: dict[str, dict[str, Any]], order: dict[str, int]) -> list[dic
 
 
 def _bar(total: int, initial: int, enabled: bool) -> Any:
-    if not enabled or not sys.stderr.isatty():  # redirected to a file, a bar would dump every update
+    from hiab_sim.terminal import progress_wanted
+
+    if not enabled or not progress_wanted(sys.stderr):  # redirected to a file, a bar would dump every update
         return None
     from tqdm import tqdm
 
-    return tqdm(total=total, initial=initial, desc="sweep points", unit="point", file=sys.stderr)
+    # leave=False: the bar is wiped when done, so the sweep's answer opens what stays on the terminal
+    return tqdm(total=total, initial=initial, desc="sweep points", unit="point", file=sys.stderr, leave=False)

@@ -147,6 +147,7 @@ def other_path(path: str) -> str:
 def trajectory_arrays(fine: TaskProblem, checks: dict[str, DesignCheck], prefix: str = "") -> dict[str, Array]:
     """``trajectory.npz``'s arrays of one task on its fine grid (SI units; keys prefixed by ``prefix``)."""
     arrays: dict[str, Array] = {f"{prefix}time": fine.times, f"{prefix}reference_tcp": fine.reference.tcp()}
+    arrays[f"{prefix}payload_mass"] = fine.task.payload.mass_at(fine.times)  # the video draws it while held
     for name in ("initial", "optimal"):
         ev = checks[name].evaluation
         arrays[f"{prefix}{name}_position"] = ev.joints.position

@@ -25,6 +25,10 @@ from hiab_sim.results.schema import Result
 SUMMARY_FILE = "summary.md"
 #: Binding limits named in the summary (largest cost per unit of relaxation first).
 BINDING_SHOWN = 3
+#: The boundary of the battery energy in words: what every answer-first summary states its energy at.
+BATTERY_BOUNDARY = "at the battery (shared DC bus, regeneration credited)"
+#: The boundary shown instead when a result has no battery model.
+NET_BOUNDARY = "net electrical energy of the motors (regeneration credited; no battery model in this study)"
 
 #: Link-length fields of one chain in words (see :class:`hiab_sim.crane.description.ChainLengths`).
 LENGTH_WORDS = {
@@ -105,12 +109,22 @@ def _energy_line(r: Result) -> str:
     if r.energy is not None:
         e = r.energy
         before, after = e.initial.battery_energy_J, e.optimal.battery_energy_J
-        where = "at the battery (shared DC bus, regeneration credited)"
+        where = BATTERY_BOUNDARY
     else:
         before, after = r.initial.net_electrical_energy_J, r.optimal.net_electrical_energy_J
-        where = "net electrical energy of the motors (regeneration credited; no battery model in this study)"
-    change = 100.0 * (after - before) / before
-    return f"Energy per cycle {where}: {before / 1e3:.3f} kJ before, {after / 1e3:.3f} kJ after ({change:+.2f} %)."
+        where = NET_BOUNDARY
+    return f"Energy per cycle {where}: {before_after(before, after)}."
+
+
+def before_after(before: float, after: float, names: tuple[str, str] = ("before", "after")) -> str:
+    """``"15.670 kJ before, 15.230 kJ after (-2.81 %)"`` from two energies [J] (the change relative to ``before``)."""
+    change = f" ({100.0 * (after - before) / before:+.2f} %)" if before != 0.0 else ""
+    return f"{before / 1e3:.3f} kJ {names[0]}, {after / 1e3:.3f} kJ {names[1]}{change}"
+
+
+def files_line(folder: Path, files: Sequence[str]) -> str:
+    """The summary's last line: where the files are."""
+    return f"Files in {folder}: {', '.join(files)}."
 
 
 def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[str]:
@@ -145,8 +159,7 @@ def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[st
     )
     if r.buildable is not None:
         lines.append(f"Model of the buildable design: {r.buildable.mjcf_command}")
-    shown = ", ".join(files) if files else "result.json, trajectory.npz"
-    lines += ["", f"Files in {folder}: {shown}."]
+    lines += ["", files_line(folder, files or ("result.json", "trajectory.npz"))]
     return lines
 
 
