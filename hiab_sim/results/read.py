@@ -17,6 +17,10 @@ from typing import Generic, TypeVar
 from hiab_sim.crane.description import Crane
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.machine.description import Machine
+from hiab_sim.machine.design import MachineDesign
+from hiab_sim.machine.loader import PRESETS as MACHINE_PRESETS
+from hiab_sim.machine.loader import load_machine
 from hiab_sim.resources import Source
 from hiab_sim.results.design_values import DesignValues
 from hiab_sim.results.schema import RESULT_FILE, Result, read_json_as
@@ -102,6 +106,20 @@ def result_crane(run_dir: str | Path, crane: str) -> Crane:
     """The crane a result was computed for (its ``crane`` entry): a preset name, or a YAML file in the result folder."""
     path = Path(run_dir) / RESULT_FILE
     return load_crane(crane, relative_to=Source(str(path), path, False))
+
+
+def result_machine(run_dir: str | Path, result: Result) -> Machine:
+    """The machine file a machine file's result was computed for: a shipped name, or ``machine.yaml`` in the folder.
+
+    Raises:
+        InvalidInputError: the result is a crane file's (its designs are link lengths; :func:`result_crane`).
+
+    """
+    if not isinstance(result.optimal.lengths, MachineDesign):
+        raise InvalidInputError("result", str(run_dir), "is a crane file's result (read it with result_crane)")
+    source = result.crane
+    path = Path(run_dir) / source
+    return load_machine(path if source not in MACHINE_PRESETS and path.is_file() else source)
 
 
 def design_lengths(result: Result, design: str) -> DesignValues:

@@ -110,10 +110,12 @@ def run_study(
     if codesign is not None:
         result = replace(result, codesign=codesign)
     crane_file = study.crane_file
+    # a crane (machine) file, not a preset name, is copied next to the result
+    copy = "crane.yaml" if study.crane_description is not None else "machine.yaml"
     if crane_file is not None and not (crane_file.shipped and crane_file.label == study.crane_source):
-        write_atomic(folder / "crane.yaml", crane_file.read_bytes())  # a crane file, not a preset name
-        result = replace(result, crane="crane.yaml", crane_source=study.crane_source)
-    crane_label = study.crane_source if result.crane != "crane.yaml" else str(folder / "crane.yaml")
+        write_atomic(folder / copy, crane_file.read_bytes())
+        result = replace(result, crane=copy, crane_source=study.crane_source)
+    crane_label = study.crane_source if result.crane != copy else str(folder / copy)
     result = replace(result, **analysis_sections(problem, results[0].z, result, crane_label, phases))
     write_results(folder, result, arrays)
     paths: list[Path] = []
