@@ -33,6 +33,7 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.chains import HydraulicSystem
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.design import MachineDesign
+from hiab_sim.machine.dynamics.newton_euler import batched_inverse_dynamics
 from hiab_sim.machine.dynamics.paths import make_machine_dynamics
 from hiab_sim.machine.kinematics.closure import joint_to_stroke
 from hiab_sim.machine.kinematics.design_partials import stroke_design_partials
@@ -58,13 +59,28 @@ GUESSES_PER_JOINT = 5
 REACH_TOLERANCE = 1e-9
 
 
+#: The decision variables' bounds the inverse dynamics accepts, widened by this share of their span at both ends:
+#: the bounds are the NLP's (SLSQP's trial points and the finite differences may step past them by round-off).
+BOUND_SLACK = 0.25
+
+
+def unbounded(machine: Machine) -> Machine:
+    """The machine with its decision variables' bounds widened by :data:`BOUND_SLACK` of their span."""
+    chains = []
+    for chain in machine.chains:
+        variables = tuple(
+            replace(v, low=v.low - BOUND_SLACK * (v.high - v.low), high=v.high + BOUND_SLACK * (v.high - v.low))
+            for v in chain.variables
+        )
+        chains.append(replace(chain, variables=variables))
+    return replace(machine, chains=tuple(chains))
+
+
 class MachineDynamics:
     """The study's inverse-dynamics callable on a machine path: joint samples in, actuator samples out."""
 
     def __init__(self, machine: Machine, design: Array, path: str) -> None:
-        # the bounds are the NLP's (SLSQP's trial points and the finite differences may step past them
-        # by round-off); the machine is built from any design whose loops close
-        self.model = make_machine_dynamics(machine.with_design(design, check_bounds=False), None, PATHS[path])
+        self.model = make_machine_dynamics(machine, [float(x) for x in design], PATHS[path])
 
     def __call__(self, joints: JointSamples, tcp_force: ArrayLike | None = None) -> ActuatorSamples:
         """[f_x, v_x, a_x] (T, n actuators) for joint samples; ``tcp_force`` [N] (3,) or (T, 3) in the world."""
@@ -89,6 +105,7 @@ class MachineModel:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "kinematics", TrackedKinematics(self.machine, self.extra))
+        object.__setattr__(self, "_dynamics_machine", unbounded(self.machine))
 
     @property
     def name(self) -> str:
@@ -187,19 +204,37 @@ class MachineModel:
         return MachineModel(replace(self.machine, links=links), self.extra)
 
     def _designed(self, design: Any) -> Machine:
-        return self.machine.with_design(np.asarray(design.as_array()), check_bounds=False)
+        return self.machine.with_design(np.asarray(design.as_array()), check_bounds=False)  # the NLP holds the bounds
 
     def inverse_dynamics(self, design: Any, path: str) -> MachineDynamics:
         """The machine's ``analytic`` (Newton-Euler) or ``mujoco`` inverse dynamics at this design."""
         if path not in PATHS:
             raise InvalidInputError("id_path", path, f"must be one of {', '.join(PATHS)}")
-        return MachineDynamics(self.machine, np.asarray(design.as_array()), path)
+        return MachineDynamics(self.__dict__["_dynamics_machine"], np.asarray(design.as_array()), path)
 
     def design_partials(
         self, design: Any, joints: JointSamples, path: str, fd_step: float, tcp_force: ArrayLike | None
     ) -> Array:
-        """d(f, v, a)/dXi (K, 3 n, n_xi) by central differences, one model per perturbed design."""
+        """d(f, v, a)/dXi (K, 3 n, n_xi) by central differences.
+
+        The analytic path stacks the 2 n_xi designs into one Newton-Euler call
+        (:func:`~hiab_sim.machine.dynamics.newton_euler.batched_inverse_dynamics`); ``mujoco`` builds one
+        model per perturbed design.
+        """
         xi = np.asarray(design.as_array(), dtype=float)
+        machine = self.__dict__["_dynamics_machine"]
+        if path == "analytic":
+            h = fd_step * np.maximum(1.0, np.abs(xi))
+            designs = np.repeat(xi[None], 2 * len(xi), axis=0)
+            designs[0::2] += np.diag(h)
+            designs[1::2] -= np.diag(h)
+            force = None if tcp_force is None else np.asarray(tcp_force, dtype=float)[..., :2]
+            f, v, a, _ = batched_inverse_dynamics(
+                machine, designs, joints.position, joints.velocity, joints.acceleration, force
+            )
+            y = np.concatenate([f, v, a], axis=2)  # (2 n_xi, K, 3 n)
+            d = (y[0::2] - y[1::2]) / (2.0 * h[:, None, None])
+            return np.transpose(d, (1, 2, 0))
         out = np.zeros((len(joints), 3 * len(self.actuator_names), len(xi)))
         for i in range(len(xi)):
             h = fd_step * max(1.0, abs(xi[i]))
@@ -207,7 +242,7 @@ class MachineModel:
             for sign in (1.0, -1.0):
                 x = xi.copy()
                 x[i] += sign * h
-                act = MachineDynamics(self.machine, x, path)(joints, tcp_force=tcp_force)
+                act = MachineDynamics(machine, x, path)(joints, tcp_force=tcp_force)
                 values.append(np.concatenate([act.force, act.velocity, act.acceleration], axis=1))
             out[:, :, i] = (values[0] - values[1]) / (2.0 * h)
         return out
