@@ -26,7 +26,10 @@ XI_TOLERANCE = 1e-8
 ENERGY_TOLERANCE = 1e-9
 
 
-def _xi(lengths: dict[str, dict[str, float]]) -> list[float]:
+def _xi(lengths: dict[str, Any]) -> list[float]:
+    """Xi [m] of a result's design: a machine file's values in order, or the crane's (lift, tilt) x (L, Lc0, Lc)."""
+    if "values" in lengths:
+        return [float(v) for v in lengths["values"]]
     return [lengths[chain][key] for chain in ("lift", "tilt") for key in ("L", "Lc0", "Lc")]
 
 

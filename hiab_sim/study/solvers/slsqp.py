@@ -110,7 +110,7 @@ def start_points(problem: StudyProblem, count: int, seed: int = 6) -> list[Desig
         if len(starts) >= count:
             break
         xi = np.zeros(6)
-        for j, chain in enumerate(problem.problems[0].crane.chains):
+        for j, chain in enumerate(problem.study.crane.chains):
             L = rng.uniform(low[3 * j], up[3 * j])
             lo, hi = problem.working[j]
             q = mechanism.hinge_angle(chain, np.array([lo, hi]))

@@ -1,0 +1,100 @@
+"""A study of a machine file (``machine:``): the keys of a crane file's study, the machine's names and variables."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from hiab_sim.emla.config import load_emla_set
+from hiab_sim.errors import ConfigError
+from hiab_sim.machine.loader import PRESETS as MACHINE_PRESETS
+from hiab_sim.machine.loader import load_machine, locate_machine
+from hiab_sim.resources import Source, locate
+from hiab_sim.study.machines.machine_model import MachineModel
+from hiab_sim.study.spec.energy import energy_settings
+from hiab_sim.study.spec.settings import GridSettings, SolverSettings, SplineSettings, Tracking, bounds_from_mapping
+from hiab_sim.study.spec.study import Study
+from hiab_sim.study.spec.tasks import tasks_from_mapping
+from hiab_sim.yaml_fields import mapping, number, section
+
+
+def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
+    """A study of a machine file (``machine:``): its decision variables, their bounds and its names are the file's.
+
+    Keys as a crane study's, except: ``machine`` (a shipped machine or a path next to the study),
+    ``tracked`` (the tracked coordinates beyond the TCP's x, y: joint names or ``tcp_angle``;
+    default ``tcp_angle`` for each), ``initial_lengths`` (a mapping ``chain.variable: value``, default
+    the file's values) and ``bounds`` without per-chain bounds (the file declares them). ``build``,
+    ``mounting`` and ``structure`` need a crane file for now and are refused.
+    """
+    for key in ("crane", "mounting", "structure", "build"):
+        if key in top:
+            raise ConfigError(f"study: '{key}' is not available for a machine file (machine:) yet; remove it")
+    source = str(top["machine"])
+    path = Path(source)
+    folder = Path(str(file.file)).parent
+    if source not in MACHINE_PRESETS and not path.is_absolute() and (folder / path).is_file():
+        path = folder / path
+    machine_file = locate_machine(source if source in MACHINE_PRESETS else path)
+    machine = load_machine(machine_file)
+    n = len(machine.joint_names)
+    tracked_value = top.get("tracked", ["tcp_angle"] * (n - 2))
+    if not isinstance(tracked_value, list) or not all(isinstance(t, str) for t in tracked_value):
+        raise ConfigError(f"study: tracked: expected a list of names, got {tracked_value!r}")
+    tracked = tuple(tracked_value)
+    model = MachineModel(machine, tracked)
+    emla_source = str(top.get("emla", ""))
+    if not emla_source:
+        raise ConfigError("study: a machine file's study names its EMLA file (emla:)")
+    emlas = load_emla_set(locate(emla_source, "emla", relative_to=file)).renamed(model.actuator_names)
+    low, up = model.design_bounds()
+    bounds = bounds_from_mapping(top["bounds"], chains=False, joints=n)
+    bounds = replace(
+        bounds,
+        xi_low=tuple(map(float, low)),
+        xi_up=tuple(map(float, up)),
+        xi_fields=tuple(
+            f"{machine_file.label}: chains.{k.replace('.', '.variables.')}.bounds" for k in model.design_names
+        ),
+    )
+    grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
+    name = str(top.get("name", Path(str(file.file)).stem))
+    if "tasks" not in top and "reference" not in top:
+        raise ConfigError("study: give 'tasks:' (a list of tasks) or 'reference:' (one task)")
+    names = (tuple(model.tracked_names[2:]), model.joint_names)
+    tasks = tasks_from_mapping(top, folder, grid.duration, name, names)
+    if "tasks" not in top and isinstance(top.get("payload", 0.0), int | float):
+        tasks = (replace(tasks[0], payload=replace(tasks[0].payload, inertia=False)),)
+    for i, task in enumerate(tasks):
+        if task.reference.kind != "csv":
+            raise ConfigError(
+                f"study: tasks[{i}] ({task.name}): a machine file's study takes 'kind: csv' references "
+                f"(got '{task.reference.kind}'; the spiral and pick-and-place kinds prescribe a crane's telescope)"
+            )
+    initial = model.default_design
+    if "initial_lengths" in top:
+        given = mapping(top["initial_lengths"], "initial_lengths", set(model.design_names), set())
+        values = initial.as_array()
+        for key, value in given.items():
+            values[model.design_names.index(key)] = number(value, f"initial_lengths.{key}")
+        initial = model.design(values)
+    return Study(
+        name=name,
+        path=str(file.file),
+        crane_source=source,
+        crane_description=None,
+        emla_source=emla_source,
+        emlas=emlas,
+        initial_lengths=initial,
+        spline=SplineSettings(**section(SplineSettings, top.get("spline"), "spline")),
+        grid=grid,
+        tasks=tasks,
+        tracking=Tracking(**section(Tracking, top.get("tracking"), "tracking")),
+        bounds=bounds,
+        solver=SolverSettings(**section(SolverSettings, top.get("solver"), "solver")),
+        crane_file=machine_file,
+        energy=energy_settings(top),
+        machine=machine,
+        tracked=tracked,
+    )
