@@ -11,7 +11,7 @@ from result_checks import four_designs
 from hiab_sim.emla import load_emla_set
 from hiab_sim.results.read import read_result
 from hiab_sim.results.schema import Result
-from hiab_sim.study.nlp.task_problem import duty_options
+from hiab_sim.study.nlp.task_setup import duty_options
 from hiab_sim.study.run import RunOutput, run_study
 from hiab_sim.study.spec.study_file import load_study
 

@@ -14,24 +14,24 @@ not an energy, and is scaled by its value at the study's start.
 Constraints, all scaled to O(1) and written g(z) >= 0 (rows named in :attr:`constraint_names`):
 
 * ``const_a``: [f_x, v_x, a_x] = ID(theta, dtheta, ddtheta, robot(Xi)), implicit (evaluated);
-* ``const_b``..``const_d``: |r(theta) - r_ref| <= tolerance for position, velocity and
-  acceleration of the tracked r (the crane's (x_tcp, y_tcp, xt2)) at every collocation point (a tolerance band, because
-  156 equalities over-determine 66 coefficients); rest at both ends as 12 linear equalities;
+* ``const_b``..``const_d``: |r - r_ref| <= tolerance (a band: equalities would over-determine the
+  spline) for position, velocity and acceleration of the tracked r at every collocation point;
+  rest at both ends as 4 n linear equalities;
 * ``const_e``, ``const_f``: the EMLA envelope margins (peak torque, rated speed, voltage) >= 0;
 * ``const_g``: Xi within [xi_low, xi_up] (variable bounds);
-* ``const_h``: theta within the crane's joint range and the triangle margin (linear in c);
+* ``const_h``: theta within the machine's joint range and a triangle's margin (linear in c);
 * ``const_i``: |dtheta| <= joint velocity limit (linear in c);
 * ``const_j``: 0 <= x <= Lc and x <= stroke at every sample, and at both ends of the working range;
 * ``const_k``: the interior angle at the boom hinge within [margin, pi - margin] (it depends on
   theta only, so it is part of ``const_h``), which keeps Lc0 + x + Lc < L + L1;
-* ``const_l``, ``const_m`` hold by construction: the chain is solved from its triangle.
+* ``const_l``, ``const_m`` hold by construction (the chain is solved from its loop closure).
 
 Each inequality group is a constraint block (:mod:`hiab_sim.study.nlp.blocks`) and the cost an objective
 (:mod:`hiab_sim.study.nlp.objectives`); the block registry
 (:data:`hiab_sim.study.nlp.block_registry.BLOCKS`) lists the blocks once, and row names, row layout,
 clearances and the Jacobian follow from that list (:class:`~hiab_sim.study.nlp.interface.BlockLayout`).
 
-Gradients: per-sample ID partials by batched central differences (all samples and all 9
+Gradients: per-sample ID partials by batched central differences (all samples and all 3 n
 perturbations in one ID call), chained through the B-spline matrices (exact); Xi partials by
 central differences (on the analytic path, which agrees with the MuJoCo path to ~1e-14 relative, or
 with MuJoCo model rebuilds); EMLA and kinematic partials analytic.
@@ -50,9 +50,9 @@ from hiab_sim.emla import (
     EmlaSet,
     electrical_power,
 )
-from hiab_sim.emla.duty_energy import DutyOptions, drive_duty
+from hiab_sim.emla.duty_energy import drive_duty
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.study.machines.protocol import Design, StudyMachine
+from hiab_sim.study.machines.protocol import Design
 from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.nlp import blocks as bl
 from hiab_sim.study.nlp import builtin_blocks  # noqa: F401  (registers the built-in blocks, in row order)
@@ -68,6 +68,7 @@ from hiab_sim.study.nlp.interface import (
     SampleState,
 )
 from hiab_sim.study.nlp.objectives import make_objective
+from hiab_sim.study.nlp.task_setup import duty_options, working_range
 from hiab_sim.study.references.kinds import ik_start
 from hiab_sim.study.spec.study_file import Study
 from hiab_sim.study.spec.tasks import Task
@@ -79,11 +80,9 @@ C_SCALE = 0.1
 STROKE_SCALE = bl.STROKE_SCALE
 #: The ID's input check uses the working range shrunk by this much at both ends [rad].
 ID_SLACK = 0.02
-#: The optimiser (``tightened``) holds const_j at the ends of the working range with this clearance
-#: [m], so that its optimum passes the crane's exact stroke check despite SLSQP's round-off-level
-#: violations. It is part of the solver's rows only: start checks and reported violations
-#: (:meth:`TaskProblem.margins`) use the nominal const_j, so the built crane, whose strokes reach
-#: exactly 0 and the full stroke at the ends of its joint range, is a start with violation ~0.
+#: The optimiser (``tightened``) holds const_j at the ends of the working range with this clearance [m] (its
+#: optimum passes the exact stroke check despite SLSQP's round-off); the solver's rows only: start checks and
+#: reported violations (:meth:`TaskProblem.margins`) use the nominal const_j (the built machine: violation ~0).
 WORKING_CLEARANCE = 1e-6
 
 
@@ -96,31 +95,6 @@ class Evaluation(SampleState):
     cost: float  # the objective's value [its unit; W^2 s for costf2]
     constraints: Array  # scaled, feasible where >= 0
     equalities: Array  # scaled, feasible where == 0
-
-
-def duty_options(study: Study, emlas: EmlaSet, cycle_time: float) -> DutyOptions | None:
-    """The duty model of a task of ``cycle_time`` [s], or None for the paper's per-sample model.
-
-    None without a ``duty``, and when no EMLA has winding-resistance data and nothing holds the rest
-    (the seed's model: every number as before these options existed).
-    """
-    settings = study.energy.duty
-    if settings is None:
-        return None
-    options = settings.options(cycle_time, emlas)
-    if options.hold is None and not any(p.winding is not None and p.thermal is not None for p in emlas):
-        return None
-    return options
-
-
-def working_range(model: StudyMachine, joints: Array, margin: float) -> tuple[tuple[float, float], ...]:
-    """Joint range each stroke chain must serve: the samples' range widened by ``margin`` [rad]."""
-    out = []
-    ranges = model.joint_ranges()
-    for j in model.stroke_joints:
-        lo, hi = ranges[j]
-        out.append((max(lo, float(joints[:, j].min()) - margin), min(hi, float(joints[:, j].max()) + margin)))
-    return tuple(out)
 
 
 class TaskProblem:
@@ -247,8 +221,7 @@ class TaskProblem:
     @property
     def crane(self) -> Any:
         """The crane description this problem's rows see (crane-only blocks and reports; a machine file has none)."""
-        crane = getattr(self.model, "crane", None)
-        if crane is None:
+        if (crane := getattr(self.model, "crane", None)) is None:
             raise InvalidInputError("machine", self.model.name, "this part of the study needs a crane file (crane:)")
         return crane
 
