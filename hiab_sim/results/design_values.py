@@ -8,12 +8,21 @@ its variable's unit, m). The result codec tells them apart by their keys.
 
 from __future__ import annotations
 
+import numpy as np
+
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.design import MachineDesign
 
 #: A design's decision-variable values.
 DesignValues = LinkLengths | MachineDesign
+
+
+def with_values(design: DesignValues, values: object) -> DesignValues:
+    """A design of the same kind (and names) with other values (n_xi,) [m]."""
+    if isinstance(design, MachineDesign):
+        return MachineDesign(design.names, tuple(float(v) for v in np.asarray(values, dtype=float).reshape(-1)))
+    return LinkLengths.from_array(np.asarray(values, dtype=float))
 
 
 def crane_lengths(design: DesignValues, where: str = "design") -> LinkLengths:

@@ -37,11 +37,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from hiab_sim.crane.description import LinkLengths
-from hiab_sim.crane.tolerance import buildable_crane, round_lengths
+from hiab_sim.crane.tolerance import round_lengths
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.results.design_values import with_values
 from hiab_sim.study.nlp.blocks import STROKE_SCALE, WorkingRange
 from hiab_sim.study.nlp.interface import (
-    N_XI,
     Array,
     ConstraintBlock,
     DenseRows,
@@ -109,8 +109,8 @@ class RobustXi(ConstraintBlock):
         sign = np.sign(dxi)
         xi = state.lengths.as_array()
         out = dxi.copy()
-        for k in range(N_XI):
-            step = np.zeros(N_XI)
+        for k in range(len(xi)):
+            step = np.zeros(len(xi))
             step[k] = HESSIAN_STEP
             plus = self._dxi(replace_lengths(state, xi + step))
             minus = self._dxi(replace_lengths(state, xi - step))
@@ -134,7 +134,7 @@ class RobustXi(ConstraintBlock):
 def replace_lengths(state: SampleState, xi: Array) -> SampleState:
     """The same samples with other link lengths (for rows of Xi only)."""
     return SampleState(
-        LinkLengths.from_array(xi), state.joints, state.tcp, state.actuators, state.power, duty=state.duty
+        with_values(state.lengths, xi), state.joints, state.tcp, state.actuators, state.power, duty=state.duty
     )
 
 
@@ -152,11 +152,9 @@ def rounded_design(lengths: LinkLengths, tolerance: float, low: Array, up: Array
 
 
 def buildable_working_range(study: Study, working: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
-    """The working range the robust rows serve: ``working`` within the study crane's buildable range [rad]."""
-    short = buildable_crane(study.crane, study.build.stroke_margin)
-    return tuple(
-        (max(w[0], c.joint_range[0]), min(w[1], c.joint_range[1])) for w, c in zip(working, short.chains, strict=True)
-    )
+    """The working range the robust rows serve: ``working`` within the study machine's buildable range [rad]."""
+    short = study.model.buildable_ranges(study.build.stroke_margin)
+    return tuple((max(w[0], c[0]), min(w[1], c[1])) for w, c in zip(working, short, strict=True))
 
 
 def buildable_blocks(study: Study, working: Sequence[tuple[float, float]], tightened: bool) -> list[ConstraintBlock]:
@@ -169,8 +167,6 @@ def buildable_blocks(study: Study, working: Sequence[tuple[float, float]], tight
     """
     t = study.build.tolerance
     blocks: list[ConstraintBlock] = []
-    if study.crane_description is None:
-        return blocks  # a machine file's study: the buildable design is not yet available for it
     if tightened:
         # the clearance covers the first-order error of the robust rows (<= t^2 / (2 s), module docstring)
         wr = WorkingRange(study.model, buildable_working_range(study, working), ROBUST_CLEARANCE / STROKE_SCALE)

@@ -97,6 +97,12 @@ class CraneModel:
             )
         )
 
+    def buildable_ranges(self, stroke_margin: float) -> tuple[tuple[float, float], ...]:
+        """The lift's and tilt's joint ranges of :func:`hiab_sim.crane.tolerance.buildable_crane`."""
+        from hiab_sim.crane.tolerance import buildable_crane
+
+        return tuple(c.joint_range for c in buildable_crane(self.crane, stroke_margin).chains)
+
     def inverse_dynamics(self, design: Any, path: str) -> InverseDynamics:
         """The crane's ``mujoco`` or ``analytic`` inverse dynamics at these lengths."""
         return make_inverse_dynamics(self.crane, design, path)

@@ -35,7 +35,7 @@ from hiab_sim.machine.description import Machine
 from hiab_sim.machine.design import MachineDesign
 from hiab_sim.machine.dynamics.newton_euler import batched_inverse_dynamics
 from hiab_sim.machine.dynamics.paths import make_machine_dynamics
-from hiab_sim.machine.kinematics.closure import joint_to_stroke
+from hiab_sim.machine.kinematics.closure import joint_to_stroke, stroke_to_joint
 from hiab_sim.machine.kinematics.design_partials import stroke_design_partials
 from hiab_sim.machine.kinematics.tracked import TrackedKinematics
 from hiab_sim.machine.kinematics.tracked import inverse_kinematics as tracked_ik
@@ -205,6 +205,34 @@ class MachineModel:
 
     def _designed(self, design: Any) -> Machine:
         return self.machine.with_design(np.asarray(design.as_array()), check_bounds=False)  # the NLP holds the bounds
+
+    def buildable_ranges(
+        self, stroke_margin: float, field: str = "build.stroke_margin"
+    ) -> tuple[tuple[float, float], ...]:
+        """Per stroke chain: q over which the file's design keeps ``stroke_margin`` [m] from both stroke ends.
+
+        q(x = m) and q(x = stroke - m) by the closed-form inverse of the loop closure (either may be the
+        larger: a chain's stroke may fall as its joint rises), intersected with the joint's range.
+        """
+        if not (np.isfinite(stroke_margin) and stroke_margin >= 0.0):
+            raise InvalidInputError(field, stroke_margin, "must be a finite length >= 0", "m")
+        ranges = self.joint_ranges()
+        out = []
+        for chain, j in zip(self._stroke_chain_list(self.machine), self.stroke_joints, strict=True):
+            lo, hi = ranges[j]
+            if stroke_margin == 0.0:
+                out.append((lo, hi))
+                continue
+            if not 2.0 * stroke_margin < chain.actuator.stroke:
+                raise InvalidInputError(
+                    field, stroke_margin, f"must be < half the {chain.name} stroke {chain.actuator.stroke:.6g}", "m"
+                )
+            # strokes beyond those at the range's ends (where the loop may not close) give the range's end
+            at_ends = joint_to_stroke(self.machine, chain, np.array([lo, hi]))
+            ends = np.clip([stroke_margin, chain.actuator.stroke - stroke_margin], at_ends.min(), at_ends.max())
+            q = np.sort(stroke_to_joint(self.machine, chain, ends))
+            out.append((max(lo, float(q[0])), min(hi, float(q[1]))))
+        return tuple(out)
 
     def inverse_dynamics(self, design: Any, path: str) -> MachineDynamics:
         """The machine's ``analytic`` (Newton-Euler) or ``mujoco`` inverse dynamics at this design."""

@@ -149,6 +149,10 @@ class StudyMachine(Protocol):
         """The machine with the stroke chains' joint ranges replaced (the inverse dynamics' input check)."""
         ...
 
+    def buildable_ranges(self, stroke_margin: float) -> tuple[tuple[float, float], ...]:
+        """Per stroke chain: its joint range over which the built design keeps ``stroke_margin`` [m] from both ends."""
+        ...
+
     def inverse_dynamics(self, design: Design, path: str) -> InverseDynamics:
         """[f_x, v_x, a_x] = ID(q, dq, ddq, robot(Xi)) (seed eq. ``dynamics``) by ``mujoco`` or ``analytic``."""
         ...

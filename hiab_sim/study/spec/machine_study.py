@@ -12,6 +12,7 @@ from hiab_sim.machine.loader import PRESETS as MACHINE_PRESETS
 from hiab_sim.machine.loader import load_machine, locate_machine
 from hiab_sim.resources import Source, locate
 from hiab_sim.study.machines.machine_model import MachineModel
+from hiab_sim.study.spec.build import BuildSettings
 from hiab_sim.study.spec.energy import energy_settings
 from hiab_sim.study.spec.settings import GridSettings, SolverSettings, SplineSettings, Tracking, bounds_from_mapping
 from hiab_sim.study.spec.study import Study
@@ -25,10 +26,10 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
     Keys as a crane study's, except: ``machine`` (a shipped machine or a path next to the study),
     ``tracked`` (the tracked coordinates beyond the TCP's x, y: joint names or ``tcp_angle``;
     default ``tcp_angle`` for each), ``initial_lengths`` (a mapping ``chain.variable: value``, default
-    the file's values) and ``bounds`` without per-chain bounds (the file declares them). ``build``,
-    ``mounting`` and ``structure`` need a crane file for now and are refused.
+    the file's values) and ``bounds`` without per-chain bounds (the file declares them). ``mounting``
+    and ``structure`` need a crane file for now and are refused; ``build`` holds the robust rows.
     """
-    for key in ("crane", "mounting", "structure", "build"):
+    for key in ("crane", "mounting", "structure"):
         if key in top:
             raise ConfigError(f"study: '{key}' is not available for a machine file (machine:) yet; remove it")
     source = str(top["machine"])
@@ -66,11 +67,15 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
     tasks = tasks_from_mapping(top, folder, grid.duration, name, names)
     if "tasks" not in top and isinstance(top.get("payload", 0.0), int | float):
         tasks = (replace(tasks[0], payload=replace(tasks[0].payload, inertia=False)),)
+    # the spiral and pick-and-place kinds prescribe the third tracked coordinate as a crane's telescope:
+    # a machine of three joints whose third tracked coordinate is a joint may use them
+    prescribed = len(model.tracked_names) == 3 and model.tracked_names[2] in model.joint_names
     for i, task in enumerate(tasks):
-        if task.reference.kind != "csv":
+        if task.reference.kind != "csv" and not prescribed:
             raise ConfigError(
-                f"study: tasks[{i}] ({task.name}): a machine file's study takes 'kind: csv' references "
-                f"(got '{task.reference.kind}'; the spiral and pick-and-place kinds prescribe a crane's telescope)"
+                f"study: tasks[{i}] ({task.name}): this machine's study takes 'kind: csv' references (got "
+                f"'{task.reference.kind}', which prescribes the third tracked coordinate as a joint; tracked: "
+                f"{', '.join(model.tracked_names)})"
             )
     initial = model.default_design
     if "initial_lengths" in top:
@@ -93,6 +98,7 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
         tracking=Tracking(**section(Tracking, top.get("tracking"), "tracking")),
         bounds=bounds,
         solver=SolverSettings(**section(SolverSettings, top.get("solver"), "solver")),
+        build=BuildSettings.from_mapping(top.get("build")),
         crane_file=machine_file,
         energy=energy_settings(top),
         machine=machine,
