@@ -159,10 +159,17 @@ class MujocoMachineDynamics:
             out[0, i] = self.data.qpos
         return out[0], out[1], out[2]
 
-    def __call__(self, q: Any, dq: Any, ddq: Any, tcp_force: Any = None) -> MachineActuatorSamples:
+    #: ``__call__(..., pins=False)`` leaves the pin forces out
+    can_skip_pins = True
+
+    def __call__(
+        self, q: Any, dq: Any, ddq: Any, tcp_force: Any = None, *, pins: bool = True
+    ) -> MachineActuatorSamples:
         """Actuator forces, velocities, accelerations, strokes (T, n_chains) and pin forces.
 
-        Args, units and sign conventions as :class:`hiab_sim.machine.dynamics.newton_euler.NewtonEulerInverseDynamics`.
+        Args, units and sign conventions as :class:`hiab_sim.machine.dynamics.newton_euler.NewtonEulerInverseDynamics`;
+        ``pins`` False leaves the pin forces out (their arrays are NaN: a caller that needs only the actuators,
+        e.g. the optimiser's partials, skips ``mj_rnePostConstraint`` per sample).
         """
         q, dq, ddq = joint_arrays(self.tree, q, dq, ddq)
         T = q.shape[0]
@@ -187,7 +194,10 @@ class MujocoMachineDynamics:
             force[i] = solution[:n_act]
             lam = solution[n_act:].reshape(-1, 2)
             velocity[i], acceleration[i], stroke[i] = qvel[self._act], qacc[self._act], d.qpos[self._act]
-            world[i], local[i] = self._pin_forces(lam, f_ext)
+            if pins:
+                world[i], local[i] = self._pin_forces(lam, f_ext)
+        if not pins:
+            world[:], local[:] = np.nan, np.nan
         names, kinds, on, by = self._pins
         return MachineActuatorSamples(
             names=tuple(self.tree.machine.actuator_names),

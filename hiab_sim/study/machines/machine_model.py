@@ -85,7 +85,9 @@ class MachineDynamics:
     def __call__(self, joints: JointSamples, tcp_force: ArrayLike | None = None) -> ActuatorSamples:
         """[f_x, v_x, a_x] (T, n actuators) for joint samples; ``tcp_force`` [N] (3,) or (T, 3) in the world."""
         force = None if tcp_force is None else np.asarray(tcp_force, dtype=float)[..., :2]
-        out = self.model(joints.position, joints.velocity, joints.acceleration, tcp_force=force)
+        # the study needs no pin forces: a path that can leave them out is asked to
+        skip = {"pins": False} if getattr(self.model, "can_skip_pins", False) else {}
+        out = self.model(joints.position, joints.velocity, joints.acceleration, tcp_force=force, **skip)
         return ActuatorSamples(out.force, out.velocity, out.acceleration, out.stroke)
 
 
