@@ -66,13 +66,22 @@ class TrackingBand(PerSampleBlock):
         times: sample times [s], (K,).
         target: the reference's r^(order), (K, n) [m, m/s or m/s^2; rad for an attitude].
         band: the tolerance [same unit]; ``fraction`` tightens it on the optimiser's grid.
-        tracked: the names of the tracked coordinates (n,).
+        tracked: the names of the tracked coordinates (n,); ``units`` their units (m or rad; an angle's band
+            is the same number in rad: 1e-3 m -> 1 mrad).
 
     """
 
     def __init__(
-        self, order: str, times: Array, target: Array, band: float, fraction: float, tracked: tuple[str, ...]
+        self,
+        order: str,
+        times: Array,
+        target: Array,
+        band: float,
+        fraction: float,
+        tracked: tuple[str, ...],
+        units: tuple[str, ...] | None = None,
     ) -> None:
+        self.units = units if units is not None else ("m",) * len(tracked)
         self.name = f"tracking.{order}"
         self.order = order
         self.times = times
@@ -93,8 +102,10 @@ class TrackingBand(PerSampleBlock):
         return SampleRows(np.concatenate([-d / self.width, d / self.width], axis=1))
 
     def relaxation(self, values: Array) -> Relaxation:
-        """Per mm (mm/s, mm/s^2) of the band: the row 1 - e / (b phi) at an active sample moves by 1e-3 / b."""
-        return Relaxation.uniform(_TRACKING_UNITS[self.order], 1e-3 / self.band, len(values))
+        """Per mm or mrad (/s, /s^2) of the band: the row 1 - e / (b phi) at an active sample moves by 1e-3 / b."""
+        suffix = _TRACKING_UNITS[self.order][2:]
+        per_sample = tuple(("mrad" if u == "rad" else "mm") + suffix for u in self.units) * 2
+        return Relaxation(per_sample * (len(values) // len(per_sample)), np.full(len(values), 1e-3 / self.band))
 
     def limit_name(self, row: str) -> str:
         """``tracking.<order>.<coordinate>``: both sides of one coordinate's band at every sample."""

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from hiab_sim.study.analysis.buildable import buildable_blocks
+from hiab_sim.study.motion.workspace import tracked_units
 from hiab_sim.study.nlp import blocks as bl
 from hiab_sim.study.nlp.block_registry import register_block
 from hiab_sim.study.nlp.brake_rows import brake_blocks
@@ -24,8 +25,11 @@ from hiab_sim.study.nlp.thermal_rows import thermal_blocks
 def _tracking(p: Any) -> list[ConstraintBlock]:
     """The TCP tracking bands of const_b..const_d, tightened by the problem's band fraction."""
     tol, ref, t = p.study.tracking, p.reference, p.times
+    units = tracked_units(p.model)
     return [
-        bl.TrackingBand(order, t, getattr(ref, order), getattr(tol, order), p.band_fraction, p.model.tracked_names)
+        bl.TrackingBand(
+            order, t, getattr(ref, order), getattr(tol, order), p.band_fraction, p.model.tracked_names, units
+        )
         for order in ("position", "velocity", "acceleration")
     ]
 
