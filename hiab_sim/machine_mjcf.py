@@ -7,6 +7,8 @@ and a renderer need:
 * a keyframe ``home`` at the middle of every joint's working range (within what the design's
   chains reach), every dependent joint (cylinders, rods, rockers, couplers) set by the loop closure
   so that every connect equality holds (|C| < 1e-13 m, :class:`MujocoMachineDynamics.state`);
+* the template's floor lowered to :data:`FLOOR_CLEARANCE` below the lowest point the machine reaches
+  there, when it reaches under it (the template's floor suits the XS 031 on its truck bed);
 * the template's cameras ``side`` and ``perspective`` fitted to the visible geoms at every
   combination of :data:`CAMERA_POSES_PER_JOINT` poses per joint over those ranges.
 
@@ -150,6 +152,7 @@ def machine_mjcf(machine: Machine, design: Sequence[float] | Array | None = None
     world = root.find("worldbody")
     if world is None:
         raise AssertionError("an MJCF without a worldbody")
+    _lower_floor(world, float(points[:, 2].min()))
     cameras = {c.get("name"): c for c in world.findall("camera")}
     fovy = float(next(iter(cameras.values())).get("fovy", "45")) if cameras else 45.0
     for name, (position, xyaxes) in framed_cameras(points, CAMERA_ASPECT, fovy).items():
@@ -163,6 +166,20 @@ def machine_mjcf(machine: Machine, design: Sequence[float] | Array | None = None
     if not set(MODEL_CAMERAS) <= {c.get("name") for c in world.findall("camera")}:
         raise AssertionError("the model lacks a framed camera")
     return ElementTree.tostring(root, encoding="unicode")
+
+
+#: Clearance kept between the floor and the lowest point the machine reaches [m] (visual: contacts are off).
+FLOOR_CLEARANCE = 0.05
+
+
+def _lower_floor(world: ElementTree.Element, lowest: float) -> None:
+    """Move the template's floor (set for the XS 031's truck bed) below a machine that reaches under it."""
+    for geom in world.findall("geom"):
+        if geom.get("type") == "plane" and geom.get("pos"):
+            position = [float(v) for v in str(geom.get("pos")).split()]
+            if position[2] > lowest - FLOOR_CLEARANCE:
+                position[2] = lowest - FLOOR_CLEARANCE
+                geom.set("pos", _numbers(position))
 
 
 def _numbers(values: object) -> str:
