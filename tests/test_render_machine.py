@@ -86,3 +86,27 @@ def test_mjcf_from_machine_result_is_that_design(run_dir: Path, design: str, tmp
     written = mujoco.MjModel.from_xml_path(str(out))
     np.testing.assert_allclose(written.site_pos, expected.site_pos, atol=1e-15)
     np.testing.assert_allclose(written.body_pos, expected.body_pos, atol=1e-15)
+
+
+def test_render_frames_of_a_crane_result(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--frames`` also serves a crane file's result: N PNGs, the first and last frames differ."""
+    import mediapy
+    from test_render import write_result
+
+    from hiab_sim.crane.loader import load_crane
+
+    folder = write_result(tmp_path / "result", load_crane("xs031"), samples=21)
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    assert main(["render", str(folder), "--frames", str(frames), "--count", "3", "--size", "320x240"]) == 0
+    assert capsys.readouterr().out.strip() == f"wrote 3 frames to {frames}"
+    first, last = (mediapy.read_image(frames / f"frame_{i:03d}.png").astype(float) for i in (0, 2))
+    assert np.mean(np.abs(first - last)) > 0.5
+
+
+def test_render_frames_needs_an_existing_folder(
+    run_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A missing ``--frames`` folder is one line, exit 2."""
+    assert main(["render", str(run_dir), "--frames", str(tmp_path / "nowhere")]) == 2
+    assert "--frames" in capsys.readouterr().err

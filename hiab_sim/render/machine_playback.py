@@ -18,6 +18,7 @@ and the energy line are the crane's (:class:`~hiab_sim.render.frames.PlaybackRen
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,7 +32,7 @@ from hiab_sim.machine.design import MachineDesign
 from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
 from hiab_sim.machine_mjcf import machine_mjcf, posed_qpos, result_design
 from hiab_sim.model.mjcf import source_to_world
-from hiab_sim.results.read import read_result, result_machine
+from hiab_sim.results.read import RESULT_FILE, read_result, result_machine
 from hiab_sim.results.trajectory_file import read_trajectory
 
 Array = NDArray[np.float64]
@@ -62,8 +63,21 @@ class MachinePlayback:
 
 
 def is_machine_result(result_dir: str | Path) -> bool:
-    """True when the folder's result is a machine file's (its designs are :class:`MachineDesign`)."""
-    return isinstance(read_result(result_dir).optimal.lengths, MachineDesign)
+    """True when the folder's ``result.json`` stores machine designs (``{"names", "values"}``, :class:`MachineDesign`).
+
+    Only that one key is looked at: a missing or unreadable file gives False, and the crane's loader
+    (:func:`hiab_sim.render.playback.load_playback`) then names what is wrong on one line.
+    """
+    path = Path(result_dir) / RESULT_FILE
+    if not path.is_file():
+        return False
+    try:
+        document = json.loads(path.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, ValueError):
+        return False  # reported by the crane's loader, which reads the same file
+    optimal = document.get("optimal") if isinstance(document, dict) else None
+    lengths = optimal.get("lengths") if isinstance(optimal, dict) else None
+    return isinstance(lengths, dict) and "names" in lengths
 
 
 def load_machine_playback(result_dir: str | Path) -> MachinePlayback:
