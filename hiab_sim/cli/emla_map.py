@@ -5,7 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from hiab_sim.emla.config import ACTUATOR_NAMES, load_emla_set
+from hiab_sim.emla.config import load_emla_set
+from hiab_sim.emla.emla_set import EmlaSet
+from hiab_sim.emla.params import EmlaParams
 from hiab_sim.errors import InvalidInputError
 
 
@@ -19,8 +21,18 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "feasible envelope (peak torque, rated speed, voltage) and the hydraulic cylinder it replaces."
         ),
     )
-    parser.add_argument("--actuator", choices=ACTUATOR_NAMES, default="lift", help="actuator (default: lift)")
-    parser.add_argument("--config", metavar="EMLA.yaml", help="EMLA parameter file (default: XS 031 preset)")
+    parser.add_argument(
+        "--actuator",
+        metavar="NAME",
+        help="an actuator of the EMLA file (XS 031: lift, tilt, telescope; default: the file's first actuator)",
+    )
+    parser.add_argument(
+        "--emla",
+        "--config",
+        dest="emla",
+        metavar="NAME|EMLA.yaml",
+        help="EMLA file: a shipped name (xs031, paper, exact) or a YAML file (default: the XS 031 preset)",
+    )
     parser.add_argument("-o", "--output", metavar="FILE.png", help="figure path (default: emla_map_ACTUATOR.png)")
     parser.add_argument("--csv", metavar="FILE.csv", help="also write the grid as CSV")
     parser.add_argument("--npz", metavar="FILE.npz", help="also write the grid as NPZ")
@@ -28,14 +40,30 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(run=run)
 
 
+def chosen_actuator(emlas: EmlaSet, name: str | None) -> EmlaParams:
+    """The EMLA called ``name`` in the set (its first when ``None``).
+
+    Raises:
+        InvalidInputError: ``name`` is not one of the file's actuators (the message lists them).
+
+    """
+    if name is None:
+        return emlas.params[0]
+    if name not in emlas.names:
+        raise InvalidInputError(
+            "--actuator", name, f"must be one of the EMLA file's actuators: {', '.join(emlas.names)}"
+        )
+    return emlas[name]
+
+
 def run(args: argparse.Namespace) -> int:
     """Compute the map, write the requested files and print a one-line summary per file."""
     from hiab_sim.emla.maps import efficiency_map, plot_efficiency_map, save_csv, save_npz
     from hiab_sim.figure_io import save_png
 
-    params = load_emla_set(args.config)[args.actuator]
+    params = chosen_actuator(load_emla_set(args.emla), args.actuator)
     emap = efficiency_map(params, n_force=args.resolution, n_velocity=args.resolution)
-    output = Path(args.output) if args.output else Path(f"emla_map_{args.actuator}.png")
+    output = Path(args.output) if args.output else Path(f"emla_map_{params.name}.png")
     targets: list[tuple[str, Path]] = [("figure", output)]
     targets += [(kind, Path(p)) for kind, p in (("csv", args.csv), ("npz", args.npz)) if p]
     for kind, path in targets:

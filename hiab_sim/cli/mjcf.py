@@ -13,6 +13,12 @@ viewer's sliders move the crane. The keyframe ``home`` holds the same pose.
 
 ``--from-result RUN_DIR [--design optimal|initial]`` exports the exact (full-precision) design of
 an optimisation result, with the crane the result was computed for.
+
+``--machine NAME|FILE [--design chain.var=value ...]`` writes any machine file's model instead: the
+generic MJCF of :mod:`hiab_sim.machine.dynamics.mjcf_build` for that design (the file's values where
+no item sets one), with a loop-consistent keyframe ``home`` and framed cameras
+(:mod:`hiab_sim.machine_mjcf`); its motors take the actuator force [N]. ``--from-result RUN_DIR``
+of a machine file's result exports its ``--design initial|optimal`` with the machine it was computed for.
 """
 
 from __future__ import annotations
@@ -46,6 +52,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--crane", default="xs031", help="preset name or YAML file (default: xs031)")
     parser.add_argument(
+        "--machine",
+        metavar="NAME|FILE",
+        help="a machine file (shipped: xs031, exact) instead of a crane file: its generic MJCF",
+    )
+    parser.add_argument(
         "--lengths",
         metavar="L,Lc0,Lc,L,Lc0,Lc",
         help="link lengths [m], lift chain then tilt chain (default: the crane's own)",
@@ -57,9 +68,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--design",
-        choices=("optimal", "initial"),
-        default="optimal",
-        help="with --from-result: which design (default: optimal)",
+        action="extend",
+        nargs="+",
+        metavar="DESIGN",
+        help="with --from-result: optimal or initial (default: optimal); with --machine: chain.var=value items [m] "
+        "(the file's values elsewhere)",
     )
     parser.add_argument(
         "--stroke-margin",
@@ -188,8 +201,31 @@ def _crane_and_lengths(args: argparse.Namespace) -> tuple[Crane, LinkLengths]:
     )
 
 
+def _result_design(args: argparse.Namespace) -> str:
+    """The one ``--design`` of ``--from-result``: ``optimal`` (default) or ``initial``."""
+    items = args.design or ["optimal"]
+    if len(items) != 1 or items[0] not in ("optimal", "initial"):
+        raise InvalidInputError("--design", " ".join(items), "with --from-result must be optimal or initial")
+    return str(items[0])
+
+
+def _is_machine_result(run_dir: str) -> bool:
+    from hiab_sim.machine.design import MachineDesign
+    from hiab_sim.results.read import read_result
+
+    return isinstance(read_result(run_dir).optimal.lengths, MachineDesign)
+
+
 def run(args: argparse.Namespace) -> int:
     """Build the model, write it and print a one-line summary."""
+    if args.machine is not None or (args.from_result is not None and _is_machine_result(args.from_result)):
+        from hiab_sim.cli.mjcf_machine import run_machine
+
+        return run_machine(args, _result_design(args) if args.from_result is not None else None)
+    if args.from_result is not None:
+        args.design = _result_design(args)
+    elif args.design:
+        raise InvalidInputError("--design", " ".join(args.design), "needs --from-result or --machine")
     import mujoco
 
     from hiab_sim.crane.tolerance import buildable_crane

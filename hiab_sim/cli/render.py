@@ -3,6 +3,11 @@
 Needs an OpenGL backend (OSMesa on CPU: ``apt-get install libosmesa6``) and an ffmpeg binary
 (``apt-get install ffmpeg`` or ``pip install imageio-ffmpeg``); a missing one is reported on one
 line with exit status 2, and no half-written file is left behind.
+
+A machine file's result (``machine:`` in the study) plays back in the machine's own MJCF
+(:mod:`hiab_sim.render.machine_video`): both designs' joint samples, every chain body set from the
+loop closure, in the crane's layouts and captions; kinematic only. ``--frames DIR [--count N]``
+writes N frames evenly spaced over the motion as PNGs instead of a video (a quick look; needs no ffmpeg).
 """
 
 from __future__ import annotations
@@ -11,6 +16,8 @@ import argparse
 import re
 import time
 from pathlib import Path
+
+import numpy as np
 
 from hiab_sim.errors import InvalidInputError
 
@@ -65,6 +72,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="write only one frame (kinematic) as a PNG instead of a video (see --at)",
     )
     parser.add_argument("--at", type=float, metavar="SECONDS", help="time of the --still frame (default: the end)")
+    parser.add_argument(
+        "--frames",
+        metavar="DIR",
+        help="write --count frames evenly spaced over the motion as DIR/frame_<i>.png instead of a video",
+    )
+    parser.add_argument("--count", type=int, default=4, metavar="N", help="frames of --frames (default: 4)")
     parser.set_defaults(run=run)
 
 
@@ -75,6 +88,21 @@ def run(args: argparse.Namespace) -> int:
     if not args.fps > 0:
         raise InvalidInputError("--fps", args.fps, "must be > 0", "1/s")
     start = time.perf_counter()
+    from hiab_sim.render.machine_playback import is_machine_result
+
+    if is_machine_result(args.result_dir):
+        return _run_machine(args, start)
+    if args.frames:
+        from hiab_sim.render import load_playback, playback_renderer
+        from hiab_sim.render.backend import write_image
+
+        folder = _frames_folder(args)
+        data = load_playback(args.result_dir)
+        with playback_renderer(data, 30.0, args.size, "kinematic", args.layout) as renderer:
+            picks = np.unique(np.linspace(0, len(renderer) - 1, args.count).round().astype(int))
+            paths = [write_image(folder / f"frame_{i:03d}.png", renderer.frame(int(k))) for i, k in enumerate(picks)]
+        print(f"wrote {len(paths)} frames to {folder}")
+        return 0
     if args.still:
         path = render_still(args.result_dir, args.still, at_time=args.at, size=args.size, layout=args.layout)
         print(f"wrote still frame: {path}")
@@ -82,4 +110,33 @@ def run(args: argparse.Namespace) -> int:
     output = Path(args.output) if args.output else None
     path = render_result(args.result_dir, output, fps=args.fps, size=args.size, mode=args.mode, layout=args.layout)
     print(f"wrote {args.mode} playback: {path} ({time.perf_counter() - start:.1f} s)")
+    return 0
+
+
+def _frames_folder(args: argparse.Namespace) -> Path:
+    folder = Path(args.frames)
+    if args.count < 1:
+        raise InvalidInputError("--count", args.count, "must be >= 1")
+    if not folder.is_dir():
+        raise InvalidInputError("--frames", str(folder), "must be an existing folder")
+    return folder
+
+
+def _run_machine(args: argparse.Namespace, start: float) -> int:
+    """A machine file's result: frames, a still or the kinematic video."""
+    from hiab_sim.render.machine_video import render_machine_frames, render_machine_result, render_machine_still
+
+    if args.mode != "kinematic":
+        raise InvalidInputError("--mode", args.mode, "a machine file's result plays back kinematic only")
+    if args.frames:
+        paths = render_machine_frames(args.result_dir, _frames_folder(args), args.count, args.size, args.layout)
+        print(f"wrote {len(paths)} frames to {args.frames}")
+        return 0
+    if args.still:
+        path = render_machine_still(args.result_dir, args.still, at_time=args.at, size=args.size, layout=args.layout)
+        print(f"wrote still frame: {path}")
+        return 0
+    output = Path(args.output) if args.output else None
+    path = render_machine_result(args.result_dir, output, fps=args.fps, size=args.size, layout=args.layout)
+    print(f"wrote kinematic playback: {path} ({time.perf_counter() - start:.1f} s)")
     return 0

@@ -3,11 +3,16 @@
 Runs the cases of ``validate/cases.yaml`` (see :mod:`hiab_sim.validation`), writes
 ``report.json``, ``table.md`` and one ``forces_<case>.png`` per case into ``--out``, prints the
 table, and exits 1 when any error exceeds its tolerance (2 on bad input).
+
+``--machine NAME|FILE`` validates a machine file's two paths instead (Newton-Euler vs MuJoCo,
+:mod:`hiab_sim.machine_validation`): random states within the joint ranges without and with a TCP
+force (``--tcp-force FX,FY`` [N]), written as ``report.json`` and ``table.md``.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import time
 from pathlib import Path
 
@@ -54,13 +59,81 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="samples per case (default 'full': as in the case file; 'small' = 24)",
     )
     parser.add_argument(
+        "--machine",
+        metavar="NAME|FILE",
+        help="validate a machine file's paths (Newton-Euler vs MuJoCo) instead of the crane's (shipped: xs031, exact)",
+    )
+    parser.add_argument(
+        "--tcp-force",
+        metavar="FX,FY",
+        help="with --machine: TCP force [N] in the world plane, y up (default: 0,-2452, a 250 kg payload)",
+    )
+    parser.add_argument(
         "--out", type=Path, default=Path("runs/validate"), help="output folder (default: runs/validate)"
     )
     parser.set_defaults(run=run)
 
 
+#: ``--machine``'s samples per case with ``--samples full`` (the default).
+MACHINE_SAMPLES = 200
+
+
+def _tcp_force(text: str | None) -> tuple[float, float]:
+    from hiab_sim.machine_validation import DEFAULT_TCP_FORCE
+
+    if text is None:
+        return DEFAULT_TCP_FORCE
+    try:
+        fx, fy = (float(v) for v in text.split(","))
+    except ValueError:
+        raise InvalidInputError("--tcp-force", text, "must be two numbers FX,FY", "N") from None
+    if not (math.isfinite(fx) and math.isfinite(fy)):
+        raise InvalidInputError("--tcp-force", text, "must be finite", "N")
+    return fx, fy
+
+
+def run_machine(args: argparse.Namespace) -> int:
+    """The machine's two cases: print the table, write report.json and table.md, return 0 or 1."""
+    import json
+    from dataclasses import asdict
+
+    from hiab_sim.atomic_io import write_atomic
+    from hiab_sim.machine.loader import load_machine
+    from hiab_sim.machine_validation import machine_cases, machine_table
+    from hiab_sim.validation import DEFAULT_CASES, load_cases
+
+    machine = load_machine(args.machine)
+    tolerances, _ = load_cases(args.cases or DEFAULT_CASES)  # one source of the tolerances
+    force = _tcp_force(args.tcp_force)
+    if args.out.exists() and not args.out.is_dir():
+        raise InvalidInputError("--out", str(args.out), "must be a folder")
+    results = machine_cases(machine, args.samples or MACHINE_SAMPLES, force, tolerances)
+    table = machine_table(machine, results, tolerances)
+    args.out.mkdir(parents=True, exist_ok=True)
+    report = {
+        "machine": machine.name,
+        "tolerances": asdict(tolerances),
+        "passed": all(r.passed for r in results),
+        "cases": [asdict(r) for r in results],
+    }
+    write_atomic(args.out / "report.json", json.dumps(report, indent=2))
+    write_atomic(args.out / "table.md", table)
+    print(table)
+    print(f"wrote 2 files to {args.out}")
+    failed = [r.name for r in results if not r.passed]
+    if failed:
+        print(f"validation FAILED: {', '.join(failed)}")
+        return 1
+    print("validation passed")
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
     """Run every case, write the report files and return 0 (all within tolerance) or 1."""
+    if args.machine is not None:
+        return run_machine(args)
+    if args.tcp_force is not None:
+        raise InvalidInputError("--tcp-force", args.tcp_force, "needs --machine (the crane's cases set their payload)")
     from hiab_sim.crane.loader import load_crane
     from hiab_sim.validation import DEFAULT_CASES, load_cases, mujoco_path, run_case, with_samples
     from hiab_sim.validation_report import write_report

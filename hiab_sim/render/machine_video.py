@@ -1,0 +1,110 @@
+"""Videos, stills and quick frame sets of a machine file's result (see :mod:`hiab_sim.render.machine_playback`).
+
+The layout and overlay are the crane's (:mod:`hiab_sim.render.video`): overlay (the optimal design
+opaque, the initial one as a ghost), side by side or stacked; each design's caption, its battery
+energy per cycle (or, without a battery figure, the drives' cumulative net energy), the reference
+path and each design's TCP trail. Only the kinematic playback exists for a machine file's result.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.render.backend import check_gl_backend, check_output_path, ffmpeg_path, video_sink, write_image
+from hiab_sim.render.decor import INITIAL_RGBA, OPTIMAL_RGBA
+from hiab_sim.render.frames import LAYOUTS, Design, Layout, PlaybackRenderer
+from hiab_sim.render.machine_playback import (
+    MachinePlayback,
+    load_machine_playback,
+    machine_model_and_qpos,
+    machine_reference,
+)
+from hiab_sim.render.playback import frame_times, resample
+from hiab_sim.render.video import DEFAULT_LAYOUT, VIDEO_NAME, energy_notes
+
+_COLOURS = {"initial": INITIAL_RGBA, "optimal": OPTIMAL_RGBA}
+
+
+def machine_renderer(
+    data: MachinePlayback,
+    fps: float = 30.0,
+    size: tuple[int, int] = (640, 480),
+    layout: Layout = DEFAULT_LAYOUT,
+    at: np.ndarray | None = None,
+) -> PlaybackRenderer:
+    """A :class:`PlaybackRenderer` of both designs at ``fps`` (or at the instants ``at`` [s])."""
+    if layout not in LAYOUTS:
+        raise InvalidInputError("layout", layout, f"must be one of {', '.join(LAYOUTS)}")
+    at = frame_times(data.time, fps) if at is None else np.asarray(at, dtype=float)
+    designs = []
+    for motion in data.designs:
+        model, qpos = machine_model_and_qpos(data.machine, motion.design, resample(data.time, motion.position, at))
+        caption = f"{motion.name} design" + (", ghost" if layout == "overlay" and motion.name == "initial" else "")
+        battery = None if data.battery_energy_J is None else data.battery_energy_J.get(motion.name)
+        notes = energy_notes(data.time, at, motion.power, battery, data.battery_period)
+        designs.append(Design(motion.name, model, qpos, _COLOURS.get(motion.name, OPTIMAL_RGBA), caption, notes))
+    if layout == "overlay":
+        designs.reverse()  # the optimal design opaque, the initial one as a translucent ghost
+    return PlaybackRenderer(designs, machine_reference(data), size, layout=layout)
+
+
+def render_machine_result(
+    result_dir: str | Path,
+    output: str | Path | None = None,
+    fps: float = 30.0,
+    size: tuple[int, int] = (640, 480),
+    layout: Layout = DEFAULT_LAYOUT,
+    progress: Callable[[int, int], None] | None = None,
+) -> Path:
+    """Render the playback video (.mp4 or .gif, written atomically) of a machine file's result; return its path."""
+    check_gl_backend()
+    data = load_machine_playback(result_dir)
+    output = Path(result_dir) / VIDEO_NAME if output is None else Path(output)
+    check_output_path(output, (".mp4", ".gif"), "video")
+    ffmpeg_path()
+    with machine_renderer(data, fps, size, layout) as renderer, video_sink(output, size, fps) as sink:
+        for index in range(len(renderer)):
+            sink.add(renderer.frame(index))
+            if progress is not None:
+                progress(index + 1, len(renderer))
+    return output
+
+
+def render_machine_frames(
+    result_dir: str | Path,
+    folder: str | Path,
+    count: int,
+    size: tuple[int, int] = (640, 480),
+    layout: Layout = DEFAULT_LAYOUT,
+) -> list[Path]:
+    """Write ``count`` frames evenly spaced over the motion, ends included, as ``frame_<i>.png`` in ``folder``."""
+    check_gl_backend()
+    if count < 1:
+        raise InvalidInputError("--count", count, "must be >= 1")
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise InvalidInputError("--frames", str(folder), "must be an existing folder")
+    data = load_machine_playback(result_dir)
+    at = np.linspace(data.time[0], data.time[-1], count)
+    with machine_renderer(data, size=size, layout=layout, at=at) as renderer:
+        return [write_image(folder / f"frame_{i:03d}.png", renderer.frame(i)) for i in range(len(renderer))]
+
+
+def render_machine_still(
+    result_dir: str | Path,
+    output: str | Path,
+    at_time: float | None = None,
+    size: tuple[int, int] = (640, 480),
+    layout: Layout = DEFAULT_LAYOUT,
+) -> Path:
+    """Render one frame (.png) of a machine file's result at ``at_time`` [s] (default: the end)."""
+    check_gl_backend()
+    output = check_output_path(Path(output), (".png",), "image")
+    data = load_machine_playback(result_dir)
+    t = data.time[-1] if at_time is None else float(np.clip(at_time, data.time[0], data.time[-1]))
+    with machine_renderer(data, size=size, layout=layout, at=np.array([t])) as renderer:
+        return write_image(output, renderer.frame(0))
