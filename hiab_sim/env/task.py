@@ -55,7 +55,7 @@ class CraneTrackingTask(base.Task):
     def action_spec(self, physics: CranePhysics) -> specs.BoundedArray:
         """q-current references [A] within the drives' current limit."""
         return specs.BoundedArray(
-            shape=(3,), dtype=np.float64, minimum=-self.current_limit, maximum=self.current_limit, name="i_q_ref"
+            shape=self.current_limit.shape, dtype=np.float64, minimum=-self.current_limit, maximum=self.current_limit, name="i_q_ref"
         )
 
     def before_step(self, action: np.ndarray, physics: CranePhysics) -> None:
