@@ -1,0 +1,87 @@
+"""``hiab-sim simulate`` on a machine file's result: each design in closed loop on :mod:`hiab_sim.env.machine_env`.
+
+The same ``simulation.json``, table, figures and closing lines as the crane's
+(:mod:`hiab_sim.cli.simulate`), for the ideal plant: the EMLA drives' current dynamics per chain
+under the cascade controller with the plan's feedforward. What is built on the crane's model is
+refused with one line (exit 2) naming it: ``--payload-error`` (the crane's end-mass body), plant
+effects (:mod:`hiab_sim.env.plant`) and the video (drawn with the crane's dressing).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from hiab_sim.env.plant.config import Plant
+from hiab_sim.errors import InvalidInputError
+
+#: What the report says of the energy boundary and the TCP error of a machine's closed loop.
+MACHINE_ENERGY = (
+    "closed loop: int 3/2 (v_d i_d + v_q i_q) dt over the cycle at the motor terminals, summed over the drives "
+    "(the shared DC bus credits one drive's regeneration to the others; no inverter or battery); the prediction "
+    "is the same sum of the plan's P_elec per drive"
+)
+MACHINE_TCP = "distance of the simulated TCP to the study's TCP reference (x_tcp, y_tcp) in the machine's plane"
+NO_STRUCTURE = "the structure's natural frequencies are computed for the crane file only, not for a machine file"
+
+
+def refuse_crane_only(args: argparse.Namespace, plant: Plant | None) -> None:
+    """One line naming what a machine file's closed loop does not simulate (exit 2 through the CLI)."""
+    if args.payload_error != 0.0:
+        raise InvalidInputError(
+            "--payload-error", args.payload_error, "must be 0 for a machine file's result (the crane's end-mass body)"
+        )
+    if plant is not None and plant.enabled:
+        raise InvalidInputError(
+            "--plant",
+            ", ".join(plant.enabled),
+            "plant effects are built on the crane's model; a machine file's result runs the ideal plant only",
+        )
+    if args.cycles != 1:
+        raise InvalidInputError("--cycles", args.cycles, "must be 1 for a machine file's result (no thermal plant)")
+    if not args.no_video:
+        raise InvalidInputError(
+            "--no-video", False, "is needed for a machine file's result (closed_loop.mp4 draws the crane)"
+        )
+
+
+def run_machine(args: argparse.Namespace, designs: tuple[str, ...], plant: Plant | None, out: Path) -> int:
+    """Simulate every design of a machine file's result, write ``simulation.json`` (and figures), print the table."""
+    from hiab_sim.cli.simulate import closing_lines
+    from hiab_sim.env.machine_env import run_machine_closed_loop
+    from hiab_sim.env.machine_plan import read_machine_plan
+    from hiab_sim.env.validation import simulation_report, table
+
+    refuse_crane_only(args, plant)
+    plans = [read_machine_plan(args.result_dir, design) for design in designs]  # bad input fails first
+    out.mkdir(parents=True, exist_ok=True)
+    runs = []
+    for plan in plans:
+        run, physics = run_machine_closed_loop(plan)
+        physics.free()
+        runs.append(run)
+    report = simulation_report(args.result_dir, runs, [], emlas=plans[0].emlas)
+    settings = report["settings"]
+    assert isinstance(settings, dict)
+    settings.update(energy=MACHINE_ENERGY, tcp_error=MACHINE_TCP, machine=plans[0].machine.name)
+    settings["tcp_load"] = "the plan's TCP force F(t) of the study's first task, applied at site tcp"
+    entries = report["designs"]
+    assert isinstance(entries, dict)
+    for entry in entries.values():
+        entry["bandwidth_check"]["note"] = NO_STRUCTURE
+    from hiab_sim.atomic_io import write_atomic
+
+    write_atomic(out / "simulation.json", json.dumps(report, indent=2) + "\n")
+    written = ["simulation.json"]
+    if not args.no_figures:
+        from hiab_sim.env.figures import write_figures
+
+        written += [p.name for p in write_figures(out, runs, [])]
+    print(table(report))
+    print()
+    for line in closing_lines(report):
+        print(line)
+    print(f"wrote {', '.join(written)} to {out}", file=sys.stderr)
+    return 0
