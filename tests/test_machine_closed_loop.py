@@ -13,6 +13,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -28,7 +29,7 @@ from hiab_sim.study.run import run_study
 from hiab_sim.study.spec.study_file import load_study
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_machine_study import EXCAVATOR, _joint_csv  # noqa: E402
+from test_machine_study import EXCAVATOR, _joint_csv
 
 #: Tracking of the plan's own TCP on the planner's model [mm]: only the loops' residual (measured 0.04 mm).
 PLAN_TCP_MAX_MM = 0.5
@@ -58,14 +59,14 @@ def test_excavator_closed_loop_tracks_the_plan_and_uses_its_energy(plan: Machine
     """
     run, physics = run_machine_closed_loop(plan)
     physics.free()
-    summary = run.summary()
+    summary: Any = run.summary()
     assert run.actuator_names == ("boom", "arm", "bucket")
-    assert abs(summary["energy_difference_percent"]) < 100 * ENERGY_TOLERANCE  # type: ignore[operator]
-    for name, drive in summary["actuators"].items():  # type: ignore[union-attr]
+    assert abs(summary["energy_difference_percent"]) < 100 * ENERGY_TOLERANCE
+    for name, drive in summary["actuators"].items():
         predicted = drive["predicted_net_electrical_energy_J"]
         assert drive["net_electrical_energy_J"] == pytest.approx(predicted, rel=ENERGY_TOLERANCE), name
-    assert summary["tcp_error_to_plan_mm"]["max"] < PLAN_TCP_MAX_MM  # type: ignore[index]
-    assert summary["tcp_error_mm"]["max"] < TCP_MAX_MM  # type: ignore[index]
+    assert summary["tcp_error_to_plan_mm"]["max"] < PLAN_TCP_MAX_MM
+    assert summary["tcp_error_mm"]["max"] < TCP_MAX_MM
     assert summary["current_limit_fraction"] == 0.0 and summary["voltage_limit_fraction"] == 0.0
     assert run.time[-1] == pytest.approx(plan.duration, abs=0.01)
 
@@ -130,7 +131,11 @@ def test_simulate_cli_on_a_machine_result(result: Path, tmp_path: Path, capsys: 
         assert set(entry["actuators"]) == {"boom", "arm", "bucket"}
     assert "motor terminals" in report["settings"]["energy"]
     assert "closed loop uses" in capsys.readouterr().out
-    for extra, word in ((["--payload-error", "0.2"], "payload-error"), (["--plant", "realistic"], "plant"), ([], "video")):
+    for extra, word in (
+        (["--payload-error", "0.2"], "payload-error"),
+        (["--plant", "realistic"], "plant"),
+        ([], "video"),
+    ):
         args = ["simulate", str(result), "--quiet", "--out", str(out), *extra]
         if word != "video":
             args.append("--no-video")

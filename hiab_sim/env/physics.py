@@ -67,7 +67,7 @@ threading._register_atexit(_free_live_physics)  # type: ignore[attr-defined]
 
 
 class ExternalLoad(Protocol):
-    """A force set on the model before every ``mj_step`` (a machine's planned TCP force, :mod:`hiab_sim.env.machine_env`)."""
+    """A force set before every ``mj_step``: a machine's planned TCP force (:mod:`hiab_sim.env.machine_env`)."""
 
     def apply(self, model: mujoco.MjModel, data: mujoco.MjData, holding: bool) -> None:
         """Set ``data.xfrc_applied``; ``holding``: during a settled start's hold (the first sample's load)."""
