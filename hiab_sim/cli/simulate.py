@@ -22,6 +22,10 @@ ideal, the planner's own model) and, when the plant has effects on, adds ``plant
 ``simulation.json`` (:mod:`hiab_sim.env.effects`: each effect alone and all together, both designs),
 prints its table and writes ``closed_loop_plant_effects.png``. ``--cycles N`` runs N cycles with the
 winding temperature carried over; the energies are the last cycle's.
+
+A machine file's result (:mod:`hiab_sim.machine`, e.g. the excavator) runs through
+:mod:`hiab_sim.cli.simulate_machine`: the same report for the ideal plant, each chain's EMLA drive on
+the machine's generic MJCF (:mod:`hiab_sim.env.machine_env`); the crane-only options are refused.
 """
 
 from __future__ import annotations
@@ -70,9 +74,11 @@ def closing_lines(report: dict[str, object]) -> list[str]:
                 f"{margin:+.2f} ({'holds' if margin >= 0.0 else 'FAILS'}: 1 - f_v / (f_1 / 3) >= 0)."
             )
         elif check:
+            reason = check.get(
+                "note", "the EMLA file has no screw and drive_stiffness data for the natural frequencies"
+            )
             lines.append(
-                f"{design}: velocity loop {check['velocity_loop_bandwidth_Hz']:.2f} Hz; no bandwidth check "
-                "(the EMLA file has no screw and drive_stiffness data for the natural frequencies)."
+                f"{design}: velocity loop {check['velocity_loop_bandwidth_Hz']:.2f} Hz; no bandwidth check ({reason})."
             )
     boundary = report.get("energy_boundary")
     if boundary is not None:
@@ -127,11 +133,17 @@ def run(args: argparse.Namespace) -> int:
 
     plant = load_plant(args.plant) if args.plant is not None else None
     designs = ("initial", "optimal") if args.design == "both" else (args.design,)
-    for design in designs:
-        read_plan(args.result_dir, design)  # bad input fails before any simulation
     out = Path(args.out) if args.out else Path(args.result_dir)
     if out.exists() and not out.is_dir():
         raise InvalidInputError("--out", str(out), "must be a folder")
+    from hiab_sim.env.machine_plan import is_machine_result
+
+    if is_machine_result(args.result_dir):
+        from hiab_sim.cli.simulate_machine import run_machine
+
+        return run_machine(args, designs, plant, out)
+    for design in designs:
+        read_plan(args.result_dir, design)  # bad input fails before any simulation
     out.mkdir(parents=True, exist_ok=True)
     if not args.no_video:
         from hiab_sim.render.backend import ffmpeg_path

@@ -126,7 +126,7 @@ class CascadeController:
         self.motion = motion
         self.gains = gains or CascadeGains()
         reflected = np.asarray(drives.reflected_inertia, dtype=float)
-        extra = np.zeros(3) if load_mass is None else np.asarray(load_mass, dtype=float)
+        extra = np.zeros(len(reflected)) if load_mass is None else np.asarray(load_mass, dtype=float)
         self.mass = np.broadcast_to(reflected + extra, motion.stroke.shape)
         self.force_to_current = 1.0 / (drives.ratio * drives.torque_constant)
         self.limit = drives.current_limit
@@ -136,13 +136,13 @@ class CascadeController:
             step = float(motion.time[1] - motion.time[0])
             self.stroke = motion.stroke + motion.force / stiffness
             self.rate = motion.rod_velocity + np.gradient(motion.force, step, axis=0) / stiffness
-        self.integral = np.zeros(3)
+        self.integral = np.zeros(len(reflected))
         self.last_time = 0.0
         self.settled = False
 
     def reset(self) -> None:
         """Clear the integrator."""
-        self.integral = np.zeros(3)
+        self.integral = np.zeros_like(self.integral)
         self.last_time = 0.0
         self.settled = False
 
@@ -161,7 +161,7 @@ class CascadeController:
         (a heavier load); the next :meth:`__call__` then keeps that state instead of clearing it.
         """
         self.settled = True
-        return self._command(observation, 0, dt, np.zeros(3))
+        return self._command(observation, 0, dt, np.zeros_like(self.integral))
 
     def __call__(self, time_step: dm_env.TimeStep) -> np.ndarray:
         """q-current references [A] for the observation of ``time_step`` (module docstring)."""

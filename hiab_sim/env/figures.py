@@ -14,7 +14,6 @@ from typing import Any
 
 import numpy as np
 
-from hiab_sim.emla.config import ACTUATOR_NAMES
 from hiab_sim.env.rollout import ClosedLoopRun
 from hiab_sim.figure_io import new_figure, save_png
 from hiab_sim.style import COLOURS
@@ -75,8 +74,8 @@ def write_figures(folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedL
     axes = fig.subplots(2, len(runs), squeeze=False, sharex=True)
     for column, run in enumerate(runs):
         top, bottom = axes[0, column], axes[1, column]
-        for i, name in enumerate(ACTUATOR_NAMES):
-            colour = DRIVE_COLOURS[i]
+        for i, name in enumerate(run.actuator_names):
+            colour = DRIVE_COLOURS[i % len(DRIVE_COLOURS)]
             top.plot(run.time, run.current_dq[:, i, 1], color=colour, label=f"{name} i_q")
             top.plot(run.time, run.current_dq[:, i, 0], color=colour, linestyle=":", linewidth=0.8)
             magnitude = np.hypot(run.voltage_dq[:, i, 0], run.voltage_dq[:, i, 1])

@@ -22,6 +22,7 @@ import concurrent.futures.thread  # noqa: F401  (registers its exit hook first; 
 import threading
 import weakref
 from dataclasses import replace
+from typing import Protocol
 
 import mujoco
 import numpy as np
@@ -65,8 +66,19 @@ def _free_live_physics() -> None:
 threading._register_atexit(_free_live_physics)  # type: ignore[attr-defined]
 
 
+class ExternalLoad(Protocol):
+    """A force set before every ``mj_step``: a machine's planned TCP force (:mod:`hiab_sim.env.machine_env`)."""
+
+    def apply(self, model: mujoco.MjModel, data: mujoco.MjData, holding: bool) -> None:
+        """Set ``data.xfrc_applied``; ``holding``: during a settled start's hold (the first sample's load)."""
+
+
 class CranePhysics(dm_mujoco.Physics):
     """dm-control Physics whose ``step`` runs the EMLA drives at the physics rate (module docstring)."""
+
+    #: External load applied before each ``mj_step`` (none on the crane) and whether the cycle's start is held.
+    tcp_load: ExternalLoad | None = None
+    holding: bool = False
 
     drives: DriveSimulator
     slide_dofs: NDArray[np.int64]
@@ -89,23 +101,29 @@ class CranePhysics(dm_mujoco.Physics):
         drive_train: TwoMassDriveTrain | None = None,
         thermal: WindingTemperature | None = None,
         friction: FrictionMeter | None = None,
+        joints: tuple[str, ...] = SLIDES,
+        actuators: tuple[str, ...] = ACTUATORS,
     ) -> None:
-        """Attach the drives (order lift, tilt, telescope) and the plant's parts; clear the energy counters."""
+        """Attach the drives and the plant's parts; clear the energy counters.
+
+        ``joints`` are the actuated slides and ``actuators`` their motors, in the drives' order (the
+        crane's lift, tilt, telescope by default; a machine's chains, :mod:`hiab_sim.env.machine_env`).
+        """
         _LIVE.add(self)
         self.drives = drives
         self.plant = plant
         self.drive_train = drive_train
         self.thermal = thermal
         self.friction = friction
-        self.slide_dofs = np.array([self.model.jnt_dofadr[self.model.name2id(s, "joint")] for s in SLIDES])
+        self.slide_dofs = np.array([self.model.jnt_dofadr[self.model.name2id(s, "joint")] for s in joints])
         self.tcp_site = int(self.model.name2id("tcp", "site"))
-        self.actuator_ids = np.array([self.model.name2id(name, "actuator") for name in ACTUATORS])
-        self.current_reference = np.zeros(len(SLIDES))
+        self.actuator_ids = np.array([self.model.name2id(name, "actuator") for name in actuators])
+        self.current_reference = np.zeros(len(joints))
         h = float(self.model.opt.timestep)
         sensors = plant.sensors if plant is not None else None
         self.sensor = MotionSensor(sensors, drives.drives.ratio, h)
         rate = plant.current_loop.rate_Hz if plant is not None else 1.0 / h
-        self.current_error = CurrentSensorError(sensors, len(SLIDES), rate * h)
+        self.current_error = CurrentSensorError(sensors, len(joints), rate * h)
         if isinstance(drives, DiscreteCurrentLoop):
             drives.sensor = self.current_error
         self.reset_counters()
@@ -119,21 +137,22 @@ class CranePhysics(dm_mujoco.Physics):
     def reset_counters(self) -> None:
         """Zero the accumulated electrical and copper energy and the limit counters."""
         self.last = None
-        self.energy = np.zeros(len(SLIDES))
-        self.copper = np.zeros(len(SLIDES))
+        n = len(self.slide_dofs)
+        self.energy = np.zeros(n)
+        self.copper = np.zeros(n)
         self.steps = 0
-        self.current_limited_steps = np.zeros(len(SLIDES))
-        self.voltage_limited_steps = np.zeros(len(SLIDES))
-        self.inverter = np.zeros(len(SLIDES))
-        self.drive_train_loss = np.zeros(len(SLIDES))
+        self.current_limited_steps = np.zeros(n)
+        self.voltage_limited_steps = np.zeros(n)
+        self.inverter = np.zeros(n)
+        self.drive_train_loss = np.zeros(n)
         self.friction_loss = 0.0
 
     def rod_velocity(self) -> Array:
-        """v_x of the slides x1, x2, xt2 [m/s]."""
+        """v_x of the actuated slides (the crane's x1, x2, xt2) [m/s]."""
         return np.asarray(self.data.qvel[self.slide_dofs])
 
     def stroke(self) -> Array:
-        """Strokes x of the slides x1, x2, xt2 [m]."""
+        """Strokes x of the actuated slides (the crane's x1, x2, xt2) [m]."""
         return np.asarray(self.data.qpos[self.slide_dofs])
 
     def step(self, nstep: int = 1) -> None:
@@ -148,6 +167,8 @@ class CranePhysics(dm_mujoco.Physics):
             for _ in range(nstep):
                 result = self.drives.step(self.current_reference, ratio * data.qvel[self.slide_dofs], h)
                 data.ctrl[:] = result.rod_force
+                if self.tcp_load is not None:
+                    self.tcp_load.apply(model, data, self.holding)
                 mujoco.mj_step(model, data)
                 self.energy += result.electrical_energy
                 self.copper += result.copper_energy

@@ -20,6 +20,7 @@ from __future__ import annotations
 import time as _time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import Protocol
 
 import dm_env
 import numpy as np
@@ -30,13 +31,26 @@ from hiab_sim.control.cascade import CascadeController, CascadeGains
 from hiab_sim.emla.config import ACTUATOR_NAMES
 from hiab_sim.emla.drive_sim import DriveArrays
 from hiab_sim.env import make_environment
-from hiab_sim.env.loop_design import design_loop
+from hiab_sim.env.loop_design import LoopDesign, design_loop
 from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.plan import DesignPlan
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
+
+
+class PlanLike(Protocol):
+    """What a run's log compares against: the plan's fine grid [s], its P_elec per drive [W], its energy [J]."""
+
+    @property
+    def time(self) -> Array: ...  # noqa: D102
+
+    @property
+    def predicted_electrical_power(self) -> Array: ...  # noqa: D102
+
+    @property
+    def predicted_net_energy(self) -> float: ...  # noqa: D102
 
 
 @dataclass(frozen=True)
@@ -102,6 +116,7 @@ class ClosedLoopRun:
     lowest_resonance_hz: float | None = None
     bandwidth_check: dict[str, object] = field(default_factory=dict)
     settle_time_s: float = 0.0
+    actuator_names: tuple[str, ...] = ACTUATOR_NAMES
 
     @property
     def net_energy(self) -> float:
@@ -140,7 +155,7 @@ class ClosedLoopRun:
                     "peak_voltage_V": float(np.hypot(self.voltage_dq[:, i, 0], self.voltage_dq[:, i, 1]).max()),
                     "voltage_limit_V": float(self.voltage_limit[i]),
                 }
-                for i, name in enumerate(ACTUATOR_NAMES)
+                for i, name in enumerate(self.actuator_names)
             },
             "simulated_time_s": float(self.time[-1]),
             "wall_time_s": self.wall_time,
@@ -152,7 +167,7 @@ class ClosedLoopRun:
             "joint_friction_loss_J": self.friction_loss,
             "winding_temperature_C": None
             if self.winding_temperature is None
-            else {name: float(t) for name, t in zip(ACTUATOR_NAMES, self.winding_temperature, strict=True)},
+            else {name: float(t) for name, t in zip(self.actuator_names, self.winding_temperature, strict=True)},
             "cycles": list(self.cycles),
             "bandwidth_check": dict(self.bandwidth_check),
             "settle_time_s": self.settle_time_s,
@@ -179,12 +194,33 @@ def run_closed_loop(
     if isinstance(cycles, bool) or not isinstance(cycles, int) or cycles < 1:
         raise InvalidInputError("cycles", cycles, "must be an integer >= 1")
     env = make_environment(plan, payload_error=payload_error, plant=plant)
+    design = design_loop(plan, env.task.motion, plant)
+    design = replace(design, gains=gains or design.gains)
+    drives = DriveArrays.from_params(plan.emlas)
+    run = run_environment(env, design, drives, plan.design, payload_error, plan, progress, plant, cycles)
+    return run, env.physics
+
+
+def run_environment(
+    env: control.Environment,
+    design: LoopDesign,
+    drives: DriveArrays,
+    name: str,
+    payload_error: float,
+    plan: PlanLike,
+    progress: Callable[[int, int], None] | None = None,
+    plant: Plant | None = None,
+    cycles: int = 1,
+    actuator_names: tuple[str, ...] = ACTUATOR_NAMES,
+) -> ClosedLoopRun:
+    """``cycles`` cycles of a prepared environment under the cascade of ``design`` (the crane's or a machine's).
+
+    ``drives`` is the controller's model of the drives, ``plan`` what the log compares against (its
+    ``time``, ``predicted_electrical_power`` and ``predicted_net_energy``).
+    """
     physics: CranePhysics = env.physics
     task = env.task
-    design = design_loop(plan, task.motion, plant)
-    design = replace(design, gains=gains or design.gains)
     gains = design.gains
-    drives = DriveArrays.from_params(plan.emlas)
     controller = CascadeController(task.motion, drives, gains, design.stiffness, design.load_mass)
     steps = round(task.motion.time[-1] / env.control_timestep())
     history: list[dict[str, object]] = []
@@ -205,11 +241,10 @@ def run_closed_loop(
     time, error, plan_error, current, voltage, energy, qpos, wall = log
     n = len(time)
     dt = np.diff(time)
-    power = np.vstack([np.diff(energy, axis=0) / dt[:, None], np.zeros((1, 3))])
+    power = np.vstack([np.diff(energy, axis=0) / dt[:, None], np.zeros((1, energy.shape[1]))])
     power[-1] = power[-2]
-    plan = task.plan
-    run = ClosedLoopRun(
-        design=plan.design,
+    return ClosedLoopRun(
+        design=name,
         payload_error=payload_error,
         time=time,
         tcp_error=error,
@@ -238,8 +273,8 @@ def run_closed_loop(
         lowest_resonance_hz=design.lowest_resonance_hz,
         bandwidth_check=design.check(),
         settle_time_s=round(controller.settle_time() / env.control_timestep()) * env.control_timestep(),
+        actuator_names=actuator_names,
     )
-    return run, physics
 
 
 def settled_start(env: control.Environment, controller: CascadeController) -> dm_env.TimeStep:
@@ -262,11 +297,13 @@ def settled_start(env: control.Environment, controller: CascadeController) -> dm
     dt = env.control_timestep()
     substeps = round(dt / physics.timestep())
     observation = step.observation
+    physics.holding = True
     for _ in range(round(controller.settle_time() / dt)):
         task.before_step(controller.hold(observation, dt), physics)
         physics.step(substeps)
         task.after_step(physics)
         observation = task.get_observation(physics)
+    physics.holding = False
     controller.settled = True
     physics.data.time = 0.0
     physics.reset_counters()
@@ -283,12 +320,13 @@ def _one_cycle(
     """One episode: (time, TCP error, error to the plan, currents, voltages, cumulative energy, qpos, wall time)."""
     task = env.task
     nq = physics.model.nq
+    n_drives = len(physics.slide_dofs)
     time = np.empty(steps + 1)
     error = np.empty(steps + 1)
     plan_error = np.empty(steps + 1)
-    current = np.empty((steps + 1, 3, 2))
-    voltage = np.empty((steps + 1, 3, 2))
-    energy = np.empty((steps + 1, 3))
+    current = np.empty((steps + 1, n_drives, 2))
+    voltage = np.empty((steps + 1, n_drives, 2))
+    energy = np.empty((steps + 1, n_drives))
     qpos = np.empty((steps + 1, nq))
     start = _time.perf_counter()
     step = settled_start(env, controller)

@@ -1,6 +1,7 @@
 """The tracking task on the crane Physics: observations, reward, episode = the study's cycle.
 
-Action: the three drives' q-current references i_q* [A] (lift, tilt, telescope), bounded by the drive
+Action: the drives' q-current references i_q* [A] (the crane's lift, tilt, telescope, or a machine's
+chains, :mod:`hiab_sim.env.machine_env`; shapes (3,) below are (A,) there), bounded by the drive
 current limit I_max = tau_peak / (3/2 p Phi_PM) (i_d* = 0, zero-d-axis-current control).
 
 Observations (``OrderedDict`` of float arrays):
@@ -55,7 +56,11 @@ class CraneTrackingTask(base.Task):
     def action_spec(self, physics: CranePhysics) -> specs.BoundedArray:
         """q-current references [A] within the drives' current limit."""
         return specs.BoundedArray(
-            shape=(3,), dtype=np.float64, minimum=-self.current_limit, maximum=self.current_limit, name="i_q_ref"
+            shape=self.current_limit.shape,
+            dtype=np.float64,
+            minimum=-self.current_limit,
+            maximum=self.current_limit,
+            name="i_q_ref",
         )
 
     def before_step(self, action: np.ndarray, physics: CranePhysics) -> None:

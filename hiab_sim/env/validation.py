@@ -69,9 +69,9 @@ def simulate_designs(
 
 
 def simulation_report(
-    result_dir: str | Path, runs: list[ClosedLoopRun], nominal: list[ClosedLoopRun]
+    result_dir: str | Path, runs: list[ClosedLoopRun], nominal: list[ClosedLoopRun], emlas: EmlaSet | None = None
 ) -> dict[str, object]:
-    """The content of ``simulation.json``."""
+    """The content of ``simulation.json``; ``emlas`` the runs' EMLA set (None: the crane result's, read from it)."""
     designs: dict[str, object] = {}
     for run in runs:
         entry = run.summary()
@@ -99,7 +99,9 @@ def simulation_report(
             "plant": runs[0].plant if runs else "ideal",
         },
     }
-    boundary = energy_boundary(read_plan(result_dir, runs[0].design).emlas) if runs else None
+    if emlas is None and runs:
+        emlas = read_plan(result_dir, runs[0].design).emlas
+    boundary = energy_boundary(emlas) if emlas is not None else None
     if boundary is not None:
         report["energy_boundary"] = boundary
     by_design = {run.design: run for run in runs}

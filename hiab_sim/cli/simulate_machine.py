@@ -1,0 +1,133 @@
+"""``hiab-sim simulate`` on a machine file's result: each design in closed loop on :mod:`hiab_sim.env.machine_env`.
+
+The same ``simulation.json``, table, figures and closing lines as the crane's
+(:mod:`hiab_sim.cli.simulate`), for the ideal plant: the EMLA drives' current dynamics per chain
+under the cascade controller with the plan's feedforward. What is built on the crane's model is
+refused with one line (exit 2) naming it: ``--payload-error`` (the crane's end-mass body), plant
+effects (:mod:`hiab_sim.env.plant`) and the video (drawn with the crane's dressing).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from hiab_sim.emla.config import EmlaSet
+from hiab_sim.env.plant.config import Plant
+from hiab_sim.env.rollout import ClosedLoopRun
+from hiab_sim.errors import InvalidInputError
+
+#: What the report says of the energy boundary and the TCP error of a machine's closed loop.
+MACHINE_ENERGY = (
+    "closed loop: int 3/2 (v_d i_d + v_q i_q) dt over the cycle at the motor terminals, summed over the drives "
+    "(the shared DC bus credits one drive's regeneration to the others; no inverter or battery); the prediction "
+    "is the same sum of the plan's P_elec per drive"
+)
+MACHINE_TCP = "distance of the simulated TCP to the study's TCP reference (x_tcp, y_tcp) in the machine's plane"
+NO_STRUCTURE = "the structure's natural frequencies are computed for the crane file only, not for a machine file"
+
+
+BATTERY_NOTE = (
+    "battery_energy_J: the closed loop's drive powers (mean over each control step) through the EMLA file's "
+    "inverters and battery on the shared DC bus (hiab_sim.emla.battery: h_inv per drive, summed, h_bat), "
+    "summed over the steps; predicted_battery_energy_J: the result's cycle battery energy of the design "
+    "(result.json energy.<design>.battery_energy_J, the same model on the plan's fine grid)"
+)
+
+
+def predicted_battery_energy(result_dir: str | Path) -> dict[str, float]:
+    """The result's cycle battery energy per design [J] (empty where the result has no energy section)."""
+    from hiab_sim.results.read import read_result
+
+    energy = read_result(result_dir).energy
+    if energy is None:
+        return {}
+    return {"initial": energy.initial.battery_energy_J, "optimal": energy.optimal.battery_energy_J}
+
+
+def battery_entry(run: ClosedLoopRun, emlas: EmlaSet, predicted: float | None) -> dict[str, float | None]:
+    """A run's closed-loop battery energy [J] (:data:`BATTERY_NOTE`), the prediction and their difference [%]."""
+    from hiab_sim.emla.battery import battery_power
+
+    _, p_bat, _, _ = battery_power(run.electrical_power[:-1], emlas.battery)
+    energy = float(np.sum(p_bat * np.diff(run.time)))
+    return {
+        "battery_energy_J": energy,
+        "predicted_battery_energy_J": predicted,
+        "battery_energy_difference_percent": None if predicted is None else 100.0 * (energy / predicted - 1.0),
+    }
+
+
+def refuse_crane_only(args: argparse.Namespace, plant: Plant | None) -> None:
+    """One line naming what a machine file's closed loop does not simulate (exit 2 through the CLI)."""
+    if args.payload_error != 0.0:
+        raise InvalidInputError(
+            "--payload-error", args.payload_error, "must be 0 for a machine file's result (the crane's end-mass body)"
+        )
+    if plant is not None and plant.enabled:
+        raise InvalidInputError(
+            "--plant",
+            ", ".join(plant.enabled),
+            "plant effects are built on the crane's model; a machine file's result runs the ideal plant only",
+        )
+    if args.cycles != 1:
+        raise InvalidInputError("--cycles", args.cycles, "must be 1 for a machine file's result (no thermal plant)")
+    if not args.no_video:
+        raise InvalidInputError(
+            "--no-video", False, "is needed for a machine file's result (closed_loop.mp4 draws the crane)"
+        )
+
+
+def run_machine(args: argparse.Namespace, designs: tuple[str, ...], plant: Plant | None, out: Path) -> int:
+    """Simulate every design of a machine file's result, write ``simulation.json`` (and figures), print the table."""
+    from hiab_sim.cli.simulate import closing_lines
+    from hiab_sim.env.machine_env import run_machine_closed_loop
+    from hiab_sim.env.machine_plan import read_machine_plan
+    from hiab_sim.env.validation import simulation_report, table
+
+    refuse_crane_only(args, plant)
+    plans = [read_machine_plan(args.result_dir, design) for design in designs]  # bad input fails first
+    out.mkdir(parents=True, exist_ok=True)
+    runs = []
+    for plan in plans:
+        run, physics = run_machine_closed_loop(plan)
+        physics.free()
+        runs.append(run)
+    report = simulation_report(args.result_dir, runs, [], emlas=plans[0].emlas)
+    settings = report["settings"]
+    assert isinstance(settings, dict)
+    settings.update(energy=MACHINE_ENERGY, tcp_error=MACHINE_TCP, machine=plans[0].machine.name)
+    settings["tcp_load"] = "the plan's TCP force F(t) of the study's first task, applied at site tcp"
+    entries = report["designs"]
+    assert isinstance(entries, dict)
+    predicted = predicted_battery_energy(args.result_dir)
+    for run in runs:
+        entry = entries[run.design]
+        entry["bandwidth_check"]["note"] = NO_STRUCTURE
+        entry.update(battery_entry(run, plans[0].emlas, predicted.get(run.design)))
+    settings["battery_energy"] = BATTERY_NOTE
+    from hiab_sim.atomic_io import write_atomic
+
+    write_atomic(out / "simulation.json", json.dumps(report, indent=2) + "\n")
+    written = ["simulation.json"]
+    if not args.no_figures:
+        from hiab_sim.env.figures import write_figures
+
+        written += [p.name for p in write_figures(out, runs, [])]
+    print(table(report))
+    print()
+    for line in closing_lines(report):
+        print(line)
+    for design, entry in entries.items():
+        if entry.get("battery_energy_difference_percent") is not None:
+            print(
+                f"{design}: battery energy {entry['battery_energy_J']:.1f} J closed loop against "
+                f"{entry['predicted_battery_energy_J']:.1f} J planned "
+                f"({entry['battery_energy_difference_percent']:+.2f} %)."
+            )
+    print(f"wrote {', '.join(written)} to {out}", file=sys.stderr)
+    return 0

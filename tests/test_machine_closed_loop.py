@@ -1,0 +1,154 @@
+"""A machine file's design in closed loop: the excavator (a four-bar bucket) tracks its plan on the ideal plant.
+
+The plan comes from a tiny excavator study (a 4 s rest-to-rest joint move with 50 kg at the TCP);
+the closed loop is the generic MJCF per design with the EMLA drives' current dynamics and the cascade
+controller (:mod:`hiab_sim.env.machine_env`), time-stepped at 1 ms. Its energy is the drives' exact
+per-step integral, the plan's the optimiser's quadrature of its steady-state P_elec: two different
+computations of one quantity.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+
+from hiab_sim.cli import main
+from hiab_sim.cli.simulate import ENERGY_TOLERANCE, TCP_MAX_MM
+from hiab_sim.env.machine_env import machine_environment, machine_load_mass, run_machine_closed_loop
+from hiab_sim.env.machine_plan import MachinePlan, read_machine_plan
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
+from hiab_sim.study.run import run_study
+from hiab_sim.study.spec.study_file import load_study
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from test_machine_study import EXCAVATOR, _joint_csv
+
+#: Tracking of the plan's own TCP on the planner's model [mm]: only the loops' residual (measured 0.04 mm).
+PLAN_TCP_MAX_MM = 0.5
+
+
+@pytest.fixture(scope="module")
+def result(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("excavator_closed_loop")
+    _joint_csv(folder / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
+    (folder / "study.yaml").write_text(yaml.safe_dump(EXCAVATOR), encoding="utf-8")
+    out = folder / "result"
+    run_study(load_study(folder / "study.yaml"), out, figures=False, progress=None)
+    return out
+
+
+@pytest.fixture(scope="module")
+def plan(result: Path) -> MachinePlan:
+    return read_machine_plan(result, "optimal")
+
+
+def test_excavator_closed_loop_tracks_the_plan_and_uses_its_energy(plan: MachinePlan) -> None:
+    """Ideal plant = the planner's model: the energy within the CLI's 2 % and the TCP on the plan's path.
+
+    2 % is the closed-loop check of ``hiab-sim simulate`` (and the issue's); on the planner's own
+    model the difference is the feedback's work on the loops' residual plus the plan's trapezoid
+    quadrature on its 1/12 s grid, measured 0.003 % in total and below 0.2 % on the smallest drive.
+    """
+    run, physics = run_machine_closed_loop(plan)
+    physics.free()
+    summary: Any = run.summary()
+    assert run.actuator_names == ("boom", "arm", "bucket")
+    assert abs(summary["energy_difference_percent"]) < 100 * ENERGY_TOLERANCE
+    for name, drive in summary["actuators"].items():
+        predicted = drive["predicted_net_electrical_energy_J"]
+        assert drive["net_electrical_energy_J"] == pytest.approx(predicted, rel=ENERGY_TOLERANCE), name
+    assert summary["tcp_error_to_plan_mm"]["max"] < PLAN_TCP_MAX_MM
+    assert summary["tcp_error_mm"]["max"] < TCP_MAX_MM
+    assert summary["current_limit_fraction"] == 0.0 and summary["voltage_limit_fraction"] == 0.0
+    assert run.time[-1] == pytest.approx(plan.duration, abs=0.01)
+
+
+def test_load_mass_is_twice_the_kinetic_energy_of_a_unit_slide_rate(plan: MachinePlan) -> None:
+    """m_L,a from G^T M G against mj_energyVel of the machine moving slide a at 1 m/s, the others held."""
+    env = machine_environment(plan)
+    mass = machine_load_mass(plan, env.task.motion)
+    env.physics.free()
+    dynamics = MujocoMachineDynamics(plan.machine)
+    k = len(plan.time) // 2
+    q = plan.position[k]
+    n = len(q)
+    # the slide rates of unit joint rates, column j: by central differences of the strokes in q
+    jx = np.empty((n, n))
+    zeros = np.zeros((2, n))
+    for j in range(n):
+        h = 1e-6
+        rows = np.stack([q + h * np.eye(n)[j], q - h * np.eye(n)[j]])
+        stroke = dynamics(rows, zeros, zeros).stroke
+        jx[:, j] = (stroke[0] - stroke[1]) / (2 * h)
+    grid = plan.time - plan.time[0]
+    index = int(np.argmin(np.abs(env.task.motion.time - grid[k])))
+    for a in range(n):
+        rate = np.linalg.solve(jx, np.eye(n)[a])
+        kinetic, _ = dynamics.energy(q[None], rate[None])
+        assert mass[index, a] == pytest.approx(2.0 * kinetic[0], rel=1e-5)
+
+
+def _open_loop_drift(plan: MachinePlan, with_load: bool) -> float:
+    """Largest stroke change [m] over 0.2 s at the first sample's feedforward current, no feedback."""
+    env = machine_environment(plan)
+    physics = env.physics
+    if not with_load:
+        physics.tcp_load = None
+    env.reset()
+    start = physics.stroke().copy()
+    physics.holding = True
+    physics.current_reference = env.task.motion.current[0].copy()
+    physics.step(200)
+    drift = float(np.max(np.abs(physics.stroke() - start)))
+    physics.free()
+    return drift
+
+
+def test_the_tcp_load_holds_the_start_on_the_planners_model(plan: MachinePlan) -> None:
+    """Feedforward current and the plan's TCP force hold the start pose in equilibrium; without the force it sags."""
+    held = _open_loop_drift(plan, with_load=True)
+    unloaded = _open_loop_drift(plan, with_load=False)
+    assert held < 1e-5  # [m]
+    assert unloaded > 100 * held
+
+
+def test_simulate_cli_on_a_machine_result(result: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "sim"
+    code = main(["simulate", str(result), "--no-video", "--no-figures", "--quiet", "--out", str(out)])
+    assert code == 0
+    report = json.loads((out / "simulation.json").read_text(encoding="utf-8"))
+    assert set(report["designs"]) == {"initial", "optimal"}
+    for entry in report["designs"].values():
+        assert abs(entry["energy_difference_percent"]) < 100 * ENERGY_TOLERANCE
+        assert set(entry["actuators"]) == {"boom", "arm", "bucket"}
+        assert abs(entry["battery_energy_difference_percent"]) < 100 * ENERGY_TOLERANCE  # through the same battery
+    assert "motor terminals" in report["settings"]["energy"]
+    assert "closed loop uses" in capsys.readouterr().out
+    for extra, word in (
+        (["--payload-error", "0.2"], "payload-error"),
+        (["--plant", "realistic"], "plant"),
+        ([], "video"),
+    ):
+        args = ["simulate", str(result), "--quiet", "--out", str(out), *extra]
+        if word != "video":
+            args.append("--no-video")
+        assert main(args) == 2
+        assert word in capsys.readouterr().err
+
+
+def test_refusals_name_the_effect() -> None:
+    from hiab_sim.cli.simulate_machine import refuse_crane_only
+    from hiab_sim.env.plant import load_plant
+
+    args = argparse.Namespace(payload_error=0.0, cycles=1, no_video=True)
+    refuse_crane_only(args, load_plant("ideal"))
+    with pytest.raises(InvalidInputError, match="drive_train"):
+        refuse_crane_only(args, load_plant("realistic"))
