@@ -84,7 +84,7 @@ def refuse_crane_only(args: argparse.Namespace, plant: Plant | None) -> None:
 
 def run_machine(args: argparse.Namespace, designs: tuple[str, ...], plant: Plant | None, out: Path) -> int:
     """Simulate every design of a machine file's result, write ``simulation.json`` (and figures), print the table."""
-    from hiab_sim.cli.simulate import closing_lines
+    from hiab_sim.cli.simulate_summary import closing_lines
     from hiab_sim.env.machine_env import run_machine_closed_loop
     from hiab_sim.env.machine_plan import read_machine_plan
     from hiab_sim.env.validation import simulation_report, table

@@ -32,17 +32,6 @@ Array = NDArray[np.float64]
 Design = DesignValues
 
 
-class TrackedSamplesLike(Protocol):
-    """Tracked coordinates r, their rates and partials w.r.t. q9 (:mod:`hiab_sim.study.motion.trajectory`)."""
-
-    position: Array
-    velocity: Array
-    acceleration: Array
-    d_position: Array
-    d_velocity: Array
-    d_acceleration: Array
-
-
 class Kinematics(Protocol):
     """The tracked coordinates of a machine (no dependence on Xi: the hinges are fixed)."""
 

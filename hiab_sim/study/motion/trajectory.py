@@ -24,6 +24,7 @@ from scipy.interpolate import BSpline
 
 from hiab_sim.crane.description import Crane
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.machine.kinematics.tracked import TrackedSamples
 
 Array = NDArray[np.float64]
 
@@ -78,20 +79,10 @@ def evaluate(basis: SplineBasis, coefficients: Array, times: Array) -> JointTraj
 # ---------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class TcpSamples:
-    """Tracked coordinates r = (x_tcp, y_tcp, xt2) and their time derivatives, each (T, 3).
-
-    ``d_position`` etc. hold the partials with respect to the joint samples, (T, 3, 9): columns
-    0-2 d/dtheta, 3-5 d/ddtheta, 6-8 d/dddtheta.
-    """
-
-    position: Array
-    velocity: Array
-    acceleration: Array
-    d_position: Array
-    d_velocity: Array
-    d_acceleration: Array
+#: Tracked coordinates r, their time derivatives and partials w.r.t. q9 (the crane's r = (x_tcp, y_tcp, xt2):
+#: each (T, 3), partials (T, 3, 9), columns 0-2 d/dtheta, 3-5 d/ddtheta, 6-8 d/dddtheta); the one samples
+#: type of every machine's tracked kinematics (:mod:`hiab_sim.machine.kinematics.tracked`).
+TcpSamples = TrackedSamples
 
 
 class TcpKinematics:

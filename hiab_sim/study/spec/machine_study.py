@@ -12,11 +12,13 @@ from hiab_sim.machine.loader import PRESETS as MACHINE_PRESETS
 from hiab_sim.machine.loader import load_machine, locate_machine
 from hiab_sim.resources import Source, locate
 from hiab_sim.study.machines.machine_model import MachineModel
-from hiab_sim.study.spec.build import BuildSettings
-from hiab_sim.study.spec.energy import energy_settings
-from hiab_sim.study.spec.settings import GridSettings, SolverSettings, SplineSettings, Tracking, bounds_from_mapping
+from hiab_sim.study.spec.settings import (
+    GridSettings,
+    bounds_from_mapping,
+    shared_sections,
+)
 from hiab_sim.study.spec.study import Study
-from hiab_sim.study.spec.tasks import tasks_from_mapping
+from hiab_sim.study.spec.tasks import study_tasks
 from hiab_sim.yaml_fields import mapping, number, section
 
 
@@ -61,12 +63,8 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
     )
     grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
     name = str(top.get("name", Path(str(file.file)).stem))
-    if "tasks" not in top and "reference" not in top:
-        raise ConfigError("study: give 'tasks:' (a list of tasks) or 'reference:' (one task)")
     names = (tuple(model.tracked_names[2:]), model.joint_names)
-    tasks = tasks_from_mapping(top, folder, grid.duration, name, names)
-    if "tasks" not in top and isinstance(top.get("payload", 0.0), int | float):
-        tasks = (replace(tasks[0], payload=replace(tasks[0].payload, inertia=False)),)
+    tasks = study_tasks(top, folder, grid.duration, name, names)
     # the spiral and pick-and-place kinds prescribe the third tracked coordinate as a crane's telescope:
     # a machine of three joints whose third tracked coordinate is a joint may use them
     prescribed = len(model.tracked_names) == 3 and model.tracked_names[2] in model.joint_names
@@ -92,15 +90,11 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
         emla_source=emla_source,
         emlas=emlas,
         initial_lengths=initial,
-        spline=SplineSettings(**section(SplineSettings, top.get("spline"), "spline")),
         grid=grid,
         tasks=tasks,
-        tracking=Tracking(**section(Tracking, top.get("tracking"), "tracking")),
         bounds=bounds,
-        solver=SolverSettings(**section(SolverSettings, top.get("solver"), "solver")),
-        build=BuildSettings.from_mapping(top.get("build")),
+        **shared_sections(top),
         crane_file=machine_file,
-        energy=energy_settings(top),
         machine=machine,
         tracked=tracked,
     )

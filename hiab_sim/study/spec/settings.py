@@ -7,6 +7,7 @@ own ranges in ``__post_init__``; :func:`bounds_from_mapping` reads the ``bounds:
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -15,7 +16,9 @@ import numpy as np
 from hiab_sim.checks import check_choice, check_range
 from hiab_sim.crane.description import CHAIN_NAMES
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.yaml_fields import mapping, number, vector
+from hiab_sim.study.spec.build import BuildSettings
+from hiab_sim.study.spec.energy import energy_settings
+from hiab_sim.yaml_fields import mapping, number, section, vector
 
 ID_PATHS = ("mujoco", "analytic")
 
@@ -210,3 +213,14 @@ def bounds_from_mapping(data: Any, chains: bool = True, joints: int = 3) -> Boun
     if "working_range" in d:
         values["working_range"] = str(d["working_range"])
     return Bounds(**values)
+
+
+def shared_sections(top: Mapping[str, Any]) -> dict[str, Any]:
+    """The sections a crane file's and a machine file's study read alike: spline, tracking, solver, build, energy."""
+    return {
+        "spline": SplineSettings(**section(SplineSettings, top.get("spline"), "spline")),
+        "tracking": Tracking(**section(Tracking, top.get("tracking"), "tracking")),
+        "solver": SolverSettings(**section(SolverSettings, top.get("solver"), "solver")),
+        "build": BuildSettings.from_mapping(top.get("build")),
+        "energy": energy_settings(top),
+    }

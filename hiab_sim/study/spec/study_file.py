@@ -18,7 +18,6 @@ within ``tasks:`` a plain number is a constant mass with its inertia (see :mod:`
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -32,8 +31,7 @@ from hiab_sim.errors import ConfigError
 from hiab_sim.resources import DEFAULT_STUDY, Source, locate
 from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.machines.crane_model import CraneModel
-from hiab_sim.study.spec.build import BuildSettings
-from hiab_sim.study.spec.energy import ENERGY_KEYS, energy_settings
+from hiab_sim.study.spec.energy import ENERGY_KEYS
 from hiab_sim.study.spec.machine_study import machine_study_from_dict
 from hiab_sim.study.spec.settings import (
     ID_PATHS,
@@ -43,9 +41,10 @@ from hiab_sim.study.spec.settings import (
     SplineSettings,
     Tracking,
     bounds_from_mapping,
+    shared_sections,
 )
 from hiab_sim.study.spec.study import Study
-from hiab_sim.study.spec.tasks import tasks_from_mapping
+from hiab_sim.study.spec.tasks import study_tasks
 from hiab_sim.yaml_fields import mapping, positive, read_yaml, section
 
 _TOP = {
@@ -105,12 +104,7 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
     bounds = bounds_from_mapping(top["bounds"])
     grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
     name = str(top.get("name", Path(str(file.file)).stem))
-    if "tasks" not in top and "reference" not in top:
-        raise ConfigError("study: give 'tasks:' (a list of tasks) or 'reference:' (one task)")
-    tasks = tasks_from_mapping(top, Path(str(file.file)).parent, grid.duration, name)
-    if "tasks" not in top and isinstance(top.get("payload", 0.0), int | float):
-        # single-reference form: a plain number is today's payload, its weight only (module docstring)
-        tasks = (replace(tasks[0], payload=replace(tasks[0].payload, inertia=False)),)
+    tasks = study_tasks(top, Path(str(file.file)).parent, grid.duration, name)
     initial = _lengths(top.get("initial_lengths"), crane, bounds)
     moved = "initial_lengths" not in top and initial != crane.default_lengths
     return Study(
@@ -121,17 +115,13 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
         emla_source=emla_source,
         emlas=emlas,
         initial_lengths=initial,
-        spline=SplineSettings(**section(SplineSettings, top.get("spline"), "spline")),
         grid=grid,
         tasks=tasks,
-        tracking=Tracking(**section(Tracking, top.get("tracking"), "tracking")),
         bounds=bounds,
-        solver=SolverSettings(**section(SolverSettings, top.get("solver"), "solver")),
-        build=BuildSettings.from_mapping(top.get("build")),
+        **shared_sections(top),
         mounting=None if top.get("mounting") is None else MountingSpace.from_mapping(top["mounting"]),
         crane_file=crane_file,
         start_moved_from=crane.default_lengths if moved else None,
-        energy=energy_settings(top),
         structure=StructureSettings.from_mapping(top.get("structure"), crane),
     )
 

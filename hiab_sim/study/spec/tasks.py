@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -169,6 +169,25 @@ def tasks_from_mapping(
     if duplicate is not None:
         raise ConfigError(f"tasks: the name {duplicate!r} is used twice; task names must be unique")
     return tuple(tasks)
+
+
+def study_tasks(
+    top: Mapping[str, Any],
+    folder: Path,
+    grid_duration: float,
+    study_name: str,
+    names: tuple[tuple[str, ...], tuple[str, ...]] = CRANE_NAMES,
+) -> tuple[Task, ...]:
+    """A study file's tasks (:func:`tasks_from_mapping`), its single-reference form keeping a plain payload's meaning.
+
+    In that form a plain ``payload: <kg>`` is today's payload, its weight only (no inertia).
+    """
+    if "tasks" not in top and "reference" not in top:
+        raise ConfigError("study: give 'tasks:' (a list of tasks) or 'reference:' (one task)")
+    tasks = tasks_from_mapping(top, folder, grid_duration, study_name, names)
+    if "tasks" not in top and isinstance(top.get("payload", 0.0), int | float):
+        tasks = (replace(tasks[0], payload=replace(tasks[0].payload, inertia=False)),)
+    return tasks
 
 
 def check_tasks(tasks: tuple[Task, ...], kin: Kinematics, model: StudyMachine | Crane) -> None:
