@@ -116,7 +116,8 @@ def soil_keys(where: str) -> list[Key]:
             f"{where}.soil",
             type="text",
             allowed="one of " + ", ".join(f"`{n}`" for n in SOILS) + ", or a soil file",
-            description="A shipped soil or a soil file (see Soil file below).",
+            description="A shipped soil or a soil file (see Soil file below); a path is read from the working folder, "
+            "not next to the study.",
         ),
         replace(
             rows["ground"],
