@@ -36,8 +36,15 @@ def children(keys: list[Key], container: str) -> set[str]:
 def _refused(fmt: FileFormat, form: Form, key: str, path: str, documents: list[Any]) -> bool:
     """Whether ``key``, added at ``path`` to every document of ``form``, makes the loader fail on each.
 
-    The key's value is the one a document of another form holds there (an empty mapping if none does).
+    A document of ``form`` that holds the key (each one loads) shows it accepted. Otherwise the key's value
+    is the one a document of another form holds there (an empty mapping if none does).
     """
+    for document in documents:
+        try:
+            if key in container(document, path):
+                return False
+        except KeyError:
+            continue
     donors = []
     for document in fmt.documents():
         if form.holds(document):

@@ -1,7 +1,10 @@
 """The documented keys of every file format, built from the dataclasses and readers that own them.
 
 Each format is a list of :class:`Key` rows: a *section* (a mapping whose keys are listed after it), a
-*value*, or *free* (any name or dotted path). Where a reader builds a dataclass from a section
+*value*, *free* (any name or dotted path) or *names* (names another file defines, which the loader
+checks against it: a machine's decision variables); a row with a ``form`` belongs to that form of the
+file only (a study's ``crane`` or ``machine`` form, :class:`hiab_sim.docs_site.formats.Form`).
+Where a reader builds a dataclass from a section
 (:func:`hiab_sim.yaml_fields.section` and its kin), the rows come from that dataclass
 (:func:`~hiab_sim.docs_site.dataclass_fields.field_rows`: its type, default, the docstring's
 description and unit, the range its ``__post_init__`` checks); the keys a reader handles by hand are
