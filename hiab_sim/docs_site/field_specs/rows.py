@@ -42,9 +42,9 @@ def free(path: str, description: str, type_: str = "") -> Key:
     return Key(path, "free", type_, description=description)
 
 
-def names(path: str, description: str, type_: str = "", form: str = "") -> Key:
+def names(path: str, description: str, type_: str = "", form: str = "", default: str = "") -> Key:
     """A mapping whose keys are names another file defines (the loader checks them against that file)."""
-    return Key(path, "names", type_, description=description, form=form)
+    return Key(path, "names", type_, default=default, description=description, form=form)
 
 
 def in_form(form: str, keys: list[Key]) -> list[Key]:

@@ -125,9 +125,10 @@ def study_keys() -> list[Key]:
         names(
             "initial_lengths",
             "Decision variable `chain.variable` (as `hiab-sim machine show` lists them) -> start value "
-            "[the variable's unit], within the machine file's bounds; default: the file's values.",
+            "[the variable's unit], within the machine file's bounds.",
             "mapping",
             form="machine",
+            default="the machine file's values",
         )
     )
     rows += [
