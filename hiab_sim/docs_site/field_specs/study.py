@@ -234,14 +234,11 @@ def study_keys() -> list[Key]:
         ),
     ]
     rows += [section("solver", "Solver settings.", "defaults"), *from_class("solver", SolverSettings)]
-    rows += in_form(
-        "crane",
-        [
-            section("build", "Manufacturing tolerance and stroke margin.", "defaults"),
-            *from_class("build", BuildSettings),
-            *_mounting_keys(),
-        ],
-    )
+    rows += [
+        section("build", "Manufacturing tolerance and stroke margin.", "defaults"),
+        *from_class("build", BuildSettings),
+    ]
+    rows += in_form("crane", _mounting_keys())
     rows += [
         Key(
             "objective",
