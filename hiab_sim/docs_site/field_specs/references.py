@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from hiab_sim.docs_site.field_specs.rows import Key, from_class, in_form, section
+from hiab_sim.docs_site.field_specs.rows import Key, from_class, section
 
 
 def reference_keys(where: str) -> list[Key]:
@@ -77,11 +77,17 @@ def reference_keys(where: str) -> list[Key]:
         ),
     ]
     needed = "one of `reference`, `tasks`" if where == "reference" else "required"
-    rows = [section(f"{where}{{spiral}}", "A TCP spiral in the vertical plane (kind omitted or `spiral`).", needed)]
+    machine = " A machine file's study: only where its third tracked coordinate is a joint (else `csv`)."
+    rows = [
+        section(
+            f"{where}{{spiral}}", "A TCP spiral in the vertical plane (kind omitted or `spiral`)." + machine, needed
+        )
+    ]
     rows += [replace(k, path=f"{where}{{spiral}}.{k.path.lstrip('.')}") for k in spiral]
-    rows.append(section(f"{where}{{pick_and_place}}", "Rest to rest from `pick` to `place` over a clearance.", needed))
+    rows.append(
+        section(f"{where}{{pick_and_place}}", "Rest to rest from `pick` to `place` over a clearance." + machine, needed)
+    )
     rows += [replace(k, path=f"{where}{{pick_and_place}}.{k.path.lstrip('.')}") for k in pick]
-    rows = in_form("crane", rows)  # both prescribe a crane's telescope: a machine file's study takes `csv`
     rows.append(section(f"{where}{{csv}}", "A sampled trajectory from a CSV file, fitted by a B-spline.", needed))
     rows += [replace(k, path=f"{where}{{csv}}.{k.path.lstrip('.')}") for k in csv]
     return rows
