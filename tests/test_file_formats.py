@@ -32,6 +32,19 @@ def test_a_key_the_loader_rejects_or_an_undocumented_key_is_caught(monkeypatch: 
     assert any("'substeps'" in line and "rejects" in line for line in found)
 
 
+def test_a_key_documented_for_the_wrong_form_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:
+    """`tracked` documented for the crane form only: the machine form's documents hold it and load, so it is reported.
+
+    The study's keys are compared per form (crane file or machine file), not over the union of the forms.
+    """
+    rows = [replace(k, form="crane") if k.path == "tracked" else k for k in KEYS["study"]()]
+    monkeypatch.setitem(KEYS, "study", lambda: rows)
+    found = discrepancies("study")
+    assert any(line.startswith("study (machine form): top level") and "'tracked'" in line for line in found), found
+    machine_only = [k for k in KEYS["study"]() if k.form == "machine"]
+    assert {k.path for k in machine_only} >= {"machine", "initial_lengths", "bounds.joint_velocity"}
+
+
 def test_reference_rows_take_defaults_and_ranges_from_the_dataclasses() -> None:
     """The study's spline and tracking rows carry the dataclasses' defaults and their __post_init__ ranges."""
     rows = {k.path: k for k in study_keys()}

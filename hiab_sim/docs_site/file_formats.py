@@ -7,12 +7,15 @@ loader accepts (:func:`hiab_sim.docs_site.probe.accepted_keys`).
 
 from __future__ import annotations
 
+import copy
 import re
+from typing import Any
 
 from hiab_sim.docs_site.field_specs import KEYS, Key
-from hiab_sim.docs_site.formats import FORMATS
+from hiab_sim.docs_site.formats import FORMATS, FileFormat, Form
 from hiab_sim.docs_site.markdown import table
-from hiab_sim.docs_site.probe import accepted_keys, split
+from hiab_sim.docs_site.probe import accepted_keys, container, split
+from hiab_sim.errors import HiabSimError
 
 
 def key_name(segment: str) -> str:
@@ -30,29 +33,90 @@ def children(keys: list[Key], container: str) -> set[str]:
     return {key_name(split(k.path)[-1]) for k in keys if parent(k.path) == container}
 
 
-def discrepancies(name: str) -> list[str]:
-    """Where the documented keys of format ``name`` and the keys its loader accepts differ (empty: none)."""
-    fmt, keys = FORMATS[name], KEYS[name]()
-    documents = fmt.documents()
-    containers = [""] + [k.path for k in keys if k.kind == "section"]
+def _refused(fmt: FileFormat, form: Form, key: str, path: str, documents: list[Any]) -> bool:
+    """Whether ``key``, added at ``path`` to every document of ``form``, makes the loader fail on each.
+
+    A document of ``form`` that holds the key (each one loads) shows it accepted. Otherwise the key's value
+    is the one a document of another form holds there (an empty mapping if none does).
+    """
+    for document in documents:
+        try:
+            if key in container(document, path):
+                return False
+        except KeyError:
+            continue
+    donors = []
+    for document in fmt.documents():
+        if form.holds(document):
+            continue
+        try:
+            node = container(document, path)
+        except KeyError:
+            continue
+        if key in node:
+            donors.append(node[key])
+    value = donors[0] if donors else {}
+    for document in documents:
+        trial = copy.deepcopy(document)
+        container(trial, path)[key] = copy.deepcopy(value)
+        try:
+            fmt.load(trial)
+        except HiabSimError:
+            continue
+        return False
+    return True
+
+
+def _compare(fmt: FileFormat, keys: list[Key], form: Form | None) -> list[str]:
+    """The differences in one form (None: a format with one form) between documented and accepted keys."""
+    documents = [d for d in fmt.documents() if form is None or form.holds(d)]
+    visible = [k for k in keys if form is None or k.form in ("", form.name)]
+    elsewhere = {(parent(k.path), key_name(split(k.path)[-1])) for k in keys} - {
+        (parent(k.path), key_name(split(k.path)[-1])) for k in visible
+    }
+    kinds = {"": "section"} | {k.path: k.kind for k in visible if k.kind in ("section", "names")}
+    label = fmt.name if form is None else f"{fmt.name} ({form.name} form)"
     out = []
-    for path in containers:
+    for path, kind in kinds.items():
         accepted = accepted_keys(fmt.load, documents, path)
-        documented = children(keys, path)
+        documented = children(visible, path)
         where = path or "top level"
         if accepted is None:
-            out.append(f"{name}: {where}: the loader accepts any key here; document it as free")
+            out.append(f"{label}: {where}: the loader accepts any key here; document it as free")
+            continue
+        if kind == "names":  # names another file defines: the loader checks them, the reference names none
+            out += [f"{label}: {where}: names from another file; the reference documents {k!r}" for k in documented]
             continue
         for key in sorted(accepted - documented):
-            out.append(f"{name}: {where}: the loader accepts {key!r}, the reference does not document it")
+            if form is not None and (path, key) in elsewhere and _refused(fmt, form, key, path, documents):
+                continue  # the loader's list of keys spans the forms; this form refuses the key
+            out.append(f"{label}: {where}: the loader accepts {key!r}, the reference does not document it")
         for key in sorted(documented - accepted):
-            out.append(f"{name}: {where}: the reference documents {key!r}, the loader rejects it")
+            out.append(f"{label}: {where}: the reference documents {key!r}, the loader rejects it")
+    return out
+
+
+def discrepancies(name: str) -> list[str]:
+    """Where the documented keys of format ``name`` and the keys its loader accepts differ (empty: none).
+
+    A format with forms (:class:`~hiab_sim.docs_site.formats.Form`) is compared per form, on that form's
+    documents, with the keys documented for every form or for it; a key its loader lists but documented
+    for other forms only must make the loader fail when added to this form's documents.
+    """
+    fmt, keys = FORMATS[name], KEYS[name]()
+    out = []
+    for form in fmt.forms or (None,):
+        out += _compare(fmt, keys, form)
     return out
 
 
 def _code(text: str) -> str:
     text = re.sub(r":\w+:`~?([^`]+)`", r"`\1`", text)
     return text.replace("``", "`")
+
+
+#: What the key column adds after a mapping whose keys the file chooses.
+_MARKS = {"free": " (any key)", "names": " (names from another file)"}
 
 
 def _shown(path: str) -> str:
@@ -80,7 +144,7 @@ def file_formats_markdown() -> str:
     for name, fmt in FORMATS.items():
         rows = [
             (
-                _shown(k.path) + (" (any key)" if k.kind == "free" else ""),
+                _shown(k.path) + _MARKS.get(k.kind, "") + (f" ({k.form} form)" if k.form else ""),
                 k.type,
                 k.unit,
                 k.default or ("required" if k.kind == "value" else ""),
@@ -90,5 +154,12 @@ def file_formats_markdown() -> str:
             for k in KEYS[name]()
         ]
         parts += ["", f"## {fmt.title}", "", f"Read by `{fmt.reader}`.", ""]
+        if fmt.forms:
+            forms = "; ".join(f"*{f.name} form*: {_code(f.description)}" for f in fmt.forms)
+            parts += [
+                f"{len(fmt.forms)} forms, chosen by the top-level key: {forms}. A key marked with a form "
+                "belongs to that form only (the loader refuses it in the other); unmarked keys belong to both.",
+                "",
+            ]
         parts.append(table(("key", "type", "unit", "default", "allowed", "description"), rows))
     return "\n".join(parts) + "\n"

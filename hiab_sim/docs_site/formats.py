@@ -18,14 +18,32 @@ from hiab_sim.resources import Source, shipped, shipped_names
 
 
 @dataclass(frozen=True)
+class Form:
+    """One form of a file format, chosen by the top-level key ``key`` (a study names a ``crane`` or a ``machine``).
+
+    The keys of each form are compared with what the loader accepts on the documents of that form only;
+    a key documented for other forms only must make the loader fail on this form's documents.
+    """
+
+    name: str
+    key: str
+    description: str
+
+    def holds(self, document: Any) -> bool:
+        """Whether ``document`` is of this form."""
+        return isinstance(document, dict) and self.key in document
+
+
+@dataclass(frozen=True)
 class FileFormat:
-    """One kind of file: its title, what reads it, and valid documents to probe the loader with."""
+    """One kind of file: its title, what reads it, valid documents to probe the loader with, and its forms."""
 
     name: str
     title: str
     reader: str  # the function that reads it, for the page
     load: Callable[[Any], object]
     documents: Callable[[], list[Any]]
+    forms: tuple[Form, ...] = ()  # none: one form
 
 
 def _parsed(source: Source) -> Any:
@@ -68,13 +86,34 @@ def _load_emla(document: Any) -> object:
     return emla_set_from_mapping(document)
 
 
+#: Control points of a machine study's CSV fit in the probe's documents (see :func:`_study_documents`).
+_PROBE_FIT_POINTS = 80
+
+
 def _study_documents() -> list[Any]:
+    """The shipped studies; a machine file's study with tasks also as one ``reference`` (+ ``payload``).
+
+    The shipped machine study is a duty mix of one task: its single-reference copy lets the probe reach
+    the top-level ``reference`` and ``payload`` of the machine form. The probe loads each document dozens
+    of times; a CSV reference's fit there takes :data:`_PROBE_FIT_POINTS` control points (its default
+    by duration costs seconds per load; the shipped digging cycle passes its fit tolerance with these).
+    """
     names = sorted(shipped_names("study"))
     out = []
     for name in names:
         document = _parsed(shipped("study", name))
         if isinstance(document, dict) and ("reference" in document or "tasks" in document):
             out.append(document)
+            if "machine" in document and document.get("tasks"):
+                for task in document["tasks"]:
+                    if task["reference"].get("kind") == "csv":
+                        task["reference"].setdefault("control_points", _PROBE_FIT_POINTS)
+                task = document["tasks"][0]
+                single = {k: v for k, v in document.items() if k != "tasks"}
+                single["reference"] = task["reference"]
+                single.update({k: task[k] for k in ("payload",) if k in task})
+                single["spline"] = {**single.get("spline", {}), **{"control_points": task["control_points"]}}
+                out.append(single)
     return out
 
 
@@ -89,6 +128,18 @@ def _via_file(document: Any, reader: Callable[[Path], object]) -> object:
         path = Path(folder) / "probe.yaml"
         path.write_text(yaml.safe_dump(document))
         return reader(path)
+
+
+def _load_soil(document: Any) -> object:
+    from hiab_sim.machine.dynamics.soil_file import soil_from_mapping
+
+    return soil_from_mapping(document)
+
+
+def _soil_documents() -> list[Any]:
+    from hiab_sim.machine.dynamics.soil_file import SOILS, locate_soil
+
+    return [_parsed(locate_soil(name)) for name in sorted(SOILS)]
 
 
 def _load_sweep(document: Any) -> object:
@@ -136,9 +187,26 @@ FORMATS: dict[str, FileFormat] = {
             "EMLA file",
             "hiab_sim.emla.config.load_emla_set",
             _load_emla,
-            lambda: [_parsed(shipped("emla", "default"))],
+            lambda: [_parsed(shipped("emla", name)) for name in ("default", "exact")],  # the crane's names, a machine's
         ),
-        FileFormat("study", "Study file", "hiab_sim.study.spec.study_file.load_study", _load_study, _study_documents),
+        FileFormat(
+            "study",
+            "Study file",
+            "hiab_sim.study.spec.study_file.load_study",
+            _load_study,
+            _study_documents,
+            (
+                Form("crane", "crane", "a crane file's study (`crane:`)"),
+                Form("machine", "machine", "a machine file's study (`machine:`, `study_file.machine_study_from_dict`)"),
+            ),
+        ),
+        FileFormat(
+            "soil",
+            "Soil file",
+            "hiab_sim.machine.dynamics.soil_file.load_soil",
+            _load_soil,
+            _soil_documents,
+        ),
         FileFormat("sweep", "Sweep file", "hiab_sim.sweep.spec.load_sweep", _load_sweep, _sweep_documents),
         FileFormat(
             "cases",

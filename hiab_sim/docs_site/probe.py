@@ -7,6 +7,10 @@ Keys a valid document holds and the loader reads without error count as accepted
 file-format reference compares these sets with the documented keys, so the reference can name neither
 a key the loaders reject nor miss one they accept.
 
+A format with several forms (a study names a crane file or a machine file:
+:class:`hiab_sim.docs_site.formats.Form`) is probed per form, on that form's documents only
+(:func:`hiab_sim.docs_site.file_formats.discrepancies`).
+
 Path grammar: segments joined by ``.``; ``name[]`` is the first element of a list; ``name{kind}`` a
 mapping whose ``kind`` is ``kind``; ``<word>`` any key (the first the document has there).
 """

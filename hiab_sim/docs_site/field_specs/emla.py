@@ -1,13 +1,14 @@
 """The EMLA file's keys (:func:`hiab_sim.emla.config.emla_set_from_mapping`), from the EMLA dataclasses.
 
-Every value may carry its provenance (``{value, source}``); an actuator may override any shared section.
+Every value may carry its provenance (``{value, source}``); the actuators are a mapping of any names (a
+study checks them against its machine's actuators), each may override any shared section.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
 
-from hiab_sim.docs_site.field_specs.rows import Key, from_class, section, sourced
+from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, section, sourced
 
 
 def emla_keys() -> list[Key]:
@@ -39,30 +40,28 @@ def emla_keys() -> list[Key]:
     rows = [
         section("pmsm", "The motor shared by every actuator (an actuator may override any key in its own `pmsm`)."),
         *[replace(k, path=f"pmsm.{k.path}") for k in pmsm],
-        section("actuators", "One section per actuator (`lift`, `tilt`, `telescope`)."),
+        free(
+            "actuators",
+            "Actuator name (an identifier) -> actuator, at least one. A study checks the names against its "
+            "machine's actuators: a crane file's `lift`, `tilt`, `telescope`; a machine file's `actuators`.",
+            "mapping",
+        ),
     ]
-    for name in ("lift", "tilt", "telescope"):
-        where = f"actuators.{name}"
-        rows.append(section(where, f"The {name} EMLA: gearbox, screw, optional overrides."))
-        rows += [replace(k, path=f"{where}.{k.path}") for k in actuator]
-        rows.append(section(f"{where}.pmsm", "Overrides of the shared `pmsm` keys.", default="none"))
-        rows += [replace(k, path=f"{where}.pmsm.{k.path}", default="shared") for k in pmsm]
-        rows.append(section(f"{where}.thermal", "Overrides of the shared `thermal` keys.", default="none"))
-        rows += [replace(k, path=f"{where}.thermal.{k.path}", default="shared") for k in thermal]
-        rows.append(section(f"{where}.drive_losses", "Overrides of the shared `drive_losses` keys.", default="none"))
-        rows += [replace(k, path=f"{where}.drive_losses.{k.path}", default="shared") for k in losses]
-        for key, doc, keys in (
-            ("winding_resistance", "Overrides of the shared `winding_resistance` keys.", winding),
-            ("holding_brake", "Overrides of the shared `holding_brake` keys.", brake),
-        ):
-            rows.append(section(f"{where}.{key}", doc, default="none"))
-            rows += [replace(k, path=f"{where}.{key}.{k.path}", default="shared") for k in keys]
-        rows.append(section(f"{where}.screw", "Overrides of the shared `screw` keys.", default="none"))
-        rows += [replace(k, path=f"{where}.screw.{k.path}", default="shared") for k in screw]
-        rows.append(
-            section(f"{where}.drive_stiffness", "Overrides of the shared `drive_stiffness` keys.", default="none")
-        )
-        rows += [replace(k, path=f"{where}.drive_stiffness.{k.path}", default="shared") for k in stiffness]
+    where = "actuators.<actuator>"
+    rows.append(section(where, "One EMLA: gearbox, screw, optional overrides of the shared sections."))
+    rows += [replace(k, path=f"{where}.{k.path}") for k in actuator]
+    rows.append(section(f"{where}.pmsm", "Overrides of the shared `pmsm` keys.", default="none"))
+    rows += [replace(k, path=f"{where}.pmsm.{k.path}", default="shared") for k in pmsm]
+    for key, keys in (
+        ("thermal", thermal),
+        ("drive_losses", losses),
+        ("winding_resistance", winding),
+        ("holding_brake", brake),
+        ("screw", screw),
+        ("drive_stiffness", stiffness),
+    ):
+        rows.append(section(f"{where}.{key}", f"Overrides of the shared `{key}` keys.", default="none"))
+        rows += [replace(k, path=f"{where}.{key}.{k.path}", default="shared") for k in keys]
     rows += [
         section(
             "thermal",

@@ -48,15 +48,17 @@ def reference_keys(where: str) -> list[Key]:
         Key(
             "file",
             type="path",
-            description="CSV `t, x, y[, xt2]` (TCP) or `t, theta1, theta2, xt2` (joints), "
-            "SI units, a header row, `#` comments; relative to the study file.",
+            description="CSV in the machine's columns: `t, x, y` and each further tracked coordinate by name "
+            "(TCP form: the crane's `xt2`, a machine file's `tracked`, e.g. `tcp_angle`) or `t` and every joint "
+            "by name (joint form: the crane's `theta1, theta2, xt2`); SI units, a header row, `#` comments; "
+            "relative to the study file.",
         ),
         Key(
             "telescope",
             type="number",
-            unit="m",
+            unit="m (the coordinate's)",
             default="none",
-            description="xt2 when the TCP file has no `xt2` column.",
+            description="The further tracked coordinate (the crane's xt2) when the TCP file has no column for it.",
         ),
         Key(
             "control_points",
@@ -75,9 +77,16 @@ def reference_keys(where: str) -> list[Key]:
         ),
     ]
     needed = "one of `reference`, `tasks`" if where == "reference" else "required"
-    rows = [section(f"{where}{{spiral}}", "A TCP spiral in the vertical plane (kind omitted or `spiral`).", needed)]
+    machine = " A machine file's study: only where its third tracked coordinate is a joint (else `csv`)."
+    rows = [
+        section(
+            f"{where}{{spiral}}", "A TCP spiral in the vertical plane (kind omitted or `spiral`)." + machine, needed
+        )
+    ]
     rows += [replace(k, path=f"{where}{{spiral}}.{k.path.lstrip('.')}") for k in spiral]
-    rows.append(section(f"{where}{{pick_and_place}}", "Rest to rest from `pick` to `place` over a clearance.", needed))
+    rows.append(
+        section(f"{where}{{pick_and_place}}", "Rest to rest from `pick` to `place` over a clearance." + machine, needed)
+    )
     rows += [replace(k, path=f"{where}{{pick_and_place}}.{k.path.lstrip('.')}") for k in pick]
     rows.append(section(f"{where}{{csv}}", "A sampled trajectory from a CSV file, fitted by a B-spline.", needed))
     rows += [replace(k, path=f"{where}{{csv}}.{k.path.lstrip('.')}") for k in csv]
@@ -93,3 +102,34 @@ def payload_keys(where: str) -> list[Key]:
     ]
     rows += [replace(k, path=f"{where}.{k.path}") for k in from_class("", Payload)]
     return rows
+
+
+def soil_keys(where: str) -> list[Key]:
+    """A task's soil contact at ``where`` (:meth:`hiab_sim.study.spec.soil_contact.SoilContact.from_mapping`)."""
+    from hiab_sim.machine.dynamics.soil_file import SOILS
+    from hiab_sim.study.spec.soil_contact import ATTITUDE, SoilContact
+
+    facts = from_class("", SoilContact, skip=("source", "soil"))
+    rows = {k.path: k for k in facts}
+    return [
+        section(
+            where,
+            "The soil the tool tip (the TCP) cuts along the reference: its cutting force (the fundamental "
+            f"earthmoving equation) on the TCP; needs `{ATTITUDE}` among the machine's `tracked`.",
+            default="none",
+        ),
+        Key(
+            f"{where}.soil",
+            type="text",
+            allowed="one of " + ", ".join(f"`{n}`" for n in SOILS) + ", or a soil file",
+            description="A shipped soil or a soil file (see Soil file below); a path is read from the working folder, "
+            "not next to the study.",
+        ),
+        replace(
+            rows["ground"],
+            path=f"{where}.ground",
+            unit="m",
+            description="Height of the horizontal ground surface in the world frame.",
+        ),
+        replace(rows["width"], path=f"{where}.width", unit="m", description="The bucket's cutting-edge width."),
+    ]

@@ -20,12 +20,16 @@ class Key:
     """One documented key: dotted path (grammar of :mod:`hiab_sim.docs_site.probe`), kind and its facts."""
 
     path: str
-    kind: str = "value"  # "value", "section" (a mapping of the keys below it) or "free" (any key)
+    #: "value", "section" (a mapping of the keys below it), "free" (any key) or "names" (keys the loader
+    #: takes from another file, e.g. a machine's decision variables: checked, but not listed here)
+    kind: str = "value"
     type: str = ""
     unit: str = ""
     default: str = ""
     allowed: str = ""
     description: str = ""
+    #: The form of the file the key belongs to (:class:`hiab_sim.docs_site.formats.Form`); "" every form.
+    form: str = ""
 
 
 def section(path: str, description: str, default: str = "required") -> Key:
@@ -36,6 +40,16 @@ def section(path: str, description: str, default: str = "required") -> Key:
 def free(path: str, description: str, type_: str = "") -> Key:
     """A mapping whose keys are names or dotted paths chosen by the user."""
     return Key(path, "free", type_, description=description)
+
+
+def names(path: str, description: str, type_: str = "", form: str = "", default: str = "") -> Key:
+    """A mapping whose keys are names another file defines (the loader checks them against that file)."""
+    return Key(path, "names", type_, default=default, description=description, form=form)
+
+
+def in_form(form: str, keys: list[Key]) -> list[Key]:
+    """``keys`` marked as belonging to the file form ``form`` only."""
+    return [replace(k, form=form) for k in keys]
 
 
 def from_class(prefix: str, cls: type, skip: tuple[str, ...] = ("label",), **overrides: dict[str, str]) -> list[Key]:

@@ -1,9 +1,16 @@
-"""The study file's keys (:func:`hiab_sim.study.spec.study_file.study_from_dict`), from its settings dataclasses."""
+"""The study file's keys (:func:`hiab_sim.study.spec.study_file.study_from_dict`), from its settings dataclasses.
+
+Two forms: a crane file's study (``crane:``) and a machine file's (``machine:``,
+:func:`~hiab_sim.study.spec.study_file.machine_study_from_dict`); a row with a ``form`` belongs to that one only.
+"""
 
 from __future__ import annotations
 
-from hiab_sim.docs_site.field_specs.references import payload_keys, reference_keys
-from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, section
+from dataclasses import replace
+
+from hiab_sim.docs_site.dataclass_fields import field_rows
+from hiab_sim.docs_site.field_specs.references import payload_keys, reference_keys, soil_keys
+from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, in_form, names, section
 
 
 def _structure_keys() -> list[Key]:
@@ -23,128 +30,9 @@ def _structure_keys() -> list[Key]:
     ]
 
 
-def study_keys() -> list[Key]:
-    """The study file (:func:`hiab_sim.study.spec.study_file.study_from_dict`)."""
-    from hiab_sim.study.nlp.objectives import OBJECTIVES
-    from hiab_sim.study.spec.build import BuildSettings
-    from hiab_sim.study.spec.energy import DutySettings
-    from hiab_sim.study.spec.study_file import GridSettings, SolverSettings, SplineSettings, Tracking
-
-    rows = [
-        Key("name", type="text", default="the file's stem", description="Study name (result folder, reports)."),
-        Key("crane", type="text", description="Crane preset name (`xs031`) or a crane file, relative to the study."),
-        Key("emla", type="text", default="default", description="EMLA preset name or an EMLA file."),
-        section(
-            "initial_lengths",
-            "Start of the optimisation (default: the crane's own lengths, moved into the bounds).",
-            default="the crane's",
-        ),
-    ]
-    for chain in ("lift", "tilt"):
-        rows.append(section(f"initial_lengths.{chain}", f"The {chain} chain's start."))
-        rows += [
-            Key(
-                f"initial_lengths.{chain}.{k}", type="number", unit="m", allowed="> 0, within the bounds", description=d
-            )
-            for k, d in (("L", "Base pivot -> boom hinge."), ("Lc0", "Piston offset."), ("Lc", "Rod length."))
-        ]
-    rows += [
-        section("spline", "Joint-trajectory B-splines (eqs. `matrix_basis`..`matrix_basis_dd`).", "defaults"),
-        *from_class("spline", SplineSettings),
-    ]
-    rows += [section("grid", "Collocation grid.", "defaults"), *from_class("grid", GridSettings)]
-    rows += reference_keys("reference")
-    rows += payload_keys("payload")
-    rows += [
-        Key(
-            "tasks",
-            kind="value",
-            type="list",
-            default="one of `reference`, `tasks`",
-            description="Tasks of a duty mix (instead of `reference` and `payload`).",
-        ),
-        section("tasks[]", "One task."),
-        Key("tasks[].name", type="text", description="Unique task name."),
-        Key("tasks[].weight", type="number", allowed="> 0", description="Share of the work (e.g. cycles per hour)."),
-        Key(
-            "tasks[].control_points",
-            type="integer",
-            default="by duration",
-            allowed=">= 7",
-            description="The task's spline control points.",
-        ),
-        *reference_keys("tasks[].reference"),
-        *payload_keys("tasks[].payload"),
-    ]
-    rows += [section("tracking", "Tolerance bands of const_b..const_d.", "defaults"), *from_class("tracking", Tracking)]
-    rows += _structure_keys()
-    rows += [
-        section("bounds", "Box and path bounds of the NLP."),
-        *[
-            k
-            for chain in ("lift", "tilt")
-            for k in (
-                section(f"bounds.{chain}", f"Bounds of the {chain} chain's Xi (const_g)."),
-                Key(
-                    f"bounds.{chain}.low",
-                    type="[number, number, number]",
-                    unit="m",
-                    allowed="0 < low < up",
-                    description="Lower bounds of L, Lc0, Lc.",
-                ),
-                Key(
-                    f"bounds.{chain}.up",
-                    type="[number, number, number]",
-                    unit="m",
-                    description="Upper bounds of L, Lc0, Lc.",
-                ),
-            )
-        ],
-        Key(
-            "bounds.joint_velocity",
-            type="[number, number, number]",
-            unit="rad/s, rad/s, m/s",
-            default="[0.6, 0.6, 0.5]",
-            allowed="> 0",
-            description="Joint-velocity limits (const_i).",
-        ),
-        Key(
-            "bounds.triangle_margin_deg",
-            type="number",
-            unit="deg",
-            default="10",
-            allowed="[0, 60)",
-            description="Smallest interior angle at the boom hinge and its supplement (const_k).",
-        ),
-        Key(
-            "bounds.working_margin_deg",
-            type="number",
-            unit="deg",
-            default="3",
-            allowed="[0, 30]",
-            description="With `working_range: reference`, the reference's joint range widened by this.",
-        ),
-        Key(
-            "bounds.envelope_margin",
-            type="number",
-            default="0.02",
-            allowed="[0, 0.5)",
-            description="EMLA envelope margins held at the collocation points.",
-        ),
-        Key(
-            "bounds.working_range",
-            type="text",
-            default="crane",
-            allowed="one of `crane`, `reference`",
-            description="`crane`: the design serves the crane's full joint range; `reference`: only the reference's.",
-        ),
-    ]
-    rows += [section("solver", "Solver settings.", "defaults"), *from_class("solver", SolverSettings)]
-    rows += [
-        section("build", "Manufacturing tolerance and stroke margin.", "defaults"),
-        *from_class("build", BuildSettings),
-    ]
-    rows += [
+def _mounting_keys() -> list[Key]:
+    """The study's ``mounting`` section (:meth:`hiab_sim.crane.mounting.MountingSpace.from_mapping`)."""
+    return [
         section("mounting", "Mounting-space polygons of the base pivots and a pin clearance.", "none"),
         Key(
             "mounting.lift",
@@ -175,6 +63,183 @@ def study_keys() -> list[Key]:
             allowed=">= 2",
             description="Joint samples over the working range for the boom clearance.",
         ),
+    ]
+
+
+def study_keys() -> list[Key]:
+    """The study file (:func:`hiab_sim.study.spec.study_file.study_from_dict`)."""
+    from hiab_sim.machine.loader import PRESETS as MACHINE_PRESETS
+    from hiab_sim.study.nlp.objectives import OBJECTIVES
+    from hiab_sim.study.spec.build import BuildSettings
+    from hiab_sim.study.spec.energy import DutySettings
+    from hiab_sim.study.spec.study_file import Bounds, GridSettings, SolverSettings, SplineSettings, Tracking
+
+    bounds = field_rows(Bounds, ())
+
+    rows = [
+        Key("name", type="text", default="the file's stem", description="Study name (result folder, reports)."),
+        Key(
+            "crane",
+            type="text",
+            description="Crane preset name (`xs031`) or a crane file, relative to the study.",
+            form="crane",
+        ),
+        Key(
+            "machine",
+            type="text",
+            allowed="one of " + ", ".join(f"`{n}`" for n in MACHINE_PRESETS) + ", or a path",
+            description="Shipped machine name or a machine file, relative to the study.",
+            form="machine",
+        ),
+        Key(
+            "tracked",
+            type="list of text",
+            default="`tcp_angle` per joint beyond two",
+            allowed="joint names or `tcp_angle`",
+            description="The tracked coordinates beyond the TCP's x, y (one per joint beyond two): "
+            "the reference's further columns, held within the tracking bands.",
+            form="machine",
+        ),
+        Key(
+            "emla",
+            type="text",
+            default="`default` (crane form); required (machine form)",
+            description="EMLA preset name or an EMLA file; its actuator names must be the machine's actuators.",
+        ),
+        section(
+            "initial_lengths",
+            "Start of the optimisation (default: the crane's own lengths, moved into the bounds).",
+            default="the crane's",
+        ),
+    ]
+    for chain in ("lift", "tilt"):
+        rows.append(section(f"initial_lengths.{chain}", f"The {chain} chain's start."))
+        rows += [
+            Key(
+                f"initial_lengths.{chain}.{k}", type="number", unit="m", allowed="> 0, within the bounds", description=d
+            )
+            for k, d in (("L", "Base pivot -> boom hinge."), ("Lc0", "Piston offset."), ("Lc", "Rod length."))
+        ]
+    rows = [*rows[:5], *in_form("crane", rows[5:])]  # the crane's initial lengths; the machine's below
+    rows.append(
+        names(
+            "initial_lengths",
+            "Decision variable `chain.variable` (as `hiab-sim machine show` lists them) -> start value "
+            "[the variable's unit], within the machine file's bounds.",
+            "mapping",
+            form="machine",
+            default="the machine file's values",
+        )
+    )
+    rows += [
+        section("spline", "Joint-trajectory B-splines (eqs. `matrix_basis`..`matrix_basis_dd`).", "defaults"),
+        *from_class("spline", SplineSettings),
+    ]
+    rows += [section("grid", "Collocation grid.", "defaults"), *from_class("grid", GridSettings)]
+    rows += reference_keys("reference")
+    rows += payload_keys("payload")
+    rows += [
+        Key(
+            "tasks",
+            kind="value",
+            type="list",
+            default="one of `reference`, `tasks`",
+            description="Tasks of a duty mix (instead of `reference` and `payload`).",
+        ),
+        section("tasks[]", "One task."),
+        Key("tasks[].name", type="text", description="Unique task name."),
+        Key("tasks[].weight", type="number", allowed="> 0", description="Share of the work (e.g. cycles per hour)."),
+        Key(
+            "tasks[].control_points",
+            type="integer",
+            default="by duration",
+            allowed=">= 7",
+            description="The task's spline control points.",
+        ),
+        *reference_keys("tasks[].reference"),
+        *payload_keys("tasks[].payload"),
+        *soil_keys("tasks[].soil"),
+    ]
+    rows += [section("tracking", "Tolerance bands of const_b..const_d.", "defaults"), *from_class("tracking", Tracking)]
+    rows += in_form("crane", _structure_keys())
+    rows += [
+        section("bounds", "Box and path bounds of the NLP (a machine file declares its decision variables' own)."),
+        *[
+            replace(k, form="crane")
+            for chain in ("lift", "tilt")
+            for k in (
+                section(f"bounds.{chain}", f"Bounds of the {chain} chain's Xi (const_g)."),
+                Key(
+                    f"bounds.{chain}.low",
+                    type="[number, number, number]",
+                    unit="m",
+                    allowed="0 < low < up",
+                    description="Lower bounds of L, Lc0, Lc.",
+                ),
+                Key(
+                    f"bounds.{chain}.up",
+                    type="[number, number, number]",
+                    unit="m",
+                    description="Upper bounds of L, Lc0, Lc.",
+                ),
+            )
+        ],
+        Key(
+            "bounds.joint_velocity",
+            type="[number, number, number]",
+            unit="rad/s, rad/s, m/s",
+            default=bounds["joint_velocity"]["default"],
+            allowed="> 0",
+            description="Joint-velocity limits |dtheta1|, |dtheta2|, |dxt2| (const_i).",
+            form="crane",
+        ),
+        Key(
+            "bounds.joint_velocity",
+            type="list of number, one per joint",
+            unit="rad/s or m/s (the joint's)",
+            allowed="> 0",
+            description="Joint-velocity limits in the machine's joint order (const_i).",
+            form="machine",
+        ),
+        Key(
+            "bounds.triangle_margin_deg",
+            type="number",
+            unit="deg",
+            default="10",
+            allowed="[0, 60)",
+            description="Smallest interior angle at the boom hinge and its supplement (const_k).",
+        ),
+        Key(
+            "bounds.working_margin_deg",
+            type="number",
+            unit="deg",
+            default="3",
+            allowed="[0, 30]",
+            description="With `working_range: reference`, the reference's joint range widened by this.",
+        ),
+        Key(
+            "bounds.envelope_margin",
+            type="number",
+            default="0.02",
+            allowed="[0, 0.5)",
+            description="EMLA envelope margins held at the collocation points.",
+        ),
+        Key(
+            "bounds.working_range",
+            type="text",
+            default=bounds["working_range"]["default"],
+            allowed=bounds["working_range"]["allowed"],
+            description="`crane` or `machine`: the design serves the machine's full joint range (the crane's, or "
+            "each joint's working range in the machine file); `reference`: only the reference's.",
+        ),
+    ]
+    rows += [section("solver", "Solver settings.", "defaults"), *from_class("solver", SolverSettings)]
+    rows += [
+        section("build", "Manufacturing tolerance and stroke margin.", "defaults"),
+        *from_class("build", BuildSettings),
+    ]
+    rows += in_form("crane", _mounting_keys())
+    rows += [
         Key(
             "objective",
             type="text",
