@@ -65,7 +65,8 @@ def load_emla_set(path: str | Path | Source | None = None, relative_to: Source |
 
     ``None`` loads the XS 031 default preset; a relative path resolves next to ``relative_to``
     when given (see :func:`hiab_sim.resources.locate`). The file has a shared ``pmsm`` section
-    and an ``actuators`` section with ``lift``, ``tilt`` and ``telescope``; an actuator may
+    and an ``actuators`` section with one section per actuator, named as the machine names them (the
+    XS 031's ``lift``, ``tilt``, ``telescope`` are put in that order); an actuator may
     override motor parameters in its own ``pmsm`` mapping. Every value is a bare number or
     ``{value: ..., source: "read|estimate|derived|model: ..."}``.
 

@@ -146,7 +146,9 @@ class StudyProblem:
             self.row_name(k, f"rest {i}") for k in range(len(self.tasks)) for i in range(first.n_equalities)
         ]
         self.cost_scale = 1.0
-        self.cost_scale = max(self.evaluate(self.initial_point(study.initial_lengths)).cost, 1e-300)
+        self.cost_scale = max(
+            abs(self.evaluate(self.initial_point(study.initial_lengths)).cost), 1e-300
+        )  # |f0|: an energy may be negative
 
     @property
     def n_tasks(self) -> int:

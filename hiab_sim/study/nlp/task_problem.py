@@ -205,7 +205,7 @@ class TaskProblem:
                     error.value,
                     f"the start is not an admissible crane: {error.allowed}",
                 ) from None
-        self.cost_scale = max(float(cost_scale), 1e-300)
+        self.cost_scale = max(abs(float(cost_scale)), 1e-300)  # |f0|: a battery energy may be negative (recovered)
 
     def fine_times(self) -> Array:
         """The task's re-check grid: ``grid.fine_factor`` times denser than its collocation grid [s]."""

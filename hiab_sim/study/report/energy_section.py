@@ -342,7 +342,7 @@ def energy_lines(r: Result) -> list[str]:
         lines.append(
             "hydraulic baselines at the battery, same cycle: "
             + ", ".join(
-                f"{k} {v.cycle_battery_energy_J / 1e3:.2f} kJ (EMLA -{v.emla_saving_percent:.1f} %)"
+                f"{k} {v.cycle_battery_energy_J / 1e3:.2f} kJ (EMLA {-v.emla_saving_percent:+.1f} %)"
                 for k, v in h.optimal.at_battery.items()
             )
         )

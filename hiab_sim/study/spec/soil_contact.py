@@ -18,6 +18,7 @@ it leaves out is at most that band (module docstring of :mod:`hiab_sim.study.spe
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -67,10 +68,12 @@ class SoilContact:
         return np.column_stack([planar, np.zeros(len(planar))])
 
     @classmethod
-    def from_mapping(cls, data: Any, where: str = "soil") -> SoilContact:
-        """Read ``{soil, ground, width}``."""
+    def from_mapping(cls, data: Any, where: str = "soil", folder: Path | None = None) -> SoilContact:
+        """Read ``{soil, ground, width}``; a soil file's relative path resolves next to the study (``folder``)."""
         d = mapping(data, where, {"soil", "ground", "width"}, {"soil", "ground", "width"})
         source = str(d["soil"])
+        if folder is not None and not Path(source).is_absolute() and (folder / source).is_file():
+            source = str(folder / source)
         return cls(
             source=source,
             ground=number(d["ground"], f"{where}.ground"),

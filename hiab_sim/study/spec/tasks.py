@@ -159,7 +159,7 @@ def tasks_from_mapping(
                 reference=reference_from_mapping(d["reference"], f"{where}.reference", folder, grid_duration, names),
                 payload=Payload.from_value(d.get("payload", 0.0), f"{where}.payload"),
                 control_points=points,
-                soil=None if d.get("soil") is None else SoilContact.from_mapping(d["soil"], f"{where}.soil"),
+                soil=None if d.get("soil") is None else SoilContact.from_mapping(d["soil"], f"{where}.soil", folder),
             )
         except InvalidInputError as error:
             raise InvalidInputError(_prefixed(where, error.field), error.value, error.allowed, error.unit) from None
