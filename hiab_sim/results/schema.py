@@ -25,6 +25,7 @@ from hiab_sim.results.analysis_sections import Buildable, CrossEvaluation, Feasi
 from hiab_sim.results.codec import from_json, optional, to_json
 from hiab_sim.results.design_values import DesignValues
 from hiab_sim.results.energy_sections import Codesign, EnergyReport, HydraulicBaseline
+from hiab_sim.results.multistart import MultiStart
 from hiab_sim.results.playback_view import PlaybackView as PlaybackView  # re-exported: the renderer's contract
 from hiab_sim.structure.summary import StructureSummary
 
@@ -204,50 +205,6 @@ class Recheck:
     net_electrical_energy_J: float
     initial_max_violation_scaled: float
     force_difference_between_paths_N: float
-
-
-@dataclass(frozen=True)
-class StartRow:
-    """One start of a multi-start run; a failed start has no optimal lengths or cost."""
-
-    start: int
-    initial_lengths: DesignValues
-    optimal_lengths: DesignValues | None
-    cost_W2s: float | None
-    success: bool
-    message: str
-    iterations: int
-
-
-@dataclass(frozen=True)
-class DistinctOptimum:
-    """Converged starts whose Xi agree within the tolerance; energy written with more than one start."""
-
-    xi: tuple[float, ...]  # [m], lift L, Lc0, Lc, tilt L, Lc0, Lc
-    cost_W2s: float | None
-    starts: tuple[int, ...]
-    net_electrical_energy_J: float | None = optional()
-
-
-@dataclass(frozen=True)
-class FailedStart:
-    """A start whose solver failed (no optimum)."""
-
-    start: int
-    initial_xi: tuple[float, ...]
-    message: str
-
-
-@dataclass(frozen=True)
-class MultiStart:
-    """Whether every converged start reached the same Xi within ``tolerance_m``; else the distinct optima."""
-
-    starts: tuple[StartRow, ...]
-    tolerance_m: float
-    converged_starts: int
-    same_optimum: bool
-    distinct_optima: tuple[DistinctOptimum, ...]
-    failed_starts: tuple[FailedStart, ...]
 
 
 @dataclass(frozen=True)

@@ -26,17 +26,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.atomic_io import write_atomic
+from hiab_sim.results.multistart import DistinctOptimum, FailedStart, MultiStart, StartRow
 from hiab_sim.results.schema import (
     RESULT_FILE,
     CrossEvaluation,
-    DistinctOptimum,
-    FailedStart,
     HistoryRow,
     Improvement,
-    MultiStart,
     Result,
     Settings,
-    StartRow,
     TaskResult,
 )
 from hiab_sim.results.trajectory_file import write_trajectory
