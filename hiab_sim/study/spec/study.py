@@ -73,6 +73,12 @@ class Study:
                 raise InvalidInputError(
                     f"initial_lengths.{name}", float(start), f"must lie in the bounds [{low:.6g}, {up:.6g}]", "m"
                 )
+        catalogue = self.energy.transmission
+        unknown = [] if catalogue is None else [n for n, _ in catalogue.options if n not in self.emlas.names]
+        if unknown:
+            raise InvalidInputError(
+                "transmission", ", ".join(unknown), f"keys must be the study's actuators: {', '.join(self.emlas.names)}"
+            )
         if len(self.bounds.joint_velocity) != len(self.model.joint_names):
             raise InvalidInputError(
                 "bounds.joint_velocity",
