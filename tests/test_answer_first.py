@@ -1,7 +1,7 @@
 """The answer first: energy-map, pareto and sweep open their console output with the answer, save it, draw no bars.
 
 Each command runs once on the tiny study (a few seconds each): its stdout begins with the text of
-``summary.txt`` in its output folder, that text holds the numbers of the command's own files
+``summary.md`` in its output folder, that text holds the numbers of the command's own files
 (``energy_map.json``, ``pareto.csv``, ``sweep.parquet`` and the points' ``result.json``), and
 nothing reaches stderr (no progress bar or status line when the output is not a terminal).
 """

@@ -38,7 +38,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Compute and write the map, print its answer first and save it as ``summary.txt``; return the exit status."""
+    """Compute and write the map, print its answer first and save it as ``summary.md``; return the exit status."""
     from hiab_sim.cli.answer_output import ANSWER_FILE, publish_answer
     from hiab_sim.study.nlp.task_problem import TaskProblem
     from hiab_sim.study.report.summary import limit_in_words

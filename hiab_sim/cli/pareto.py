@@ -29,7 +29,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Compute the front, write the table and figure, print the answer first (``summary.txt``); return the status."""
+    """Compute the front, write the table and figure, print the answer first (``summary.md``); return the status."""
     import pandas as pd
 
     from hiab_sim.atomic_io import write_atomic

@@ -29,7 +29,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the sweep, print its answer first (also ``summary.txt``), then the details; return the exit status."""
+    """Run the sweep, print its answer first (also ``summary.md``), then the details; return the exit status."""
     from hiab_sim.cli.answer_output import ANSWER_FILE, publish_answer
     from hiab_sim.results.read import read_result
     from hiab_sim.sweep.answers import sweep_answer
