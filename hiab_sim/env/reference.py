@@ -11,7 +11,7 @@ The TCP reference is interpolated with a cubic spline.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import mujoco
 import numpy as np
@@ -21,6 +21,7 @@ from scipy.interpolate import CubicSpline
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla.drive import drive_state
+from hiab_sim.emla.params import EmlaParams
 from hiab_sim.env.plan import DesignPlan
 from hiab_sim.model.mjcf import source_to_world
 
@@ -90,9 +91,16 @@ def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
     tcp_force = None if plan.payload == 0.0 else np.array([0.0, -plan.payload * plan.crane.gravity, 0.0])
     actuators = dynamics(joints, tcp_force)
     qpos, qvel, _ = dynamics.state(joints)
+    # the feedforward inverts the simulated drive: its screw and gearbox are ideal (the plant models no
+    # transmission efficiency), so the planner's transmission losses are left out of the current
     current = np.stack(
         [
-            drive_state(params, actuators.force[:, i], actuators.velocity[:, i], actuators.acceleration[:, i]).i_q
+            drive_state(
+                ideal_transmission(params),
+                actuators.force[:, i],
+                actuators.velocity[:, i],
+                actuators.acceleration[:, i],
+            ).i_q
             for i, params in enumerate(plan.emlas)
         ],
         axis=1,
@@ -118,3 +126,9 @@ def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
         reference_tcp=source_to_world(tcp),
         planned_tcp=planned_tcp,
     )
+
+
+def ideal_transmission(params: EmlaParams) -> EmlaParams:
+    """The EMLA with its screw and gearbox efficiency 1 (the closed loop's drive model), other losses kept."""
+    losses = replace(params.losses, transmission_efficiency_forward=1.0, transmission_efficiency_backdriven=1.0)
+    return replace(params, losses=losses)
