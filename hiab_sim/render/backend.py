@@ -19,9 +19,9 @@ import contextlib
 import os
 import shutil
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -155,6 +155,34 @@ def video_sink(path: Path, size: tuple[int, int], fps: float) -> Iterator[VideoS
                 raise
             detail = str(error).strip().splitlines()[-1]
             raise BackendUnavailableError(f"ffmpeg could not write {path}: {detail}") from None
+
+
+class FrameSource(Protocol):
+    """Frames by index: a renderer of a playback."""
+
+    def __len__(self) -> int:
+        """Number of frames."""
+        ...
+
+    def frame(self, index: int) -> NDArray[np.uint8]:
+        """Frame ``index`` as RGB (H, W, 3) uint8."""
+        ...
+
+
+def write_video(
+    frames: FrameSource,
+    path: Path,
+    size: tuple[int, int],
+    fps: float,
+    progress: Callable[[int, int], None] | None = None,
+) -> Path:
+    """Encode every frame of ``frames`` into ``path`` (:func:`video_sink`), reporting ``progress(done, total)``."""
+    with video_sink(path, size, fps) as sink:
+        for index in range(len(frames)):
+            sink.add(frames.frame(index))
+            if progress is not None:
+                progress(index + 1, len(frames))
+    return path
 
 
 def write_image(path: Path, image: NDArray[np.uint8]) -> Path:

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.render.backend import check_gl_backend, check_output_path, ffmpeg_path, video_sink, write_image
+from hiab_sim.render.backend import check_gl_backend, check_output_path, ffmpeg_path, write_image, write_video
 from hiab_sim.render.decor import INITIAL_RGBA, OPTIMAL_RGBA
 from hiab_sim.render.frames import LAYOUTS, Design, Layout, PlaybackRenderer
 from hiab_sim.render.machine_playback import (
@@ -66,12 +66,8 @@ def render_machine_result(
     output = Path(result_dir) / VIDEO_NAME if output is None else Path(output)
     check_output_path(output, (".mp4", ".gif"), "video")
     ffmpeg_path()
-    with machine_renderer(data, fps, size, layout) as renderer, video_sink(output, size, fps) as sink:
-        for index in range(len(renderer)):
-            sink.add(renderer.frame(index))
-            if progress is not None:
-                progress(index + 1, len(renderer))
-    return output
+    with machine_renderer(data, fps, size, layout) as renderer:
+        return write_video(renderer, output, size, fps, progress)
 
 
 def render_machine_frames(

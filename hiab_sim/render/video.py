@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.model.mjcf import build_model, source_to_world
-from hiab_sim.render.backend import check_gl_backend, check_output_path, ffmpeg_path, video_sink, write_image
+from hiab_sim.render.backend import check_gl_backend, check_output_path, ffmpeg_path, write_image, write_video
 from hiab_sim.render.decor import INITIAL_RGBA, OPTIMAL_RGBA
 from hiab_sim.render.dress import machine_dress
 from hiab_sim.render.frames import LAYOUTS, Design, Layout, PlaybackRenderer
@@ -179,15 +179,8 @@ def render_result(
     _check_size(size, even=output.suffix.lower() == ".mp4")
     check_output_path(output, (".mp4", ".gif"), "video")
     ffmpeg_path()
-    with (
-        playback_renderer(data, fps, size, mode, layout, energy=load_power(result_dir, data)) as renderer,
-        video_sink(output, size, fps) as sink,
-    ):
-        for index in range(len(renderer)):
-            sink.add(renderer.frame(index))
-            if progress is not None:
-                progress(index + 1, len(renderer))
-    return output
+    with playback_renderer(data, fps, size, mode, layout, energy=load_power(result_dir, data)) as renderer:
+        return write_video(renderer, output, size, fps, progress)
 
 
 def render_still(
