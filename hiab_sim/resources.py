@@ -9,6 +9,8 @@ kind          folder in the source tree   shipped names
 ``crane``     ``hiab_sim/presets/``       ``xs031``
 ``emla``      ``hiab_sim/presets/``       ``default``, ``xs031``, ``paper`` (the seed's), ``exact``
 ``plant``     ``hiab_sim/presets/``       ``realistic`` (the closed loop's plant effects)
+``machine``   ``hiab_sim/presets/``       ``xs031``, ``exact`` (machine files, :mod:`hiab_sim.machine`)
+``soil``      ``hiab_sim/presets/``       ``loose_sand``, ``medium_clay``
 ``study``     ``optimize/``               every ``*.yaml`` by its path without the suffix,
                                           e.g. ``xs031_spiral``, ``sweeps/<name>``
 ``cases``     ``validate/``               ``cases``
@@ -32,13 +34,15 @@ from typing import Literal
 
 from hiab_sim.errors import ConfigError
 
-Kind = Literal["crane", "emla", "study", "cases", "mjcf", "plant"]
+Kind = Literal["crane", "emla", "study", "cases", "mjcf", "plant", "machine", "soil"]
 
 #: Package (anchor) and sub-folder of each kind's shipped files.
 _FOLDERS: dict[str, tuple[str, str]] = {
     "crane": ("hiab_sim", "presets"),
     "emla": ("hiab_sim", "presets"),
     "plant": ("hiab_sim", "presets"),
+    "machine": ("hiab_sim", "presets"),
+    "soil": ("hiab_sim", "presets"),
     "study": ("hiab_sim._data.studies", ""),
     "cases": ("hiab_sim._data.validate", ""),
     "mjcf": ("hiab_sim._data.mjcf", ""),
@@ -53,6 +57,8 @@ _NAMED: dict[str, dict[str, str]] = {
         "exact": "emla_exact.yaml",
     },
     "plant": {"realistic": "plant_realistic.yaml"},
+    "machine": {"xs031": "xs031_machine.yaml", "exact": "exact_excavator.yaml"},
+    "soil": {"loose_sand": "soil_loose_sand.yaml", "medium_clay": "soil_medium_clay.yaml"},
 }
 _SUFFIX = {"mjcf": ".xml"}
 
@@ -64,6 +70,8 @@ _WHAT = {
     "cases": "case file",
     "mjcf": "MJCF file",
     "plant": "plant",
+    "machine": "machine",
+    "soil": "soil",
 }
 
 DEFAULT_STUDY = "xs031_spiral"
@@ -152,16 +160,19 @@ def shipped(kind: Kind, name: str) -> Source:
     return Source(name, names[name], shipped=True)
 
 
-def locate(source: str | Path, kind: Kind, relative_to: Source | None = None) -> Source:
+def locate(source: str | Path | Source, kind: Kind, relative_to: Source | None = None) -> Source:
     """Resolve a preset or shipped name, or a file path, to a :class:`Source`.
 
-    Order: a shipped name of ``kind`` (a ``str`` only); an absolute path; a relative path next
-    to ``relative_to`` (the file that names it) when given, else against the working folder.
+    Order: a :class:`Source` as it is (already located); a shipped name of ``kind`` (a ``str``
+    only); an absolute path; a relative path next to ``relative_to`` (the file that names it) when
+    given, else against the working folder.
 
     Raises:
         ConfigError: Neither a shipped name nor an existing file; the message names both options.
 
     """
+    if isinstance(source, Source):
+        return source
     if isinstance(source, str):
         names = shipped_names(kind)
         if source in names:

@@ -333,7 +333,7 @@ def load_cases(path: str | Path | Source = DEFAULT_CASES) -> tuple[Tolerances, l
         InvalidInputError: A value out of range, named by its field.
 
     """
-    found = path if isinstance(path, Source) else locate(path, "cases")
+    found = locate(path, "cases")
     top = mapping(read_yaml(found), found.label, {"tolerances", "payload_force", "cases"}, {"cases"})
     tolerances = Tolerances(**section(Tolerances, top.get("tolerances"), "tolerances"))
     payload = vector(top.get("payload_force", [0.0, -2452.0, 0.0]), "payload_force", 3)

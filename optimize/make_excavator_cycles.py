@@ -44,7 +44,8 @@ from hiab_sim.machine.description import Machine
 from hiab_sim.machine.kinematics.assembly import usable_stroke
 from hiab_sim.machine.kinematics.closure import joint_to_actuator
 from hiab_sim.machine.kinematics.forward import forward_kinematics
-from hiab_sim.machine.loader import load_machine, locate_machine
+from hiab_sim.machine.loader import load_machine
+from hiab_sim.resources import shipped
 from hiab_sim.study.references.kinds import septic_law
 
 HERE = Path(__file__).resolve().parent
@@ -343,7 +344,7 @@ def build(machine: Machine) -> dict[str, str]:
 def main(out_dir: Path = HERE) -> None:
     """Write both CSVs into ``out_dir`` and print their times and peak rod speeds."""
     machine = load_machine("exact")
-    if str(Y_GROUND) not in locate_machine("exact").read_text():
+    if str(Y_GROUND) not in shipped("machine", "exact").read_text():
         raise InvalidInputError("Y_GROUND", Y_GROUND, "must be the ground level the machine file states")
     out_dir.mkdir(parents=True, exist_ok=True)
     for file, text in build(machine).items():

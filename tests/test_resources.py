@@ -10,7 +10,7 @@ import yaml
 from hiab_sim.cli import main
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.errors import ConfigError
-from hiab_sim.resources import locate, shipped, shipped_names
+from hiab_sim.resources import Kind, locate, shipped, shipped_names
 from hiab_sim.study.spec.study_file import load_study, study_from_dict
 
 REPO = Path(__file__).resolve().parents[1]
@@ -78,3 +78,24 @@ def test_optimize_accepts_a_shipped_study_name(tmp_path: Path, capsys: pytest.Ca
     assert main(["optimize", "no_such_study", "--out", str(tmp_path / "o"), "--no-video", "--no-figures"]) == 2
     err = capsys.readouterr().err.strip()
     assert "xs031_spiral" in err and len(err.splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    ("kind", "name", "file"),
+    [("machine", "exact", "exact_excavator.yaml"), ("soil", "medium_clay", "soil_medium_clay.yaml")],
+)
+def test_machines_and_soils_resolve_like_every_kind(tmp_path: Path, kind: Kind, name: str, file: str) -> None:
+    """A shipped machine or soil by name, the same file by path, and a missing one named with the shipped names."""
+    shipped_file = REPO / "hiab_sim" / "presets" / file
+    by_name = locate(name, kind)
+    assert by_name.shipped and by_name.read_text() == shipped_file.read_text(encoding="utf-8")
+    copy = tmp_path / file
+    copy.write_text(shipped_file.read_text(encoding="utf-8"), encoding="utf-8")
+    by_path = locate(str(copy), kind)
+    assert not by_path.shipped and by_path.read_text() == by_name.read_text()
+    assert locate(by_path, kind) is by_path
+    with pytest.raises(
+        ConfigError, match=rf"cannot read {kind} 'nope': neither a shipped name \(.*{name}.*\)"
+    ) as caught:
+        locate("nope", kind)
+    assert "\n" not in str(caught.value)

@@ -139,7 +139,7 @@ def test_soil_files_load_with_sources_and_refuse_bad_values_by_field() -> None:
         soil_from_mapping({**data, "adhesion_Pa": 1000.0})
     with pytest.raises(ConfigError, match="unknown"):
         soil_from_mapping({**data, "colour": "brown"})
-    with pytest.raises(ConfigError, match="shipped soil"):
+    with pytest.raises(ConfigError, match=r"soil 'no_such_soil': neither a shipped name \(loose_sand, medium_clay\)"):
         load_soil("no_such_soil")
 
 

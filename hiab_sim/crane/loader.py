@@ -76,7 +76,7 @@ def load_crane(source: str | Path | Source = "xs031", relative_to: Source | None
         InvalidInputError: a value out of its allowed range (the field is named).
 
     """
-    found = source if isinstance(source, Source) else locate(source, "crane", relative_to)
+    found = locate(source, "crane", relative_to)
     return crane_from_dict(read_yaml(found), origin=found.label)
 
 

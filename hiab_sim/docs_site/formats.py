@@ -68,9 +68,9 @@ def _machine_documents() -> list[Any]:
     The probe's ``<chain>`` is a document's first chain: the reordered copy lets it reach the
     ``linkage`` keys (and their bodies) on a chain that has a four-bar.
     """
-    from hiab_sim.machine.loader import PRESETS, locate_machine, read_machine_yaml
+    from hiab_sim.machine.loader import PRESETS, read_machine_yaml
 
-    documents = [read_machine_yaml(locate_machine(name)) for name in sorted(PRESETS, reverse=True)]
+    documents = [read_machine_yaml(shipped("machine", name)) for name in sorted(PRESETS, reverse=True)]
     for document in list(documents):
         chains = document["chains"]
         linkages = [name for name, chain in chains.items() if chain.get("kind") == "linkage"]
@@ -137,9 +137,9 @@ def _load_soil(document: Any) -> object:
 
 
 def _soil_documents() -> list[Any]:
-    from hiab_sim.machine.dynamics.soil_file import SOILS, locate_soil
+    from hiab_sim.machine.dynamics.soil_file import SOILS
 
-    return [_parsed(locate_soil(name)) for name in sorted(SOILS)]
+    return [_parsed(shipped("soil", name)) for name in sorted(SOILS)]
 
 
 def _load_sweep(document: Any) -> object:

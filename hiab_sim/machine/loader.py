@@ -13,7 +13,6 @@ lie within their declared bounds.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -26,11 +25,11 @@ from hiab_sim.machine.chains import Actuator, Chain, DecisionVariable, Hydraulic
 from hiab_sim.machine.description import Link, Machine
 from hiab_sim.machine.kinematics.assembly import check_machine
 from hiab_sim.machine.parts import IDENTITY, Matrix3, Pose, RigidBody, Vector3, rot_z
-from hiab_sim.resources import Source
+from hiab_sim.resources import Source, locate, shipped_names
 from hiab_sim.yaml_fields import integer, mapping, number, text, vector
 
-#: Shipped machines: name -> file in hiab_sim/presets/.
-PRESETS = {"xs031": "xs031_machine.yaml", "exact": "exact_excavator.yaml"}
+#: Shipped machines' names (files in hiab_sim/presets/, :mod:`hiab_sim.resources` kind ``machine``).
+PRESETS: tuple[str, ...] = tuple(shipped_names("machine"))
 
 _TOP = {"name", "source", "gravity", "links", "chains", "tcp"}
 _TOP_OPTIONAL = {"hydraulic", "workspace", "notes"}
@@ -68,21 +67,10 @@ def read_machine_yaml(source: Source) -> Any:
         raise ConfigError(f"{source.label}: not valid YAML: {' '.join(str(error).split())}") from None
 
 
-def locate_machine(source: str | Path | Source) -> Source:
-    """A shipped machine by name (``xs031``, ``exact``) or a file path; a missing file raises :class:`ConfigError`."""
-    if isinstance(source, Source):
-        return source
-    name = str(source)
-    if name in PRESETS:
-        return Source(name, resources.files("hiab_sim") / "presets" / PRESETS[name], True)
-    path = Path(name)
-    if not path.is_file():
-        raise ConfigError(f"machine {name!r}: no such file, nor a shipped machine ({', '.join(sorted(PRESETS))})")
-    return Source(str(path), path, False)
-
-
 def load_machine(source: str | Path | Source = "xs031", *, check_assembly: bool = True) -> Machine:
-    """Load and validate a machine; ``check_assembly`` False skips the working-range assembly check.
+    """Load and validate a machine (a shipped name or a path, :func:`hiab_sim.resources.locate`).
+
+    ``check_assembly`` False skips the working-range assembly check.
 
     Raises:
         ConfigError: unknown machine or file, malformed YAML, unknown or missing keys.
@@ -90,7 +78,7 @@ def load_machine(source: str | Path | Source = "xs031", *, check_assembly: bool 
             ``check_assembly``) the first assembly failure of :func:`check_machine`.
 
     """
-    found = locate_machine(source)
+    found = locate(source, "machine")
     return machine_from_dict(read_machine_yaml(found), origin=found.label, check_assembly=check_assembly)
 
 

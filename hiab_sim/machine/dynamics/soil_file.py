@@ -22,17 +22,16 @@ raise :class:`~hiab_sim.errors.InvalidInputError` naming the field (``soil.cohes
 from __future__ import annotations
 
 from collections.abc import Mapping
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
 from hiab_sim.errors import ConfigError
 from hiab_sim.machine.dynamics.soil import SoilProperties
-from hiab_sim.resources import Source
+from hiab_sim.resources import Source, locate, shipped_names
 from hiab_sim.yaml_fields import mapping, read_yaml, sourced_number, text
 
-#: Shipped soils: name -> file in hiab_sim/presets/.
-SOILS = {"loose_sand": "soil_loose_sand.yaml", "medium_clay": "soil_medium_clay.yaml"}
+#: Shipped soils' names (files in hiab_sim/presets/, :mod:`hiab_sim.resources` kind ``soil``).
+SOILS: tuple[str, ...] = tuple(shipped_names("soil"))
 #: The numbers of a soil file, in the order of SoilProperties' fields.
 FIELDS = (
     "density_kg_m3",
@@ -44,19 +43,6 @@ FIELDS = (
 )
 #: Provenance words a value's source starts with.
 PROVENANCE = ("read", "derived", "estimate")
-
-
-def locate_soil(source: str | Path | Source) -> Source:
-    """A shipped soil by name (``loose_sand``, ``medium_clay``) or a file path; neither raises ConfigError."""
-    if isinstance(source, Source):
-        return source
-    name = str(source)
-    if name in SOILS:
-        return Source(name, resources.files("hiab_sim") / "presets" / SOILS[name], True)
-    path = Path(name)
-    if not path.is_file():
-        raise ConfigError(f"soil {name!r}: no such file, nor a shipped soil ({', '.join(sorted(SOILS))})")
-    return Source(str(path), path, False)
 
 
 def soil_from_mapping(data: Any, where: str = "soil") -> SoilProperties:
@@ -73,6 +59,6 @@ def soil_from_mapping(data: Any, where: str = "soil") -> SoilProperties:
 
 
 def load_soil(source: str | Path | Source) -> SoilProperties:
-    """Read a soil file (a shipped name or a path) into validated SoilProperties."""
-    found = locate_soil(source)
+    """Read a soil file (a shipped name or a path, :func:`hiab_sim.resources.locate`) into validated SoilProperties."""
+    found = locate(source, "soil")
     return soil_from_mapping(read_yaml(found), where=found.label)

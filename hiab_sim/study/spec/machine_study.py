@@ -9,7 +9,7 @@ from typing import Any
 from hiab_sim.emla.config import load_emla_set
 from hiab_sim.errors import ConfigError
 from hiab_sim.machine.loader import PRESETS as MACHINE_PRESETS
-from hiab_sim.machine.loader import load_machine, locate_machine
+from hiab_sim.machine.loader import load_machine
 from hiab_sim.resources import Source, locate
 from hiab_sim.study.machines.machine_model import MachineModel
 from hiab_sim.study.spec.settings import (
@@ -39,7 +39,7 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
     folder = Path(str(file.file)).parent
     if source not in MACHINE_PRESETS and not path.is_absolute() and (folder / path).is_file():
         path = folder / path
-    machine_file = locate_machine(source if source in MACHINE_PRESETS else path)
+    machine_file = locate(source if source in MACHINE_PRESETS else path, "machine")
     machine = load_machine(machine_file)
     n = len(machine.joint_names)
     tracked_value = top.get("tracked", ["tcp_angle"] * (n - 2))
