@@ -69,6 +69,7 @@ from hiab_sim.crane.names import JOINT_NAMES
 from hiab_sim.dynamics.checks import check_joints, tcp_force_samples
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.model.mjcf import SLIDES, build_spec, source_to_world
+from hiab_sim.model.states import mechanical_energies
 
 Array = NDArray[np.float64]
 
@@ -248,16 +249,7 @@ class MujocoInverseDynamics:
         one of :meth:`state`.
         """
         qpos, qvel, _ = self.state(joints)
-        m, d = self.model, self.data
-        out = np.empty((len(joints), 2))
-        for i in range(len(joints)):
-            d.qpos[:] = qpos[i]
-            d.qvel[:] = qvel[i]
-            mujoco.mj_fwdPosition(m, d)
-            mujoco.mj_energyPos(m, d)
-            mujoco.mj_energyVel(m, d)
-            out[i] = d.energy
-        return out[:, 0], out[:, 1]
+        return mechanical_energies(self.model, self.data, qpos, qvel)
 
 
 def mechanical_energy(crane: Crane, lengths: LinkLengths | None, joints: JointSamples) -> Array:

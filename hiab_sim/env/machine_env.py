@@ -10,11 +10,12 @@ the Physics (:class:`~hiab_sim.env.physics.CranePhysics`), the tracking task
   simulation extras per chain: armature J_m k^2 + M_sm [kg] and damping b_f [N s/m] on the rod slide
   (eqs. ``torque_torque``, ``torque_force``), loops as ``connect`` equalities, one force motor per
   chain (ctrl = the drive's rod force k (tau - tau_f) [N]); implicit-fast integration at 1 ms.
-* **Planned motion.** The plan's joint samples joined by quintic Hermite interpolation at the
-  physics rate (:func:`hiab_sim.env.reference.quintic_hermite`), closed on the loops and solved for
-  the load-side f_x, v_x, a_x, x by MuJoCo inverse dynamics of the bare mechanism with the study's
-  TCP force (:class:`~hiab_sim.machine.dynamics.mujoco_path.MujocoMachineDynamics`, eq.
-  ``dynamics``); the feedforward current is :func:`hiab_sim.emla.drive.drive_state`'s i_q.
+* **Planned motion.** The crane's builder (:func:`hiab_sim.env.reference.motion_of_plan`): the
+  plan's joint samples joined by quintic Hermite interpolation at the physics rate, closed on the
+  loops and solved for the load-side f_x, v_x, a_x, x by MuJoCo inverse dynamics of the bare
+  mechanism with the study's TCP force
+  (:class:`~hiab_sim.machine.dynamics.mujoco_path.MujocoMachineDynamics`, eq. ``dynamics``); the
+  feedforward current is :func:`hiab_sim.emla.drive.drive_state`'s i_q of the study's drives.
 * **TCP load.** The plan's TCP force F(t) (:mod:`hiab_sim.env.machine_plan`) is applied at site
   ``tcp`` every physics step (``xfrc_applied``, with its moment about the body's centre of mass),
   at the planned time; during the settled start's hold, the first sample's. It is the planner's
@@ -41,13 +42,12 @@ from dm_control.rl import control
 from numpy.typing import NDArray
 
 from hiab_sim.control.cascade import CascadeGains
-from hiab_sim.emla.drive import drive_state
 from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator
 from hiab_sim.env import CURRENT_BANDWIDTH_HZ, PHYSICS_TIMESTEP
 from hiab_sim.env.loop_design import LoopDesign
 from hiab_sim.env.machine_plan import MachinePlan
 from hiab_sim.env.physics import CranePhysics
-from hiab_sim.env.reference import PlannedMotion, quintic_hermite
+from hiab_sim.env.reference import PlannedMotion, RodSamples, motion_of_plan, physics_times
 from hiab_sim.env.rollout import ClosedLoopRun, run_environment
 from hiab_sim.env.task import CraneTrackingTask
 from hiab_sim.errors import InvalidInputError
@@ -77,40 +77,17 @@ def _to_world(points: Array) -> Array:
 
 def machine_motion(plan: MachinePlan, timestep: float) -> tuple[PlannedMotion, Array]:
     """The plan every ``timestep`` [s] (module docstring) and the TCP force there, MuJoCo world (N, 3) [N]."""
-    count = round(plan.duration / timestep) + 1
-    times = plan.time[0] + timestep * np.arange(count)
-    pos, vel, acc = quintic_hermite(plan.time, plan.position, plan.velocity, plan.acceleration, times)
+    times = physics_times(plan, timestep)
     force = np.stack([np.interp(times, plan.time, plan.tcp_force[:, i]) for i in range(3)], axis=1)
     dynamics = MujocoMachineDynamics(plan.machine)
-    actuators = dynamics(pos, vel, acc, tcp_force=force[:, :2])
-    qpos, qvel, _ = dynamics.state(pos, vel, acc)
-    current = np.stack(
-        [
-            drive_state(params, actuators.force[:, i], actuators.velocity[:, i], actuators.acceleration[:, i]).i_q
-            for i, params in enumerate(plan.emlas)
-        ],
-        axis=1,
-    )
+
+    def loaded_dynamics(pos: Array, vel: Array, acc: Array) -> tuple[RodSamples, Array, Array]:
+        actuators = dynamics(pos, vel, acc, tcp_force=force[:, :2])
+        qpos, qvel, _ = dynamics.state(pos, vel, acc)
+        return actuators, qpos, qvel
+
     reference = np.stack([np.interp(times, plan.time, plan.reference_tcp[:, i]) for i in range(2)], axis=1)
-    model, data = dynamics.model, mujoco.MjData(dynamics.model)
-    site = model.site("tcp").id
-    planned_tcp = np.empty((count, 3))
-    for k in range(count):
-        data.qpos[:] = qpos[k]
-        mujoco.mj_kinematics(model, data)
-        planned_tcp[k] = data.site_xpos[site]
-    motion = PlannedMotion(
-        time=times - plan.time[0],
-        qpos=qpos,
-        qvel=qvel,
-        stroke=actuators.stroke,
-        rod_velocity=actuators.velocity,
-        rod_acceleration=actuators.acceleration,
-        force=actuators.force,
-        current=current,
-        reference_tcp=_to_world(reference),
-        planned_tcp=planned_tcp,
-    )
+    motion = motion_of_plan(plan, times, dynamics.model, loaded_dynamics, plan.emlas, _to_world(reference))
     return motion, _to_world(force[:, :2])
 
 

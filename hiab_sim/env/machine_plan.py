@@ -19,8 +19,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.emla.config import EmlaSet
-from hiab_sim.env.plan import DESIGNS
+from hiab_sim.env.plan import PlannedDesign, open_design
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.design import MachineDesign
@@ -32,38 +31,22 @@ Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
-class MachinePlan:
-    """One design of a machine file's result.
+class MachinePlan(PlannedDesign):
+    """One design of a machine file's result (the fields of :class:`~hiab_sim.env.plan.PlannedDesign` and these).
+
+    ``emlas`` is the study's EMLA set, one per chain in chain order; ``position``, ``velocity`` and
+    ``acceleration`` are the independent joints in the machine's joint order, (K, J) [rad or m];
+    ``reference_tcp`` is (x_tcp, y_tcp, extra tracked) in {W}, (K, 3) [m, m, rad or m];
+    ``predicted_electrical_power`` is per drive, (K, A) [W].
 
     Attributes:
-        design: ``initial`` or ``optimal``.
         machine: The machine with the design's decision variables set.
-        emlas: The study's EMLA set, one per chain in chain order.
-        time: Fine-grid sample times [s], (K,).
-        position, velocity, acceleration: Planned independent joints (machine joint order), (K, J) [rad or m].
-        reference_tcp: The study's reference (x_tcp, y_tcp, extra tracked) in {W}, (K, 3) [m, m, rad or m].
-        predicted_electrical_power: Planned P_elec per drive, (K, A) [W].
-        predicted_net_energy: The optimiser's net electrical energy of the design [J].
         tcp_force: The force on the TCP the plan's inverse dynamics took, (K, 3) [N] in {W}.
 
     """
 
-    design: str
     machine: Machine
-    emlas: EmlaSet
-    time: Array
-    position: Array
-    velocity: Array
-    acceleration: Array
-    reference_tcp: Array
-    predicted_electrical_power: Array
-    predicted_net_energy: float
     tcp_force: Array
-
-    @property
-    def duration(self) -> float:
-        """Cycle duration [s]."""
-        return float(self.time[-1] - self.time[0])
 
     @property
     def actuator_names(self) -> tuple[str, ...]:
@@ -85,14 +68,11 @@ def read_machine_plan(result_dir: str | Path, design: str) -> MachinePlan:
             (its EMLA set and TCP force are needed; one line naming it).
 
     """
-    if design not in DESIGNS:
-        raise InvalidInputError("design", design, f"must be one of {', '.join(DESIGNS)}")
-    run = open_run(result_dir, Result)
-    result, trajectory = run.result, run.trajectory
-    summary = result.optimal if design == "optimal" else result.initial
-    values = summary.lengths
+    found = open_design(result_dir, design)
+    run, values = found.run, found.summary.lengths
     if not isinstance(values, MachineDesign):
         raise InvalidInputError("result", str(result_dir), "is a crane file's result (read it with read_plan)")
+    result = run.result
     machine = result_machine(run.folder, result).with_design(values.values, check_bounds=False)
     try:
         study = load_study(result.study)
@@ -100,20 +80,13 @@ def read_machine_plan(result_dir: str | Path, design: str) -> MachinePlan:
         raise ConfigError(
             f"{run.folder}: the study file {result.study} is needed for its EMLA set and TCP force ({error})"
         ) from error
-    time = trajectory.time()
+    time = found.planned["time"]
     task = study.tasks[0]
     force = task.id_force(study.model.kinematics, study.model.gravity, time)
     tcp_force = np.zeros((len(time), 3)) if force is None else np.broadcast_to(force, (len(time), 3)).copy()
     return MachinePlan(
-        design=design,
+        **found.planned,
         machine=machine,
         emlas=study.emlas,
-        time=time,
-        position=trajectory.design(design, "position"),
-        velocity=trajectory.design(design, "velocity"),
-        acceleration=trajectory.design(design, "acceleration"),
-        reference_tcp=trajectory.get("reference_tcp"),
-        predicted_electrical_power=trajectory.design(design, "electrical_power"),
-        predicted_net_energy=float(summary.net_electrical_energy_J),
         tcp_force=np.asarray(tcp_force, dtype=float),
     )

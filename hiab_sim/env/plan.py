@@ -1,5 +1,8 @@
 """The optimiser's plan for one design, read from a result folder.
 
+:func:`open_design` reads one design of any result folder (``result.json`` and ``trajectory.npz``)
+into the fields every plan has (:class:`PlannedDesign`); a crane file's plan (:class:`DesignPlan`)
+and a machine file's (:class:`hiab_sim.env.machine_plan.MachinePlan`) add their own.
 ``read_plan(result_dir, design)`` returns what the closed-loop validation needs: the crane, the EMLA
 set and the payload of the study, the design's link lengths, its planned joint trajectory
 (positions, rates, accelerations on the fine grid), the study's TCP reference and the optimiser's
@@ -11,6 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -19,38 +23,31 @@ from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.results.design_values import crane_lengths
-from hiab_sim.results.read import open_run, result_crane
-from hiab_sim.results.schema import Result
+from hiab_sim.results.read import DESIGNS, RunFolder, open_run, result_crane
+from hiab_sim.results.schema import DesignSummary, Result
 from hiab_sim.study.spec.study_file import load_study
 
 Array = NDArray[np.float64]
 
-#: Designs a result holds.
-DESIGNS: tuple[str, ...] = ("initial", "optimal")
-
 
 @dataclass(frozen=True)
-class DesignPlan:
-    """One design of a study result.
+class PlannedDesign:
+    """What the closed loop needs of any design's plan, a crane file's or a machine file's.
 
     Attributes:
         design: ``initial`` or ``optimal``.
-        crane: The crane description.
-        emlas: The EMLA set the study used.
-        lengths: The design's link lengths Xi [m].
+        emlas: The EMLA set the study used, one per actuator in the model's order.
         time: Fine-grid sample times [s], (K,), from 0 to the cycle duration.
-        position, velocity, acceleration: Planned (Θ1, Θ2, xt2) and their rates, (K, 3) [rad, m].
-        reference_tcp: The study's TCP reference in the source frame {W}, (K, 3) [m].
-        predicted_electrical_power: Planned P_elec per actuator, (K, 3) [W].
+        position, velocity, acceleration: Planned independent joints and their rates, (K, J)
+            [rad or m; per s; per s^2] (the crane's Θ1, Θ2, xt2).
+        reference_tcp: The study's reference in the source frame {W}, (K, 3) [m, m, rad or m].
+        predicted_electrical_power: Planned P_elec per actuator, (K, A) [W].
         predicted_net_energy: The optimiser's net electrical energy of the design [J].
-        payload: Mass hanging at the TCP in the study [kg].
 
     """
 
     design: str
-    crane: Crane
     emlas: EmlaSet
-    lengths: LinkLengths
     time: Array
     position: Array
     velocity: Array
@@ -58,7 +55,6 @@ class DesignPlan:
     reference_tcp: Array
     predicted_electrical_power: Array
     predicted_net_energy: float
-    payload: float
 
     @property
     def duration(self) -> float:
@@ -66,7 +62,39 @@ class DesignPlan:
         return float(self.time[-1] - self.time[0])
 
 
-def read_plan(result_dir: str | Path, design: str) -> DesignPlan:
+@dataclass(frozen=True)
+class DesignPlan(PlannedDesign):
+    """One design of a crane file's result (the fields of :class:`PlannedDesign` and the crane's).
+
+    Attributes:
+        crane: The crane description.
+        lengths: The design's link lengths Xi [m].
+        payload: Mass hanging at the TCP in the study [kg].
+
+    """
+
+    crane: Crane
+    lengths: LinkLengths
+    payload: float
+
+
+@dataclass(frozen=True)
+class DesignRun:
+    """One design of a result folder, read once for every kind of plan.
+
+    Attributes:
+        run: The folder as :func:`hiab_sim.results.read.open_run` read it.
+        summary: The design's summary in ``result.json``.
+        planned: The design's planned fields (:class:`PlannedDesign`'s, all but ``emlas``) from ``trajectory.npz``.
+
+    """
+
+    run: RunFolder[Result]
+    summary: DesignSummary
+    planned: dict[str, Any]
+
+
+def open_design(result_dir: str | Path, design: str) -> DesignRun:
     """Read ``result.json`` and ``trajectory.npz`` of an ``hiab-sim optimize`` folder for one design.
 
     Raises:
@@ -77,20 +105,36 @@ def read_plan(result_dir: str | Path, design: str) -> DesignPlan:
     if design not in DESIGNS:
         raise InvalidInputError("design", design, f"must be one of {', '.join(DESIGNS)}")
     run = open_run(result_dir, Result)
-    result, trajectory = run.result, run.trajectory
-    summary = result.optimal if design == "optimal" else result.initial
+    trajectory = run.trajectory
+    summary = run.result.optimal if design == "optimal" else run.result.initial
+    planned = {
+        "design": design,
+        "time": trajectory.time(),
+        "position": trajectory.design(design, "position"),
+        "velocity": trajectory.design(design, "velocity"),
+        "acceleration": trajectory.design(design, "acceleration"),
+        "reference_tcp": trajectory.get("reference_tcp"),
+        "predicted_electrical_power": trajectory.design(design, "electrical_power"),
+        "predicted_net_energy": float(summary.net_electrical_energy_J),
+    }
+    return DesignRun(run, summary, planned)
+
+
+def read_plan(result_dir: str | Path, design: str) -> DesignPlan:
+    """The plan of one design of a crane file's result (:func:`open_design`, the study's crane and EMLA set).
+
+    Raises:
+        InvalidInputError: unknown design.
+        ConfigError: the folder holds no result, or its files are malformed (one line naming them).
+
+    """
+    found = open_design(result_dir, design)
+    result = found.run.result
     return DesignPlan(
-        design=design,
-        crane=result_crane(run.folder, result.crane),
+        **found.planned,
+        crane=result_crane(found.run.folder, result.crane),
         emlas=_study_emlas(result.study),
-        lengths=crane_lengths(summary.lengths, "result"),
-        time=trajectory.time(),
-        position=trajectory.design(design, "position"),
-        velocity=trajectory.design(design, "velocity"),
-        acceleration=trajectory.design(design, "acceleration"),
-        reference_tcp=trajectory.get("reference_tcp"),
-        predicted_electrical_power=trajectory.design(design, "electrical_power"),
-        predicted_net_energy=float(summary.net_electrical_energy_J),
+        lengths=crane_lengths(found.summary.lengths, "result"),
         payload=float(result.settings.payload_kg),
     )
 

@@ -6,12 +6,17 @@ for the quintic B-spline between knots). MuJoCo inverse dynamics (:mod:`hiab_sim
 on the model without drives) then gives the load-side actuator force f_x, velocity, acceleration and
 stroke at every physics step (eq. ``dynamics``), and :func:`hiab_sim.emla.drive_state` the q-current
 that produces them in steady electrical state (eqs. ``torque_force``, ``torque_torque``, ``dq0voltage``).
-The TCP reference is interpolated with a cubic spline.
+The TCP reference is interpolated with a cubic spline. :func:`motion_of_plan` is the one builder
+of a :class:`PlannedMotion`: the crane's (:func:`planned_motion`) and a machine file's
+(:func:`hiab_sim.env.machine_env.machine_motion`) differ only in the inverse dynamics, the drives the
+feedforward inverts and how the reference is read.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
+from typing import Protocol
 
 import mujoco
 import numpy as np
@@ -22,8 +27,9 @@ from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla.drive import drive_state
 from hiab_sim.emla.params import EmlaParams
-from hiab_sim.env.plan import DesignPlan
+from hiab_sim.env.plan import DesignPlan, PlannedDesign
 from hiab_sim.model.mjcf import source_to_world
+from hiab_sim.model.states import site_positions
 
 Array = NDArray[np.float64]
 
@@ -81,39 +87,67 @@ class PlannedMotion:
         return int(min(max(round(time / step), 0), len(self.time) - 1))
 
 
-def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
-    """Sample the plan every ``timestep`` [s] (see the module docstring)."""
+#: Inverse dynamics of a planned motion at the physics rate: the independent joints' positions, rates
+#: and accelerations (N, J) -> the actuators' load-side samples and the loop-consistent MuJoCo
+#: ``qpos``, ``qvel`` (N, nv) of the model the planned TCP is read on.
+MotionDynamics = Callable[[Array, Array, Array], tuple["RodSamples", Array, Array]]
+
+
+class RodSamples(Protocol):
+    """Load-side actuator samples (N, A) of either inverse-dynamics path (crane or machine file)."""
+
+    @property
+    def force(self) -> Array:
+        """Load-side force f_x [N], > 0 extends."""
+        ...
+
+    @property
+    def velocity(self) -> Array:
+        """Rod velocity v_x [m/s]."""
+        ...
+
+    @property
+    def acceleration(self) -> Array:
+        """Rod acceleration a_x [m/s^2]."""
+        ...
+
+    @property
+    def stroke(self) -> Array:
+        """Stroke x [m]."""
+        ...
+
+
+def physics_times(plan: PlannedDesign, timestep: float) -> Array:
+    """Times [s] (N,) of the physics steps over the plan's cycle, from its first sample, ``timestep`` [s] apart."""
     count = round(plan.duration / timestep) + 1
-    times = plan.time[0] + timestep * np.arange(count)
+    return plan.time[0] + timestep * np.arange(count)
+
+
+def motion_of_plan(
+    plan: PlannedDesign,
+    times: Array,
+    model: mujoco.MjModel,
+    dynamics: MotionDynamics,
+    drives: Iterable[EmlaParams],
+    reference_tcp: Array,
+) -> PlannedMotion:
+    """The plan at ``times`` (:func:`physics_times`): joints, inverse dynamics, feedforward currents, TCPs.
+
+    The joints are the quintic Hermite interpolant of the plan's fine-grid samples; ``dynamics``
+    gives f_x, v_x, a_x, x and the loop-consistent state (eq. ``dynamics``); each drive of ``drives``
+    (the model the feedforward inverts, in actuator order) gives the steady-state q-current of
+    :func:`hiab_sim.emla.drive_state`; the planned TCP is site ``tcp`` of ``model`` at that state.
+    ``reference_tcp`` is the study's reference at ``times`` in MuJoCo world coordinates (N, 3) [m].
+    """
     pos, vel, acc = quintic_hermite(plan.time, plan.position, plan.velocity, plan.acceleration, times)
-    joints = JointSamples(pos, vel, acc)
-    dynamics = MujocoInverseDynamics(plan.crane, plan.lengths)
-    tcp_force = None if plan.payload == 0.0 else np.array([0.0, -plan.payload * plan.crane.gravity, 0.0])
-    actuators = dynamics(joints, tcp_force)
-    qpos, qvel, _ = dynamics.state(joints)
-    # the feedforward inverts the simulated drive: its screw and gearbox are ideal (the plant models no
-    # transmission efficiency), so the planner's transmission losses are left out of the current
+    actuators, qpos, qvel = dynamics(pos, vel, acc)
     current = np.stack(
         [
-            drive_state(
-                ideal_transmission(params),
-                actuators.force[:, i],
-                actuators.velocity[:, i],
-                actuators.acceleration[:, i],
-            ).i_q
-            for i, params in enumerate(plan.emlas)
+            drive_state(params, actuators.force[:, i], actuators.velocity[:, i], actuators.acceleration[:, i]).i_q
+            for i, params in enumerate(drives)
         ],
         axis=1,
     )
-    tcp = CubicSpline(plan.time, plan.reference_tcp, axis=0)(times)
-    model = dynamics.model
-    data = mujoco.MjData(model)
-    site = model.site("tcp").id
-    planned_tcp = np.empty((count, 3))
-    for k in range(count):
-        data.qpos[:] = qpos[k]
-        mujoco.mj_kinematics(model, data)
-        planned_tcp[k] = data.site_xpos[site]
     return PlannedMotion(
         time=times - plan.time[0],
         qpos=qpos,
@@ -123,9 +157,28 @@ def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
         rod_acceleration=actuators.acceleration,
         force=actuators.force,
         current=current,
-        reference_tcp=source_to_world(tcp),
-        planned_tcp=planned_tcp,
+        reference_tcp=reference_tcp,
+        planned_tcp=site_positions(model, qpos, "tcp"),
     )
+
+
+def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
+    """Sample a crane file's plan every ``timestep`` [s] (see the module docstring)."""
+    times = physics_times(plan, timestep)
+    dynamics = MujocoInverseDynamics(plan.crane, plan.lengths)
+    tcp_force = None if plan.payload == 0.0 else np.array([0.0, -plan.payload * plan.crane.gravity, 0.0])
+
+    def crane_dynamics(pos: Array, vel: Array, acc: Array) -> tuple[RodSamples, Array, Array]:
+        joints = JointSamples(pos, vel, acc)
+        actuators = dynamics(joints, tcp_force)
+        qpos, qvel, _ = dynamics.state(joints)
+        return actuators, qpos, qvel
+
+    # the feedforward inverts the simulated drive: its screw and gearbox are ideal (the plant models no
+    # transmission efficiency), so the planner's transmission losses are left out of the current
+    drives = [ideal_transmission(params) for params in plan.emlas]
+    reference = source_to_world(CubicSpline(plan.time, plan.reference_tcp, axis=0)(times))
+    return motion_of_plan(plan, times, dynamics.model, crane_dynamics, drives, reference)
 
 
 def ideal_transmission(params: EmlaParams) -> EmlaParams:

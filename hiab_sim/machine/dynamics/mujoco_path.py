@@ -45,6 +45,7 @@ from hiab_sim.machine.dynamics.tree import (
     pin_layout,
     tcp_force_array,
 )
+from hiab_sim.model.states import mechanical_energies
 
 Array = NDArray[np.float64]
 
@@ -233,13 +234,5 @@ class MujocoMachineDynamics:
         """Kinetic and potential energy [J], (T,) each (``mj_energyVel``, ``mj_energyPos``), zero at y = 0."""
         q = np.atleast_2d(np.asarray(q, dtype=float))
         qpos, qvel, _ = self.state(q, dq, np.zeros_like(q))
-        m, d = self.model, self.data
-        out = np.empty((q.shape[0], 2))
-        for i in range(q.shape[0]):
-            d.qpos[:] = qpos[i]
-            d.qvel[:] = qvel[i]
-            mujoco.mj_fwdPosition(m, d)
-            mujoco.mj_energyPos(m, d)
-            mujoco.mj_energyVel(m, d)
-            out[i] = d.energy
-        return out[:, 1], out[:, 0]
+        potential, kinetic = mechanical_energies(self.model, self.data, qpos, qvel)
+        return kinetic, potential
