@@ -5,9 +5,7 @@ The crane reader handles its keys by hand (no dataclass per section), so each ro
 
 from __future__ import annotations
 
-from dataclasses import replace
-
-from hiab_sim.docs_site.field_specs.rows import Key, free, section
+from hiab_sim.docs_site.field_specs.rows import Key, free, section, section_of
 
 
 def crane_keys() -> list[Key]:
@@ -68,27 +66,29 @@ def crane_keys() -> list[Key]:
             default="none",
             description="Pin-to-pin length at zero stroke (read, not used by the model).",
         ),
-        section(
+        *section_of(
             "counterbalance",
             "Counterbalance valve in the outlet of the load-holding chamber (hydraulic baselines at the battery).",
+            [
+                Key("side", type="piston | rod", description="The chamber the valve holds."),
+                Key("pilot_ratio", type="number", allowed="> 0", description="Pilot ratio R."),
+                Key(
+                    "setting_pressure",
+                    type="number",
+                    unit="Pa",
+                    allowed="> 0",
+                    description="Setting p_set: opens when p_out + R p_pilot = p_set.",
+                ),
+                Key(
+                    "check_pressure",
+                    type="number",
+                    unit="Pa",
+                    allowed=">= 0",
+                    default="0",
+                    description="Cracking pressure of the free-flow check.",
+                ),
+            ],
             default="none",
-        ),
-        Key("counterbalance.side", type="piston | rod", description="The chamber the valve holds."),
-        Key("counterbalance.pilot_ratio", type="number", allowed="> 0", description="Pilot ratio R."),
-        Key(
-            "counterbalance.setting_pressure",
-            type="number",
-            unit="Pa",
-            allowed="> 0",
-            description="Setting p_set: opens when p_out + R p_pilot = p_set.",
-        ),
-        Key(
-            "counterbalance.check_pressure",
-            type="number",
-            unit="Pa",
-            allowed=">= 0",
-            default="0",
-            description="Cracking pressure of the free-flow check.",
         ),
     ]
     rows = [
@@ -98,13 +98,11 @@ def crane_keys() -> list[Key]:
         section("chains", "The two closed chains (cylinder, rod, boom triangle)."),
     ]
     for name in ("lift", "tilt"):
-        rows.append(section(f"chains.{name}", f"The {name} chain."))
-        rows += [replace(k, path=f"chains.{name}.{k.path}") for k in chain]
+        rows += section_of(f"chains.{name}", f"The {name} chain.", chain)
     rows += [
         section("telescope", "The telescope: a prismatic joint xt2 along x of the cylinder frame {P22}."),
         Key("telescope.parent", type="text", description="Link the telescope cylinder is fixed to."),
-        section("telescope.cylinder_frame", "{P22} in the parent link frame."),
-        *[replace(k, path=f"telescope.cylinder_frame.{k.path}") for k in pose],
+        *section_of("telescope.cylinder_frame", "{P22} in the parent link frame.", pose),
         Key(
             "telescope.rod_offset",
             type="number",
@@ -127,14 +125,12 @@ def crane_keys() -> list[Key]:
             allowed="within [0, stroke]",
             description="Working range of xt2.",
         ),
-        section("tcp", "TCP frame in the end-mass frame."),
-        *[replace(k, path=f"tcp.{k.path}") for k in pose],
+        *section_of("tcp", "TCP frame in the end-mass frame.", pose),
         free("bodies", "Rigid bodies by name, each `{frame, mass, com, inertia}` in its source frame."),
         section("hydraulic_cylinders", "The cylinders the EMLAs replace (hydraulic baseline).", default="none"),
     ]
     for name in ("lift", "tilt", "telescope"):
-        rows.append(section(f"hydraulic_cylinders.{name}", f"The {name} cylinder."))
-        rows += [replace(k, path=f"hydraulic_cylinders.{name}.{k.path}") for k in cylinder]
+        rows += section_of(f"hydraulic_cylinders.{name}", f"The {name} cylinder.", cylinder)
     rows += [
         Key(
             "hydraulic_cylinders.supply_pressure",
@@ -143,22 +139,28 @@ def crane_keys() -> list[Key]:
             allowed="> 0",
             description="System (relief) pressure p_s.",
         ),
-        section("hydraulic_cylinders.friction", "Seal friction of every cylinder.", default="none"),
-        Key(
-            "hydraulic_cylinders.friction.coulomb",
-            type="number",
-            unit="N",
-            default="0",
-            allowed=">= 0",
-            description="Coulomb seal friction F_c opposing the rod velocity.",
-        ),
-        Key(
-            "hydraulic_cylinders.friction.viscous",
-            type="number",
-            unit="N s/m",
-            default="0",
-            allowed=">= 0",
-            description="Viscous friction b.",
+        *section_of(
+            "hydraulic_cylinders.friction",
+            "Seal friction of every cylinder.",
+            [
+                Key(
+                    "coulomb",
+                    type="number",
+                    unit="N",
+                    default="0",
+                    allowed=">= 0",
+                    description="Coulomb seal friction F_c opposing the rod velocity.",
+                ),
+                Key(
+                    "viscous",
+                    type="number",
+                    unit="N s/m",
+                    default="0",
+                    allowed=">= 0",
+                    description="Viscous friction b.",
+                ),
+            ],
+            default="none",
         ),
     ]
     return rows

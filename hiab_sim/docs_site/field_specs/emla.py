@@ -6,9 +6,7 @@ study checks them against its machine's actuators), each may override any shared
 
 from __future__ import annotations
 
-from dataclasses import replace
-
-from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, section, sourced
+from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, section_of, sourced
 
 
 def emla_keys() -> list[Key]:
@@ -38,8 +36,9 @@ def emla_keys() -> list[Key]:
     winding = sourced(from_class("", WindingResistance))
     brake = sourced(from_class("", HoldingBrake))
     rows = [
-        section("pmsm", "The motor shared by every actuator (an actuator may override any key in its own `pmsm`)."),
-        *[replace(k, path=f"pmsm.{k.path}") for k in pmsm],
+        *section_of(
+            "pmsm", "The motor shared by every actuator (an actuator may override any key in its own `pmsm`).", pmsm
+        ),
         free(
             "actuators",
             "Actuator name (an identifier) -> actuator, at least one. A study checks the names against its "
@@ -48,11 +47,9 @@ def emla_keys() -> list[Key]:
         ),
     ]
     where = "actuators.<actuator>"
-    rows.append(section(where, "One EMLA: gearbox, screw, optional overrides of the shared sections."))
-    rows += [replace(k, path=f"{where}.{k.path}") for k in actuator]
-    rows.append(section(f"{where}.pmsm", "Overrides of the shared `pmsm` keys.", default="none"))
-    rows += [replace(k, path=f"{where}.pmsm.{k.path}", default="shared") for k in pmsm]
+    rows += section_of(where, "One EMLA: gearbox, screw, optional overrides of the shared sections.", actuator)
     for key, keys in (
+        ("pmsm", pmsm),
         ("thermal", thermal),
         ("drive_losses", losses),
         ("winding_resistance", winding),
@@ -60,46 +57,37 @@ def emla_keys() -> list[Key]:
         ("screw", screw),
         ("drive_stiffness", stiffness),
     ):
-        rows.append(section(f"{where}.{key}", f"Overrides of the shared `{key}` keys.", default="none"))
-        rows += [replace(k, path=f"{where}.{key}.{k.path}", default="shared") for k in keys]
-    rows += [
-        section(
-            "thermal",
-            "Continuous torque and first-order winding model of every motor (thermal limits).",
-            default="none",
-        ),
-        *[replace(k, path=f"thermal.{k.path}") for k in thermal],
-        section(
-            "drive_losses", "Optional transmission, inverter and brake losses; all off by default.", default="none"
-        ),
-        Key(
-            "drive_losses.enabled",
-            type="true/false",
-            default="true",
-            description="`false` keeps every loss off (the keys below are then ignored).",
-        ),
-        *[replace(k, path=f"drive_losses.{k.path}") for k in losses],
-        section(
+        rows += section_of(
+            f"{where}.{key}", f"Overrides of the shared `{key}` keys.", keys, "none", keys_default="shared"
+        )
+    enabled = Key(
+        "enabled",
+        type="true/false",
+        default="true",
+        description="`false` keeps every loss off (the keys below are then ignored).",
+    )
+    shared = (
+        ("thermal", "Continuous torque and first-order winding model of every motor (thermal limits).", thermal),
+        ("drive_losses", "Optional transmission, inverter and brake losses; all off by default.", [enabled, *losses]),
+        (
             "winding_resistance",
             "R_s(T) = R_s,ref (1 + alpha (T - T_ref)): hot windings (hiab_sim.emla.electrothermal).",
-            default="none",
+            winding,
         ),
-        *[replace(k, path=f"winding_resistance.{k.path}") for k in winding],
-        section("holding_brake", "The holding brake on every motor shaft (hiab_sim.emla.hold).", default="none"),
-        *[replace(k, path=f"holding_brake.{k.path}") for k in brake],
-        section(
+        ("holding_brake", "The holding brake on every motor shaft (hiab_sim.emla.hold).", brake),
+        (
             "screw",
             "Every screw as a column under its push force (buckling rows and margins); none: no buckling check.",
-            default="none",
+            screw,
         ),
-        *[replace(k, path=f"screw.{k.path}") for k in screw],
-        section(
+        (
             "drive_stiffness",
             "Axial stiffness of every drive train (natural frequencies); none: no frequency check.",
-            default="none",
+            stiffness,
         ),
-        *[replace(k, path=f"drive_stiffness.{k.path}") for k in stiffness],
-        section("battery", "Shared DC bus and battery efficiencies (battery energy).", default="defaults"),
-        *[replace(k, path=f"battery.{k.path}") for k in sourced(from_class("", BatteryParams), required=False)],
-    ]
+    )
+    for key, description, keys in shared:
+        rows += section_of(key, description, keys, "none")
+    battery = sourced(from_class("", BatteryParams), required=False)
+    rows += section_of("battery", "Shared DC bus and battery efficiencies (battery energy).", battery, "defaults")
     return rows

@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from hiab_sim.docs_site.dataclass_fields import checked_fields
-from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, section, under
+from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, section, section_of
 
 #: Shown for a vector the loader reads as (x, y) or (x, y, z) (``_vec3``: z defaults to 0).
 POINT = "[x, y] or [x, y, z]"
@@ -62,18 +62,17 @@ def _body(where: str, description: str, default: str = "none") -> list[Key]:
 
     checked = _checked(RigidBody)
     one = "exactly one of `inertia`, `inertia_zz`"
-    return [
-        section(where, description, default),
-        Key(f"{where}.mass", type="number", unit="kg", allowed=checked["mass"], description="Mass."),
+    keys = [
+        Key("mass", type="number", unit="kg", allowed=checked["mass"], description="Mass."),
         Key(
-            f"{where}.com",
+            "com",
             type=POINT,
             unit="m",
             allowed=checked["com"],
             description="Centre of mass in the body's frame; z defaults to 0.",
         ),
         Key(
-            f"{where}.inertia",
+            "inertia",
             type="3x3 nested list",
             unit="kg m^2",
             default=one,
@@ -81,7 +80,7 @@ def _body(where: str, description: str, default: str = "none") -> list[Key]:
             description="Inertia about the centre of mass in the frame's axes.",
         ),
         Key(
-            f"{where}.inertia_zz",
+            "inertia_zz",
             type="number",
             unit="kg m^2",
             default=one,
@@ -89,6 +88,7 @@ def _body(where: str, description: str, default: str = "none") -> list[Key]:
             description="Planar inertia Izz only; stored as the thin plate diag(Izz/2, Izz/2, Izz).",
         ),
     ]
+    return section_of(where, description, keys, default)
 
 
 def _links() -> list[Key]:
@@ -110,8 +110,7 @@ def _links() -> list[Key]:
             default=f"{moving}; the root's: `fixed`",
             allowed=checked["joint_kind"],
         ),
-        section(f"{where}.joint_frame", rows["joint_frame"].description, "identity"),
-        *under(f"{where}.joint_frame", _pose(required_r=False)),
+        *section_of(f"{where}.joint_frame", rows["joint_frame"].description, _pose(required_r=False), "identity"),
         replace(
             rows["joint_range"],
             path=f"{where}.joint_range",
@@ -218,8 +217,7 @@ def _hydraulic() -> list[Key]:
     return [
         section("hydraulic", "The hydraulic cylinders the EMLAs replace (the hydraulic baseline).", "none"),
         free("hydraulic.cylinders", "Cylinder name (an actuator's `hydraulic_cylinder`) -> cylinder.", "mapping"),
-        section("hydraulic.cylinders.<cylinder>", "One double-acting single-rod cylinder."),
-        *under("hydraulic.cylinders.<cylinder>", cylinder),
+        *section_of("hydraulic.cylinders.<cylinder>", "One double-acting single-rod cylinder.", cylinder),
         Key(
             "hydraulic.supply_pressure",
             type="number",
@@ -227,21 +225,18 @@ def _hydraulic() -> list[Key]:
             allowed=checked["supply_pressure"],
             description="System (relief) pressure p_s.",
         ),
-        section("hydraulic.friction", "Seal friction of every cylinder.", "none"),
-        *[
-            Key(
-                f"hydraulic.friction.{name}",
-                type="number",
-                unit=unit,
-                default="0",
-                allowed=checked[f"friction.{name}"],
-                description=text,
-            )
-            for name, unit, text in (
-                ("coulomb", "N", "Coulomb seal friction F_c opposing the rod velocity, per cylinder."),
-                ("viscous", "N s/m", "Viscous friction b, per cylinder."),
-            )
-        ],
+        *section_of(
+            "hydraulic.friction",
+            "Seal friction of every cylinder.",
+            [
+                Key(name, type="number", unit=unit, default="0", allowed=checked[f"friction.{name}"], description=text)
+                for name, unit, text in (
+                    ("coulomb", "N", "Coulomb seal friction F_c opposing the rod velocity, per cylinder."),
+                    ("viscous", "N s/m", "Viscous friction b, per cylinder."),
+                )
+            ],
+            "none",
+        ),
     ]
 
 
@@ -257,14 +252,20 @@ def machine_keys() -> list[Key]:
         top["gravity"],
         *_links(),
         *_chains(),
-        section("tcp", "The TCP: its link and its frame there."),
-        Key("tcp.link", type="text", description=top["tcp_link"].description),
-        *under("tcp", _pose(required_r=True)),
+        *section_of(
+            "tcp",
+            "The TCP: its link and its frame there.",
+            [Key("link", type="text", description=top["tcp_link"].description), *_pose(required_r=True)],
+        ),
         *_hydraulic(),
-        section("workspace", top["workspace"].description, "none"),
-        *[
-            Key(f"workspace.{axis}", type="[number, number]", unit="m", allowed=workspace[axis], description=text)
-            for axis, text in (("x", "[x_min, x_max] of the TCP."), ("y", "[y_min, y_max] of the TCP."))
-        ],
+        *section_of(
+            "workspace",
+            top["workspace"].description,
+            [
+                Key(axis, type="[number, number]", unit="m", allowed=workspace[axis], description=text)
+                for axis, text in (("x", "[x_min, x_max] of the TCP."), ("y", "[y_min, y_max] of the TCP."))
+            ],
+            "none",
+        ),
         Key("notes", type="text, list or mapping", default="none", description="Free provenance notes, not read."),
     ]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from hiab_sim.docs_site.field_specs.rows import Key, from_class, section
+from hiab_sim.docs_site.field_specs.rows import Key, from_class, section, section_of
 
 
 def reference_keys(where: str) -> list[Key]:
@@ -78,30 +78,25 @@ def reference_keys(where: str) -> list[Key]:
     ]
     needed = "one of `reference`, `tasks`" if where == "reference" else "required"
     machine = " A machine file's study: only where its third tracked coordinate is a joint (else `csv`)."
-    rows = [
-        section(
-            f"{where}{{spiral}}", "A TCP spiral in the vertical plane (kind omitted or `spiral`)." + machine, needed
-        )
+    spiral_text = "A TCP spiral in the vertical plane (kind omitted or `spiral`)."
+    return [
+        *section_of(f"{where}{{spiral}}", spiral_text + machine, spiral, needed),
+        *section_of(
+            f"{where}{{pick_and_place}}",
+            "Rest to rest from `pick` to `place` over a clearance." + machine,
+            pick,
+            needed,
+        ),
+        *section_of(f"{where}{{csv}}", "A sampled trajectory from a CSV file, fitted by a B-spline.", csv, needed),
     ]
-    rows += [replace(k, path=f"{where}{{spiral}}.{k.path.lstrip('.')}") for k in spiral]
-    rows.append(
-        section(f"{where}{{pick_and_place}}", "Rest to rest from `pick` to `place` over a clearance." + machine, needed)
-    )
-    rows += [replace(k, path=f"{where}{{pick_and_place}}.{k.path.lstrip('.')}") for k in pick]
-    rows.append(section(f"{where}{{csv}}", "A sampled trajectory from a CSV file, fitted by a B-spline.", needed))
-    rows += [replace(k, path=f"{where}{{csv}}.{k.path.lstrip('.')}") for k in csv]
-    return rows
 
 
 def payload_keys(where: str) -> list[Key]:
     """The payload at ``where`` (``payload`` or ``tasks[].payload``): a number or the ``Payload`` mapping."""
     from hiab_sim.study.spec.payload import Payload
 
-    rows = [
-        section(where, "A number (constant mass [kg]) or a mapping: the mass held from pick to release.", default="0")
-    ]
-    rows += [replace(k, path=f"{where}.{k.path}") for k in from_class("", Payload)]
-    return rows
+    text = "A number (constant mass [kg]) or a mapping: the mass held from pick to release."
+    return section_of(where, text, from_class("", Payload), default="0")
 
 
 def soil_keys(where: str) -> list[Key]:

@@ -72,3 +72,17 @@ def sourced(keys: list[Key], required: bool = True) -> list[Key]:
 def under(prefix: str, keys: list[Key]) -> list[Key]:
     """``keys`` moved under the mapping ``prefix`` (``a`` -> ``prefix.a``)."""
     return [replace(k, path=f"{prefix}.{k.path}") for k in keys]
+
+
+def section_of(
+    path: str, description: str, keys: list[Key], default: str = "required", *, keys_default: str | None = None
+) -> list[Key]:
+    """A section (:func:`section`, its own ``default``) and its keys moved under it (:func:`under`).
+
+    ``keys_default`` replaces every key's default: an actuator's overrides of a shared section are
+    the shared rows with ``keys_default="shared"``.
+    """
+    rows = under(path, keys)
+    if keys_default is not None:
+        rows = [replace(k, default=keys_default) for k in rows]
+    return [section(path, description, default), *rows]

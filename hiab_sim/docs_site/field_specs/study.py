@@ -6,11 +6,9 @@ Two forms: a crane file's study (``crane:``) and a machine file's (``machine:``,
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 from hiab_sim.docs_site.dataclass_fields import field_rows
 from hiab_sim.docs_site.field_specs.references import payload_keys, reference_keys, soil_keys
-from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, in_form, names, section
+from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, in_form, names, section, section_of
 
 
 def _structure_keys() -> list[Key]:
@@ -112,14 +110,12 @@ def study_keys() -> list[Key]:
             default="the crane's",
         ),
     ]
+    start = [
+        Key(k, type="number", unit="m", allowed="> 0, within the bounds", description=d)
+        for k, d in (("L", "Base pivot -> boom hinge."), ("Lc0", "Piston offset."), ("Lc", "Rod length."))
+    ]
     for chain in ("lift", "tilt"):
-        rows.append(section(f"initial_lengths.{chain}", f"The {chain} chain's start."))
-        rows += [
-            Key(
-                f"initial_lengths.{chain}.{k}", type="number", unit="m", allowed="> 0, within the bounds", description=d
-            )
-            for k, d in (("L", "Base pivot -> boom hinge."), ("Lc0", "Piston offset."), ("Lc", "Rod length."))
-        ]
+        rows += section_of(f"initial_lengths.{chain}", f"The {chain} chain's start.", start)
     rows = [*rows[:5], *in_form("crane", rows[5:])]  # the crane's initial lengths; the machine's below
     rows.append(
         names(
@@ -162,28 +158,26 @@ def study_keys() -> list[Key]:
     ]
     rows += [section("tracking", "Tolerance bands of const_b..const_d.", "defaults"), *from_class("tracking", Tracking)]
     rows += in_form("crane", _structure_keys())
+    chain_bounds = [
+        Key(
+            "low",
+            type="[number, number, number]",
+            unit="m",
+            allowed="0 < low < up",
+            description="Lower bounds of L, Lc0, Lc.",
+        ),
+        Key("up", type="[number, number, number]", unit="m", description="Upper bounds of L, Lc0, Lc."),
+    ]
     rows += [
         section("bounds", "Box and path bounds of the NLP (a machine file declares its decision variables' own)."),
-        *[
-            replace(k, form="crane")
-            for chain in ("lift", "tilt")
-            for k in (
-                section(f"bounds.{chain}", f"Bounds of the {chain} chain's Xi (const_g)."),
-                Key(
-                    f"bounds.{chain}.low",
-                    type="[number, number, number]",
-                    unit="m",
-                    allowed="0 < low < up",
-                    description="Lower bounds of L, Lc0, Lc.",
-                ),
-                Key(
-                    f"bounds.{chain}.up",
-                    type="[number, number, number]",
-                    unit="m",
-                    description="Upper bounds of L, Lc0, Lc.",
-                ),
-            )
-        ],
+        *in_form(
+            "crane",
+            [
+                k
+                for chain in ("lift", "tilt")
+                for k in section_of(f"bounds.{chain}", f"Bounds of the {chain} chain's Xi (const_g).", chain_bounds)
+            ],
+        ),
         Key(
             "bounds.joint_velocity",
             type="[number, number, number]",
