@@ -9,7 +9,7 @@ import yaml
 
 from hiab_sim.cli import main
 
-#: The excavator study of ``test_machine_study``: three joints from one pose to another in 4 s, 50 kg held.
+#: A small excavator study: three joints from one pose to another in 4 s (``move.csv``, :func:`joint_csv`), 50 kg held.
 EXCAVATOR_STUDY = {
     "name": "excavator_move",
     "machine": "exact",
@@ -21,17 +21,26 @@ EXCAVATOR_STUDY = {
 }
 
 
+def joint_csv(path: Path, names: tuple[str, ...], start: list[float], end: list[float], duration: float) -> None:
+    """A rest-to-rest quintic joint move (t, q...) sampled at 10 Hz."""
+    t = np.linspace(0.0, duration, int(10 * duration) + 1)
+    tau = t / duration
+    s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
+    q = np.asarray(start)[None] + s[:, None] * (np.asarray(end) - np.asarray(start))[None]
+    lines = ["# a test move", ",".join(("t", *names))]
+    lines += [",".join(f"{v:.12g}" for v in row) for row in np.column_stack([t, q])]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def excavator_move(folder: Path) -> None:
+    """Write the excavator study's ``move.csv`` and ``study.yaml`` into ``folder``."""
+    joint_csv(folder / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
+    (folder / "study.yaml").write_text(yaml.safe_dump(EXCAVATOR_STUDY), encoding="utf-8")
+
+
 def excavator_result(folder: Path) -> Path:
     """Write the study into ``folder``, optimise it (no video, figures or report) and return the result folder."""
-    t = np.linspace(0.0, 4.0, 41)
-    tau = t / 4.0
-    s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)  # rest to rest (quintic)
-    start, end = np.array([0.0, -1.8, -1.0]), np.array([0.5, -1.3, -0.3])
-    rows = ["t,alpha,beta,gamma"] + [
-        ",".join(f"{v:.12g}" for v in (ti, *(start + si * (end - start)))) for ti, si in zip(t, s, strict=True)
-    ]
-    (folder / "move.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
-    (folder / "study.yaml").write_text(yaml.safe_dump(EXCAVATOR_STUDY), encoding="utf-8")
+    excavator_move(folder)
     run = folder / "run"
     status = main(
         [

@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-import yaml
 
 from hiab_sim.cli import main
 from hiab_sim.cli.simulate import ENERGY_TOLERANCE, TCP_MAX_MM
@@ -29,7 +28,7 @@ from hiab_sim.study.run import run_study
 from hiab_sim.study.spec.study_file import load_study
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_machine_study import EXCAVATOR, _joint_csv
+from machine_result_helper import excavator_move
 
 #: Tracking of the plan's own TCP on the planner's model [mm]: only the loops' residual (measured 0.04 mm).
 PLAN_TCP_MAX_MM = 0.5
@@ -38,8 +37,7 @@ PLAN_TCP_MAX_MM = 0.5
 @pytest.fixture(scope="module")
 def result(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("excavator_closed_loop")
-    _joint_csv(folder / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
-    (folder / "study.yaml").write_text(yaml.safe_dump(EXCAVATOR), encoding="utf-8")
+    excavator_move(folder)
     out = folder / "result"
     run_study(load_study(folder / "study.yaml"), out, figures=False, progress=None)
     return out

@@ -12,23 +12,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from machine_result_helper import EXCAVATOR_STUDY, joint_csv
 
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.spec.study_file import load_study, study_from_dict
 
 REPO = Path(__file__).resolve().parents[1]
-
-
-def _joint_csv(path: Path, names: tuple[str, ...], start: list[float], end: list[float], duration: float) -> None:
-    """A rest-to-rest quintic joint move (t, q...) sampled at 10 Hz."""
-    t = np.linspace(0.0, duration, int(10 * duration) + 1)
-    tau = t / duration
-    s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
-    q = np.asarray(start)[None] + s[:, None] * (np.asarray(end) - np.asarray(start))[None]
-    lines = ["# a test move", ",".join(("t", *names))]
-    lines += [",".join(f"{v:.12g}" for v in row) for row in np.column_stack([t, q])]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
 def _tcp_csv(path: Path, kin_study: object, joints: Path) -> None:
@@ -47,22 +37,11 @@ def _study(folder: Path, top: dict[str, object]) -> object:
     return load_study(path)
 
 
-EXCAVATOR = {
-    "name": "excavator_move",
-    "machine": "exact",
-    "emla": "exact",
-    "tasks": [{"name": "move", "weight": 1, "reference": {"kind": "csv", "file": "move.csv"}, "payload": 50.0}],
-    "spline": {"control_points": 12, "degree": 5},
-    "grid": {"duration": 4.0, "intervals": 12, "fine_factor": 4},
-    "bounds": {"joint_velocity": [0.6, 0.6, 1.0]},
-}
-
-
 @pytest.fixture(scope="module")
 def excavator(tmp_path_factory: pytest.TempPathFactory) -> StudyProblem:
     folder = tmp_path_factory.mktemp("excavator")
-    _joint_csv(folder / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
-    return StudyProblem(_study(folder, EXCAVATOR))  # type: ignore[arg-type]
+    joint_csv(folder / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
+    return StudyProblem(_study(folder, EXCAVATOR_STUDY))  # type: ignore[arg-type]
 
 
 def test_excavator_problem_is_sized_and_named_by_its_machine_file(excavator: StudyProblem) -> None:
@@ -100,7 +79,7 @@ def test_excavator_gradients_match_central_differences(excavator: StudyProblem) 
 
 def test_xs031_machine_file_and_crane_file_give_the_same_nlp(tmp_path: Path) -> None:
     """The XS 031 through its machine file (tracking xt2) equals the crane file's NLP at a perturbed point."""
-    _joint_csv(tmp_path / "joints.csv", ("theta1", "theta2", "xt2"), [0.3, -1.5, 0.2], [0.9, -1.0, 0.6], 4.0)
+    joint_csv(tmp_path / "joints.csv", ("theta1", "theta2", "xt2"), [0.3, -1.5, 0.2], [0.9, -1.0, 0.6], 4.0)
     common = {
         "spline": {"control_points": 12, "degree": 5},
         "grid": {"duration": 4.0, "intervals": 12, "fine_factor": 4},
@@ -164,8 +143,8 @@ def test_xs031_machine_file_and_crane_file_give_the_same_nlp(tmp_path: Path) -> 
 
 
 def test_machine_study_refuses_what_it_cannot_take_with_one_line(tmp_path: Path) -> None:
-    _joint_csv(tmp_path / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
-    base = dict(EXCAVATOR)
+    joint_csv(tmp_path / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
+    base = dict(EXCAVATOR_STUDY)
     with pytest.raises(ConfigError, match="kind: csv"):
         study_from_dict(
             {
