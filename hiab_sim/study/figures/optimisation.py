@@ -254,40 +254,34 @@ def write_figures(
         decision_figure(history, indices, labels, c, paths[c], low, up)
     if crane is None:  # a machine file's study: the crane's structure and spiral drawings do not apply
         del paths["structure"], paths["spiral"]
-        actuator_figure(arrays["time"], checks, paths["actuators"])
-        efficiency_figure(emlas, checks, paths["maps"])
-        energy_figure(arrays["time"], checks, paths["energy"])
-        if result.sensitivity is not None:
-            paths["sensitivity"] = out / "sensitivity.png"
-            sensitivity_figure(result.sensitivity, paths["sensitivity"])
-        return list(paths.values()) + hydraulic_figure(out / "energy_emla_vs_hydraulic.png", result)
-    joints = arrays["optimal_position"]
-    mid = len(joints) // 2
-    label = f"t = {arrays['time'][mid]:.2f} s of the optimal motion"
-    loads = result.structure
-    most = None
-    if loads is not None:
-        pin = loads.optimal.most_loaded_pin
-        most = (pin, loads.optimal.pins[pin].peak_N)
-    structure_figure(
-        crane, {k: crane_lengths(v) for k, v in designs.items()}, joints[mid], paths["structure"], label, most
-    )
-    spiral_figure(
-        crane,
-        crane_lengths(designs["optimal"]),
-        joints,
-        arrays["reference_tcp"],
-        arrays["optimal_tcp"],
-        paths["spiral"],
-        arrays["time"],
-    )
+    else:
+        joints = arrays["optimal_position"]
+        mid = len(joints) // 2
+        label = f"t = {arrays['time'][mid]:.2f} s of the optimal motion"
+        loads = result.structure
+        most = None
+        if loads is not None:
+            pin = loads.optimal.most_loaded_pin
+            most = (pin, loads.optimal.pins[pin].peak_N)
+        structure_figure(
+            crane, {k: crane_lengths(v) for k, v in designs.items()}, joints[mid], paths["structure"], label, most
+        )
+        spiral_figure(
+            crane,
+            crane_lengths(designs["optimal"]),
+            joints,
+            arrays["reference_tcp"],
+            arrays["optimal_tcp"],
+            paths["spiral"],
+            arrays["time"],
+        )
     actuator_figure(arrays["time"], checks, paths["actuators"])
     efficiency_figure(emlas, checks, paths["maps"])
     energy_figure(arrays["time"], checks, paths["energy"])
     if result.sensitivity is not None:
         paths["sensitivity"] = out / "sensitivity.png"
         sensitivity_figure(result.sensitivity, paths["sensitivity"])
-    if result.structure is not None:
+    if crane is not None and result.structure is not None:
         from hiab_sim.structure.report import natural_frequency_figure
 
         paths["frequency"] = natural_frequency_figure(
