@@ -14,7 +14,9 @@ from __future__ import annotations
 import argparse
 import math
 import time
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Protocol
 
 from hiab_sim.errors import InvalidInputError
 
@@ -120,6 +122,25 @@ def run_machine(args: argparse.Namespace) -> int:
     write_atomic(args.out / "table.md", table)
     print(table)
     print(f"wrote 2 files to {args.out}")
+    return verdict(results)
+
+
+class CaseOutcome(Protocol):
+    """What the verdict reads of a case's result (crane or machine file)."""
+
+    @property
+    def name(self) -> str:
+        """The case's name."""
+        ...
+
+    @property
+    def passed(self) -> bool:
+        """Whether every error of the case is within its tolerance."""
+        ...
+
+
+def verdict(results: Sequence[CaseOutcome]) -> int:
+    """Print the verdict over the cases and return the exit status: 0 all within tolerance, else 1."""
     failed = [r.name for r in results if not r.passed]
     if failed:
         print(f"validation FAILED: {', '.join(failed)}")
@@ -160,9 +181,4 @@ def run(args: argparse.Namespace) -> int:
     print()
     print((args.out / "table.md").read_text())
     print(f"wrote {len(written)} files to {args.out}")
-    failed = [r.name for r in results if not r.passed]
-    if failed:
-        print(f"validation FAILED: {', '.join(failed)}")
-        return 1
-    print("validation passed")
-    return 0
+    return verdict(results)
