@@ -136,8 +136,6 @@ def framing_points(model: mujoco.MjModel, qpos: Array) -> Array:
 
 def machine_mjcf(machine: Machine, design: Sequence[float] | Array | None = None) -> str:
     """The MJCF text of the machine at ``design`` with keyframe ``home`` and framed cameras (module docstring)."""
-    from hiab_sim.render.camera import MODEL_CAMERAS, framed_cameras
-
     if design is not None:
         machine = machine.with_design(design)
     dynamics = MujocoMachineDynamics(machine)
@@ -153,6 +151,19 @@ def machine_mjcf(machine: Machine, design: Sequence[float] | Array | None = None
     if world is None:
         raise AssertionError("an MJCF without a worldbody")
     _lower_floor(world, float(points[:, 2].min()))
+    place_cameras(world, points)
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+def place_cameras(world: ElementTree.Element, points: Array) -> None:
+    """Set the cameras of an MJCF ``worldbody`` (adding any missing) to frame ``points`` (P, 3) [m].
+
+    Each camera is :func:`hiab_sim.render.camera.framed_cameras`'s at :data:`CAMERA_ASPECT` and the
+    first camera's ``fovy`` [deg] (45 without one), given by ``pos`` and ``xyaxes`` (``quat`` and
+    ``euler`` dropped); the crane's MJCF (``hiab-sim mjcf``) and a machine file's are framed alike.
+    """
+    from hiab_sim.render.camera import MODEL_CAMERAS, framed_cameras
+
     cameras = {c.get("name"): c for c in world.findall("camera")}
     fovy = float(next(iter(cameras.values())).get("fovy", "45")) if cameras else 45.0
     for name, (position, xyaxes) in framed_cameras(points, CAMERA_ASPECT, fovy).items():
@@ -165,7 +176,6 @@ def machine_mjcf(machine: Machine, design: Sequence[float] | Array | None = None
         camera.attrib.pop("euler", None)
     if not set(MODEL_CAMERAS) <= {c.get("name") for c in world.findall("camera")}:
         raise AssertionError("the model lacks a framed camera")
-    return ElementTree.tostring(root, encoding="unicode")
 
 
 #: Clearance kept between the floor and the lowest point the machine reaches [m] (visual: contacts are off).

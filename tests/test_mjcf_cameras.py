@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 
 from hiab_sim.cli import main
-from hiab_sim.cli.mjcf import CAMERA_ASPECT, workspace_qpos
+from hiab_sim.cli.mjcf import workspace_qpos
 from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.machine_mjcf import CAMERA_ASPECT
 from hiab_sim.render.camera import geom_corners
 
 

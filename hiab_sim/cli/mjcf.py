@@ -105,8 +105,6 @@ def parse_lengths(text: str) -> LinkLengths:
 
 #: Poses per joint over its working range that the cameras are fitted to (every combination).
 CAMERA_POSES_PER_JOINT = 4
-#: Aspect ratio (width / height) the cameras are fitted for: the template's off-screen buffer, 1280 x 720.
-CAMERA_ASPECT = 16.0 / 9.0
 
 
 def workspace_qpos(crane: Crane, lengths: LinkLengths) -> np.ndarray:
@@ -136,7 +134,8 @@ def frame_cameras(text: str, model: object, crane: Crane, lengths: LinkLengths, 
 
     import mujoco
 
-    from hiab_sim.render.camera import MODEL_CAMERAS, framed_cameras, geom_corners
+    from hiab_sim.machine_mjcf import place_cameras
+    from hiab_sim.render.camera import geom_corners
 
     assert isinstance(model, mujoco.MjModel)
     data = mujoco.MjData(model)
@@ -149,17 +148,7 @@ def frame_cameras(text: str, model: object, crane: Crane, lengths: LinkLengths, 
     root = ElementTree.fromstring(text)
     world = root.find("worldbody")
     assert world is not None
-    cameras = {c.get("name"): c for c in world.findall("camera")}
-    fovy = float(next(iter(cameras.values())).get("fovy", "45")) if cameras else 45.0
-    for name, (position, xyaxes) in framed_cameras(np.concatenate(corners), CAMERA_ASPECT, fovy).items():
-        camera = cameras.get(name)
-        if camera is None:
-            camera = ElementTree.SubElement(world, "camera", name=name, fovy=f"{fovy:g}")
-        camera.set("pos", " ".join(f"{v:.4f}" for v in position))
-        camera.set("xyaxes", " ".join(f"{v:.4f}" for v in xyaxes))
-        camera.attrib.pop("quat", None)
-        camera.attrib.pop("euler", None)
-    assert set(MODEL_CAMERAS) <= {c.get("name") for c in world.findall("camera")}
+    place_cameras(world, np.concatenate(corners))
     return ElementTree.tostring(root, encoding="unicode")
 
 
