@@ -274,3 +274,58 @@ class BlockLayout:
         """A row vector as {block name: {row name: value}} (e.g. multipliers for a sensitivity report)."""
         rows = np.asarray(rows, dtype=float)
         return {name: dict(zip(self.names[s], map(float, rows[s]), strict=True)) for name, s in self.slices.items()}
+
+
+class ScaledRows(Protocol):
+    """What a problem's ``evaluate(z)`` holds that its scaled cost and rows are read from."""
+
+    @property
+    def cost(self) -> float:
+        """The objective's value at z [its unit]."""
+        ...
+
+    @property
+    def constraints(self) -> Array:
+        """Scaled inequality rows, feasible where >= 0."""
+        ...
+
+    @property
+    def equalities(self) -> Array:
+        """Scaled equalities, feasible where == 0."""
+        ...
+
+
+class ScaledProblem(ABC):
+    """The scaled NLP read from one evaluation: cost, inequality rows, equalities and nominal margins.
+
+    A task's problem (:class:`hiab_sim.study.nlp.task_problem.TaskProblem`) and a study's (its tasks'
+    stacked, :class:`hiab_sim.study.nlp.problem.StudyProblem`) read them alike from their
+    :meth:`evaluate`; each sets ``cost_scale`` [the objective's unit] and ``clearance`` (per row, scaled).
+    """
+
+    cost_scale: float
+    clearance: Array
+
+    @abstractmethod
+    def evaluate(self, z: Array) -> ScaledRows:
+        """Everything computed at the point z."""
+
+    def cost(self, z: Array) -> float:
+        """Scaled cost f / f_scale (a study: the weighted sum sum_k w_k f_k over its tasks)."""
+        return self.evaluate(z).cost / self.cost_scale
+
+    def constraints(self, z: Array) -> Array:
+        """Scaled inequality rows g(z) >= 0 (a study: every task's rows, stacked)."""
+        return self.evaluate(z).constraints
+
+    def equalities(self, z: Array) -> Array:
+        """Rest-to-rest equalities, linear in the spline coefficients (a study: every task's)."""
+        return self.evaluate(z).equalities
+
+    def margins(self, z: Array) -> Array:
+        """Nominal scaled inequality margins (feasible where >= 0): the solver's rows without the clearance.
+
+        The tracking bands and envelope margins stay as the problem holds them (``tightened``);
+        only the working-range clearance, a safety the optimiser adds for its own optimum, is removed.
+        """
+        return self.evaluate(z).constraints + self.clearance

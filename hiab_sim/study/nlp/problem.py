@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 
 from hiab_sim.emla import EmlaSet
 from hiab_sim.study.machines.protocol import Design
-from hiab_sim.study.nlp.interface import Array, ConstraintBlock
+from hiab_sim.study.nlp.interface import Array, ConstraintBlock, ScaledProblem
 from hiab_sim.study.nlp.task_problem import Evaluation, TaskProblem
 from hiab_sim.study.spec.study_file import Study
 
@@ -61,7 +61,7 @@ class StackedBlock:
     rows: slice  # rows in the stacked problem
 
 
-class StudyProblem:
+class StudyProblem(ScaledProblem):
     """The scaled NLP of a study of one or more tasks (module docstring).
 
     Args:
@@ -228,22 +228,6 @@ class StudyProblem:
             equalities=np.concatenate([ev.equalities for ev in evs]),
             tasks=evs,
         )
-
-    def cost(self, z: Array) -> float:
-        """Scaled cost sum_k w_k f_k / f_scale."""
-        return self.evaluate(z).cost / self.cost_scale
-
-    def constraints(self, z: Array) -> Array:
-        """Scaled inequality rows of every task, g(z) >= 0."""
-        return self.evaluate(z).constraints
-
-    def equalities(self, z: Array) -> Array:
-        """Every task's rest-to-rest equalities."""
-        return self.evaluate(z).equalities
-
-    def margins(self, z: Array) -> Array:
-        """Nominal scaled margins (the rows without the optimiser's clearance)."""
-        return self.evaluate(z).constraints + self.clearance
 
     def max_violation(self, z: Array) -> float:
         """Largest violation over every task (its rows, equalities and the Xi bounds), scaled units."""

@@ -66,6 +66,7 @@ from hiab_sim.study.nlp.interface import (
     SamplePartials,
     SampleRows,
     SampleState,
+    ScaledProblem,
 )
 from hiab_sim.study.nlp.objectives import make_objective
 from hiab_sim.study.nlp.task_setup import duty_options, working_range
@@ -97,7 +98,7 @@ class Evaluation(SampleState):
     equalities: Array  # scaled, feasible where == 0
 
 
-class TaskProblem:
+class TaskProblem(ScaledProblem):
     """The scaled rows and cost of one task of a study on a time grid (its collocation grid by default).
 
     Args:
@@ -299,26 +300,6 @@ class TaskProblem:
             self._eval_cache.clear()
         self._eval_cache[key] = ev
         return ev
-
-    def cost(self, z: Array) -> float:
-        """Scaled cost f / f_scale."""
-        return self.evaluate(z).cost / self.cost_scale
-
-    def constraints(self, z: Array) -> Array:
-        """Scaled inequality constraints g(z) >= 0."""
-        return self.evaluate(z).constraints
-
-    def equalities(self, z: Array) -> Array:
-        """Rest-to-rest equalities (linear in c)."""
-        return self.evaluate(z).equalities
-
-    def margins(self, z: Array) -> Array:
-        """Nominal scaled inequality margins (feasible where >= 0): the solver's rows without the clearance.
-
-        The tracking bands and envelope margins stay as this problem holds them (``tightened``);
-        only the working-range clearance, a safety the optimiser adds for its own optimum, is removed.
-        """
-        return self.evaluate(z).constraints + self.clearance
 
     def max_violation(self, z: Array) -> float:
         """Largest violation of any nominal constraint (:meth:`margins`) or bound, in scaled units."""
