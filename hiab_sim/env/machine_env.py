@@ -47,13 +47,13 @@ from hiab_sim.env import CURRENT_BANDWIDTH_HZ, PHYSICS_TIMESTEP
 from hiab_sim.env.loop_design import LoopDesign
 from hiab_sim.env.machine_plan import MachinePlan
 from hiab_sim.env.physics import CranePhysics
-from hiab_sim.env.reference import PlannedMotion, RodSamples, motion_of_plan, physics_times
+from hiab_sim.env.reference import PlannedMotion, motion_of_plan, physics_times
 from hiab_sim.env.rollout import ClosedLoopRun, run_environment
 from hiab_sim.env.task import CraneTrackingTask
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.dynamics.mjcf_build import spec_of_tree
 from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
-from hiab_sim.machine.dynamics.tree import SimulationExtras, machine_tree
+from hiab_sim.machine.dynamics.tree import MachineActuatorSamples, SimulationExtras, machine_tree
 from hiab_sim.model.mjcf import source_to_world
 
 Array = NDArray[np.float64]
@@ -81,7 +81,7 @@ def machine_motion(plan: MachinePlan, timestep: float) -> tuple[PlannedMotion, A
     force = np.stack([np.interp(times, plan.time, plan.tcp_force[:, i]) for i in range(3)], axis=1)
     dynamics = MujocoMachineDynamics(plan.machine)
 
-    def loaded_dynamics(pos: Array, vel: Array, acc: Array) -> tuple[RodSamples, Array, Array]:
+    def loaded_dynamics(pos: Array, vel: Array, acc: Array) -> tuple[MachineActuatorSamples, Array, Array]:
         actuators = dynamics(pos, vel, acc, tcp_force=force[:, :2])
         qpos, qvel, _ = dynamics.state(pos, vel, acc)
         return actuators, qpos, qvel

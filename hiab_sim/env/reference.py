@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
-from typing import Protocol
 
 import mujoco
 import numpy as np
@@ -24,10 +23,11 @@ from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
-from hiab_sim.dynamics.samples import JointSamples
+from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.emla.drive import drive_state
 from hiab_sim.emla.params import EmlaParams
 from hiab_sim.env.plan import DesignPlan, PlannedDesign
+from hiab_sim.machine.dynamics.tree import MachineActuatorSamples
 from hiab_sim.model.mjcf import source_to_world
 from hiab_sim.model.states import site_positions
 
@@ -90,31 +90,7 @@ class PlannedMotion:
 #: Inverse dynamics of a planned motion at the physics rate: the independent joints' positions, rates
 #: and accelerations (N, J) -> the actuators' load-side samples and the loop-consistent MuJoCo
 #: ``qpos``, ``qvel`` (N, nv) of the model the planned TCP is read on.
-MotionDynamics = Callable[[Array, Array, Array], tuple["RodSamples", Array, Array]]
-
-
-class RodSamples(Protocol):
-    """Load-side actuator samples (N, A) of either inverse-dynamics path (crane or machine file)."""
-
-    @property
-    def force(self) -> Array:
-        """Load-side force f_x [N], > 0 extends."""
-        ...
-
-    @property
-    def velocity(self) -> Array:
-        """Rod velocity v_x [m/s]."""
-        ...
-
-    @property
-    def acceleration(self) -> Array:
-        """Rod acceleration a_x [m/s^2]."""
-        ...
-
-    @property
-    def stroke(self) -> Array:
-        """Stroke x [m]."""
-        ...
+MotionDynamics = Callable[[Array, Array, Array], tuple[ActuatorSamples | MachineActuatorSamples, Array, Array]]
 
 
 def physics_times(plan: PlannedDesign, timestep: float) -> Array:
@@ -168,7 +144,7 @@ def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
     dynamics = MujocoInverseDynamics(plan.crane, plan.lengths)
     tcp_force = None if plan.payload == 0.0 else np.array([0.0, -plan.payload * plan.crane.gravity, 0.0])
 
-    def crane_dynamics(pos: Array, vel: Array, acc: Array) -> tuple[RodSamples, Array, Array]:
+    def crane_dynamics(pos: Array, vel: Array, acc: Array) -> tuple[ActuatorSamples, Array, Array]:
         joints = JointSamples(pos, vel, acc)
         actuators = dynamics(joints, tcp_force)
         qpos, qvel, _ = dynamics.state(joints)

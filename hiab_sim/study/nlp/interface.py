@@ -43,7 +43,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -276,25 +276,6 @@ class BlockLayout:
         return {name: dict(zip(self.names[s], map(float, rows[s]), strict=True)) for name, s in self.slices.items()}
 
 
-class ScaledRows(Protocol):
-    """What a problem's ``evaluate(z)`` holds that its scaled cost and rows are read from."""
-
-    @property
-    def cost(self) -> float:
-        """The objective's value at z [its unit]."""
-        ...
-
-    @property
-    def constraints(self) -> Array:
-        """Scaled inequality rows, feasible where >= 0."""
-        ...
-
-    @property
-    def equalities(self) -> Array:
-        """Scaled equalities, feasible where == 0."""
-        ...
-
-
 class ScaledProblem(ABC):
     """The scaled NLP read from one evaluation: cost, inequality rows, equalities and nominal margins.
 
@@ -307,8 +288,12 @@ class ScaledProblem(ABC):
     clearance: Array
 
     @abstractmethod
-    def evaluate(self, z: Array) -> ScaledRows:
-        """Everything computed at the point z."""
+    def evaluate(self, z: Array) -> Any:
+        """Everything computed at the point z: ``cost`` [the objective's unit], ``constraints``, ``equalities``.
+
+        Typed by each problem (:class:`~hiab_sim.study.nlp.task_problem.Evaluation`,
+        :class:`~hiab_sim.study.nlp.problem.StudyEvaluation`, both frozen).
+        """
 
     def cost(self, z: Array) -> float:
         """Scaled cost f / f_scale (a study: the weighted sum sum_k w_k f_k over its tasks)."""
