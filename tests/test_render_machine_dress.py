@@ -171,3 +171,17 @@ def test_marks_are_the_pivots_the_design_moves(machine: Machine) -> None:
     rods = initial.copy()
     rods[keys.index("arm.Lc")] += 0.02  # a rod length moves no pivot
     assert moved_pivots(machine, [initial, rods]) == ()
+
+
+def test_a_link_whose_mass_lies_off_its_chord_is_drawn_bent_through_its_knee(machine: Machine) -> None:
+    """The eXact boom (mass 0.38 m off B->A) bends through the arm cylinder's base pin E; the arm is straight."""
+    from hiab_sim.render.dress_machine import spine
+
+    boom, arm = machine.link("boom"), machine.link("arm")
+    carried = [np.asarray(p.position, dtype=float) for c in machine.chains for p in c.pivots if p.link == "boom"]
+    to_arm = np.asarray(arm.joint_frame.position, dtype=float)
+    line = spine(to_arm, carried, np.asarray(boom.body.com), 0.27)  # type: ignore[union-attr]
+    np.testing.assert_allclose(line[1], machine.chain("arm").pivot("base").position)
+    to_bucket = np.asarray(machine.link("bucket").joint_frame.position, dtype=float)
+    carried = [np.asarray(p.position, dtype=float) for c in machine.chains for p in c.pivots if p.link == "arm"]
+    assert len(spine(to_bucket, carried, np.asarray(arm.body.com), 0.29)) == 2  # type: ignore[union-attr]

@@ -8,10 +8,13 @@ next to it where the file gives none:
 * **Links** are square steel box sections whose depth h follows from the link's mass m [kg] and
   reach l [m] (the farthest point it carries from its joint): with a wall t = h / :data:`SLENDERNESS`,
   the mass per length is m / l = rho (h^2 - (h - 2 t)^2) = 0.19 rho h^2, so h = sqrt(m / (0.19 rho l))
-  (:func:`section_depth`; the eXact's 227 kg, 2.05 m boom: 0.27 m). The capsules to a link's child
-  link and to the TCP are the link itself; those to its pivots are lugs of :data:`LUG_DEPTH`
-  times that depth. Rockers and couplers follow the same rule from their own bodies.
-  A massless root (a slewing chassis) takes :data:`ROOT_FACTOR` times the deepest link.
+  (:func:`section_depth`; the eXact's 227 kg, 2.05 m boom: 0.27 m; a tool's parts drawn as blocks
+  are not counted). The section runs from the link's joint to each child link's joint (and the
+  TCP), straight or, when the centre of mass lies off that chord, bent through the knee
+  (:func:`spine`); lugs of :data:`LUG_DEPTH` times the depth run from it to every other point the
+  link carries (:func:`link_plates`). The model's capsules of the link are not drawn. Rockers and
+  couplers are bars of the same rule from their own bodies; a massless root (a slewing chassis)
+  takes :data:`ROOT_FACTOR` times the deepest link.
 * **Actuators**: a barrel of the named hydraulic cylinder's bore plus the crane's wall and a rod of
   its rod diameter (the crane's rule, :data:`~hiab_sim.render.dress.BARREL_WALL_M`); without
   cylinder data, the radius of a uniform solid cylinder with the actuator body's mass and axial
@@ -195,16 +198,19 @@ def machine_file_dress(model: mujoco.MjModel, machine: Machine, ground: float | 
     kind: dict[int, str] = {}
     section: dict[int, tuple[float, float]] = {}
     radius: dict[int, float] = {}
+    tool_turns = machine.link(machine.tcp_link).joint_kind == "revolute"
+    tool_link = machine.link(machine.tcp_link)
+    carried = () if tool_turns else tuple(p for p in tool_link.parts if p.name != tool_link.name)  # drawn as blocks
     depth: dict[str, float] = {}
     for k, body in enumerate(tree.bodies):
         if body.inertia is None or (body.chain is not None and body.name.endswith((".cylinder", ".rod"))):
             continue
         ends = [end for _, end in _ends(model, body_id[body.name], found["hiab_red"])]
         length = _reach(_main_points(tree, k) or ends)
+        own = body.inertia.mass - sum(p.mass for p in carried) if body.name == tool_link.name else body.inertia.mass
         if length > POINT_TOLERANCE_M:
-            depth[body.name] = section_depth(body.inertia.mass, length)
+            depth[body.name] = section_depth(own, length)
     deepest = max(depth.values(), default=0.1)
-    tool_turns = machine.link(machine.tcp_link).joint_kind == "revolute"
     hidden: set[int] = set(int(g) for g in np.nonzero(model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE)[0])
     plates: list[Plate] = []
     for k, body in enumerate(tree.bodies):
@@ -240,17 +246,12 @@ def machine_file_dress(model: mujoco.MjModel, machine: Machine, ground: float | 
     widths = [p.width for p in plates] + [w for _, w in section.values()]
     tcp_site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "tcp")
     tool = body_id[machine.tcp_link]
-    tool_link = machine.link(machine.tcp_link)
-    blocks: tuple[Block, ...] = ()
     anchor = None
     if tool_turns and tool_link.body is not None:
         anchor = (tool, np.asarray(tool_link.body.com, dtype=float))
-    elif not tool_turns:
-        blocks = tuple(
-            Block(tool, np.asarray(p.com, dtype=float), float((p.mass / STEEL_DENSITY) ** (1.0 / 3.0)))
-            for p in tool_link.parts
-            if p.name != tool_link.name
-        )
+    blocks = tuple(
+        Block(tool, np.asarray(p.com, dtype=float), float((p.mass / STEEL_DENSITY) ** (1.0 / 3.0))) for p in carried
+    )
     pin_length = max(widths, default=0.1) + 2.0 * PIN_OVERHANG_M
     return MachineDress(
         kind, section, radius, pins, pin_sites, pin_length, blocks, tcp_site,
