@@ -53,6 +53,9 @@ PIN_OVERHANG_M = 0.02
 STEEL_DENSITY = 7850.0
 #: Truck bed under the column: (length, width, height) [m], a choice of a small truck's bed.
 BED_SIZE_M = (2.2, 1.0, 0.16)
+#: A ghost's (alpha < 1) widths across the plane and radii over the opaque design's: a choice, so that
+#: where the two overlap the ghost's faces lie behind the opaque ones instead of flickering with them.
+GHOST_INSET = 0.9
 #: Self-lighting of the slabs: a choice, so a top face the headlight grazes does not read as a hole.
 SLAB_EMISSION = 0.5
 #: Plane normal of the models' world (the machine moves in MuJoCo's x-z plane): the pins' axis.
@@ -245,11 +248,13 @@ def dress_scene(
 ) -> None:
     """Restyle the model's geoms of scene indices ``span`` = [start, stop) and add pins, blocks, tool, slabs.
 
-    ``colour`` (RGB(A) in [0, 1]) paints the structure; ``alpha`` < 1 draws everything as a ghost
-    (and ``ground`` False leaves the slabs to the opaque design). A ``payload_kg`` > 0 (the mass
+    ``colour`` (RGB(A) in [0, 1]) paints the structure; ``alpha`` < 1 draws everything as a ghost,
+    set back behind the opaque design where they overlap (:data:`GHOST_INSET`), and ``ground``
+    False leaves the slabs to the opaque design. A ``payload_kg`` > 0 (the mass
     held at this frame) is drawn with the tool (:func:`payload_box`); 0 draws none.
     """
     structure = (*colour[:3], alpha)
+    inset = 1.0 if alpha >= 1.0 else GHOST_INSET
     for i in range(*span):
         geom = scene.geoms[i]
         if geom.objtype != mujoco.mjtObj.mjOBJ_GEOM:
@@ -265,14 +270,15 @@ def dress_scene(
             depth, width = dress.section[geom.objid]
             geom.type = mujoco.mjtGeom.mjGEOM_BOX
             geom.mat[:] = section_frame(np.asarray(geom.mat).reshape(3, 3)[:, 2])
-            geom.size[:] = (0.5 * depth, 0.5 * width, half + 0.25 * depth)
+            geom.size[:] = (0.5 * depth, 0.5 * width * inset, half + 0.25 * depth)
             geom.rgba[:] = structure
         else:
             geom.type = mujoco.mjtGeom.mjGEOM_CYLINDER
-            geom.size[:] = (dress.radius[geom.objid], dress.radius[geom.objid], half)
+            r = dress.radius[geom.objid] * inset
+            geom.size[:] = (r, r, half)
             geom.rgba[:] = (*(BARREL_RGBA if kind == "barrel" else ROD_RGBA)[:3], alpha)
         geom.emission = 0.15
-    _pins(scene, data, dress, alpha)
+    _pins(scene, data, dress, alpha, inset)
     for block in dress.blocks:
         rotation = data.xmat[block.body].reshape(3, 3)
         centre = data.xpos[block.body] + rotation @ block.com
@@ -281,7 +287,7 @@ def dress_scene(
     for plate in dress.plates:
         start, end = plate_ends(data, plate)
         length = float(np.linalg.norm(end - start))
-        size = (0.5 * plate.depth, 0.5 * plate.width, 0.5 * length + 0.25 * plate.depth)
+        size = (0.5 * plate.depth, 0.5 * plate.width * inset, 0.5 * length + 0.25 * plate.depth)
         _add(scene, mujoco.mjtGeom.mjGEOM_BOX, size, 0.5 * (start + end), section_frame(end - start), structure)
     eye = np.eye(3)
     if dress.hook:
@@ -298,10 +304,10 @@ def dress_scene(
             scene.geoms[scene.ngeom - 1].emission = SLAB_EMISSION
 
 
-def _pins(scene: mujoco.MjvScene, data: mujoco.MjData, dress: MachineDress, alpha: float) -> None:
-    """A pin across the plane at every hinge anchor and every loop-closing site."""
+def _pins(scene: mujoco.MjvScene, data: mujoco.MjData, dress: MachineDress, alpha: float, inset: float) -> None:
+    """A pin across the plane at every hinge anchor and every loop-closing site (``inset``: its length's share)."""
     mat = section_frame(PLANE_NORMAL)
-    size = (0.5 * PIN_DIAMETER_M, 0.5 * PIN_DIAMETER_M, 0.5 * dress.pin_length)
+    size = (0.5 * PIN_DIAMETER_M, 0.5 * PIN_DIAMETER_M, 0.5 * dress.pin_length * inset)
     where = [data.xanchor[j] for j in dress.pins] + [data.site_xpos[s] for s in dress.pin_sites]
     for centre in where:
         _add(scene, mujoco.mjtGeom.mjGEOM_CYLINDER, size, centre, mat, (*PIN_RGBA[:3], alpha))

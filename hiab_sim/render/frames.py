@@ -27,7 +27,7 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.render import decor
 from hiab_sim.render.backend import open_renderer
 from hiab_sim.render.camera import camera_axes, fit_camera, geom_corners
-from hiab_sim.render.dress import MachineDress, dress_points, dress_scene
+from hiab_sim.render.dress import PLANE_NORMAL, MachineDress, dress_points, dress_scene
 from hiab_sim.render.labels import caption_bitmap, stamp
 
 Array = NDArray[np.float64]
@@ -175,6 +175,8 @@ class PlaybackRenderer:
         depth = float(np.max((points - self.camera.lookat) @ forward)) + 1.0
         aspect = panel_width / panel_height
         self._backdrop = (depth, 4.0 * (self.camera.distance + depth) * np.tan(np.radians(fovy)) * max(aspect, 1.0))
+        # a ghost's part within this of the opaque one's (1.5 px in the plane of motion) is not drawn: it would flicker
+        self._same_m = 1.5 * 2.0 * self.camera.distance * np.tan(np.radians(fovy) / 2.0) / panel_height
         self._line = max(16, min(panel_height // 14 if layout == "stacked" else height // 20, panel_width // 28))
         self._captions = [caption_bitmap(d.caption or d.name, text_colour(d.rgba), self._line) for d in self.designs]
 
@@ -213,6 +215,8 @@ class PlaybackRenderer:
                 body = mujoco.mj_name2id(design.model, mujoco.mjtObj.mjOBJ_BODY, name)
                 if site >= 0 or body >= 0:
                     found[name] = np.array(data.site_xpos[site] if site >= 0 else data.xpos[body])
+                    if design.dress is not None:  # on the pin's end facing the camera, not inside the section
+                        found[name] -= PLANE_NORMAL * 0.5 * design.dress.pin_length
                     decor.add_ball(scene, found[name], MARK_RADIUS_M, design.rgba)
             where.append(found)
         for first, second in itertools.pairwise(where):
@@ -266,7 +270,7 @@ class PlaybackRenderer:
         for design, data in zip(self.designs[1:], self._data[1:], strict=True):
             start = scene.ngeom
             mujoco.mjv_addGeoms(design.model, data, self._option, self._perturb, mujoco.mjtCatBit.mjCAT_DYNAMIC, scene)
-            decor.drop_coincident(scene, start)
+            decor.drop_coincident(scene, start, self._same_m)
             spans.append((start, scene.ngeom))
         for k, (design, data, span) in enumerate(zip(self.designs, self._data, spans, strict=True)):
             if design.dress is not None:
@@ -277,7 +281,7 @@ class PlaybackRenderer:
                     payload_kg=design.payload_at(index),
                 )  # fmt: skip
                 if k > 0:  # the ghost's pins, plates and blocks where the opaque design has them already
-                    decor.drop_coincident(scene, start)
+                    decor.drop_coincident(scene, start, self._same_m)
             elif k > 0:
                 decor.tint_geoms(scene, span[0], (*design.rgba[:3], GHOST_ALPHA), weight=0.8)
         self._decorate(scene, self.designs, index)
