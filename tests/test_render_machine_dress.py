@@ -185,3 +185,16 @@ def test_a_link_whose_mass_lies_off_its_chord_is_drawn_bent_through_its_knee(mac
     to_bucket = np.asarray(machine.link("bucket").joint_frame.position, dtype=float)
     carried = [np.asarray(p.position, dtype=float) for c in machine.chains for p in c.pivots if p.link == "arm"]
     assert len(spine(to_bucket, carried, np.asarray(arm.body.com), 0.29)) == 2  # type: ignore[union-attr]
+
+
+def test_excavator_page_shows_the_three_committed_frames() -> None:
+    """docs/results/excavator.md embeds the start, middle and end frames that docs_figures.sh writes, each committed."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    page = (root / "docs" / "results" / "excavator.md").read_text(encoding="utf-8")
+    script = (root / "scripts" / "docs_figures.sh").read_text(encoding="utf-8")
+    for which in ("start", "middle", "end"):
+        name = f"excavator_{which}.png"
+        assert f"](../figures/{name})" in page and f'"$OUT/{name}"' in script, name
+        assert (root / "docs" / "figures" / name).is_file(), name
