@@ -2,17 +2,40 @@
 # Re-make docs/figures/ from the tool: the validation page's figures (MuJoCo vs analytic inverse
 # dynamics over the cases of `hiab-sim validate`, and the balance residuals), the default study's
 # figures, three frames (start, middle, end) of the playback and closed-loop videos, the EMLA map and
-# the energy map. With SLOW=1 also the sweeps and the Pareto front (tens of optimisations). Run after
-# scripts/setup.sh. ONLY=validation makes the validation figures only (seconds); FIGURES_DIR (default
-# docs/figures), VALIDATION_SAMPLES (default: the case file's) and PYTHON (default .venv/bin/python)
-# change where they go, how many samples per case and which interpreter runs them (the test uses all three).
+# the energy map, and three frames of the eXact excavator's digging video (excavator_<start|middle|end>.png).
+# With SLOW=1 also the sweeps and the Pareto front (tens of optimisations). Run after scripts/setup.sh.
+# ONLY=validation makes the validation figures only (seconds), ONLY=excavator the excavator's frames only
+# (its optimisation: minutes); FIGURES_DIR (default docs/figures), VALIDATION_SAMPLES (default: the case
+# file's), PYTHON (default .venv/bin/python) and HIAB_SIM (default .venv/bin/hiab-sim) change where they go,
+# how many samples per case and which interpreter and command run them (the test uses the first three).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-HS=.venv/bin/hiab-sim
+HS="${HIAB_SIM:-.venv/bin/hiab-sim}"
 RUN="${RUN_DIR:-runs/docs_xs031_spiral}"
+EXCAVATOR_RUN="${EXCAVATOR_RUN_DIR:-runs/docs_exact_digging}"
 PY="${PYTHON:-.venv/bin/python}"
 OUT="${FIGURES_DIR:-docs/figures}"
 mkdir -p "$OUT"
+# The excavator (a machine file's study): its playback dressed from the machine description, three frames
+# evenly spaced over the digging cycle, ends included (the optimal design over the ghost of the initial one).
+# REUSE=1 keeps an excavator result folder that already holds a result.json (no new optimisation).
+excavator_frames() {
+  if [ "${REUSE:-0}" != "1" ] || [ ! -f "$EXCAVATOR_RUN/result.json" ]; then
+    $HS optimize optimize/exact_digging.yaml --out "$EXCAVATOR_RUN" --force --no-video --no-figures --no-report \
+      --quiet >/dev/null
+  fi
+  local frames="$EXCAVATOR_RUN/docs_frames"
+  rm -rf "$frames" && mkdir -p "$frames"
+  $HS render "$EXCAVATOR_RUN" --frames "$frames" --count 3 --size 800x450 >/dev/null
+  mv "$frames/frame_000.png" "$OUT/excavator_start.png"
+  mv "$frames/frame_001.png" "$OUT/excavator_middle.png"
+  mv "$frames/frame_002.png" "$OUT/excavator_end.png"
+}
+if [ "${ONLY:-}" = "excavator" ]; then
+  excavator_frames
+  echo "re-made the excavator's frames in $OUT from $EXCAVATOR_RUN"
+  exit 0
+fi
 $PY -m hiab_sim.docs_site.validation_figures --out "$OUT" ${VALIDATION_SAMPLES:+--samples "$VALIDATION_SAMPLES"} >/dev/null
 if [ "${ONLY:-}" = "validation" ]; then
   echo "re-made the validation figures in $OUT"
@@ -53,4 +76,5 @@ if [ "${SLOW:-0}" = "1" ]; then
   cp "$RUN/sweep_payload_gear/sweep_summary.png" "$OUT/sweep_payload_gear.png"
   cp "$RUN/sweep_payload_gear/sweep_saving_map.png" "$OUT/sweep_payload_gear_map.png"
 fi
-echo "re-made $OUT from $RUN"
+excavator_frames
+echo "re-made $OUT from $RUN and $EXCAVATOR_RUN"

@@ -94,21 +94,32 @@ def tint_geoms(scene: mujoco.MjvScene, start: int, rgba: Sequence[float], weight
             geom.rgba[3] = min(float(geom.rgba[3]), float(target[3]))
 
 
-def _geom_key(geom: mujoco.MjvGeom, tolerance: float) -> tuple[int, ...]:
-    placement = np.concatenate([np.asarray(geom.pos), np.asarray(geom.size)])
-    return (int(geom.type), *np.round(placement / tolerance).astype(int).tolist())
+def _geom_features(scene: mujoco.MjvScene, stop: int) -> tuple[NDArray[np.int_], Array]:
+    """Type and (both axis ends, size) (n, 9) [m] of the scene's first ``stop`` geoms: placement and orientation."""
+    types = np.array([int(scene.geoms[i].type) for i in range(stop)], dtype=int)
+    features = np.empty((stop, 9))
+    for i in range(stop):
+        geom = scene.geoms[i]
+        pos, size = np.asarray(geom.pos, dtype=float), np.asarray(geom.size, dtype=float)
+        axis = np.asarray(geom.mat, dtype=float).reshape(3, 3)[:, 2] * size[2]
+        features[i] = np.concatenate([pos + axis, pos - axis, size])
+    return types, features
 
 
 def drop_coincident(scene: mujoco.MjvScene, start: int, tolerance: float = 1e-4) -> None:
-    """Remove the geoms from index ``start`` on that coincide with one before ``start``.
+    """Remove the geoms from index ``start`` on that coincide with one before ``start`` to within ``tolerance`` [m].
 
-    Overlaid designs share their booms (link lengths move only the cylinders): drawing the
-    shared geoms twice would only blend their colours. Kept geoms are compacted in place.
+    Coincide: the same type, both ends of the axis and the sizes within ``tolerance``. Overlaid
+    designs share their booms (link lengths move only the cylinders): drawing the shared geoms
+    twice would only blend their colours, or, a fraction of a pixel apart, make them flicker. Kept
+    geoms are compacted in place.
     """
-    seen = {_geom_key(scene.geoms[i], tolerance) for i in range(start)}
+    types, features = _geom_features(scene, scene.ngeom)
+    earlier_types, earlier = types[:start], features[:start]
     kept = start
     for i in range(start, scene.ngeom):
-        if _geom_key(scene.geoms[i], tolerance) in seen:
+        same = earlier_types == types[i]
+        if same.any() and np.min(np.max(np.abs(earlier[same] - features[i]), axis=1)) <= tolerance:
             continue
         if kept != i:
             _copy_geom(scene.geoms[kept], scene.geoms[i])

@@ -27,7 +27,7 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.render import decor
 from hiab_sim.render.backend import open_renderer
 from hiab_sim.render.camera import camera_axes, fit_camera, geom_corners
-from hiab_sim.render.dress import MachineDress, dress_points, dress_scene
+from hiab_sim.render.dress import PLANE_NORMAL, MachineDress, dress_points, dress_scene
 from hiab_sim.render.labels import caption_bitmap, stamp
 
 Array = NDArray[np.float64]
@@ -63,7 +63,7 @@ class Design:
     tcp_site: str = "tcp"
     #: The machine's dressing (box booms, cylinders of the data, pins, blocks, hook, bed); None: the bare model.
     dress: MachineDress | None = None
-    #: Sites marked with a ball of the design's colour (pivots that move between designs).
+    #: Sites (or bodies, at their origin) marked with a ball of the design's colour (pivots that move between designs).
     marks: tuple[str, ...] = ()
     #: Payload mass held at the TCP per frame [kg] (0 while not held), drawn with the dressing; () for none.
     payload: tuple[float, ...] = ()
@@ -102,6 +102,13 @@ class Design:
     def payload_at(self, index: int) -> float:
         """Payload mass held at frame ``index`` [kg] (0 without a payload)."""
         return float(self.payload[index]) if self.payload else 0.0
+
+
+def _dress_geoms(design: Design) -> int:
+    """Most scene geoms a design adds beyond its model's: pins, hook, payload, blocks, plates, slabs, marks."""
+    dress = design.dress
+    parts = 0 if dress is None else len(dress.blocks) + len(dress.plates) + len(dress.slabs)
+    return design.model.njnt + design.model.neq + 4 + parts + len(design.marks)
 
 
 class PlaybackRenderer:
@@ -146,7 +153,7 @@ class PlaybackRenderer:
         self._perturb = mujoco.MjvPerturb()
         panel_width = width // panels if layout == "side-by-side" else width
         panel_height = height // panels if layout == "stacked" else height
-        extra = sum(d.model.njnt + 9 + len(d.marks) for d in self.designs)  # pins, blocks, hook, payload, bed, marks
+        extra = sum(_dress_geoms(d) for d in self.designs)
         max_geom = sum(d.model.ngeom for d in self.designs) + decor.MAX_SEGMENTS * (len(self.designs) + 1) + 16 + extra
         self._renderers: list[mujoco.Renderer] = []
         try:
@@ -168,6 +175,8 @@ class PlaybackRenderer:
         depth = float(np.max((points - self.camera.lookat) @ forward)) + 1.0
         aspect = panel_width / panel_height
         self._backdrop = (depth, 4.0 * (self.camera.distance + depth) * np.tan(np.radians(fovy)) * max(aspect, 1.0))
+        # a ghost's part within this of the opaque one's (1.5 px in the plane of motion) is not drawn: it would flicker
+        self._same_m = 1.5 * 2.0 * self.camera.distance * np.tan(np.radians(fovy) / 2.0) / panel_height
         self._line = max(16, min(panel_height // 14 if layout == "stacked" else height // 20, panel_width // 28))
         self._captions = [caption_bitmap(d.caption or d.name, text_colour(d.rgba), self._line) for d in self.designs]
 
@@ -196,15 +205,18 @@ class PlaybackRenderer:
         self._marks(scene, designs)
 
     def _marks(self, scene: mujoco.MjvScene, designs: Sequence[Design]) -> None:
-        """A ball of each design's colour at its marked sites; overlaid, a line from each to the next design's."""
+        """A ball of each design's colour at its marked sites and bodies; overlaid, a line to the next design's."""
         where: list[dict[str, Array]] = []
         for design in designs:
             data = self._data[self.designs.index(design)]
             found = {}
             for name in design.marks:
                 site = mujoco.mj_name2id(design.model, mujoco.mjtObj.mjOBJ_SITE, name)
-                if site >= 0:
-                    found[name] = np.array(data.site_xpos[site])
+                body = mujoco.mj_name2id(design.model, mujoco.mjtObj.mjOBJ_BODY, name)
+                if site >= 0 or body >= 0:
+                    found[name] = np.array(data.site_xpos[site] if site >= 0 else data.xpos[body])
+                    if design.dress is not None:  # on the pin's end facing the camera, not inside the section
+                        found[name] -= PLANE_NORMAL * 0.5 * design.dress.pin_length
                     decor.add_ball(scene, found[name], MARK_RADIUS_M, design.rgba)
             where.append(found)
         for first, second in itertools.pairwise(where):
@@ -258,15 +270,18 @@ class PlaybackRenderer:
         for design, data in zip(self.designs[1:], self._data[1:], strict=True):
             start = scene.ngeom
             mujoco.mjv_addGeoms(design.model, data, self._option, self._perturb, mujoco.mjtCatBit.mjCAT_DYNAMIC, scene)
-            decor.drop_coincident(scene, start)
+            decor.drop_coincident(scene, start, self._same_m)
             spans.append((start, scene.ngeom))
         for k, (design, data, span) in enumerate(zip(self.designs, self._data, spans, strict=True)):
             if design.dress is not None:
                 alpha = 1.0 if k == 0 else GHOST_ALPHA
+                start = scene.ngeom
                 dress_scene(
                     scene, span, design.model, data, design.dress, design.rgba, alpha, ground=k == 0,
                     payload_kg=design.payload_at(index),
                 )  # fmt: skip
+                if k > 0:  # the ghost's pins, plates and blocks where the opaque design has them already
+                    decor.drop_coincident(scene, start, self._same_m)
             elif k > 0:
                 decor.tint_geoms(scene, span[0], (*design.rgba[:3], GHOST_ALPHA), weight=0.8)
         self._decorate(scene, self.designs, index)

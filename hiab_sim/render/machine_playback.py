@@ -12,8 +12,9 @@ couplers included, is set per frame from the loop closure polished on MuJoCo's o
 (:meth:`~hiab_sim.machine.dynamics.mujoco_path.MujocoMachineDynamics.state`), so the connect
 equalities hold to |C| < 1e-13 m in every frame. Frames, captions, the reference path, the TCP trails
 and the energy line are the crane's (:class:`~hiab_sim.render.frames.PlaybackRenderer`,
-:func:`~hiab_sim.render.video.energy_notes`); the machine is drawn with the builder's capsules
-(the crane's box-section dressing reads the XS 031's description and is not drawn here).
+:func:`~hiab_sim.render.video.energy_notes`); the machine is dressed from its description
+(:mod:`hiab_sim.render.dress_machine`), standing on the ground level of the soil its study's tasks
+cut (``tasks[].soil.ground``, read from the study file the result names, when that file is there).
 """
 
 from __future__ import annotations
@@ -60,6 +61,7 @@ class MachinePlayback:
     payload_mass: Array | None = None
     battery_energy_J: dict[str, float] | None = None
     battery_period: str = "cycle"
+    ground: float | None = None  # the soil's ground level in the description's world y [m]; None: none given
 
 
 def is_machine_result(result_dir: str | Path) -> bool:
@@ -114,7 +116,18 @@ def load_machine_playback(result_dir: str | Path) -> MachinePlayback:
     if result.energy is not None:
         battery = {"initial": result.energy.initial.battery_energy_J, "optimal": result.energy.optimal.battery_energy_J}
         period = "duty period" if result.energy.optimal.duty is not None else "cycle"
-    return MachinePlayback(machine, time, reference, tuple(motions), payload, battery, period)
+    return MachinePlayback(
+        machine, time, reference, tuple(motions), payload, battery, period, study_ground(result.study)
+    )
+
+
+def study_ground(study: str) -> float | None:
+    """The ground level [m] of the first task with soil in the study file ``study``; None without one or the file."""
+    if not Path(study).is_file():
+        return None
+    from hiab_sim.study.spec.study_file import load_study
+
+    return next((task.soil.ground for task in load_study(study).tasks if task.soil is not None), None)
 
 
 def machine_model_and_qpos(machine: Machine, design: Array, position: Array) -> tuple[mujoco.MjModel, Array]:

@@ -3,7 +3,11 @@
 The layout and overlay are the crane's (:mod:`hiab_sim.render.video`): overlay (the optimal design
 opaque, the initial one as a ghost), side by side or stacked; each design's caption, its battery
 energy per cycle (or, without a battery figure, the drives' cumulative net energy), the reference
-path and each design's TCP trail. Only the kinematic playback exists for a machine file's result.
+path and each design's TCP trail. Each design is dressed from the machine description
+(:func:`~hiab_sim.render.dress_machine.machine_file_dress`: box-section links, barrels and rods,
+pins, the tool, base and ground) with the task's payload drawn while held; the chain pivots that
+the decision variables move are marked in each design's colour (:func:`~hiab_sim.render.dress_machine.moved_pivots`).
+Only the kinematic playback exists for a machine file's result.
 """
 
 from __future__ import annotations
@@ -16,6 +20,7 @@ import numpy as np
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.render.backend import check_gl_backend, check_output_path, ffmpeg_path, write_image, write_video
 from hiab_sim.render.decor import INITIAL_RGBA, OPTIMAL_RGBA
+from hiab_sim.render.dress_machine import machine_file_dress, moved_pivots
 from hiab_sim.render.frames import LAYOUTS, Design, Layout, PlaybackRenderer
 from hiab_sim.render.machine_playback import (
     MachinePlayback,
@@ -24,7 +29,7 @@ from hiab_sim.render.machine_playback import (
     machine_reference,
 )
 from hiab_sim.render.playback import frame_times, resample
-from hiab_sim.render.video import DEFAULT_LAYOUT, VIDEO_NAME, energy_notes
+from hiab_sim.render.video import DEFAULT_LAYOUT, VIDEO_NAME, energy_notes, held_payload
 
 _COLOURS = {"initial": INITIAL_RGBA, "optimal": OPTIMAL_RGBA}
 
@@ -41,12 +46,20 @@ def machine_renderer(
         raise InvalidInputError("layout", layout, f"must be one of {', '.join(LAYOUTS)}")
     at = frame_times(data.time, fps) if at is None else np.asarray(at, dtype=float)
     designs = []
+    marks = moved_pivots(data.machine, [motion.design for motion in data.designs])
+    payload = held_payload(data, at)
     for motion in data.designs:
         model, qpos = machine_model_and_qpos(data.machine, motion.design, resample(data.time, motion.position, at))
         caption = f"{motion.name} design" + (", ghost" if layout == "overlay" and motion.name == "initial" else "")
         battery = None if data.battery_energy_J is None else data.battery_energy_J.get(motion.name)
         notes = energy_notes(data.time, at, motion.power, battery, data.battery_period)
-        designs.append(Design(motion.name, model, qpos, _COLOURS.get(motion.name, OPTIMAL_RGBA), caption, notes))
+        dress = machine_file_dress(model, data.machine.with_design(motion.design), data.ground)
+        designs.append(
+            Design(
+                motion.name, model, qpos, _COLOURS.get(motion.name, OPTIMAL_RGBA), caption, notes,
+                dress=dress, marks=marks, payload=payload,
+            )
+        )  # fmt: skip
     if layout == "overlay":
         designs.reverse()  # the optimal design opaque, the initial one as a translucent ghost
     return PlaybackRenderer(designs, machine_reference(data), size, layout=layout)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -96,7 +97,21 @@ def playback_renderer(
     return PlaybackRenderer(designs, source_to_world(data.reference_tcp), size, layout=layout, shadows=shadows)
 
 
-def held_payload(data: PlaybackData, at: Array) -> tuple[float, ...]:
+class HeldPayload(Protocol):
+    """What :func:`held_payload` reads of a playback: sample times [s] and the payload mass held [kg]."""
+
+    @property
+    def time(self) -> Array:
+        """Sample times (K,) [s], increasing."""
+        ...
+
+    @property
+    def payload_mass(self) -> Array | None:
+        """Payload mass held at each sample (K,) [kg]; None without a payload."""
+        ...
+
+
+def held_payload(data: HeldPayload, at: Array) -> tuple[float, ...]:
     """The payload mass held at each frame instant ``at`` [kg]; () when the result has none.
 
     The schedule is a step (:class:`hiab_sim.study.spec.payload.Payload`: held for pick <= t <
