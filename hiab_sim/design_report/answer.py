@@ -4,8 +4,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.design_report.page import esc, figure, num, paragraph, section, table
+from hiab_sim.machine.description import Machine
 from hiab_sim.results.design_values import crane_lengths
 from hiab_sim.results.schema import Result
 
@@ -23,8 +26,25 @@ def built_lengths(result: Result) -> LinkLengths:
     return crane_lengths(result.optimal.lengths if result.buildable is None else result.buildable.lengths)
 
 
-def question(result: Result, crane: Crane) -> str:
-    """What was asked, of which machine, for which work."""
+#: A machine file's decision-variable kinds in words (:mod:`hiab_sim.machine.design`).
+KIND_WORDS = {
+    "hinge_distance": "pivot distance from the chain's hinge (the seed's L)",
+    "pivot_x": "pivot x in its link frame",
+    "pivot_y": "pivot y in its link frame",
+    "piston_offset": "piston offset Lc0",
+    "rod_length": "rod length Lc",
+    "retracted_length": "retracted length x0 = Lc0 + Lc",
+}
+
+
+def _variables_text(machine: Crane | Machine) -> str:
+    if isinstance(machine, Crane):
+        return "per chain: base pivot distance L, piston offset Lc0, rod length Lc [m]"
+    return ", ".join(f"{v.key} ({KIND_WORDS.get(v.kind, v.kind)})" for v in machine.decision_variables) + " [m]"
+
+
+def question(result: Result, machine: Crane | Machine) -> str:
+    """What was asked, of which machine (a crane file's or a machine file's), for which work."""
     tasks = (
         f"{len(result.tasks)} tasks (a duty mix: " + ", ".join(f"{t.name} x {t.weight:g}" for t in result.tasks) + ")"
         if result.tasks
@@ -39,11 +59,11 @@ def question(result: Result, crane: Crane) -> str:
     )
     rows = [
         ("study", result.name),
-        ("machine", f"{crane.name} ({crane.source})"),
+        ("machine", f"{machine.name} ({machine.source if isinstance(machine, Crane) else result.crane})"),
         ("work", tasks),
         ("payload", f"{result.settings.payload_kg:g} kg"),
         ("objective", objective),
-        ("decision variables", "per chain: base pivot distance L, piston offset Lc0, rod length Lc [m]"),
+        ("decision variables", _variables_text(machine)),
     ]
     if result.energy is not None:
         rows.append(("duty", result.energy.duty))
@@ -54,6 +74,49 @@ def question(result: Result, crane: Crane) -> str:
             "on the least energy, within its actuators' envelope, strokes, joint ranges and thermal limits?"
         ),
         table(("item", "value"), rows),
+    )
+
+
+def _buildable_text(result: Result) -> str:
+    if result.buildable is None:
+        return ""
+    b = result.buildable
+    return (
+        f" Rounded to the {1e3 * b.tolerance_m:g} mm manufacturing tolerance with a {1e3 * b.stroke_margin_m:g} mm "
+        f"stroke margin; every design within ±{1e3 * b.tolerance_m:g} mm stays feasible (worst margin "
+        f"{1e3 * b.tolerance_check.margin:.3f} mm) and its net energy differs from the optimum's by "
+        f"{b.net_energy_change_vs_optimum_J + 0.0:+.1f} J. Export: {b.mjcf_command}"
+    )
+
+
+def machine_design(result: Result, machine: Machine, folder: Path) -> str:
+    """A machine file's design to build: each decision variable and each pivot it moves, in the link's frame."""
+    chosen = result.optimal.lengths if result.buildable is None else result.buildable.lengths
+    before_values, after_values = result.initial.lengths.as_array(), chosen.as_array()
+    rows = [
+        (v.key, KIND_WORDS.get(v.kind, v.kind), f"{a:.4f} → {b:.4f}", f"{1e3 * (b - a):+.1f} mm")
+        for v, a, b in zip(machine.decision_variables, before_values, after_values, strict=True)
+    ]
+    before, after = (
+        machine.with_design(before_values, check_bounds=False),
+        machine.with_design(after_values, check_bounds=False),
+    )
+    moves = []
+    for old, new in zip(before.chains, after.chains, strict=True):
+        for p, q in zip(old.pivots, new.pivots, strict=True):
+            delta = 1e3 * (np.asarray(q.position, dtype=float) - np.asarray(p.position, dtype=float))
+            if np.any(np.abs(delta) > 1e-9):
+                moves.append((f"{old.name}.{p.role}", p.link, f"Δx {delta[0]:+.1f}, Δy {delta[1]:+.1f} mm"))
+    text = (
+        "Build "
+        + "; ".join(f"{v.key} = {b:.4f} m" for v, b in zip(machine.decision_variables, after_values, strict=True))
+        + "."
+    )
+    return section(
+        "The answer: the design to build",
+        f'<div class="answer">{paragraph(text + _buildable_text(result))}</div>',
+        table(("variable", "meaning", "initial → design [m]", "change"), rows),
+        table(("pivot", "on link", "move in the link's frame"), moves) if moves else "",
     )
 
 
@@ -76,15 +139,7 @@ def design(result: Result, crane: Crane, folder: Path) -> str:
                 f"{before.Lc0:.3f} / {before.Lc:.3f} → {after.Lc0:.3f} / {after.Lc:.3f}",
             )
         )
-    text = f"Build {_lengths_text(build, crane)}."
-    if result.buildable is not None:
-        b = result.buildable
-        text += (
-            f" Rounded to the {1e3 * b.tolerance_m:g} mm manufacturing tolerance with a {1e3 * b.stroke_margin_m:g} mm "
-            f"stroke margin; every design within ±{1e3 * b.tolerance_m:g} mm stays feasible (worst margin "
-            f"{1e3 * b.tolerance_check.margin:.3f} mm) and its net energy differs from the optimum's by "
-            f"{b.net_energy_change_vs_optimum_J + 0.0:+.1f} J. Export: {b.mjcf_command}"
-        )
+    text = f"Build {_lengths_text(build, crane)}." + _buildable_text(result)
     return section(
         "The answer: the design to build",
         f'<div class="answer">{paragraph(text)}</div>',

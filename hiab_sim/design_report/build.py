@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from hiab_sim.atomic_io import write_atomic
+from hiab_sim.crane.description import Crane
 from hiab_sim.design_report.analysis import (
     closed_loop,
     constraints,
@@ -14,10 +15,12 @@ from hiab_sim.design_report.analysis import (
     structure,
     thermal,
 )
-from hiab_sim.design_report.answer import design, energies, question
+from hiab_sim.design_report.answer import design, energies, machine_design, question
 from hiab_sim.design_report.page import document
 from hiab_sim.design_report.provenance import provenance
-from hiab_sim.results.read import read_result, result_crane
+from hiab_sim.machine.description import Machine
+from hiab_sim.machine.design import MachineDesign
+from hiab_sim.results.read import read_result, result_crane, result_machine
 
 REPORT_FILE = "report.html"
 
@@ -26,10 +29,16 @@ def report_html(run_dir: str | Path) -> str:
     """The report of ``run_dir`` as one self-contained HTML page (figures embedded, no network reference)."""
     folder = Path(run_dir)
     result = read_result(folder)
-    crane = result_crane(folder, result.crane)
+    machine: Crane | Machine
+    if isinstance(result.optimal.lengths, MachineDesign):
+        machine = result_machine(folder, result)
+        answer = machine_design(result, machine, folder)
+    else:
+        machine = result_crane(folder, result.crane)
+        answer = design(result, machine, folder)
     body = [
-        question(result, crane),
-        design(result, crane, folder),
+        question(result, machine),
+        answer,
         energies(result, folder),
         constraints(result),
         thermal(result),
@@ -40,7 +49,7 @@ def report_html(run_dir: str | Path) -> str:
         duty_mix(result, folder),
         provenance(result, folder),
     ]
-    return document(f"Design report: {result.name} on the {crane.name}", body)
+    return document(f"Design report: {result.name} on the {machine.name}", body)
 
 
 def write_report(run_dir: str | Path, out: str | Path | None = None, pdf: bool = False) -> list[Path]:

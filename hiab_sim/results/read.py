@@ -30,8 +30,6 @@ View = TypeVar("View")
 
 #: Designs a result holds, in the order tools show them.
 DESIGNS = ("initial", "optimal")
-#: Actuators whose peaks a result reports.
-ACTUATORS = ("lift", "tilt", "telescope")
 _HINT = "write one with 'hiab-sim optimize'"
 
 
@@ -51,11 +49,13 @@ class DesignSummary:
 
 @dataclass(frozen=True)
 class RunSummary:
-    """What other tools need from a result folder."""
+    """What other tools need from a result folder: the machine's name, its variables' and actuators' names."""
 
     folder: Path
     name: str
-    crane: Crane
+    machine: str
+    design_names: tuple[str, ...]
+    actuators: tuple[str, ...]
     designs: dict[str, DesignSummary]
     saved_percent: float  # net energy saved by the optimum [%]
     recheck_max_violation: float  # fine-grid re-check of the optimum (scaled)
@@ -133,6 +133,7 @@ def summarise(run_dir: str | Path) -> RunSummary:
     """Read a result folder into a :class:`RunSummary`."""
     folder = Path(run_dir)
     result = read_result(folder)
+    actuators = tuple(result.optimal.actuators)
     designs = {}
     for name in DESIGNS:
         entry = result.optimal if name == "optimal" else result.initial
@@ -142,15 +143,23 @@ def summarise(run_dir: str | Path) -> RunSummary:
             net_energy_J=entry.net_electrical_energy_J,
             drawn_energy_J=entry.drawn_energy_summed_drives_J,
             battery_energy_J=None if energy is None else energy.battery_energy_J,
-            peak_force_N={a: entry.actuators[a].peak_force_N for a in ACTUATORS},
-            peak_power_W={a: entry.actuators[a].peak_electrical_power_W for a in ACTUATORS},
-            min_envelope_margin={a: entry.actuators[a].min_envelope_margin for a in ACTUATORS},
+            peak_force_N={a: entry.actuators[a].peak_force_N for a in actuators},
+            peak_power_W={a: entry.actuators[a].peak_electrical_power_W for a in actuators},
+            min_envelope_margin={a: entry.actuators[a].min_envelope_margin for a in actuators},
             max_violation=entry.max_violation,
         )
+    lengths = result.optimal.lengths
+    if isinstance(lengths, MachineDesign):
+        machine, names = result_machine(folder, result).name, lengths.names
+    else:
+        crane = result_crane(folder, result.crane)
+        machine, names = crane.name, tuple(f"{c.name}.{k}" for c in crane.chains for k in ("L", "Lc0", "Lc"))
     return RunSummary(
         folder=folder,
         name=result.name,
-        crane=result_crane(folder, result.crane),
+        machine=machine,
+        design_names=tuple(names),
+        actuators=actuators,
         designs=designs,
         saved_percent=result.improvement.net_energy_saved_percent,
         recheck_max_violation=result.recheck.max_violation_scaled,

@@ -1,4 +1,4 @@
-"""A study's structural limits: the ``structure`` section of a study file, validated against its crane.
+"""A study's structural limits: the ``structure`` section of a study file, validated against its machine's pins.
 
 Example for the XS 031 (every key optional; without the section no structural row enters the NLP)::
 
@@ -9,19 +9,20 @@ Example for the XS 031 (every key optional; without the section no structural ro
         lift.base_pivot: 120000.0
       min_natural_frequency_Hz: 5.0     # lowest locked-rotor frequency at every sample [Hz]
 
-Pin names are ``<chain>.<pin>`` with the pins of :data:`hiab_sim.structure.pin_loads.CHAIN_PINS`.
+Pin names are a crane file's ``<chain>.<pin>`` with the pins of
+:data:`hiab_sim.structure.pin_loads.CHAIN_PINS`, or a machine file's hinge (joint) and loop-pin names
+(:func:`hiab_sim.structure.machine_structure.machine_pin_names`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from hiab_sim.checks import check_range
-from hiab_sim.crane.description import Crane
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.structure.buckling import DEFAULT_SAFETY_FACTOR, check_safety_factor
-from hiab_sim.structure.pin_loads import pins
 from hiab_sim.yaml_fields import mapping, number, positive
 
 
@@ -56,16 +57,15 @@ class StructureSettings:
         """True when at least one structural row enters the NLP."""
         return self.buckling or bool(self.pin_load_limits_N) or self.min_natural_frequency_Hz is not None
 
-    def check_pins(self, crane: Crane) -> None:
-        """Raise :class:`InvalidInputError` for a limited pin the crane does not have."""
-        known = [pin.name for pin in pins(crane)]
+    def check_pins(self, known: Sequence[str]) -> None:
+        """Raise :class:`InvalidInputError` for a limited pin not among the machine's pins ``known``."""
         for name, _ in self.pin_load_limits_N:
             if name not in known:
                 raise InvalidInputError("structure.pin_load_limits", name, f"must be one of {', '.join(known)}")
 
     @classmethod
-    def from_mapping(cls, data: Any, crane: Crane, where: str = "structure") -> StructureSettings:
-        """Build from a study's ``structure`` mapping (None: no structural rows), pin names checked on ``crane``."""
+    def from_mapping(cls, data: Any, pin_names: Sequence[str], where: str = "structure") -> StructureSettings:
+        """Build from a study's ``structure`` mapping (None: no structural rows), pin names checked on ``pin_names``."""
         if data is None:
             return cls()
         keys = {"buckling", "buckling_safety_factor", "pin_load_limits", "min_natural_frequency_Hz"}
@@ -87,5 +87,5 @@ class StructureSettings:
             if frequency is None
             else positive(frequency, f"{where}.min_natural_frequency_Hz", "Hz"),
         )
-        settings.check_pins(crane)
+        settings.check_pins(pin_names)
         return settings

@@ -21,8 +21,9 @@ def _structure_keys() -> list[Key]:
         *rows,
         free(
             "structure.pin_load_limits",
-            "Pin name (`<chain>.<pin>`, as `hiab-sim machine show` lists them) -> largest |F| [N] > 0; "
-            "one row per pin and sample.",
+            "Pin name -> largest |F| [N] > 0; one row per pin and sample. Crane form: `<chain>.<pin>` with "
+            "pin `base_pivot`, `boom_hinge` or `rod_end`; machine form: a hinge by its joint's name or a loop pin "
+            "`<chain>.<pin>` (the names of a result's `structure.pins`).",
             "number",
         ),
     ]
@@ -157,7 +158,7 @@ def study_keys() -> list[Key]:
         *soil_keys("tasks[].soil"),
     ]
     rows += [section("tracking", "Tolerance bands of const_b..const_d.", "defaults"), *from_class("tracking", Tracking)]
-    rows += in_form("crane", _structure_keys())
+    rows += _structure_keys()
     chain_bounds = [
         Key(
             "low",

@@ -1,11 +1,13 @@
 """Side-by-side comparison of result folders: one table row per run and design, and a figure.
 
-Columns (SI units scaled for reading): the six link lengths [mm]; net electrical energy and
-drawn energy without regeneration [kJ] on the fine grid; peak actuator force [kN] and peak
-electrical power [kW] of lift and tilt; the smallest EMLA envelope margin over the three
-actuators (fraction of the limit); the design's max constraint violation (scaled); and the saving
-of net energy against the same run's initial design [%]. Energies of runs with different tasks
-(reference, payload) are not comparable with each other, only with their own initial design.
+Columns (SI units scaled for reading): every run's decision variables by name (``chain variable``)
+[mm]; net electrical energy, energy drawn (positive part of the summed power) and battery energy
+[kJ] on the fine grid; peak force [kN] and peak electrical power [kW] of every actuator by name;
+the smallest EMLA envelope margin over the actuators (fraction of the limit); the design's max
+constraint violation (scaled); and the saving of net energy against the same run's initial design
+[%]. Runs of different machines share a table: a column another machine lacks holds NaN. Energies
+of runs with different tasks (reference, payload) are not comparable with each other, only with
+their own initial design.
 """
 
 from __future__ import annotations
@@ -21,97 +23,118 @@ from hiab_sim.atomic_io import write_atomic
 from hiab_sim.results.read import DESIGNS, RunSummary
 from hiab_sim.style import colour
 
-#: Column header -> unit, in table order.
-COLUMNS: tuple[tuple[str, str], ...] = (
-    ("run", ""),
-    ("design", ""),
-    ("lift L", "mm"),
-    ("lift Lc0", "mm"),
-    ("lift Lc", "mm"),
-    ("tilt L", "mm"),
-    ("tilt Lc0", "mm"),
-    ("tilt Lc", "mm"),
+#: Columns after the design variables and before the per-actuator peaks: header -> unit.
+_ENERGY_COLUMNS: tuple[tuple[str, str], ...] = (
     ("net energy", "kJ"),
     ("drawn energy", "kJ"),
     ("battery energy", "kJ"),
-    ("lift peak force", "kN"),
-    ("tilt peak force", "kN"),
-    ("lift peak power", "kW"),
-    ("tilt peak power", "kW"),
+)
+#: Columns after the per-actuator peaks.
+_LAST_COLUMNS: tuple[tuple[str, str], ...] = (
     ("min envelope margin", "1"),
     ("max violation", "1"),
     ("saving vs initial", "%"),
 )
 
 
+def variable_names(runs: Sequence[RunSummary]) -> list[str]:
+    """The decision variables of every run, in order of first appearance (``chain.variable``)."""
+    out: list[str] = []
+    for run in runs:
+        out += [name for name in run.design_names if name not in out]
+    return out
+
+
+def actuator_names(runs: Sequence[RunSummary]) -> list[str]:
+    """The actuators of every run, in order of first appearance."""
+    out: list[str] = []
+    for run in runs:
+        out += [name for name in run.actuators if name not in out]
+    return out
+
+
+def columns(runs: Sequence[RunSummary]) -> list[tuple[str, str]]:
+    """Column header -> unit, in table order, for these runs (their variables and actuators by name)."""
+    cols = [("run", ""), ("design", "")]
+    cols += [(name.replace(".", " "), "mm") for name in variable_names(runs)]
+    cols += list(_ENERGY_COLUMNS)
+    actuators = actuator_names(runs)
+    cols += [(f"{a} peak force", "kN") for a in actuators] + [(f"{a} peak power", "kW") for a in actuators]
+    return cols + list(_LAST_COLUMNS)
+
+
 @dataclass(frozen=True)
 class Row:
-    """One row of the comparison: a run's design and its numbers, in :data:`COLUMNS` order."""
+    """One row of the comparison: a run's design and its numbers by column header (units of :func:`columns`).
+
+    A run lacking a column's variable or actuator (another machine's) has NaN there.
+    """
 
     run: str
     design: str
-    values: tuple[float, ...]  # every column after run and design, in the units of COLUMNS
+    values: dict[str, float]
 
 
 def rows(runs: Sequence[RunSummary]) -> list[Row]:
     """Table rows: for each run its initial then its optimal design."""
     out = []
+    variables, actuators = variable_names(runs), actuator_names(runs)
     for run in runs:
         initial = run.designs["initial"].net_energy_J
         for name in DESIGNS:
             d = run.designs[name]
-            values = (
-                *(1e3 * v for v in d.lengths.as_array()),
-                d.net_energy_J / 1e3,
-                d.drawn_energy_J / 1e3,
-                math.nan if d.battery_energy_J is None else d.battery_energy_J / 1e3,
-                d.peak_force_N["lift"] / 1e3,
-                d.peak_force_N["tilt"] / 1e3,
-                d.peak_power_W["lift"] / 1e3,
-                d.peak_power_W["tilt"] / 1e3,
-                min(d.min_envelope_margin.values()),
-                d.max_violation,
-                100.0 * (1.0 - d.net_energy_J / initial),
-            )
+            given = dict(zip(run.design_names, (float(v) for v in d.lengths.as_array()), strict=True))
+            values = {v.replace(".", " "): 1e3 * given.get(v, math.nan) for v in variables}
+            values["net energy"] = d.net_energy_J / 1e3
+            values["drawn energy"] = d.drawn_energy_J / 1e3
+            values["battery energy"] = math.nan if d.battery_energy_J is None else d.battery_energy_J / 1e3
+            values.update({f"{a} peak force": d.peak_force_N.get(a, math.nan) / 1e3 for a in actuators})
+            values.update({f"{a} peak power": d.peak_power_W.get(a, math.nan) / 1e3 for a in actuators})
+            values["min envelope margin"] = min(d.min_envelope_margin.values())
+            values["max violation"] = d.max_violation
+            values["saving vs initial"] = 100.0 * (1.0 - d.net_energy_J / initial)
             out.append(Row(run.name, name, values))
     return out
 
 
-_FORMATS = ("{:.1f}",) * 6 + ("{:.3f}",) * 3 + ("{:.2f}",) * 4 + ("{:.3f}", "{:.1e}", "{:.2f}")
+def _format(unit: str, name: str) -> str:
+    return {"mm": "{:.1f}", "kJ": "{:.3f}", "kN": "{:.2f}", "kW": "{:.2f}", "%": "{:.2f}"}.get(
+        unit, "{:.1e}" if name == "max violation" else "{:.3f}"
+    )
 
 
-def header() -> list[str]:
+def header(cols: Sequence[tuple[str, str]]) -> list[str]:
     """Column titles with units."""
-    return [f"{name} [{unit}]" if unit else name for name, unit in COLUMNS]
+    return [f"{name} [{unit}]" if unit else name for name, unit in cols]
 
 
-def format_table(table: Sequence[Row]) -> str:
+def format_table(table: Sequence[Row], cols: Sequence[tuple[str, str]]) -> str:
     """A fixed-width text table (one line per row, header first)."""
-    cells = [header()] + [
-        [r.run, r.design, *(f.format(v) for f, v in zip(_FORMATS, r.values, strict=True))] for r in table
+    cells = [header(cols)] + [
+        [r.run, r.design, *(_format(u, n).format(r.values[n]) for n, u in cols[2:])] for r in table
     ]
-    widths = [max(len(row[i]) for row in cells) for i in range(len(COLUMNS))]
+    widths = [max(len(row[i]) for row in cells) for i in range(len(cols))]
     lines = ["  ".join(c.ljust(w) if i < 2 else c.rjust(w) for i, (c, w) in enumerate(zip(row, widths, strict=True)))
              for row in cells]  # fmt: skip
     return "\n".join(lines) + "\n"
 
 
-def to_csv(table: Sequence[Row]) -> str:
+def to_csv(table: Sequence[Row], cols: Sequence[tuple[str, str]]) -> str:
     """The table as CSV with full precision (header with units)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(header())
+    writer.writerow(header(cols))
     for r in table:
-        writer.writerow([r.run, r.design, *(repr(float(v)) for v in r.values)])
+        writer.writerow([r.run, r.design, *(repr(float(r.values[n])) for n, _ in cols[2:])])
     return buffer.getvalue()
 
 
 def write_comparison(out: Path, runs: Sequence[RunSummary]) -> list[Path]:
     """Write ``comparison.csv``, ``comparison.txt`` and ``comparison.png`` into ``out`` atomically."""
-    table = rows(runs)
+    table, cols = rows(runs), columns(runs)
     paths = [out / "comparison.csv", out / "comparison.txt", out / "comparison.png"]
-    write_atomic(paths[0], to_csv(table))
-    write_atomic(paths[1], format_table(table))
+    write_atomic(paths[0], to_csv(table, cols))
+    write_atomic(paths[1], format_table(table, cols))
     write_atomic(paths[2], comparison_figure(runs))
     return paths
 
@@ -139,11 +162,19 @@ def comparison_figure(runs: Sequence[RunSummary]) -> bytes:
     energy_ax.set_ylabel("net electrical energy [kJ]")
     energy_ax.set_title("energy per run (saving vs its initial design)")
     energy_ax.legend(loc="lower right")
-    labels = ["lift L", "lift Lc0", "lift Lc", "tilt L", "tilt Lc0", "tilt Lc"]
+    variables = variable_names(runs)
+    labels = [v.replace(".", " ") for v in variables]
     pos = np.arange(len(labels))
     step = 0.8 / max(len(runs), 1)
     for i, run in enumerate(runs):
-        change = 1e3 * (run.designs["optimal"].lengths.as_array() - run.designs["initial"].lengths.as_array())
+        moved = dict(
+            zip(
+                run.design_names,
+                run.designs["optimal"].lengths.as_array() - run.designs["initial"].lengths.as_array(),
+                strict=True,
+            )
+        )
+        change = np.array([1e3 * moved.get(v, np.nan) for v in variables])
         bars = length_ax.bar(pos - 0.4 + (i + 0.5) * step, change, step, color=colour("optimal"),
                              alpha=1.0 - 0.6 * i / max(len(runs), 1), edgecolor="black", linewidth=0.5, label=run.name,
                              hatch=("", "//", "..", "xx", "\\\\")[i % 5])  # fmt: skip
@@ -151,6 +182,6 @@ def comparison_figure(runs: Sequence[RunSummary]) -> bytes:
     length_ax.axhline(0.0, color="0.3", linewidth=0.6)
     length_ax.set_xticks(pos, labels)
     length_ax.set_ylabel("optimal - initial [mm]")
-    length_ax.set_title("change of each link length")
+    length_ax.set_title("change of each decision variable")
     length_ax.legend(fontsize=8)
     return png_bytes(fig)

@@ -208,6 +208,10 @@ class MachineModel:
     def _designed(self, design: Any) -> Machine:
         return self.machine.with_design(np.asarray(design.as_array()), check_bounds=False)  # the NLP holds the bounds
 
+    def machine_at(self, design: Any) -> Machine:
+        """The machine description with ``design``'s decision-variable values (bounds not checked: the NLP's)."""
+        return self._designed(design)
+
     def buildable_ranges(
         self, stroke_margin: float, field: str = "build.stroke_margin"
     ) -> tuple[tuple[float, float], ...]:

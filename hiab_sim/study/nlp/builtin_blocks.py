@@ -18,6 +18,7 @@ from hiab_sim.study.nlp import blocks as bl
 from hiab_sim.study.nlp.block_registry import register_block
 from hiab_sim.study.nlp.brake_rows import brake_blocks
 from hiab_sim.study.nlp.interface import ConstraintBlock
+from hiab_sim.study.nlp.machine_structure_rows import machine_structure_blocks
 from hiab_sim.study.nlp.structure_rows import structure_blocks
 from hiab_sim.study.nlp.thermal_rows import thermal_blocks
 
@@ -53,8 +54,10 @@ register_block("buildable", lambda p: buildable_blocks(p.study, p.working, p.tig
 register_block(
     "structure",
     lambda p: (
-        []
-        if p.study.crane_description is None  # a machine file's study: structure rows not yet available for it
+        machine_structure_blocks(
+            p.study.structure, p.times, p.model, p.emlas, p.tcp_force, p.fd_step, p.task.payload.mass
+        )
+        if p.study.crane_description is None  # a machine file's study: its description's rows
         else structure_blocks(p.study.structure, p.times, p.crane, p.emlas, p.tcp_force, p.fd_step, p.task.payload.mass)
     ),
 )

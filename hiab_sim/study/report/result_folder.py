@@ -204,7 +204,7 @@ def build_result(
         tasks=tuple(task_results) if problem.n_tasks > 1 else None,
         cross_evaluation=cross,
         # the structure of the one task's motion; a mix's tasks load the structure differently (not reported yet)
-        structure=structure_section(fines[0], first_checks) if one and study.crane_description is not None else None,
+        structure=structure_section(fines[0], first_checks) if one else None,
     )
     return result, arrays, first_checks
 

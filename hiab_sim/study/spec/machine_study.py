@@ -11,6 +11,8 @@ from hiab_sim.errors import ConfigError
 from hiab_sim.machine.loader import PRESETS as MACHINE_PRESETS
 from hiab_sim.machine.loader import load_machine
 from hiab_sim.resources import Source, locate
+from hiab_sim.structure.machine_structure import machine_pin_names
+from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.machines.machine_model import MachineModel
 from hiab_sim.study.spec.settings import (
     GridSettings,
@@ -29,9 +31,10 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
     ``tracked`` (the tracked coordinates beyond the TCP's x, y: joint names or ``tcp_angle``;
     default ``tcp_angle`` for each), ``initial_lengths`` (a mapping ``chain.variable: value``, default
     the file's values) and ``bounds`` without per-chain bounds (the file declares them). ``mounting``
-    and ``structure`` need a crane file for now and are refused; ``build`` holds the robust rows.
+    needs a crane file for now and is refused; ``build`` holds the robust rows; ``structure`` names the
+    machine's hinges (joint names) and loop pins in ``pin_load_limits``.
     """
-    for key in ("crane", "mounting", "structure"):
+    for key in ("crane", "mounting"):
         if key in top:
             raise ConfigError(f"study: '{key}' is not available for a machine file (machine:) yet; remove it")
     source = str(top["machine"])
@@ -97,4 +100,5 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
         crane_file=machine_file,
         machine=machine,
         tracked=tracked,
+        structure=StructureSettings.from_mapping(top.get("structure"), machine_pin_names(machine)),
     )

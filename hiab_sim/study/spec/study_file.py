@@ -29,6 +29,7 @@ from hiab_sim.crane.mounting import MountingSpace
 from hiab_sim.emla.config import load_emla_set
 from hiab_sim.errors import ConfigError
 from hiab_sim.resources import DEFAULT_STUDY, Source, locate
+from hiab_sim.structure.pin_loads import pins
 from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.machines.crane_model import CraneModel
 from hiab_sim.study.spec.energy import ENERGY_KEYS
@@ -122,7 +123,7 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
         mounting=None if top.get("mounting") is None else MountingSpace.from_mapping(top["mounting"]),
         crane_file=crane_file,
         start_moved_from=crane.default_lengths if moved else None,
-        structure=StructureSettings.from_mapping(top.get("structure"), crane),
+        structure=StructureSettings.from_mapping(top.get("structure"), [pin.name for pin in pins(crane)]),
     )
 
 

@@ -1,0 +1,257 @@
+"""Structural rows of a machine file's NLP: screw buckling, pin peak loads, the lowest natural frequency.
+
+The rows of :mod:`hiab_sim.study.nlp.structure_rows` for a study of a machine file (``machine:``),
+through the machine's description and Newton-Euler path instead of the crane's closed form:
+
+* :class:`MachineBucklingRows` (``structure.buckling``): 1 - n f / P_cr(s) >= 0 per actuator with
+  screw data, s the pin-to-pin column x0 + x (:mod:`hiab_sim.structure.machine_structure`). Exact
+  partials: du = n (df P_cr - f dP_cr) / P_cr^2 with df the inverse dynamics' partials and
+  dP_cr = (dP_cr/ds) ds, ds = dx (the loop closure's exact stroke partials,
+  :meth:`~hiab_sim.study.machines.machine_model.MachineModel.stroke_margin_partials`) + dx0 (x0 =
+  Lc0 + Lc, or the ``retracted_length`` variable itself where the chain declares one);
+* :class:`MachinePinLoadRows` (``structure.pin_load_limits``): 1 - |F_p| / F_max >= 0 per limited pin
+  (Newton-Euler pin forces), partials by central differences (all samples at once);
+* :class:`MachineFrequencyRows` (``structure.min_natural_frequency_Hz``): f_1 / f_min - 1 >= 0 at each
+  sample's pose with the payload held at the TCP (:mod:`hiab_sim.structure.machine_modes`), partials
+  by central differences of the positions and the design.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from hiab_sim.emla.emla_set import EmlaSet
+from hiab_sim.machine.dynamics.paths import make_machine_dynamics
+from hiab_sim.structure.buckling import critical_load
+from hiab_sim.structure.machine_modes import machine_natural_frequencies
+from hiab_sim.structure.machine_structure import machine_pin_loads
+from hiab_sim.structure.settings import StructureSettings
+from hiab_sim.study.machines.machine_model import MachineModel
+from hiab_sim.study.nlp.interface import Array, PerSampleBlock, Relaxation, SamplePartials, SampleRows, SampleState
+
+
+def _retracted_partials(model: MachineModel, chain: Any) -> Array:
+    """dx0/dXi (n_xi,) of a chain's retracted length x0 = Lc0 + Lc (or its ``retracted_length`` variable)."""
+    out = np.zeros(len(model.design_names))
+    retracted = any(v.kind == "retracted_length" for v in chain.variables)
+    counted = ("retracted_length",) if retracted else ("piston_offset", "rod_length")
+    for v in chain.variables:
+        if v.kind in counted:
+            out[model.design_names.index(v.key)] = 1.0
+    return out
+
+
+class MachineBucklingRows(PerSampleBlock):
+    """1 - n f / P_cr per actuator with screw data and sample, on a machine file (module docstring)."""
+
+    def __init__(self, times: Array, model: MachineModel, emlas: EmlaSet, safety_factor: float) -> None:
+        self.name = "structure.buckling"
+        self.times = times
+        self.model = model
+        self.safety_factor = safety_factor
+        by_name = {p.name: p for p in emlas}
+        names = model.actuator_names
+        self.columns = tuple(k for k, name in enumerate(names) if by_name[name].screw is not None)
+        self.screws = tuple(by_name[names[k]].screw for k in self.columns)
+        self.sample_rows = tuple(f"{names[k]} push <= P_cr / n" for k in self.columns)
+
+    def _columns(self, state: SampleState) -> tuple[Array, Array, Array]:
+        """S (K, r) [m], ds/dq (K, r, n) and ds/dXi (K, r, n_xi) of the buckled actuators."""
+        model, q = self.model, state.joints.position
+        machine = model.machine_at(state.lengths)
+        margins = model.stroke_margins(state.lengths, q)
+        dq_m, dxi_m = model.stroke_margin_partials(state.lengths, q)
+        stroke_row = {name: 3 * c for c, name in enumerate(model.stroke_chains)}
+        chains = {c.name: c for c in machine.chains}
+        K, n, nxi = q.shape[0], q.shape[1], len(model.design_names)
+        s = np.zeros((K, len(self.columns)))
+        ds_dq = np.zeros((K, len(self.columns), n))
+        ds_dxi = np.zeros((K, len(self.columns), nxi))
+        for r, (k, screw) in enumerate(zip(self.columns, self.screws, strict=True)):
+            assert screw is not None
+            name = model.actuator_names[k]
+            chain = chains[name]
+            if chain.kind == "direct":
+                j = model.joint_names.index(chain.joint)
+                if screw.retracted_length is None:
+                    raise AssertionError(f"{name}: a direct actuator's screw has its retracted_length (loader)")
+                s[:, r] = screw.retracted_length + q[:, j]
+                ds_dq[:, r, j] = 1.0
+                continue
+            row = stroke_row[name]
+            x0 = float(chain.actuator.piston_offset or 0.0) + float(chain.actuator.rod_length or 0.0)
+            s[:, r] = x0 + margins[:, row]
+            ds_dq[:, r] = dq_m[:, row]
+            ds_dxi[:, r] = dxi_m[:, row] + _retracted_partials(model, chain)
+        return s, ds_dq, ds_dxi
+
+    def _loads(self, s: Array) -> tuple[Array, Array]:
+        out = [critical_load(screw, s[:, r]) for r, screw in enumerate(self.screws)]  # type: ignore[arg-type]
+        return np.stack([o[0] for o in out], axis=1), np.stack([o[1] for o in out], axis=1)
+
+    def values(self, state: SampleState) -> Array:
+        """1 - u per sample, sample-major (K * r,)."""
+        s, _, _ = self._columns(state)
+        load, _ = self._loads(s)
+        f = np.asarray(state.actuators.force, dtype=float)[:, list(self.columns)]
+        return (1.0 - self.safety_factor * f / load).ravel()
+
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per % of the buckling load: (1 - g)(1 - 1 / 1.01), as the crane's rows."""
+        g = np.asarray(values, dtype=float)
+        return Relaxation(("%",) * len(g), (1.0 - g) * (1.0 - 1.0 / 1.01))
+
+    def jacobian(self, state: SampleState, partials: SamplePartials) -> SampleRows:
+        """-du/dq (positions, rates, accelerations) and -du/dXi (exact; module docstring)."""
+        s, ds_dq, ds_dxi = self._columns(state)
+        load, slope = self._loads(s)
+        cols = list(self.columns)
+        f = np.asarray(state.actuators.force, dtype=float)[:, cols]
+        df_dq = partials.id_q[:, cols, :]
+        df_dxi = partials.id_xi[:, cols, :]
+        n = ds_dq.shape[2]
+        dP_dq = np.zeros_like(df_dq)
+        dP_dq[:, :, :n] = slope[:, :, None] * ds_dq
+        dP_dxi = slope[:, :, None] * ds_dxi
+        factor = (self.safety_factor / load)[:, :, None]
+        ratio = (f / load)[:, :, None]
+        return SampleRows(-factor * (df_dq - ratio * dP_dq), -factor * (df_dxi - ratio * dP_dxi))
+
+
+class _DifferencedRows(PerSampleBlock):
+    """Rows g(design, q, dq, ddq) per sample with central-difference partials in q9 and the design."""
+
+    step: float
+    model: MachineModel
+    uses_rates: bool = True
+
+    def _rows(self, design: Any, position: Array, velocity: Array, acceleration: Array) -> Array:
+        raise NotImplementedError
+
+    def values(self, state: SampleState) -> Array:
+        """The rows per sample, sample-major."""
+        j = state.joints
+        return self._rows(state.lengths, j.position, j.velocity, j.acceleration).ravel()
+
+    def jacobian(self, state: SampleState, partials: SamplePartials) -> SampleRows:
+        """Central differences in each of q9 (all samples at once; rates only if they enter) and the design."""
+        j = state.joints
+        q9 = np.concatenate([j.position, j.velocity, j.acceleration], axis=1)
+        K, n, r = q9.shape[0], j.position.shape[1], len(self.sample_rows)
+        dq = np.zeros((K, r, 3 * n))
+        for k in range(3 * n if self.uses_rates else n):
+            h = self.step * np.maximum(1.0, np.abs(q9[:, k]))
+            up, down = q9.copy(), q9.copy()
+            up[:, k] += h
+            down[:, k] -= h
+            rows_up = self._rows(state.lengths, up[:, :n], up[:, n : 2 * n], up[:, 2 * n :])
+            rows_down = self._rows(state.lengths, down[:, :n], down[:, n : 2 * n], down[:, 2 * n :])
+            dq[:, :, k] = (rows_up - rows_down) / (2.0 * h[:, None])
+        values = state.lengths.as_array()
+        dxi = np.zeros((K, r, len(values)))
+        for k in range(len(values)):
+            h = self.step * max(1.0, abs(values[k]))
+            plus, minus = values.copy(), values.copy()
+            plus[k] += h
+            minus[k] -= h
+            rows_up = self._rows(self.model.design(plus), j.position, j.velocity, j.acceleration)
+            rows_down = self._rows(self.model.design(minus), j.position, j.velocity, j.acceleration)
+            dxi[:, :, k] = (rows_up - rows_down) / (2.0 * h)
+        return SampleRows(dq, dxi)
+
+
+class MachinePinLoadRows(_DifferencedRows):
+    """1 - |F_p| / F_max per limited pin and sample (Newton-Euler pin forces of the machine)."""
+
+    def __init__(
+        self,
+        times: Array,
+        model: MachineModel,
+        limits: tuple[tuple[str, float], ...],
+        tcp_force: Array | None,
+        step: float,
+    ) -> None:
+        self.name = "structure.pin_load"
+        self.times = times
+        self.model = model
+        self.limits = limits
+        self.limit = np.array([value for _, value in limits])
+        self.tcp_force = None if tcp_force is None else np.broadcast_to(np.asarray(tcp_force, float), (len(times), 3))
+        self.step = step
+        self.sample_rows = tuple(f"{name} |F| <= {value:.6g} N" for name, value in limits)
+
+    def _rows(self, design: Any, position: Array, velocity: Array, acceleration: Array) -> Array:
+        machine = self.model.machine_at(design)
+        force = None if self.tcp_force is None else self.tcp_force[:, :2]
+        out = make_machine_dynamics(machine, None, "newton_euler")(position, velocity, acceleration, tcp_force=force)
+        loads = machine_pin_loads(machine, position, out.pins)
+        names = [pin.name for pin in loads.pins]
+        index = [names.index(name) for name, _ in self.limits]
+        return 1.0 - loads.magnitude[:, index] / self.limit
+
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per kN of a pin's rating: (1 - g) 1e3 / F_max."""
+        g = np.asarray(values, dtype=float)
+        limit = np.tile(self.limit, len(g) // len(self.limit))
+        return Relaxation(("kN",) * len(g), (1.0 - g) * 1e3 / limit)
+
+
+class MachineFrequencyRows(_DifferencedRows):
+    """f_1(q_k, design) / f_min - 1 per sample: the lowest locked-rotor frequency at the sample's pose."""
+
+    uses_rates = False
+
+    def __init__(
+        self,
+        times: Array,
+        model: MachineModel,
+        emlas: EmlaSet,
+        minimum_Hz: float,
+        tcp_force: Array | None,
+        step: float,
+        payload_kg: float = 0.0,
+    ) -> None:
+        self.name = "structure.natural_frequency"
+        self.times = times
+        self.model = model
+        self.emlas = emlas
+        self.minimum = minimum_Hz
+        self.tcp_force = None if tcp_force is None else np.broadcast_to(np.asarray(tcp_force, float), (len(times), 3))
+        self.step = step
+        self.payload_kg = payload_kg
+        self.sample_rows = (f"lowest frequency >= {minimum_Hz:.6g} Hz",)
+
+    def _rows(self, design: Any, position: Array, velocity: Array, acceleration: Array) -> Array:
+        machine = self.model.machine_at(design)
+        inverse = make_machine_dynamics(machine, None, "newton_euler")
+        force = None if self.tcp_force is None else self.tcp_force[:, :2]
+        modes = machine_natural_frequencies(machine, inverse, self.emlas, position, force, self.payload_kg)
+        return (modes.lowest_Hz / self.minimum - 1.0)[:, None]
+
+    def relaxation(self, values: Array) -> Relaxation:
+        """Per Hz of the minimum lowered: (1 + g) / f_min."""
+        g = np.asarray(values, dtype=float)
+        return Relaxation(("Hz",) * len(g), (1.0 + g) / self.minimum)
+
+
+def machine_structure_blocks(
+    settings: StructureSettings,
+    times: Array,
+    model: MachineModel,
+    emlas: EmlaSet,
+    tcp_force: Array | None,
+    step: float,
+    payload_kg: float = 0.0,
+) -> list[PerSampleBlock]:
+    """The structural blocks a machine file's study asks for (none by default)."""
+    out: list[PerSampleBlock] = []
+    if settings.buckling and any(p.screw is not None for p in emlas):
+        out.append(MachineBucklingRows(times, model, emlas, settings.buckling_safety_factor))
+    if settings.pin_load_limits_N:
+        out.append(MachinePinLoadRows(times, model, settings.pin_load_limits_N, tcp_force, step))
+    if settings.min_natural_frequency_Hz is not None:
+        floor = settings.min_natural_frequency_Hz
+        out.append(MachineFrequencyRows(times, model, emlas, floor, tcp_force, step, payload_kg))
+    return out
