@@ -11,15 +11,19 @@ from __future__ import annotations
 import csv
 import json
 import math
+import shlex
 from pathlib import Path
 
+import numpy as np
 import pytest
 from browser_helper import References
 from machine_result_helper import excavator_result
 from test_study_small import small_study, write_study
 
 from hiab_sim.cli import main
-from hiab_sim.results.read import read_result
+from hiab_sim.machine.kinematics.forward import forward_kinematics
+from hiab_sim.results.read import read_result, result_machine
+from hiab_sim.study.machines.machine_model import MachineModel
 
 #: Whole commands (optimize, report, compare) on two small runs: not in the fast tier.
 pytestmark = pytest.mark.e2e
@@ -80,3 +84,27 @@ def test_compare_puts_machine_and_crane_results_in_one_table_by_name(
         )
         assert math.isnan(float(row["boom L [mm]"]))
     assert (out / "comparison.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_machine_result_reports_a_buildable_design_that_serves_its_range(excavator_run: Path, tmp_path: Path) -> None:
+    """The rounded design is on the 1 mm grid within 1 mm of the optimum and its mjcf command runs.
+
+    Its strokes, by an independent closure (the forward kinematics), stay in [0, stroke] over the
+    buildable range.
+    """
+    result = read_result(excavator_run)
+    b = result.buildable
+    assert b is not None and b.crane_check.passed and b.tolerance_check.passed and b.recheck.passed
+    rounded, optimal = np.asarray(b.lengths.values), np.asarray(result.optimal.lengths.values)  # type: ignore[union-attr]
+    assert np.all(np.abs(rounded - optimal) <= b.tolerance_m + 1e-12)
+    assert np.allclose(rounded / b.tolerance_m, np.round(rounded / b.tolerance_m), atol=1e-9)
+    machine = result_machine(excavator_run, result).with_design(rounded, check_bounds=False)
+    ranges = MachineModel(result_machine(excavator_run, result), ("tcp_angle",)).buildable_ranges(b.stroke_margin_m)
+    for chain, (lo, hi) in zip([c for c in machine.chains if c.kind != "direct"], ranges, strict=True):
+        q = np.tile([0.5 * sum(machine.joint_link(j).joint_range) for j in machine.joint_names], (101, 1))
+        q[:, machine.joint_names.index(chain.joint)] = np.linspace(lo, hi, 101)
+        x = forward_kinematics(machine, q).stroke[chain.name]
+        assert float(np.min(x)) >= -1e-12 and float(np.max(x)) <= chain.actuator.stroke + 1e-12, chain.name
+    argv = shlex.split(b.mjcf_command)[1:]
+    assert main([*argv, "-o", str(tmp_path / "built.xml")]) == 0
+    assert (tmp_path / "built.xml").read_text().startswith("<mujoco")

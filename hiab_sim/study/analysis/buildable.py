@@ -138,6 +138,22 @@ def replace_lengths(state: SampleState, xi: Array) -> SampleState:
     )
 
 
+def rounded_values(values: Array, tolerance: float, low: Array, up: Array) -> Array:
+    """Design values rounded to the nearest multiple of ``tolerance`` [m] (half away from zero), inside [low, up].
+
+    A rounded value outside a bound moves to the nearest grid point inside it (the bound rounded
+    inward), so the design stays within ``tolerance`` of the optimum and inside the bounds; the
+    decimals a drawing would print are kept (the binary noise of the multiplication removed).
+    """
+    digits = max(0, -math.floor(math.log10(tolerance)) + 3)
+    x = np.asarray(values, dtype=float) / tolerance
+    rounded = np.round(np.sign(x) * np.floor(np.abs(x) + 0.5) * tolerance, digits)
+    low_grid = np.ceil(np.asarray(low) / tolerance - 1e-9) * tolerance
+    up_grid = np.floor(np.asarray(up) / tolerance + 1e-9) * tolerance
+    out: Array = np.round(np.clip(rounded, low_grid, up_grid), digits).astype(float)
+    return out
+
+
 def rounded_design(lengths: LinkLengths, tolerance: float, low: Array, up: Array) -> LinkLengths:
     """Xi rounded to the nearest multiple of ``tolerance`` [m], kept on the grid inside [low, up].
 

@@ -11,6 +11,7 @@ from hiab_sim.results.schema import Result
 from hiab_sim.study.analysis.sensitivity import sensitivity
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.report.buildable_section import buildable_line, buildable_section
+from hiab_sim.study.report.machine_buildable import machine_buildable_section
 from hiab_sim.study.solvers.feasibility import phase_lines
 
 #: Multipliers printed to stdout (all are in result.json).
@@ -22,8 +23,7 @@ def analysis_sections(
 ) -> dict[str, Any]:
     """Keyword arguments for ``dataclasses.replace(result, ...)``: buildable, feasibility, sensitivity."""
     return {
-        # the buildable design is the crane file's for now (a machine file's study has none yet)
-        "buildable": None
+        "buildable": machine_buildable_section(problem, z, result.optimal, crane_label)
         if problem.study.crane_description is None
         else buildable_section(problem, z, result.optimal, crane_label),
         "feasibility": tuple(phases) if phases else None,

@@ -100,14 +100,21 @@ def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, c
 
 def buildable_line(b: Buildable) -> str:
     """One stdout line: the rounded design, its checks and energy."""
-    lengths = crane_lengths(b.lengths, "buildable.lengths")
-    lift, tilt = lengths.lift, lengths.tilt
+    if isinstance(b.lengths, LinkLengths):
+        lift, tilt = b.lengths.lift, b.lengths.tilt
+        design = (
+            f"lift L={lift.L:g} Lc0={lift.Lc0:g} Lc={lift.Lc:g}  tilt L={tilt.L:g} Lc0={tilt.Lc0:g} Lc={tilt.Lc:g} m"
+        )
+        check = "crane check"
+    else:
+        design = " ".join(f"{k}={v:g}" for k, v in zip(b.lengths.names, b.lengths.values, strict=True)) + " m"
+        check = "stroke check"
     ok = all(c.passed for c in (b.crane_check, b.tolerance_check, b.recheck))
     return (
         f"buildable (rounded to {b.tolerance_m * 1e3:g} mm, stroke margin {b.stroke_margin_m * 1e3:g} mm): "
-        f"lift L={lift.L:g} Lc0={lift.Lc0:g} Lc={lift.Lc:g}  tilt L={tilt.L:g} Lc0={tilt.Lc0:g} Lc={tilt.Lc:g} m  "
+        f"{design}  "
         f"net energy {b.net_electrical_energy_J / 1e3:.3f} kJ ({b.net_energy_change_vs_optimum_J:+.1f} J vs optimum); "
-        f"{'checks passed' if ok else 'CHECK FAILED'}: crane check {'ok' if b.crane_check.passed else 'FAILED'}, "
+        f"{'checks passed' if ok else 'CHECK FAILED'}: {check} {'ok' if b.crane_check.passed else 'FAILED'}, "
         f"+-{b.tolerance_m * 1e3:g} mm worst margin {b.tolerance_check.margin * 1e3:.3f} mm, "
         f"fine-grid re-check max violation {b.recheck.margin:.1e}"
     )
