@@ -103,7 +103,9 @@ def test_map_of_a_battery_energy_study_is_its_objective(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("variables", [(0, 1), (1, 2), (0, 2)])
-def test_no_feasible_cell_beats_the_optimum(optimum: tuple[StudyProblem, Path, Any], variables: tuple[int, int]) -> None:
+def test_no_feasible_cell_beats_the_optimum(
+    optimum: tuple[StudyProblem, Path, Any], variables: tuple[int, int]
+) -> None:
     """The map's best feasible cell is no better than the optimum, and the cell nearest it is within a grid step.
 
     The optimum's trajectory is fixed and two lengths vary: the optimum is a KKT point of this slice too,
@@ -235,7 +237,9 @@ def test_energy_map_cli_writes_the_map_and_names_the_base(tmp_path: Path, capsys
 def test_energy_map_cli_maps_a_duty_mix(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """A duty mix is mapped (not refused): its tasks and weights, the objective's unit and per-task limits."""
     study = write_study(tmp_path, two_task_mix("battery_energy"))
-    assert main(["energy-map", str(study), "--vars", "lift.L,tilt.Lc0", "--grid", "3", "--out", str(tmp_path / "m")]) == 0
+    assert (
+        main(["energy-map", str(study), "--vars", "lift.L,tilt.Lc0", "--grid", "3", "--out", str(tmp_path / "m")]) == 0
+    )
     out = capsys.readouterr().out
     assert "battery_energy weighted over the tasks (1 x spiral + 3 x second) [J" in out
     summary = json.loads((tmp_path / "m" / "energy_map.json").read_text())

@@ -199,6 +199,7 @@ class FrontPoint:
     message: str
     iterations: int
     design_names: tuple[str, ...] = ()
+    z: tuple[float, ...] = ()  # the point's scaled NLP variables (not a table column)
 
     def as_row(self) -> dict[str, Any]:
         """A table row."""
@@ -310,6 +311,7 @@ def _point(
         message,
         iterations,
         tuple(problem.model.design_names),
+        tuple(float(v) for v in z),
     )
 
 

@@ -256,9 +256,8 @@ def _validate(
     try:
         if emla is not None:
             emla_set_from_mapping(emla, where="EMLA set")
-        checked = dict(study)
-        if emla is not None:
-            checked["emla"] = "default"  # the point's EMLA mapping is checked above; the file is written per point
-        return study_from_dict(checked, study_file)
+        # the point's EMLA mapping is checked above (the file is written per point); the study is built with
+        # the base study's EMLA file, whose actuators are the machine's
+        return study_from_dict(dict(study), study_file)
     except HiabSimError as error:
         raise ConfigError(f"{where}: the study rejects it: {error}") from None
