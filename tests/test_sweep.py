@@ -219,7 +219,7 @@ def test_sweep_of_a_machine_files_study_names_its_variables_and_actuators(tmp_pa
     ratios = [p.emla["actuators"]["boom"]["gear_ratio"]["value"] for p in sweep.points if p.emla is not None]
     assert ratios == [3.5, 4.5]
     path.write_text(yaml.safe_dump({"study": "exact_digging", "grid": {"emla.lift.gear_ratio": [4.0]}}))
-    with pytest.raises(ConfigError, match="emla.lift.gear_ratio"):
+    with pytest.raises(ConfigError, match=r"emla\.lift\.gear_ratio"):
         load_sweep(path)
 
 

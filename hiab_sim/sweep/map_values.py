@@ -47,8 +47,8 @@ from hiab_sim.emla import battery_energy, electrical_power, energy_summary
 from hiab_sim.emla.battery import rest_battery_energy
 from hiab_sim.emla.duty_energy import drive_duty
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.analysis.buildable import replace_lengths
+from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.report.design_check import fine_problem
