@@ -255,3 +255,21 @@ def test_bad_vars_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str], bad
     err = capsys.readouterr().err
     assert "--vars" in err and "lift.L, lift.Lc0, lift.Lc, tilt.L, tilt.Lc0, tilt.Lc" in err
     assert not any(tmp_path.iterdir())
+
+
+@pytest.mark.slow
+def test_map_at_a_mix_optimum_reads_every_tasks_trajectory(tmp_path: Path) -> None:
+    """At a two-task mix's optimum (its result folder) the map gives the run's weighted costf2, energies, objective.
+
+    The base reads each task's trajectory (``task<k>_`` arrays) and fits its spline; about 2 min on 2 cores.
+    """
+    study = load_study(write_study(tmp_path, two_task_mix("battery_energy")))
+    output = run_study(study, tmp_path / "run", progress=None, figures=False)
+    problem = StudyProblem(study, id_path="analytic")
+    at = evaluate_designs(problem, optimum_design(output.folder, problem), output.result.optimal.lengths.as_array())
+    result = output.result
+    assert at.objective[0] == pytest.approx(result.history[-1].scaled_cost, rel=1e-9)
+    assert at.costf2[0] == pytest.approx(result.optimal.collocation_cost_W2s, rel=1e-9)
+    assert at.net_energy[0] == pytest.approx(result.optimal.net_electrical_energy_J, rel=1e-9)
+    assert at.battery_energy[0] == pytest.approx(result.energy.optimal.battery_energy_J, rel=1e-9)
+    assert at.feasible[0]

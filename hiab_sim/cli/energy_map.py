@@ -33,7 +33,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "two, lift.L,lift.Lc0 on the XS 031: a chain's L and Lc0 together keep its stroke on the joint range, "
         "so their map has a feasible region)",
     )
-    parser.add_argument("--grid", type=int, default=30, metavar="N", help="grid points per axis (default 30)")
+    parser.add_argument("--grid", type=int, default=50, metavar="N", help="grid points per axis (default 50)")
     parser.add_argument("--result", metavar="DIR", help="result folder of hiab-sim optimize: map around its optimum")
     parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<study name>/energy_map)")
     parser.set_defaults(run=run)

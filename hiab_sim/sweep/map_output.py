@@ -132,7 +132,7 @@ def write_map(m: EnergyMap, out: Path) -> list[Path]:
 def infeasible_note(m: EnergyMap) -> str | None:
     """Why cells are infeasible, in words: the most frequent binding limit and which variables to map instead.
 
-    None when most cells are feasible. The hint names the other lengths of the chain the binding
+    None when most cells are feasible. The hint names the other decision variables of the chain the binding
     limit belongs to (they move that limit), else the two variables of the map with wider bounds.
     """
     from hiab_sim.study.report.summary import limit_in_words
@@ -155,7 +155,7 @@ def infeasible_note(m: EnergyMap) -> str | None:
     head = "no feasible cell" if not feasible.any() else f"only {int(feasible.sum())} feasible cells"
     return (
         f"{head} of {feasible.size}: {share} cells break {limit_in_words(top)} "
-        f"with the other lengths fixed at the {m.base.source.split(' (')[0]};\n{hint}"
+        f"with the other decision variables fixed at the {m.base.source.split(' (')[0]};\n{hint}"
     )
 
 
@@ -185,8 +185,8 @@ def figure_png(m: EnergyMap) -> bytes:
     fig = new_figure((13, 5.6))
     axes = fig.subplots(1, 2)
     panels = (
-        (v.objective, f"{objective_words(m)} / its value at the study's start"),
-        (v.net_energy / 1e3, f"net electrical energy {energy_words(m)} [kJ]"),
+        (v.objective, f"objective ({m.objective}, {m.objective_unit}) / its value at the study's start"),
+        (v.net_energy / 1e3, "net electrical energy " + ("per cycle" if len(m.tasks) == 1 else "weighted") + " [kJ]"),
     )
     for ax, (values, title) in zip(axes, panels, strict=True):
         grid = np.ma.masked_where(~feasible, m.grid(values))
@@ -227,9 +227,11 @@ def figure_png(m: EnergyMap) -> bytes:
     handles += [Patch(color=palette(n % 10), alpha=0.35) for n in range(len(labels))]
     names += [f"infeasible: {limit_in_words(name)}" for name in labels]
     fig.legend(handles, names, loc="outside lower center", ncol=2, fontsize=8)
-    fig.suptitle(
-        f"Energy map over {m.variables[0]} x {m.variables[1]}; the other lengths and the trajectory at the "
-        f"{m.base.source}",
-        fontsize=10,
+    title = (
+        f"Energy map over {m.variables[0]} x {m.variables[1]}; the other decision variables and the trajectory at "
+        f"the {m.base.source}"
     )
+    if len(m.tasks) > 1:
+        title += "\nduty mix, objective and energies weighted: " + " + ".join(f"{w:g} x {n}" for n, w in m.tasks)
+    fig.suptitle(title, fontsize=10)
     return png_bytes(fig)
