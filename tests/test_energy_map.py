@@ -273,3 +273,23 @@ def test_map_at_a_mix_optimum_reads_every_tasks_trajectory(tmp_path: Path) -> No
     assert at.net_energy[0] == pytest.approx(result.optimal.net_electrical_energy_J, rel=1e-9)
     assert at.battery_energy[0] == pytest.approx(result.energy.optimal.battery_energy_J, rel=1e-9)
     assert at.feasible[0]
+
+
+def test_design_space_modules_hold_no_machine_names_as_literals() -> None:
+    """No string constant of the sweep package or its three commands equals a name a shipped machine file gives."""
+    import ast
+
+    from test_machine_names import PACKAGE, _shipped_names
+
+    names = _shipped_names()
+    modules = [
+        *sorted((PACKAGE / "sweep").glob("*.py")),
+        *(PACKAGE / "cli" / f for f in ("energy_map.py", "pareto.py", "sweep.py")),
+    ]
+    found = [
+        f"{path.relative_to(PACKAGE)}:{node.lineno}: {node.value!r}"
+        for path in modules
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and node.value in names
+    ]
+    assert not found, found

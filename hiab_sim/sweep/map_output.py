@@ -221,7 +221,7 @@ def figure_png(m: EnergyMap) -> bytes:
         for ax in axes:
             ax.text(
                 0.5, 0.5, wrapped, transform=ax.transAxes, ha="center", va="center", fontsize=8.5,
-                bbox={"boxstyle": "round", "fc": "white", "ec": "0.3", "alpha": 0.92},
+                bbox={"boxstyle": "round", "fc": (1.0, 1.0, 1.0, 0.92), "ec": "0.3"},  # white, 92 % opaque
             )  # fmt: skip
     handles, names = axes[0].get_legend_handles_labels()
     handles += [Patch(color=palette(n % 10), alpha=0.35) for n in range(len(labels))]
