@@ -17,7 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from lengths_helper import CRANE, feasible_lengths
 from test_study_small import small_study, write_study
-from test_sweep import TINY
+from test_sweep import TINY, machine_form
 
 from hiab_sim.cli import main
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
@@ -194,14 +194,7 @@ def test_mix_cell_is_the_weighted_sum_of_its_tasks_alone() -> None:
 def test_machine_file_map_of_the_xs031_equals_the_crane_files(tmp_path: Path) -> None:
     """The XS 031 through its machine file (tracking xt2) maps the same numbers as through its crane file."""
     crane = small_study(**TINY)
-    machine = {k: v for k, v in crane.items() if k not in ("crane", "bounds")}
-    # the crane file's study keeps the crane's full joint range; the machine file's keeps the machine's
-    machine |= {
-        "machine": "xs031",
-        "emla": "default",
-        "tracked": ["xt2"],
-        "bounds": {"joint_velocity": [0.6, 0.6, 0.5], "working_range": "machine"},
-    }
+    machine = machine_form(crane)
     maps = {}
     for key, data in (("crane", crane), ("machine", machine)):
         problem = StudyProblem(load_study(write_study(tmp_path, data, f"{key}.yaml")), id_path="analytic")

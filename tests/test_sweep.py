@@ -33,6 +33,21 @@ def write_sweep(folder: Path, body: dict[str, Any], name: str = "sweep.yaml") ->
     return path
 
 
+def machine_form(crane: dict[str, Any]) -> dict[str, Any]:
+    """A crane file's study mapping of the XS 031 as the same study of its machine file (tracking xt2).
+
+    The crane file's study keeps the crane's full joint range, the machine file's the machine's (the
+    same range); the machine file declares the decision variables' bounds.
+    """
+    machine = {k: v for k, v in crane.items() if k not in ("crane", "bounds")}
+    return machine | {
+        "machine": "xs031",
+        "emla": "default",
+        "tracked": ["xt2"],
+        "bounds": {"joint_velocity": [0.6, 0.6, 0.5], "working_range": "machine"},
+    }
+
+
 def comparable(frame: pd.DataFrame) -> pd.DataFrame:
     """The table without its timing columns (they differ between runs of the same point).
 
@@ -226,13 +241,7 @@ def test_sweep_of_a_machine_files_study_names_its_variables_and_actuators(tmp_pa
 def test_machine_file_sweep_point_is_the_crane_file_sweep_point(tmp_path: Path) -> None:
     """One point of the tiny study through the XS 031's machine file gives the crane file's optimum and energies."""
     crane = small_study(**TINY)
-    machine = {k: v for k, v in crane.items() if k not in ("crane", "bounds")}
-    machine |= {
-        "machine": "xs031",
-        "emla": "default",
-        "tracked": ["xt2"],
-        "bounds": {"joint_velocity": [0.6, 0.6, 0.5], "working_range": "machine"},
-    }
+    machine = machine_form(crane)
     frames = {}
     for key, study in (("crane", crane), ("machine", machine)):
         folder = tmp_path / key
