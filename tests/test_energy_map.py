@@ -254,7 +254,7 @@ def test_bad_vars_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str], bad
 def test_map_at_a_mix_optimum_reads_every_tasks_trajectory(tmp_path: Path) -> None:
     """At a two-task mix's optimum (its result folder) the map gives the run's weighted costf2, energies, objective.
 
-    The base reads each task's trajectory (``task<k>_`` arrays) and fits its spline; about 2 min on 2 cores.
+    The base reads each task's trajectory (``task<k>_`` arrays) and fits its spline; about 45 s on 2 shared cores.
     """
     study = load_study(write_study(tmp_path, two_task_mix("battery_energy")))
     output = run_study(study, tmp_path / "run", progress=None, figures=False)
