@@ -1,4 +1,4 @@
-"""Pareto fronts by the epsilon-constraint method: criterion samples, the inactive end, monotonicity."""
+"""Pareto fronts by the epsilon-constraint method: criterion samples, their Jacobian, the inactive end, mixes."""
 
 from __future__ import annotations
 
@@ -7,35 +7,81 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_energy_map import two_task_mix
 from test_study_small import small_study, write_study
 from test_sweep import TINY
 
 from hiab_sim.cli import main
+from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
+from hiab_sim.emla.drive import drive_state
+from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.solvers.slsqp import SolveResult, solve
 from hiab_sim.study.spec.study_file import study_from_dict
-from hiab_sim.sweep.pareto import EpsilonProblem, criterion, pareto_front, samples_of_points
+from hiab_sim.sweep.pareto import (
+    FEASIBLE,
+    EpsilonProblem,
+    criterion,
+    criterion_samples,
+    pareto_front,
+    samples_jacobian,
+)
 
 
 @pytest.fixture(scope="module")
-def plain() -> tuple[TaskProblem, SolveResult]:
+def plain() -> tuple[StudyProblem, SolveResult]:
     """The tiny study (analytic ID) and its plain optimum."""
     study = study_from_dict(small_study(**TINY), "tiny.yaml")
-    problem = TaskProblem(study)
+    problem = StudyProblem(study)
     return problem, solve(problem, study.initial_lengths, progress=None)
 
 
-def test_stacked_samples_equal_the_problems_own_forces(plain: tuple[TaskProblem, SolveResult]) -> None:
-    """The criterion's forces (designs stacked on the analytic path) equal the NLP's ID forces at start and optimum."""
+@pytest.fixture(scope="module")
+def mix() -> StudyProblem:
+    """The tiny study as a two-task mix (weights 1 and 3, a payload in the second)."""
+    return StudyProblem(study_from_dict(two_task_mix(), "mix.yaml"))
+
+
+def test_criterion_samples_equal_the_cranes_stacked_analytic_id(plain: tuple[StudyProblem, SolveResult]) -> None:
+    """The criterion's forces and rms torque equal the crane's stacked analytic ID at start and optimum."""
     problem, result = plain
+    p = problem.problems[0]
     for z in (result.z0, result.z):
-        stacked = samples_of_points(problem, np.vstack([z, z]), "peak_force")
-        own = problem.evaluate(z).actuators.force.ravel()
-        np.testing.assert_allclose(stacked[0], own, rtol=1e-12, atol=1e-8)
-        np.testing.assert_array_equal(stacked[0], stacked[1])
+        design, c = p.unpack(z)
+        q = p.joints(c)
+        f, v, a, _ = batched_inverse_dynamics(
+            problem.study.crane, design.as_array()[None], q.position, q.velocity, q.acceleration, p.tcp_force
+        )
+        np.testing.assert_allclose(criterion_samples(problem, z, "peak_force"), f[0].ravel(), rtol=1e-12, atol=1e-8)
+        tau = np.column_stack(
+            [drive_state(e, f[0, :, i], v[0, :, i], a[0, :, i]).motor_torque for i, e in enumerate(p.emlas)]
+        )
+        rms = np.sqrt(np.mean(np.sum(tau**2, axis=1)))
+        assert criterion_samples(problem, z, "rms_torque")[0] == pytest.approx(rms, rel=1e-12)
 
 
-def test_inactive_epsilon_reproduces_the_plain_optimum(plain: tuple[TaskProblem, SolveResult]) -> None:
+@pytest.mark.parametrize("name", ["peak_force", "rms_torque"])
+def test_criterion_jacobian_matches_central_differences_on_a_mix(mix: StudyProblem, name: str) -> None:
+    """D samples / dz of a two-task mix equals central differences, in the Xi columns and each task's own columns."""
+    rng = np.random.default_rng(5)
+    z = mix.initial_point(mix.study.initial_lengths)
+    z[mix.n_xi :] += rng.normal(0.0, 2e-3, mix.n - mix.n_xi)
+    jac = samples_jacobian(mix, z, name)
+    columns = [*range(mix.n_xi), *(off + j for off in mix.offsets for j in (0, 7, 20))]
+    h = 1e-6
+    for i in columns:
+        up, down = z.copy(), z.copy()
+        up[i] += h
+        down[i] -= h
+        fd = (criterion_samples(mix, up, name) - criterion_samples(mix, down, name)) / (2 * h)
+        scale = max(1.0, float(np.abs(fd).max()))
+        np.testing.assert_allclose(jac[:, i], fd, atol=1e-5 * scale)
+    # a task's samples do not depend on another task's coefficients
+    rows0 = len(mix.problems[0].times) * 3 if name == "peak_force" else 1
+    assert not jac[:rows0, mix.offsets[1] :].any() and not jac[rows0:, mix.offsets[0] : mix.offsets[1]].any()
+
+
+def test_inactive_epsilon_reproduces_the_plain_optimum(plain: tuple[StudyProblem, SolveResult]) -> None:
     """With epsilon far above the optimum's criterion, the epsilon problem from the start finds the plain optimum."""
     problem, result = plain
     c0 = criterion(problem, result.z, "rms_torque")
@@ -46,17 +92,39 @@ def test_inactive_epsilon_reproduces_the_plain_optimum(plain: tuple[TaskProblem,
 
 
 @pytest.mark.e2e
-def test_front_is_monotone_from_the_plain_optimum(plain: tuple[TaskProblem, SolveResult]) -> None:
+def test_front_is_monotone_from_the_plain_optimum(plain: tuple[StudyProblem, SolveResult]) -> None:
     """A lower peak force never comes with a lower objective; each point holds its epsilon; it starts at the optimum."""
     problem, result = plain
     front = pareto_front(problem, result.z, "peak_force", 3)
     assert all(p.accepted for p in front), [p.message for p in front]
     assert front[0].objective_value == problem.evaluate(result.z).cost
+    assert front[0].design_names == problem.model.design_names
     for previous, point in itertools.pairwise(front):
         assert point.epsilon < previous.epsilon
         assert point.criterion <= point.epsilon * (1.0 + 1e-6)
         assert point.objective >= previous.objective - 1e-9
     assert front[-1].objective > front[0].objective  # the trade-off is real, not a flat line
+
+
+@pytest.mark.slow
+def test_front_point_of_a_mix_is_feasible_for_every_task(mix: StudyProblem) -> None:
+    """Each accepted point of a two-task mix's front holds every task's rows and its epsilon on every task.
+
+    Checked on each task's own one-task problem (built alone, its own rows and violation) and on the
+    forces of each task's ID, not on the stacked problem the front was solved on. About 260 s on 2 cores.
+    """
+    optimum = solve(mix, mix.study.initial_lengths, progress=None)
+    front = pareto_front(mix, optimum.z, "peak_force", 3)
+    assert sum(p.accepted for p in front) >= 2, [p.message for p in front]
+    for point in front:
+        if not point.accepted:
+            continue
+        z = np.asarray(point.z)
+        for k, task in enumerate(mix.study.tasks):
+            alone = TaskProblem(mix.study, task=task)
+            zk = mix.task_z(z, k)
+            assert alone.max_violation(zk) <= FEASIBLE
+            assert np.abs(alone.evaluate(zk).actuators.force).max() <= point.epsilon * (1.0 + 1e-6)
 
 
 def test_pareto_cli_rejects_too_few_points(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

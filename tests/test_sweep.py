@@ -33,6 +33,21 @@ def write_sweep(folder: Path, body: dict[str, Any], name: str = "sweep.yaml") ->
     return path
 
 
+def machine_form(crane: dict[str, Any]) -> dict[str, Any]:
+    """A crane file's study mapping of the XS 031 as the same study of its machine file (tracking xt2).
+
+    The crane file's study keeps the crane's full joint range, the machine file's the machine's (the
+    same range); the machine file declares the decision variables' bounds.
+    """
+    machine = {k: v for k, v in crane.items() if k not in ("crane", "bounds")}
+    return machine | {
+        "machine": "xs031",
+        "emla": "default",
+        "tracked": ["xt2"],
+        "bounds": {"joint_velocity": [0.6, 0.6, 0.5], "working_range": "machine"},
+    }
+
+
 def comparable(frame: pd.DataFrame) -> pd.DataFrame:
     """The table without its timing columns (they differ between runs of the same point).
 
@@ -208,3 +223,38 @@ def test_shipped_study_name_resolves(tmp_path: Path) -> None:
     path.write_text(yaml.safe_dump({"study": "no_such_study", "grid": {"payload": [0.0]}}))
     with pytest.raises(ConfigError, match="no_such_study"):
         load_sweep(path)
+
+
+def test_sweep_of_a_machine_files_study_names_its_variables_and_actuators(tmp_path: Path) -> None:
+    """A sweep over the eXact arm's digging study: EMLA paths by the file's actuators, columns by its variables."""
+    path = tmp_path / "s.yaml"
+    path.write_text(yaml.safe_dump({"study": "exact_digging", "grid": {"emla.boom.gear_ratio": [3.5, 4.5]}}))
+    sweep = load_sweep(path)
+    assert sweep.design_names[:3] == ("boom.L", "boom.Lc0", "boom.Lc") and "bucket.Gx" in sweep.design_names
+    ratios = [p.emla["actuators"]["boom"]["gear_ratio"]["value"] for p in sweep.points if p.emla is not None]
+    assert ratios == [3.5, 4.5]
+    path.write_text(yaml.safe_dump({"study": "exact_digging", "grid": {"emla.lift.gear_ratio": [4.0]}}))
+    with pytest.raises(ConfigError, match=r"emla\.lift\.gear_ratio"):
+        load_sweep(path)
+
+
+def test_machine_file_sweep_point_is_the_crane_file_sweep_point(tmp_path: Path) -> None:
+    """One point of the tiny study through the XS 031's machine file gives the crane file's optimum and energies."""
+    crane = small_study(**TINY)
+    machine = machine_form(crane)
+    frames = {}
+    for key, study in (("crane", crane), ("machine", machine)):
+        folder = tmp_path / key
+        folder.mkdir()
+        write_study(folder, study)
+        path = folder / "sweep.yaml"
+        path.write_text(yaml.safe_dump({"study": "study.yaml", "grid": {"payload": [60.0]}}))
+        with make_executor(workers=1) as executor:
+            outcome = run_sweep(load_sweep(path), folder / "out", executor, progress=False)
+        frames[key], _ = read_table(outcome.table)
+    a, b = frames["crane"].iloc[0], frames["machine"].iloc[0]
+    assert a["status"] == b["status"] == "ok", (a["message"], b["message"])
+    columns = [c for c in frames["crane"].columns if c.startswith("opt_") or c.startswith("start_")]
+    assert "opt_lift_L_m" in columns and "opt_tilt_Lc_m" in columns
+    for c in columns:
+        assert b[c] == pytest.approx(a[c], rel=1e-6, abs=1e-7), c

@@ -13,10 +13,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "pareto",
         help="Pareto front of the energy objective against peak actuator force or rms motor torque.",
         description=(
-            "Optimise the study, find the least criterion its constraints allow, and minimise the objective "
-            "(the seed paper's squared-power cost costf2, W^2 s) with criterion <= epsilon for epsilon from the "
-            "optimum's criterion down to that least "
-            "value, each a full SQP optimisation. Writes pareto.csv, pareto.json and pareto.png."
+            "Optimise the study, find the least criterion its constraints allow, and minimise the study's "
+            "objective (any registered one, in its unit; for a duty mix the weighted sum over its tasks, every "
+            "task's constraints held and the criterion the worst over the tasks) with criterion <= epsilon for "
+            "epsilon from the optimum's criterion down to that least value, each a full SQP optimisation. Crane "
+            "files and machine files alike. Writes pareto.csv, pareto.json and pareto.png."
         ),
     )
     parser.add_argument(
@@ -47,23 +48,28 @@ def run(args: argparse.Namespace) -> int:
         raise InvalidInputError("--points", args.points, "must be >= 2")
     study = load_study(args.study or DEFAULT_STUDY)
     study_problem = make_problem(study)
-    if study_problem.n_tasks != 1:
-        from hiab_sim.errors import InvalidInputError
-
-        raise InvalidInputError("tasks", study_problem.n_tasks, "the Pareto front serves a study of one task")
-    problem = study_problem.problems[0]
     check_start(study_problem, study_problem.initial_point(study.initial_lengths))
     out = Path(args.out) if args.out else Path("runs") / study.name / f"pareto_{args.against}"
     with StatusLine(f"optimising {study.name} and {args.points - 1} limits on the {args.against} ..."):
         optimum = solve(study_problem, study.initial_lengths, progress=None)
-        front = pareto_front(problem, optimum.z, args.against, args.points)
+        front = pareto_front(study_problem, optimum.z, args.against, args.points)
     frame = pd.DataFrame([p.as_row() for p in front])
     out.mkdir(parents=True, exist_ok=True)
     write_atomic(out / "pareto.csv", frame.to_csv(index=False))
     unit = CRITERIA[args.against]
-    summary = {"study": study.path, "criterion": args.against, "unit": unit, "points": frame.to_dict("records")}
+    summary = {
+        "study": study.path,
+        "criterion": args.against,
+        "unit": unit,
+        "criterion_note": "the worst over the tasks" if study_problem.n_tasks > 1 else "over the cycle",
+        "objective_name": study_problem.objective.name,
+        "objective_unit": study_problem.objective.unit,
+        "tasks": [{"name": t.name, "weight": float(t.weight)} for t in study.tasks],
+        "design_variables": list(study.model.design_names),
+        "points": frame.to_dict("records"),
+    }
     write_atomic(out / "pareto.json", json.dumps(summary, indent=2) + "\n")
-    write_atomic(out / "pareto.png", front_figure_png(front, args.against, study.name))
+    write_atomic(out / "pareto.png", front_figure_png(front, args.against, study.name, study_problem.objective.name))
     details = []
     for p in front:
         status = "ok" if p.accepted else f"not converged: {p.message}"
@@ -72,5 +78,6 @@ def run(args: argparse.Namespace) -> int:
             f"({p.iterations} iterations, {status})"
         )
     files = ["pareto.csv", "pareto.json", "pareto.png", ANSWER_FILE]
-    publish_answer(front_answer(front, args.against, problem.objective.name, study.name, out, files), out, details)
+    answer = front_answer(front, args.against, study_problem.objective.name, study.name, out, files)
+    publish_answer(answer, out, details)
     return 0

@@ -24,8 +24,8 @@ import numpy as np
 import pandas as pd
 
 from hiab_sim.study.report.summary import BATTERY_BOUNDARY, NET_BOUNDARY, before_after, files_line, limit_in_words
-from hiab_sim.sweep.energy_map import VARIABLES, EnergyMap
-from hiab_sim.sweep.map_output import infeasible_note
+from hiab_sim.sweep.energy_map import EnergyMap
+from hiab_sim.sweep.map_output import infeasible_note, objective_words
 from hiab_sim.sweep.pareto import CRITERIA, FrontPoint
 
 #: The study objectives in words (names of :data:`hiab_sim.study.nlp.objectives.OBJECTIVES`).
@@ -64,12 +64,12 @@ def map_answer(m: EnergyMap, s: dict[str, Any], title: str, per: str, folder: Pa
         def moves(cell: dict[str, Any]) -> str:
             parts = []
             for name in names:
-                value, before = cell["xi_m"][VARIABLES.index(name)], m.base.xi[VARIABLES.index(name)]
+                value, before = cell["xi_m"][m.index(name)], m.base.xi[m.index(name)]
                 parts.append(f"{name} = {value * 1e3:.0f} mm ({(value - before) * 1e3:+.0f})")
             return ", ".join(parts)
 
         lines.append(
-            f"Best feasible mounting on the map (least study objective, {m.objective}): {moves(best)}; "
+            f"Best feasible mounting on the map (least study objective, {objective_words(m)}): {moves(best)}; "
             f"change from the {base_words} in brackets."
         )
         lines.append(
@@ -91,7 +91,7 @@ def map_answer(m: EnergyMap, s: dict[str, Any], title: str, per: str, folder: Pa
     if best is not None:
         lines.append(f"{s['feasible_cells']} of {s['cells']} cells feasible." if note is None else _sentence(note))
     lines.append(
-        f"The other four lengths and the joint trajectory stay at the {base_words}; "
+        f"The other {len(m.design_names) - 2} decision variables and the joint trajectories stay at the {base_words}; "
         f"binding there: {limit_in_words(base['binding_constraint'])}."
     )
     lines += ["", files_line(folder, files)]
@@ -171,10 +171,11 @@ def front_answer(
         lines.append("- knee: none (fewer than three converged points, or the front is straight)")
     else:
         lines.append(point("knee (farthest from the line through the ends)", front[knee]))
-        xi = front[knee].xi
+        knee_point = front[knee]
+        names = knee_point.design_names or tuple(f"xi_{k}" for k in range(len(knee_point.xi)))
         lines.append(
-            "  link lengths at the knee [mm]: "
-            + ", ".join(f"{n} {v * 1e3:.0f}" for n, v in zip(VARIABLES, xi, strict=True))
+            "  decision variables at the knee [mm]: "
+            + ", ".join(f"{n} {v * 1e3:.0f}" for n, v in zip(names, knee_point.xi, strict=True))
         )
     failed = len(front) - len(ok)
     if failed:

@@ -10,12 +10,28 @@ from typing import Any
 import numpy as np
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.sweep.energy_map import FEASIBILITY_TOLERANCE, VARIABLES, EnergyMap
+from hiab_sim.sweep.energy_map import FEASIBILITY_TOLERANCE, EnergyMap
 
 TRAJECTORY_NOTE = (
-    "joint trajectory fixed at the base design's (the optimum's spline or the start's inverse-kinematics fit); "
-    "tracking, joint-range and joint-velocity rows depend on it only and hold over the whole map"
+    "joint trajectory of every task fixed at the base design's (the optimum's spline or the start's "
+    "inverse-kinematics fit); tracking, joint-range and joint-velocity rows depend on it only and hold over the "
+    "whole map"
 )
+
+
+def objective_words(m: EnergyMap) -> str:
+    """The map's objective and its unit in words, weighted over the tasks of a mix."""
+    if len(m.tasks) == 1:
+        return f"{m.objective} [{m.objective_unit}]"
+    parts = " + ".join(f"{w:g} x {name}" for name, w in m.tasks)
+    return f"{m.objective} weighted over the tasks ({parts}) [{m.objective_unit} per unit of the weights]"
+
+
+def energy_words(m: EnergyMap) -> str:
+    """What an energy of the map is counted over: a cycle, or the weighted tasks of a mix."""
+    if len(m.tasks) == 1:
+        return "per cycle"
+    return "weighted over the tasks (" + " + ".join(f"{w:g} x {name}" for name, w in m.tasks) + ")"
 
 
 def summary(m: EnergyMap) -> dict[str, Any]:
@@ -32,7 +48,8 @@ def summary(m: EnergyMap) -> dict[str, Any]:
         return {
             "xi_m": v.xi[k].tolist(),
             "objective": float(v.objective[k]),
-            "cost_W2s": float(v.cost[k]),
+            "objective_value": float(v.objective_value[k]),
+            "costf2_W2s": float(v.costf2[k]),
             "net_electrical_energy_J": float(v.net_energy[k]),
             "battery_energy_J": float(v.battery_energy[k]),
             "binding_constraint": v.names[int(v.binding[k])],
@@ -54,14 +71,21 @@ def summary(m: EnergyMap) -> dict[str, Any]:
         "axes_m": [a.tolist() for a in m.axes],
         "base": m.base.source,
         "base_xi_m": m.base.xi.tolist(),
-        "fixed": {name: float(m.base.xi[i]) for i, name in enumerate(VARIABLES) if name not in m.variables},
+        "design_variables": list(m.design_names),
+        "fixed": {name: float(m.base.xi[i]) for i, name in enumerate(m.design_names) if name not in m.variables},
+        "tasks": [{"name": name, "weight": w} for name, w in m.tasks],
         "trajectory": TRAJECTORY_NOTE,
+        "objective_name": m.objective,
+        "objective_unit": m.objective_unit,
         "objective_note": (
-            f"the study's objective ({m.objective}) on the collocation grid divided by its value at the study's start"
+            f"objective: the study's {objective_words(m)} on the collocation grid divided by its value at the "
+            "study's start; objective_value: the same in its unit; costf2_W2s: the paper's squared-power cost "
+            "(whatever the objective); energies " + energy_words(m)
         ),
         "at_base": {
             "objective": float(b.objective[0]),
-            "cost_W2s": float(b.cost[0]),
+            "objective_value": float(b.objective_value[0]),
+            "costf2_W2s": float(b.costf2[0]),
             "net_electrical_energy_J": float(b.net_energy[0]),
             "drawn_energy_summed_drives_J": float(b.drawn_energy[0]),
             "battery_energy_J": float(b.battery_energy[0]),
@@ -86,7 +110,8 @@ def write_map(m: EnergyMap, out: Path) -> list[Path]:
         "axis0_m": m.axes[0],
         "axis1_m": m.axes[1],
         "objective": m.grid(v.objective),
-        "cost_W2s": m.grid(v.cost),
+        "objective_value": m.grid(v.objective_value),
+        "costf2_W2s": m.grid(v.costf2),
         "net_energy_J": m.grid(v.net_energy),
         "drawn_energy_J": m.grid(v.drawn_energy),
         "battery_energy_J": m.grid(v.battery_energy),
@@ -107,7 +132,7 @@ def write_map(m: EnergyMap, out: Path) -> list[Path]:
 def infeasible_note(m: EnergyMap) -> str | None:
     """Why cells are infeasible, in words: the most frequent binding limit and which variables to map instead.
 
-    None when most cells are feasible. The hint names the other lengths of the chain the binding
+    None when most cells are feasible. The hint names the other decision variables of the chain the binding
     limit belongs to (they move that limit), else the two variables of the map with wider bounds.
     """
     from hiab_sim.study.report.summary import limit_in_words
@@ -121,7 +146,7 @@ def infeasible_note(m: EnergyMap) -> str | None:
     top = v.names[int(names[np.argmax(counts)])]
     share = int(counts.max())
     chain = top.split(".")[1] if top.count(".") >= 2 else ""
-    others = [x for x in VARIABLES if x.startswith(f"{chain}.") and x not in m.variables] if chain else []
+    others = [x for x in m.design_names if x.startswith(f"{chain}.") and x not in m.variables] if chain else []
     hint = (
         f"map {' and '.join(others[:2])} instead (they move this limit)"
         if others
@@ -130,7 +155,7 @@ def infeasible_note(m: EnergyMap) -> str | None:
     head = "no feasible cell" if not feasible.any() else f"only {int(feasible.sum())} feasible cells"
     return (
         f"{head} of {feasible.size}: {share} cells break {limit_in_words(top)} "
-        f"with the other lengths fixed at the {m.base.source.split(' (')[0]};\n{hint}"
+        f"with the other decision variables fixed at the {m.base.source.split(' (')[0]};\n{hint}"
     )
 
 
@@ -149,7 +174,7 @@ def figure_png(m: EnergyMap) -> bytes:
     from hiab_sim.study.report.summary import limit_in_words
 
     v = m.values
-    i, j = VARIABLES.index(m.variables[0]), VARIABLES.index(m.variables[1])
+    i, j = m.index(m.variables[0]), m.index(m.variables[1])
     feasible = m.grid(v.feasible)
     binding = m.grid(v.binding)
     labels = sorted({v.names[int(k)] for k in binding[~feasible]})
@@ -160,8 +185,8 @@ def figure_png(m: EnergyMap) -> bytes:
     fig = new_figure((13, 5.6))
     axes = fig.subplots(1, 2)
     panels = (
-        (v.objective, "objective / its value at the base design"),
-        (v.net_energy / 1e3, "net electrical energy per cycle [kJ]"),
+        (v.objective, f"objective ({m.objective}, {m.objective_unit}) / its value at the study's start"),
+        (v.net_energy / 1e3, "net electrical energy " + ("per cycle" if len(m.tasks) == 1 else "weighted") + " [kJ]"),
     )
     for ax, (values, title) in zip(axes, panels, strict=True):
         grid = np.ma.masked_where(~feasible, m.grid(values))
@@ -196,15 +221,17 @@ def figure_png(m: EnergyMap) -> bytes:
         for ax in axes:
             ax.text(
                 0.5, 0.5, wrapped, transform=ax.transAxes, ha="center", va="center", fontsize=8.5,
-                bbox={"boxstyle": "round", "fc": "white", "ec": "0.3", "alpha": 0.92},
+                bbox={"boxstyle": "round", "fc": (1.0, 1.0, 1.0, 0.92), "ec": "0.3"},  # white, 92 % opaque
             )  # fmt: skip
     handles, names = axes[0].get_legend_handles_labels()
     handles += [Patch(color=palette(n % 10), alpha=0.35) for n in range(len(labels))]
     names += [f"infeasible: {limit_in_words(name)}" for name in labels]
     fig.legend(handles, names, loc="outside lower center", ncol=2, fontsize=8)
-    fig.suptitle(
-        f"Energy map over {m.variables[0]} x {m.variables[1]}; the other lengths and the trajectory at the "
-        f"{m.base.source}",
-        fontsize=10,
+    title = (
+        f"Energy map over {m.variables[0]} x {m.variables[1]}; the other decision variables and the trajectory at "
+        f"the {m.base.source}"
     )
+    if len(m.tasks) > 1:
+        title += "\nduty mix, objective and energies weighted: " + " + ".join(f"{w:g} x {n}" for n, w in m.tasks)
+    fig.suptitle(title, fontsize=10)
     return png_bytes(fig)

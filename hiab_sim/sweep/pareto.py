@@ -1,20 +1,27 @@
 """Pareto front of the study's objective against a second criterion, by the epsilon-constraint method.
 
-Each front point minimises the objective of eq. ``costf2`` subject to every constraint of the study
-and one more, criterion(z) <= epsilon:
+Each front point minimises the study's objective (any registered one,
+:data:`hiab_sim.study.nlp.objectives.OBJECTIVES`; for a duty mix the weighted sum over its tasks,
+:class:`hiab_sim.study.nlp.problem.StudyProblem`) subject to every constraint of every task and one
+more, criterion(z) <= epsilon, where the criterion is the worst over the tasks:
 
-* ``peak_force``: max over the collocation samples and the three actuators of |f_x| [N], as the
-  rows epsilon - f_x >= 0 and epsilon + f_x >= 0 per sample and actuator (smooth);
-* ``rms_torque``: sqrt(mean_k sum_i tau_m,i(t_k)^2) [N m], the motor torques of eq.
-  ``torque_torque`` at the collocation samples (a proxy of the motors' thermal load).
+* ``peak_force``: max over the tasks, their collocation samples and the actuators of |f_x| [N],
+  as the rows epsilon - f_x >= 0 and epsilon + f_x >= 0 per task, sample and actuator (smooth);
+* ``rms_torque``: max over the tasks of sqrt(mean_k sum_i tau_m,i(t_k)^2) [N m], the motor torques
+  of eq. ``torque_torque`` at the task's collocation samples (a proxy of the motors' thermal load),
+  one row epsilon - rms_j >= 0 per task j.
 
-The epsilon rows are appended to the NLP's own rows (:class:`EpsilonProblem` wraps a
-:class:`~hiab_sim.study.nlp.task_problem.TaskProblem` through its public methods); their Jacobian is
-by central differences in z. The front's epsilon runs from the plain optimum's criterion c_0
-(epsilon inactive: the plain study) down to the least criterion c_min the constraints allow
-(:func:`minimise_criterion`, the epigraph form min t s.t. -t <= s_k <= t), equally spaced, so
-every epsilon is feasible; each point is warm-started from the previous one (or from the
-c_min design if that fails).
+The epsilon rows are appended to the NLP's own rows (:class:`EpsilonProblem` wraps the study's
+problem through its public methods). Their values come from each task's inverse dynamics on its
+machine (crane file or machine file alike: ``TaskProblem.model``); their Jacobian is chained
+exactly through the B-spline matrices from the per-sample ID partials (central differences in
+q9, :func:`hiab_sim.study.nlp.id_partials.id_joint_partials`, and in Xi,
+``StudyMachine.design_partials``) and the motor torque's analytic partials
+(:func:`hiab_sim.emla.drive.drive_state`). The front's epsilon runs from the plain optimum's
+criterion c_0 (epsilon inactive: the plain study) down to the least criterion c_min the constraints
+allow (:func:`minimise_criterion`, the epigraph form min t s.t. -t <= s_k <= t), equally spaced, so
+every epsilon is feasible; each point is warm-started from the previous one (or from the c_min
+design if that fails). Every front point is solved by SLSQP (dense), whatever the study's method.
 """
 
 from __future__ import annotations
@@ -26,10 +33,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize
 
-from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
+from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla.drive import drive_state
 from hiab_sim.errors import InvalidInputError, SolverError
+from hiab_sim.study.nlp.id_partials import id_joint_partials
 from hiab_sim.study.nlp.objectives import costf2
+from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import C_SCALE, XI_SCALE, TaskProblem
 from hiab_sim.style import colour
 
@@ -39,56 +48,83 @@ CRITERIA = {"peak_force": "N", "rms_torque": "N m"}
 FEASIBLE = 1e-6
 
 
-def samples_of_points(problem: TaskProblem, Z: Array, name: str) -> Array:
-    """What the criterion bounds at each row z of Z (m, n): forces f_x (m, 3 K) [N] or the rms torque (m, 1) [N m].
+def _check_name(name: str) -> None:
+    if name not in CRITERIA:
+        raise InvalidInputError("--against", name, f"must be one of {', '.join(CRITERIA)}")
 
-    On the analytic path with the m designs and their trajectories stacked into one call
-    (:func:`hiab_sim.dynamics.analytic_batch.batched_inverse_dynamics`); it agrees with the MuJoCo
-    path to ~1e-14 relative.
+
+def task_samples(p: TaskProblem, zk: Array, name: str, jacobian: bool = False) -> tuple[Array, Array | None]:
+    """What the criterion bounds on one task at its own z: forces f_x (K A,) [N] or its rms torque (1,) [N m].
+
+    With ``jacobian`` also their partials w.r.t. the task's z = [z_xi, z_c], (S, n_xi + n_c).
+    Forces are sample-major (row k A + i: sample k, actuator i), as the NLP's own actuator samples.
     """
-    Z = np.atleast_2d(np.asarray(Z, dtype=float))
-    m = Z.shape[0]
-    xi = Z[:, : problem.n_xi] * XI_SCALE
-    c = problem.c_ref[None] + C_SCALE * Z[:, problem.n_xi :].reshape(m, 3, problem.basis.n)
-    q, dq, ddq = (np.einsum("kn,mjn->mkj", B, c) for B in problem.B)
-    f, v, a, _ = batched_inverse_dynamics(problem.study.crane, xi, q, dq, ddq, problem.tcp_force)
+    _check_name(name)
+    design, c = p.unpack(zk)
+    joints = p.joints(c)
+    samples = JointSamples(joints.position, joints.velocity, joints.acceleration)
+    model = p.model.inverse_dynamics(design, p.id_path)
+    act = model(samples, tcp_force=p.tcp_force)
+    K, A = act.force.shape
+    n, n_xi = p.n_joints, p.n_xi
+    drives = []
     if name == "peak_force":
-        return f.reshape(m, -1)
-    if name == "rms_torque":
-        tau = np.stack(
-            [drive_state(p, f[..., i], v[..., i], a[..., i]).motor_torque for i, p in enumerate(problem.emlas)],
-            axis=-1,
-        )
-        return np.sqrt(np.mean(np.sum(tau**2, axis=-1), axis=-1))[:, None]
-    raise InvalidInputError("--against", name, f"must be one of {', '.join(CRITERIA)}")
+        s = act.force.ravel()
+    else:
+        drives = [
+            drive_state(e, act.force[:, i], act.velocity[:, i], act.acceleration[:, i]) for i, e in enumerate(p.emlas)
+        ]
+        tau = np.column_stack([d.motor_torque for d in drives])
+        s = np.array([np.sqrt(np.mean(np.sum(tau**2, axis=1)))])
+    if not jacobian:
+        return s, None
+    id_q = id_joint_partials(model, samples, p.fd_step, p.tcp_force)  # (K, 3 A outputs (f, v, a), 3 n)
+    id_xi = p.model.design_partials(design, samples, p.xi_path, p.fd_step, p.tcp_force)  # (K, 3 A, n_xi)
+    if name == "peak_force":  # q9 index = order * n + joint; B (3 orders, K, N)
+        dc = np.einsum("kaoj,okm->kajm", id_q[:, :A].reshape(K, A, 3, n), p.B) * C_SCALE
+        return s, np.hstack([id_xi[:, :A].reshape(K * A, n_xi) * XI_SCALE, dc.reshape(K * A, p.n_c)])
+    # d rms / d tau_ki = tau_ki / (K rms); tau_ki depends on (f, v, a) of actuator i at sample k only
+    w = tau / (K * max(float(s[0]), 1e-300))
+    g = np.zeros((K, 3 * A))
+    for i, d in enumerate(drives):
+        df, dv, da = d.d_motor_torque
+        g[:, i], g[:, A + i], g[:, 2 * A + i] = w[:, i] * df, w[:, i] * dv, w[:, i] * da
+    dq9 = np.einsum("ky,kyq->kq", g, id_q)
+    dc = np.einsum("koj,okm->jm", dq9.reshape(K, 3, n), p.B) * C_SCALE
+    dxi = np.einsum("ky,kyx->x", g, id_xi) * XI_SCALE
+    return s, np.concatenate([dxi, dc.ravel()])[None]
 
 
-def criterion_samples(problem: TaskProblem, z: Array, name: str) -> Array:
-    """What the criterion bounds at one z: forces f_x (3 K,) [N] or the rms motor torque (1,) [N m]."""
-    return samples_of_points(problem, np.asarray(z, dtype=float)[None], name)[0]
-
-
-def samples_jacobian(problem: TaskProblem, z: Array, name: str) -> Array:
-    """D samples / dz by central differences, all 2 n perturbations in one stacked call, (S, n)."""
+def criterion_samples(problem: StudyProblem, z: Array, name: str) -> Array:
+    """What the criterion bounds at z, every task's in task order: forces f_x [N] or each task's rms torque [N m]."""
     z = np.asarray(z, dtype=float)
-    n = len(z)
-    step = problem.fd_step * np.maximum(1.0, np.abs(z))
-    Z = np.repeat(z[None], 2 * n, axis=0)
-    Z[np.arange(n), np.arange(n)] += step
-    Z[n + np.arange(n), np.arange(n)] -= step
-    s = samples_of_points(problem, Z, name)
-    return ((s[:n] - s[n:]) / (2.0 * step[:, None])).T
+    return np.concatenate([task_samples(p, problem.task_z(z, k), name)[0] for k, p in enumerate(problem.problems)])
 
 
-def criterion(problem: TaskProblem, z: Array, name: str) -> float:
-    """The criterion's value at z [N or N m]."""
+def samples_jacobian(problem: StudyProblem, z: Array, name: str) -> Array:
+    """D samples / dz (S, n): each task's rows in the Xi columns and its own coefficient columns."""
+    z = np.asarray(z, dtype=float)
+    parts = []
+    for k, p in enumerate(problem.problems):
+        jac = task_samples(p, problem.task_z(z, k), name, jacobian=True)[1]
+        assert jac is not None
+        out = np.zeros((len(jac), problem.n))
+        off = problem.offsets[k]
+        out[:, : problem.n_xi] = jac[:, : problem.n_xi]
+        out[:, off : off + p.n_c] = jac[:, problem.n_xi :]
+        parts.append(out)
+    return np.vstack(parts)
+
+
+def criterion(problem: StudyProblem, z: Array, name: str) -> float:
+    """The criterion's value at z, the worst over the tasks [N or N m]."""
     return float(np.max(np.abs(criterion_samples(problem, z, name))))
 
 
 class EpsilonProblem:
     """The study's NLP with criterion <= epsilon appended (rows scaled by ``scale``)."""
 
-    def __init__(self, problem: TaskProblem, name: str, epsilon: float, scale: float) -> None:
+    def __init__(self, problem: StudyProblem, name: str, epsilon: float, scale: float) -> None:
         self.problem, self.name, self.epsilon, self.scale = problem, name, float(epsilon), float(scale)
 
     def rows(self, z: Array) -> Array:
@@ -147,7 +183,9 @@ class FrontPoint:
     """One point of the front: epsilon, the criterion reached, costf2 [W^2 s], the objective, status.
 
     ``objective_value`` is the study's objective [``objective_unit``: J for battery_energy, W^2 s
-    for costf2], ``objective`` the same divided by its value at the study's start.
+    for costf2; for a duty mix the weighted sum over its tasks], ``objective`` the same divided by
+    its value at the study's start; ``costf2_W2s`` the paper's squared-power cost, weighted likewise,
+    whatever the objective. ``xi`` are the machine's decision variables ``design_names`` [m].
     """
 
     epsilon: float
@@ -160,6 +198,8 @@ class FrontPoint:
     accepted: bool
     message: str
     iterations: int
+    design_names: tuple[str, ...] = ()
+    z: tuple[float, ...] = ()  # the point's scaled NLP variables (not a table column)
 
     def as_row(self) -> dict[str, Any]:
         """A table row."""
@@ -167,12 +207,13 @@ class FrontPoint:
             k: getattr(self, k)
             for k in ("epsilon", "criterion", "costf2_W2s", "objective_value", "objective_unit", "objective")
         }
-        row.update({f"xi_{k}": v for k, v in enumerate(self.xi)})
+        names = self.design_names or tuple(f"xi_{k}" for k in range(len(self.xi)))
+        row.update({f"{name}_m": v for name, v in zip(names, self.xi, strict=True)})
         row.update(accepted=self.accepted, message=self.message, iterations=self.iterations)
         return row
 
 
-def minimise_criterion(problem: TaskProblem, z0: Array, name: str) -> tuple[Array, float, bool]:
+def minimise_criterion(problem: StudyProblem, z0: Array, name: str) -> tuple[Array, float, bool]:
     """The least criterion the study's constraints allow: min t s.t. -t <= s_k(z) <= t (epigraph form).
 
     Returns (z, c_min, converged); variables (z, t) with t scaled by the criterion at z0.
@@ -211,7 +252,7 @@ def minimise_criterion(problem: TaskProblem, z0: Array, name: str) -> tuple[Arra
             {
                 "type": "eq",
                 "fun": lambda x: p.equalities(x[:n]),
-                "jac": lambda x: np.hstack([p.equalities_jacobian(x[:n]), np.zeros((12, 1))]),
+                "jac": lambda x: np.hstack([p.equalities_jacobian(x[:n]), np.zeros((len(p.equality_names), 1))]),
             },
             {"type": "ineq", "fun": ineq, "jac": ineq_jacobian},
         ],
@@ -221,11 +262,11 @@ def minimise_criterion(problem: TaskProblem, z0: Array, name: str) -> tuple[Arra
     return z, criterion(p, z, name), bool(res.success) and p.max_violation(z) <= FEASIBLE
 
 
-def pareto_front(problem: TaskProblem, z_optimum: Array, name: str, points: int) -> list[FrontPoint]:
+def pareto_front(problem: StudyProblem, z_optimum: Array, name: str, points: int) -> list[FrontPoint]:
     """The front from the plain optimum (epsilon = its criterion c_0) to the least criterion c_min.
 
     Args:
-        problem: The study's NLP.
+        problem: The study's NLP (one task or many).
         z_optimum: The plain study's optimum (scaled z), e.g. from :func:`hiab_sim.study.solvers.slsqp.solve`.
         name: ``peak_force`` or ``rms_torque``.
         points: Number of epsilon values (>= 2), equally spaced from c_0 to c_min.
@@ -233,8 +274,7 @@ def pareto_front(problem: TaskProblem, z_optimum: Array, name: str, points: int)
     """
     if points < 2:
         raise InvalidInputError("--points", points, "must be >= 2")
-    if name not in CRITERIA:
-        raise InvalidInputError("--against", name, f"must be one of {', '.join(CRITERIA)}")
+    _check_name(name)
     c0 = criterion(problem, z_optimum, name)
     z_min, c_min, converged = minimise_criterion(problem, z_optimum, name)
     if not converged:
@@ -253,13 +293,16 @@ def pareto_front(problem: TaskProblem, z_optimum: Array, name: str, points: int)
 
 
 def _point(
-    problem: TaskProblem, z: Array, name: str, epsilon: float, accepted: bool, message: str, iterations: int
+    problem: StudyProblem, z: Array, name: str, epsilon: float, accepted: bool, message: str, iterations: int
 ) -> FrontPoint:
     ev = problem.evaluate(z)
     return FrontPoint(
         epsilon,
         criterion(problem, z, name),
-        costf2(problem.emlas, problem.dt).value(ev),
+        sum(
+            w * costf2(p.emlas, p.dt).value(t)
+            for w, p, t in zip(problem.weights, problem.problems, ev.tasks, strict=True)
+        ),
         ev.cost,
         problem.objective.unit,
         ev.cost / problem.cost_scale,
@@ -267,11 +310,13 @@ def _point(
         accepted,
         message,
         iterations,
+        tuple(problem.model.design_names),
+        tuple(float(v) for v in z),
     )
 
 
-def front_figure_png(front: list[FrontPoint], name: str, title: str) -> bytes:
-    """PNG of the front: the objective against the criterion, the plain optimum marked.
+def front_figure_png(front: list[FrontPoint], name: str, title: str, objective: str = "objective") -> bytes:
+    """PNG of the front: the objective (registry name ``objective``) against the criterion, the plain optimum marked.
 
     The criterion axis also shows the change from the plain optimum in %, so a narrow span
     (a front over a few tenths of a percent) reads as what it is.
@@ -304,7 +349,7 @@ def front_figure_png(front: list[FrontPoint], name: str, title: str) -> bytes:
         top = ax.secondary_xaxis("top", functions=(to_percent, from_percent))
         top.set_xlabel(f"{words}: change from the plain optimum [%]")
     ax.set_xlabel(f"{words} [{unit}]")
-    ax.set_ylabel(f"objective ({front[0].objective_unit}) / its value at the start")
+    ax.set_ylabel(f"{objective} [{front[0].objective_unit}] / its value at the study's start")
     ax.set_title(f"{title}: what limiting the {words} costs", fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)

@@ -17,7 +17,7 @@ from typing import Any
 
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.sweep.point import RESULT_COLUMNS, PointOutcome, PointTask, run_point
+from hiab_sim.sweep.point import PointOutcome, PointTask, result_columns, run_point
 from hiab_sim.sweep.spec import Sweep
 from hiab_sim.sweep.table import TABLE_NAME, read_table, write_table
 
@@ -68,14 +68,17 @@ def run_sweep(
     order = {p.key: k for k, p in enumerate(sweep.points)}
     rows: dict[str, dict[str, Any]] = {k: r for k, r in done.items() if k in order}
     pending = [p for p in sweep.points if p.key not in rows]
-    columns = [*sweep.columns, *RESULT_COLUMNS]
+    columns = [*sweep.columns, *result_columns(sweep.design_names)]
     meta = sweep_meta(sweep)
     write_table(table, _ordered(rows, order), columns, meta)
     bar = _bar(len(sweep.points), len(rows), progress)
     ran: list[str] = []
     failed: list[str] = []
     futures: list[Future[PointOutcome]] = [
-        executor.submit(run_point, PointTask(p.key, p.values, p.study, p.emla, str(sweep.study_file))) for p in pending
+        executor.submit(
+            run_point, PointTask(p.key, p.values, p.study, p.emla, str(sweep.study_file), sweep.design_names)
+        )
+        for p in pending
     ]
     try:
         for future in as_completed(futures):

@@ -18,7 +18,10 @@ A sweep file (YAML)::
 
 Paths address the study's YAML mapping (``bounds.lift.up[0]``, ``payload``, ``solver.maxiter``);
 paths under ``emla.`` address the study's EMLA file (``emla.lift.gear_ratio`` is its
-``actuators.lift.gear_ratio``, ``emla.pmsm.peak_torque`` its ``pmsm.peak_torque``). Every point's
+``actuators.lift.gear_ratio``, ``emla.pmsm.peak_torque`` its ``pmsm.peak_torque``; an actuator is
+any name under the file's ``actuators``, e.g. ``emla.boom.gear_ratio`` of the eXact arm's). The base
+study may be a crane file's (``crane:``) or a machine file's (``machine:``), of one task or a duty
+mix: a point is a whole optimisation of that study. Every point's
 study (and EMLA set) is built and validated here, before any work starts: an unknown path, an
 empty grid or a value the study rejects raises :class:`~hiab_sim.errors.ConfigError` naming the path.
 """
@@ -33,9 +36,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from hiab_sim.emla.config import ACTUATOR_NAMES, emla_set_from_mapping
+from hiab_sim.emla.config import emla_set_from_mapping
 from hiab_sim.errors import ConfigError, HiabSimError
 from hiab_sim.resources import Source, locate
+from hiab_sim.study.spec.study import Study
 from hiab_sim.study.spec.study_file import study_from_dict
 from hiab_sim.sweep.paths import parse_path, set_path
 from hiab_sim.yaml_fields import mapping, read_yaml
@@ -64,6 +68,7 @@ class Sweep:
     columns: tuple[str, ...]
     points: tuple[Point, ...]
     axes: tuple[str, ...]  # one column per independent axis (a zipped axis: its values or first path)
+    design_names: tuple[str, ...]  # the base study's machine's decision variables, in the order of Xi
 
 
 def resolve_study(name: str, sweep_file: Path) -> Path:
@@ -181,6 +186,7 @@ def load_sweep(path: str | Path) -> Sweep:
     fixed = data.get("set", {}) or {}
     if not isinstance(fixed, dict):
         raise ConfigError("set: expected a mapping of paths to values")
+    design_names = tuple(_validate(base, None, study_file, []).model.design_names)
     columns, raw, axes = _grid_points(data["grid"]) if "grid" in data else _sample_points(data["sample"])
     paths = [c for c in columns if c not in _axis_names(data)]
     emla_base = _emla_document(base) if any(p.startswith("emla.") for p in [*fixed, *paths]) else None
@@ -201,6 +207,7 @@ def load_sweep(path: str | Path) -> Sweep:
         columns=tuple(columns),
         points=tuple(points),
         axes=tuple(axes),
+        design_names=design_names,
     )
 
 
@@ -229,7 +236,7 @@ def _assign(study: dict[str, Any], emla: dict[str, Any] | None, path: str, value
     rest = steps[1:]
     if not rest or not isinstance(rest[0], str):
         raise ConfigError(f"{path}: expected emla.<actuator>.<key> or emla.pmsm.<key>")
-    if rest[0] in ACTUATOR_NAMES:
+    if rest[0] in (emla.get("actuators") or {}):
         rest = ["actuators", *rest]
     node: Any = emla
     for step in rest[:-1]:
@@ -243,14 +250,14 @@ def _assign(study: dict[str, Any], emla: dict[str, Any] | None, path: str, value
 
 def _validate(
     study: dict[str, Any], emla: dict[str, Any] | None, study_file: Path, assignments: list[tuple[str, Any]]
-) -> None:
+) -> Study:
+    """The point's study, built (every value checked); a rejection is one ConfigError naming the assignments."""
     where = ", ".join(f"{p} = {v!r}" for p, v in assignments) or "the base study"
     try:
         if emla is not None:
             emla_set_from_mapping(emla, where="EMLA set")
-        checked = dict(study)
-        if emla is not None:
-            checked["emla"] = "default"  # the point's EMLA mapping is checked above; the file is written per point
-        study_from_dict(checked, study_file)
+        # the point's EMLA mapping is checked above (the file is written per point); the study is built with
+        # the base study's EMLA file, whose actuators are the machine's
+        return study_from_dict(dict(study), study_file)
     except HiabSimError as error:
         raise ConfigError(f"{where}: the study rejects it: {error}") from None
