@@ -148,11 +148,12 @@ def infeasible_note(m: EnergyMap) -> str | None:
     chain = top.split(".")[1] if top.count(".") >= 2 else ""
     others = [x for x in m.design_names if x.startswith(f"{chain}.") and x not in m.variables] if chain else []
     hint = (
-        f"map {' and '.join(others[:2])} instead (they move this limit)"
+        f"map {' and '.join(others[:2])} instead ({'they move' if len(others[:2]) > 1 else 'it moves'} this limit)"
         if others
         else "widen the bounds of the mapped variables, or map the lengths of the chain that binds"
     )
-    head = "no feasible cell" if not feasible.any() else f"only {int(feasible.sum())} feasible cells"
+    count = int(feasible.sum())
+    head = "no feasible cell" if count == 0 else f"only {count} feasible cell{'' if count == 1 else 's'}"
     return (
         f"{head} of {feasible.size}: {share} cells break {limit_in_words(top)} "
         f"with the other decision variables fixed at the {m.base.source.split(' (')[0]};\n{hint}"
