@@ -1,8 +1,9 @@
 """A machine file's MJCF for one design: the design from the command line or a result, posed and framed.
 
 The model is the generic one of :mod:`hiab_sim.machine.dynamics.mjcf_build` (every tree body, the
-closed loops as ``connect`` equalities, one force motor per actuator). Here it gets what a viewer
-and a renderer need:
+closed loops as ``connect`` equalities, one force motor per actuator), its joints limited to the
+machine's working ranges and the actuator slides to their strokes (``limits=True``: what
+``hiab-sim machine import`` reads back). Here it gets what a viewer and a renderer need:
 
 * a keyframe ``home`` at the middle of every joint's working range (within what the design's
   chains reach), every dependent joint (cylinders, rods, rockers, couplers) set by the loop closure
@@ -200,11 +201,13 @@ def _bare_xml(machine: Machine) -> str:
     """The generic model's XML with its bodies, inertias and sites at full precision.
 
     ``MjSpec.to_xml`` writes six significant digits (the XS 031's pins then miss by ~4e-6 m), so
-    the numbers that place the mechanism are written again from the spec with ``repr``.
+    the numbers that place the mechanism are written again from the spec with ``repr``. The joints
+    carry their ranges (working ranges and strokes, :func:`~hiab_sim.machine.dynamics.mjcf_build.joint_ranges`)
+    so that ``hiab-sim machine import`` reads the file back as it is written.
     """
     from hiab_sim.machine.dynamics.mjcf_build import build_machine_spec
 
-    spec = build_machine_spec(machine)
+    spec = build_machine_spec(machine, limits=True)
     spec.compile()
     root = ElementTree.fromstring(spec.to_xml())
     for body in root.iter("body"):
@@ -220,6 +223,9 @@ def _bare_xml(machine: Machine) -> str:
             inertial.set("pos", _numbers(source.ipos))
             inertial.set("mass", repr(float(source.mass)))
             inertial.set("fullinertia", _numbers(source.fullinertia))
+    for joint in root.iter("joint"):
+        if joint.get("range") is not None:
+            joint.set("range", _numbers(spec.joint(str(joint.get("name"))).range))
     for site in root.iter("site"):
         if site.get("name") is None:  # the template's decor
             continue

@@ -4,52 +4,29 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import mujoco
 import numpy as np
 import pytest
 
 from hiab_sim.cli import main
-from hiab_sim.machine.dynamics.mjcf_build import build_machine_spec
-from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
 from hiab_sim.machine.kinematics.assembly import check_machine
 from hiab_sim.machine.loader import load_machine
 from hiab_sim.machine.mjcf_import.importer import import_mjcf
 from hiab_sim.machine.mjcf_import.round_trip import fit_ranges, round_trip
+from hiab_sim.machine_mjcf import machine_mjcf
 
 TOLERANCE = 1e-9
 
 
 def exported_mjcf(name: str, folder: Path) -> Path:
-    """The branch's own MJCF of a shipped machine, with its ranges and a loop-consistent keyframe added.
-
-    ``mjcf_build`` writes neither joint ranges nor slide ranges (strokes) nor a closed pose; a
-    user's file carries them, so they are added here from the machine file.
-    """
-    machine = load_machine(name)
-    spec = build_machine_spec(machine)
-    for link in machine.links[1:]:
-        joint = spec.joint(link.joint)
-        joint.range = list(link.joint_range)
-        joint.limited = mujoco.mjtLimited.mjLIMITED_TRUE
-    for chain in machine.chains:
-        if chain.kind != "direct":
-            joint = spec.joint(f"{chain.name}.stroke")
-            joint.range = [0.0, chain.actuator.stroke]
-            joint.limited = mujoco.mjtLimited.mjLIMITED_TRUE
-    middle = np.array([[0.5 * sum(machine.joint_link(j).joint_range) for j in machine.joint_names]])
-    qpos, _, _ = MujocoMachineDynamics(machine).state(middle, np.zeros_like(middle), np.zeros_like(middle))
-    spec.compile()
-    key = spec.add_key()
-    key.name = "home"
-    key.qpos = list(qpos[0])
+    """The MJCF ``hiab-sim mjcf --machine`` writes for a shipped machine, as written (ranges and keyframe included)."""
     path = folder / f"{name}.xml"
-    path.write_text(spec.to_xml())
+    path.write_text(machine_mjcf(load_machine(name)))
     return path
 
 
 @pytest.mark.parametrize("name", ["xs031", "exact"])
 def test_importing_the_exporters_mjcf_reproduces_its_actuator_forces_on_both_paths(name: str, tmp_path: Path) -> None:
-    """The shipped machines' MJCF (mjcf_build) imports to a machine with the MJCF's forces to 1e-9; it checks."""
+    """The shipped machines' exported MJCF imports, unedited, to a machine with the MJCF's forces to 1e-9; it checks."""
     imported = import_mjcf(exported_mjcf(name, tmp_path))
     machine = fit_ranges(imported)
     assert check_machine(machine) == []

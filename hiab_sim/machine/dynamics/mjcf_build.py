@@ -14,7 +14,16 @@ options; contacts disabled, energy enabled):
 * per loop pin, sites ``<pin>.a`` / ``<pin>.b`` and a site-based ``connect`` equality ``<pin>``;
   site ``tcp`` is the TCP frame;
 * one ``motor`` per chain (named after it, gear 1, no control limit) on its actuated joint (the
-  rod slide, or the direct chain's prismatic joint): ctrl is the actuator force f_x [N].
+  rod slide, or the direct chain's prismatic joint): ctrl is the actuator force f_x [N];
+* with ``limits=True`` (the exported file, :mod:`hiab_sim.machine_mjcf`), the ranges of
+  :func:`joint_ranges` as ``limited`` joint ranges: each machine hinge's working range [rad] and
+  each actuator slide's stroke [0, stroke] [m] (a rod slide's coordinate is x, a direct chain's
+  joint is x itself), which ``hiab-sim machine import`` reads back as working ranges and strokes.
+  The slides' ranges are the EMLAs' end stops; a hinge's range is the working range the machine
+  file declares; the chain bodies' hinges stay unlimited (the loops hold them). A limit acts only
+  outside its range (MuJoCo instantiates a limit row once the coordinate passes it) and both ID
+  paths disable constraints, so no force inside the ranges changes. The ID paths' and the
+  simulation environment's models are built with ``limits=False``.
 
 The bare model (``extras=None``) is the mechanism: inverse dynamics of it gives the load-side
 actuator forces. :class:`SimulationExtras` adds, per actuator, the armature [kg] (rotor and screw
@@ -38,7 +47,7 @@ from hiab_sim.machine.parts import RigidBody
 from hiab_sim.model.mjcf import SOURCE_TO_WORLD, add_site_connect
 from hiab_sim.resources import mjcf_template
 
-__all__ = ["SimulationExtras", "build_machine_model", "build_machine_spec", "spec_of_tree"]
+__all__ = ["SimulationExtras", "build_machine_model", "build_machine_spec", "joint_ranges", "spec_of_tree"]
 
 
 def _quat(rotation: np.ndarray) -> list[float]:
@@ -73,10 +82,35 @@ def _capsule(body: mujoco.MjsBody, start: Any, end: Any, look: str) -> None:
     geom.fromto = [*map(float, start), *map(float, end)]
 
 
+def joint_ranges(tree: MachineTree) -> dict[str, tuple[float, float]]:
+    """The ranges the exported MJCF gives its joints, by joint name [rad or m] (see the module docstring).
+
+    Each machine joint driven through a triangle or a linkage: its working range (``joint_range``
+    of its link). Each actuator's slide: [0, stroke] (the rod slide's coordinate is the stroke x,
+    0 at the retracted length; a direct chain's prismatic joint is x itself, so its range is the
+    stroke too, which is what the import reads as that link's working range).
+    """
+    machine = tree.machine
+    out: dict[str, tuple[float, float]] = {}
+    for name in machine.joint_names:
+        span = machine.joint_link(name).joint_range
+        if span is not None:
+            out[name] = (float(span[0]), float(span[1]))
+    for chain, b in zip(machine.chains, tree.actuated, strict=True):
+        out[tree.bodies[b].joint] = (0.0, float(chain.actuator.stroke))
+    return out
+
+
 def build_machine_spec(
-    machine: Machine, design: Sequence[float] | None = None, extras: SimulationExtras | None = None
+    machine: Machine,
+    design: Sequence[float] | None = None,
+    extras: SimulationExtras | None = None,
+    *,
+    limits: bool = False,
 ) -> mujoco.MjSpec:
     """MjSpec of the machine with its decision variables set to ``design`` (default: the file's).
+
+    ``limits``: give the joints the ranges of :func:`joint_ranges` (the exported file's end stops).
 
     Raises:
         InvalidInputError: a design outside its bounds, a moving body without mass, extras of the
@@ -85,12 +119,13 @@ def build_machine_spec(
     """
     if design is not None:
         machine = machine.with_design(design)
-    return spec_of_tree(machine_tree(machine), extras)
+    return spec_of_tree(machine_tree(machine), extras, limits=limits)
 
 
-def spec_of_tree(tree: MachineTree, extras: SimulationExtras | None = None) -> mujoco.MjSpec:
-    """MjSpec of a machine tree (see the module docstring)."""
+def spec_of_tree(tree: MachineTree, extras: SimulationExtras | None = None, *, limits: bool = False) -> mujoco.MjSpec:
+    """MjSpec of a machine tree (see the module docstring); ``limits`` as :func:`build_machine_spec`."""
     machine = tree.machine
+    ranges = joint_ranges(tree) if limits else {}
     spec = mujoco.MjSpec.from_string(mjcf_template())
     spec.modelname = machine.name
     spec.option.gravity = [0.0, 0.0, -machine.gravity]
@@ -105,7 +140,10 @@ def spec_of_tree(tree: MachineTree, extras: SimulationExtras | None = None) -> m
             node = made[body.parent].add_body(name=body.name, pos=list(body.position), quat=_quat(body.rotation))
             kind = mujoco.mjtJoint.mjJNT_HINGE if body.kind == "revolute" else mujoco.mjtJoint.mjJNT_SLIDE
             axis = [0.0, 0.0, 1.0] if body.kind == "revolute" else [1.0, 0.0, 0.0]
-            node.add_joint(name=body.joint, type=kind, axis=axis)
+            hinge_or_slide = node.add_joint(name=body.joint, type=kind, axis=axis)
+            if body.joint in ranges:
+                hinge_or_slide.range = list(ranges[body.joint])
+                hinge_or_slide.limited = mujoco.mjtLimited.mjLIMITED_TRUE
             if body.inertia is None:
                 raise InvalidInputError(f"bodies.{body.name}", "no mass", "a moving body needs a mass for MuJoCo", "kg")
         if body.inertia is not None:
