@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import csv
 import json
 from pathlib import Path
 from typing import Any
@@ -261,3 +262,24 @@ def test_render_plays_the_scratch_result_back(scratch_run: Path, tmp_path: Path)
     frames = mediapy.read_video(video)
     assert frames.shape == (21, 120, 160, 3)
     assert np.mean(np.abs(frames[0].astype(float) - frames[-1].astype(float))) > 0.5
+
+
+@pytest.mark.e2e
+def test_compare_names_the_scratch_machines_variables_and_mounted_actuators(scratch_run: Path, tmp_path: Path) -> None:
+    """The full table's columns are the file's: its five variables, the peaks of the two EMLAs they move (m1, m4).
+
+    Each peak force in the table is the result's own (kN): read back, not recomputed.
+    """
+    assert main(["compare", str(scratch_run), "--out", str(tmp_path)]) == 0
+    with (tmp_path / "comparison.csv").open() as handle:
+        table = list(csv.DictReader(handle))
+    header = list(table[0])
+    assert [h for h in header if h.endswith("[mm]")] == [
+        "c_inner L [mm]", "c_inner Lc0 [mm]", "c_inner Lc [mm]", "c_jib gx [mm]", "c_jib x0 [mm]"
+    ]  # fmt: skip
+    assert [h for h in header if "peak force" in h] == ["m1 peak force [kN]", "m4 peak force [kN]"]
+    result = json.loads((scratch_run / "result.json").read_text())
+    for row in table:
+        for actuator in ("m1", "m4"):
+            peak = result[row["design"]]["actuators"][actuator]["peak_force_N"]
+            assert float(row[f"{actuator} peak force [kN]"]) == pytest.approx(peak / 1e3, rel=1e-15)

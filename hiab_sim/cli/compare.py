@@ -2,7 +2,7 @@
 
 Prints a table that fits 100 columns (per run and design: net and battery energy, the smallest
 envelope margin, the largest constraint violation and the saving against the run's own initial
-design). With ``--out DIR`` it also writes the full table (six link lengths, peaks; see
+design). With ``--out DIR`` it also writes the full table (the decision variables, peaks; see
 :mod:`hiab_sim.study.analysis.compare`) as ``comparison.csv`` and ``comparison.txt`` and the figure
 ``comparison.png``; without ``--out`` nothing is written. A folder that is missing or holds no result
 exits 2 with one line.
@@ -23,13 +23,13 @@ if TYPE_CHECKING:
 
 #: Widest console line of the short table [characters].
 CONSOLE_WIDTH = 100
-#: Short table: (title, index into Row.values, format).
+#: Short table: (title, column of Row.values, format).
 _SHORT = (
-    ("net energy [kJ]", 6, "{:.3f}"),
-    ("battery [kJ]", 8, "{:.3f}"),
-    ("min envelope margin", 13, "{:.3f}"),
-    ("max violation", 14, "{:.1e}"),
-    ("saving [%]", 15, "{:+.2f}"),
+    ("net energy [kJ]", "net energy", "{:.3f}"),
+    ("battery [kJ]", "battery energy", "{:.3f}"),
+    ("min envelope margin", "min envelope margin", "{:.3f}"),
+    ("max violation", "max violation", "{:.1e}"),
+    ("saving [%]", "saving vs initial", "{:+.2f}"),
 )
 
 
@@ -43,7 +43,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "their net electrical energy and battery energy, the smallest EMLA envelope margin (fraction of the "
             "motor's limit left), the largest constraint violation and the energy saved against the run's own "
             "initial design. Energies of runs with different tasks are comparable only with their own initial "
-            "design. --out DIR writes the full table (link lengths, peak forces and powers) and a figure."
+            "design. --out DIR writes the full table (decision variables, peak forces and powers) and a figure."
         ),
     )
     parser.add_argument("runs", nargs="+", metavar="RUN_DIR", help="result folders (each with result.json)")
@@ -56,7 +56,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 def short_table(table: Sequence[Row], width: int = CONSOLE_WIDTH) -> str:
     """The console table: run, design and the :data:`_SHORT` columns, run names shortened to fit ``width``."""
     titles = ["design", *(t for t, _, _ in _SHORT)]
-    cells = [[r.design, *(_cell(f, r.values[i]) for _, i, f in _SHORT)] for r in table]
+    cells = [[r.design, *(_cell(f, r.values.get(key, math.nan)) for _, key, f in _SHORT)] for r in table]
     widths = [max(len(row[k]) for row in [titles, *cells]) for k in range(len(titles))]
     room = width - sum(widths) - 2 * len(widths)
     names = [_shorten(r.run, room) for r in table]
@@ -87,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
     table = rows(runs)
     print(short_table(table), end="")
     if args.out is None:
-        print("full table (link lengths, peak forces and powers) and a figure: add --out DIR")
+        print("full table (decision variables, peak forces and powers) and a figure: add --out DIR")
         return 0
     out = Path(args.out)
     if out.exists() and not out.is_dir():
