@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 import csv
+import itertools
 import json
 from pathlib import Path
 from typing import Any
@@ -283,3 +284,32 @@ def test_compare_names_the_scratch_machines_variables_and_mounted_actuators(scra
         for actuator in ("m1", "m4"):
             peak = result[row["design"]]["actuators"][actuator]["peak_force_N"]
             assert float(row[f"{actuator} peak force [kN]"]) == pytest.approx(peak / 1e3, rel=1e-15)
+
+
+@pytest.mark.e2e
+def test_two_starts_on_the_scratch_machine_agree_or_report_their_distinct_optima(
+    scratch_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--starts 2`` on a machine file: a second start inside the file's bounds; the optima partition the starts.
+
+    Inside one distinct optimum every start's Xi is within the tolerance of it; two distinct optima differ by more.
+    """
+    study = scratch_run.parent / "study.yaml"
+    flags = ["--no-video", "--no-figures", "--no-report", "--quiet"]
+    assert main(["optimize", str(study), "--starts", "2", "--out", str(tmp_path / "run"), *flags]) == 0
+    multistart = json.loads((tmp_path / "run" / "result.json").read_text())["multistart"]
+    first, second = (np.array(s["initial_lengths"]["values"]) for s in multistart["starts"])
+    machine = load_machine(scratch_run.parent / "three_boom.yaml")
+    low, high = (np.array(b) for b in machine.design_bounds())
+    assert not np.allclose(first, second) and np.all((low <= second) & (second <= high))
+    converged = [s for s in multistart["starts"] if s["success"]]
+    assert multistart["converged_starts"] == len(converged) == 2
+    assert sorted(k for d in multistart["distinct_optima"] for k in d["starts"]) == [0, 1]
+    optimum = {s["start"]: np.array(s["optimal_lengths"]["values"]) for s in converged}
+    tolerance = multistart["tolerance_m"]
+    for d in multistart["distinct_optima"]:
+        assert all(np.max(np.abs(optimum[k] - np.array(d["xi"]))) <= tolerance for k in d["starts"])
+    pairs = itertools.combinations(multistart["distinct_optima"], 2)
+    assert all(np.max(np.abs(np.array(a["xi"]) - np.array(b["xi"]))) > tolerance for a, b in pairs)
+    assert multistart["same_optimum"] == (len(multistart["distinct_optima"]) == 1)
+    assert "Starts: 2 of 2 converged" in capsys.readouterr().out
