@@ -27,9 +27,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--vars",
-        default="lift.L,lift.Lc0",
-        help="two link lengths, e.g. lift.L,tilt.L (default lift.L,lift.Lc0: with working_range crane a "
-        "chain's L and Lc0 together keep its stroke on the joint range, so their map has a feasible region)",
+        default=None,
+        help="two decision variables of the study, e.g. lift.L,tilt.L on the XS 031 (default: the first two of "
+        "its first chain, the XS 031's lift.L,lift.Lc0: with working_range crane a chain's L and Lc0 together "
+        "keep its stroke on the joint range, so their map has a feasible region)",
     )
     parser.add_argument("--grid", type=int, default=50, metavar="N", help="grid points per axis (default 50)")
     parser.add_argument("--result", metavar="DIR", help="result folder of hiab-sim optimize: map around its optimum")
@@ -48,9 +49,9 @@ def run(args: argparse.Namespace) -> int:
     from hiab_sim.sweep.map_output import TRAJECTORY_NOTE, summary, write_map
     from hiab_sim.terminal import StatusLine
 
-    variables = parse_variables(args.vars)
     study = load_study(args.study or (result_study(args.result) if args.result else DEFAULT_STUDY))
     problem = TaskProblem(study, id_path="analytic")
+    variables = parse_variables(args.vars or ",".join(problem.model.design_names[:2]))
     base = optimum_design(args.result) if args.result else start_design(problem)
     with StatusLine(f"evaluating {args.grid} x {args.grid} mountings ..."):
         m = energy_map(problem, base, variables, args.grid)
