@@ -27,9 +27,11 @@ from pathlib import Path
 import numpy as np
 
 from hiab_sim.crane.loader import load_crane
+from hiab_sim.study.machines.crane_model import CraneModel
 from hiab_sim.study.motion.trajectory import TcpKinematics
 from hiab_sim.study.references.csv_file import CsvReference, read_table
 from hiab_sim.study.references.kinds import PickAndPlace
+from hiab_sim.study.spec.tasks import column_names
 
 OUT = Path(__file__).resolve().parent / "xs031_loading_cycle.csv"
 RATE = 20.0  # Hz
@@ -87,7 +89,8 @@ def main() -> None:
     crane = load_crane("xs031")
     kin = TcpKinematics(crane)
     OUT.write_text(render(kin), encoding="utf-8")
-    reference = CsvReference(read_table(OUT))
+    names = column_names(CraneModel(crane))
+    reference = CsvReference(read_table(OUT, names), names)
     reference.check_reach(kin, crane)
     t = np.linspace(0.0, reference.duration, 2001)
     speed = np.linalg.norm(reference.sample(kin, t).velocity[:, :2], axis=1).max()

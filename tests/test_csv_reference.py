@@ -14,9 +14,11 @@ from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.references.csv_file import CsvReference, read_table
 from hiab_sim.study.references.kinds import PickAndPlace, reference_from_mapping
 from hiab_sim.study.spec.study_file import load_study
+from hiab_sim.study.spec.tasks import column_names
 
 STUDY = load_study()
 CRANE = STUDY.crane
+NAMES = column_names(STUDY.model)  # the crane's columns: xt2 beyond x, y; its joints
 KIN = tr.TcpKinematics(CRANE)
 DURATION = STUDY.grid.duration
 ROWS = np.linspace(0.0, DURATION, 251)  # a 40 Hz recording of the spiral
@@ -38,7 +40,9 @@ def test_csv_of_the_spiral_reproduces_the_spiral_within_the_collocation_bands(tm
         _write(tmp_path / "spiral.csv", "t,x,y,xt2", ROWS, SPIRAL.position)
     else:
         _write(tmp_path / "spiral.csv", "t, theta1, theta2, xt2", ROWS, SPIRAL_JOINTS)
-    reference = reference_from_mapping({"kind": "csv", "file": "spiral.csv"}, "tasks[2].reference", tmp_path, 1.0)
+    reference = reference_from_mapping(
+        {"kind": "csv", "file": "spiral.csv"}, "tasks[2].reference", tmp_path, 1.0, NAMES
+    )
     assert isinstance(reference, CsvReference) and reference.duration == pytest.approx(DURATION)
     reference.check_reach(KIN, CRANE)
     fine = STUDY.grid.fine_times()
@@ -56,8 +60,8 @@ def test_tcp_csv_without_telescope_column_holds_the_given_telescope(tmp_path: Pa
     short = tmp_path / "xy.csv"  # any column order
     short.write_text("x,y,t\n" + "\n".join(f"{x:.10g},{y:.10g},{t:.10g}" for t, (x, y) in zip(ROWS, xy, strict=True)))
     full = _write(tmp_path / "xyt.csv", "t,x,y,xt2", ROWS, np.column_stack([xy, np.full(len(ROWS), 0.4)]))
-    a = CsvReference(read_table(short), telescope=0.4).sample(KIN, STUDY.grid.times())
-    b = CsvReference(read_table(full)).sample(KIN, STUDY.grid.times())
+    a = CsvReference(read_table(short, NAMES), NAMES, telescope=0.4).sample(KIN, STUDY.grid.times())
+    b = CsvReference(read_table(full, NAMES), NAMES).sample(KIN, STUDY.grid.times())
     np.testing.assert_allclose(a.position, b.position, atol=1e-12)
     np.testing.assert_allclose(a.acceleration, b.acceleration, atol=1e-9)
 
@@ -110,14 +114,14 @@ def test_bad_csv_raises_naming_file_row_and_column(tmp_path: Path, case: str) ->
     path = tmp_path / f"{case}.csv"
     path.write_text(text)
     with pytest.raises(error, match=match) as info:
-        CsvReference(read_table(path))
+        CsvReference(read_table(path, NAMES), NAMES)
     assert str(path) in str(info.value)
 
 
 def test_missing_csv_file_names_it(tmp_path: Path) -> None:
     """A missing file raises :class:`ConfigError` naming the path."""
     with pytest.raises(ConfigError, match=r"cannot read trajectory file .*nowhere.csv"):
-        reference_from_mapping({"kind": "csv", "file": "nowhere.csv"}, "reference", tmp_path, 1.0)
+        reference_from_mapping({"kind": "csv", "file": "nowhere.csv"}, "reference", tmp_path, 1.0, NAMES)
 
 
 def test_unreachable_tcp_row_names_row_and_time(tmp_path: Path) -> None:
@@ -125,7 +129,7 @@ def test_unreachable_tcp_row_names_row_and_time(tmp_path: Path) -> None:
     far = SPIRAL.position.copy()
     far[150:160, 0] += 3.0  # 3 m further out than the spiral, for 0.25 s
     path = _write(tmp_path / "far.csv", "t,x,y,xt2", ROWS, far)
-    reference = CsvReference(read_table(path), fit_tolerance=10.0)
+    reference = CsvReference(read_table(path, NAMES), NAMES, fit_tolerance=10.0)
     with pytest.raises(InvalidInputError, match=r"far.csv row 153 \(t = 3.75 s\) = 'TCP .* out of the crane's reach"):
         reference.check_reach(KIN, CRANE)
 
@@ -135,7 +139,7 @@ def test_joint_row_outside_the_range_names_row_and_column(tmp_path: Path) -> Non
     joints = SPIRAL_JOINTS.copy()
     joints[200:, 2] = 1.3  # the telescope beyond its 1.1 m range from t = 5 s
     path = _write(tmp_path / "joints.csv", "t,theta1,theta2,xt2", ROWS, joints)
-    reference = CsvReference(read_table(path), fit_tolerance=10.0)
+    reference = CsvReference(read_table(path, NAMES), NAMES, fit_tolerance=10.0)
     with pytest.raises(InvalidInputError, match=r"joints.csv row 203 \(t = 5 s\), column 'xt2' = 1.3 m"):
         reference.check_reach(KIN, CRANE)
 
@@ -151,7 +155,7 @@ def test_telescope_given_once(tmp_path: Path, header: str, telescope: float | No
         tmp_path / "tele.csv", header, ROWS, np.column_stack([SPIRAL_JOINTS[:, :2], SPIRAL.position[:, 2]])[:, :n]
     )
     with pytest.raises(ConfigError, match=match):
-        CsvReference(read_table(path), telescope=telescope)
+        CsvReference(read_table(path, NAMES), NAMES, telescope=telescope)
 
 
 @settings(max_examples=15, deadline=None)
@@ -180,7 +184,7 @@ def test_csv_of_any_pick_and_place_reproduces_it_within_the_collocation_bands(
         f"{t:.6f},{x:.6f},{y:.6f},{xt:.6f}" for t, (x, y, xt) in zip(rows, task.sample(KIN, rows).position, strict=True)
     )
     path.write_text("t,x,y,xt2\n" + body + "\n")
-    fitted = CsvReference(read_table(path))
+    fitted = CsvReference(read_table(path, NAMES), NAMES)
     grid = np.linspace(0.0, task.duration, 401)
     a, b = fitted.sample(KIN, grid), task.sample(KIN, grid)
     band = STUDY.tracking

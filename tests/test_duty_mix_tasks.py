@@ -13,10 +13,12 @@ from hiab_sim.crane.loader import load_crane
 from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla import ACTUATOR_NAMES, envelope_margins, load_emla_set
+from hiab_sim.study.machines.crane_model import CraneModel
 from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.motion.workspace import initial_joints
 from hiab_sim.study.references.kinds import reference_from_mapping
 from hiab_sim.study.spec.payload import Payload
+from hiab_sim.study.spec.tasks import column_names
 
 OPTIMIZE = Path(__file__).resolve().parents[1] / "optimize"
 MIX = yaml.safe_load((OPTIMIZE / "xs031_duty_mix.yaml").read_text())
@@ -35,7 +37,9 @@ def test_duty_mix_task_is_reachable_and_within_the_emla_envelope_with_its_payloa
     """Each duty-mix task is reachable, within the joint-rate bounds and EMLA margins >= 0.2 at the built crane."""
     task = MIX["tasks"][index]
     where = f"tasks[{index}]"
-    reference = reference_from_mapping(task["reference"], f"{where}.reference", OPTIMIZE, MIX["grid"]["duration"])
+    reference = reference_from_mapping(
+        task["reference"], f"{where}.reference", OPTIMIZE, MIX["grid"]["duration"], column_names(CraneModel(CRANE))
+    )
     payload = Payload.from_value(task["payload"], f"{where}.payload")
     reference.check_reach(KIN, CRANE)
     t = np.linspace(0.0, reference.duration, int(reference.duration / 0.05) + 1)

@@ -1,7 +1,13 @@
-"""A machine written from scratch (three booms, a prismatic extension, a jib four-bar) checks and draws."""
+"""A machine written from scratch (three booms, a prismatic extension, a jib four-bar) checks, draws and runs.
+
+``optimize``, ``simulate --no-video`` and ``render`` run on it end to end, every name the file's.
+"""
 
 from __future__ import annotations
 
+import csv
+import itertools
+import json
 from pathlib import Path
 from typing import Any
 
@@ -9,7 +15,9 @@ import numpy as np
 import pytest
 import yaml
 
+import hiab_sim
 from hiab_sim.cli import main
+from hiab_sim.cli.simulate import ENERGY_TOLERANCE, TCP_MAX_MM
 from hiab_sim.machine.kinematics.forward import forward_kinematics
 from hiab_sim.machine.loader import load_machine
 
@@ -32,8 +40,26 @@ def _moving(
     }
 
 
+def _tube(mass: float, radius: float, length: float) -> dict[str, Any]:
+    """A uniform cylinder along x from its pin: com at l/2, I_xx = m r^2/2, I_yy = I_zz = m (3 r^2 + l^2)/12."""
+    i_xx, i_yy = mass * radius**2 / 2.0, mass * (3.0 * radius**2 + length**2) / 12.0
+    return {
+        "mass": mass,
+        "com": [length / 2.0, 0.0, 0.0],
+        "inertia": [[i_xx, 0.0, 0.0], [0.0, i_yy, 0.0], [0.0, 0.0, i_yy]],
+    }
+
+
 def _actuator(stroke: float, piston_offset: float, rod_length: float, emla: str) -> dict[str, Any]:
-    return {"stroke": stroke, "piston_offset": piston_offset, "rod_length": rod_length, "emla": emla}
+    """An EMLA between two pins: a 20 kg housing over Lc0 + stroke and a 4 kg rod over Lc (choices)."""
+    return {
+        "stroke": stroke,
+        "piston_offset": piston_offset,
+        "rod_length": rod_length,
+        "emla": emla,
+        "cylinder_body": _tube(20.0, 0.05, piston_offset + stroke),
+        "rod_body": _tube(4.0, 0.02, rod_length),
+    }
 
 
 def three_boom_crane_with_jib() -> dict[str, Any]:
@@ -82,7 +108,14 @@ def three_boom_crane_with_jib() -> dict[str, Any]:
                     "rocker": {"link": "extension", "position": [2.33, 0.0]},
                     "coupler": {"link": "jib", "position": [-0.014, 0.164]},
                 },
-                "linkage": {"rocker_length": 0.24, "coupler_length": 0.24, "pin_side": 1},
+                "linkage": {
+                    "rocker_length": 0.24,
+                    "coupler_length": 0.24,
+                    "pin_side": 1,
+                    # uniform 3 kg bars, I_zz = m l^2 / 12
+                    "rocker_body": {"mass": 3.0, "com": [0.12, 0.0], "inertia_zz": 0.0144},
+                    "coupler_body": {"mass": 3.0, "com": [0.12, 0.0], "inertia_zz": 0.0144},
+                },
                 "actuator": _actuator(0.33, 0.1, 0.75, "m4"),
                 "variables": {
                     "gx": {"kind": "pivot_x", "pivot": "base", "bounds": [1.2, 1.4]},
@@ -144,3 +177,139 @@ def test_scratch_machine_with_a_too_short_jib_stroke_fails_check(
     assert main(["machine", "check", str(path)]) == 2
     out = capsys.readouterr().out.splitlines()
     assert len(out) == 1 and out[0].startswith("FAIL chains.c_jib.actuator.stroke")
+
+
+#: The scratch machine's EMLAs: the eXact excavator's (hiab_sim/presets/emla_exact.yaml), the boom's for the inner
+#: boom, the arm's for the outer boom and the extension, the bucket's for the jib (choice: a shipped, cited set).
+EMLA_OF = {"m1": "boom", "m2": "arm", "m3": "arm", "m4": "bucket"}
+#: A 4 s rest-to-rest quintic move of the four joints [rad, rad, m, rad]: every rod below the EMLAs' 0.0964 m/s.
+MOVE_START, MOVE_END, MOVE_DURATION = [0.3, -1.2, 0.5, -0.5], [0.5, -1.0, 0.6, -0.2], 4.0
+#: The study: the extension prescribed, the jib's attitude tracked, 20 kg at the TCP; few control points.
+SCRATCH_STUDY = {
+    "name": "three_boom_move",
+    "machine": "three_boom.yaml",
+    "emla": "emla_four.yaml",
+    "tracked": ["q_ext", "tcp_angle"],
+    "tasks": [{"name": "move", "weight": 1, "reference": {"kind": "csv", "file": "move.csv"}, "payload": 20.0}],
+    "spline": {"control_points": 10, "degree": 5},
+    "grid": {"duration": MOVE_DURATION, "intervals": 10, "fine_factor": 4},
+    "bounds": {"joint_velocity": [0.6, 0.6, 0.5, 1.0]},
+}
+
+
+def _joint_move(path: Path, names: list[str]) -> None:
+    """The rest-to-rest move as a joint-form trajectory file, 10 Hz."""
+    t = np.linspace(0.0, MOVE_DURATION, 41)
+    tau = t / MOVE_DURATION
+    s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
+    q = np.asarray(MOVE_START) + s[:, None] * (np.asarray(MOVE_END) - np.asarray(MOVE_START))
+    rows = [",".join(["t", *names])] + [",".join(f"{v:.12g}" for v in row) for row in np.column_stack([t, q])]
+    path.write_text("\n".join(rows) + "\n", encoding="utf-8")
+
+
+@pytest.fixture(scope="module")
+def scratch_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The scratch machine's study optimised by ``hiab-sim optimize`` (about 10 s); its result folder."""
+    folder = tmp_path_factory.mktemp("scratch_study")
+    (folder / "three_boom.yaml").write_text(yaml.safe_dump(three_boom_crane_with_jib(), sort_keys=False))
+    emla = yaml.safe_load((Path(hiab_sim.__file__).parent / "presets" / "emla_exact.yaml").read_text())
+    emla["actuators"] = {name: emla["actuators"][source] for name, source in EMLA_OF.items()}
+    (folder / "emla_four.yaml").write_text(yaml.safe_dump(emla, sort_keys=False))
+    _joint_move(folder / "move.csv", load_machine(folder / "three_boom.yaml").joint_names)
+    (folder / "study.yaml").write_text(yaml.safe_dump(SCRATCH_STUDY, sort_keys=False))
+    run = folder / "run"
+    flags = ["--no-video", "--no-figures", "--no-report", "--quiet"]
+    assert main(["optimize", str(folder / "study.yaml"), "--out", str(run), *flags]) == 0
+    return run
+
+
+@pytest.mark.e2e
+def test_optimize_converges_on_the_scratch_machine_under_its_own_names(scratch_run: Path) -> None:
+    """The optimum holds every constraint, also on the fine grid with the other ID path; names are the file's.
+
+    The re-check runs the Newton-Euler path against the study's MuJoCo one: their forces agree to 1e-6 N.
+    """
+    result = json.loads((scratch_run / "result.json").read_text())
+    assert result["solver"]["success"] and result["solver"]["max_violation_scaled"] <= 1e-6
+    assert result["optimal"]["lengths"]["names"] == ["c_inner.L", "c_inner.Lc0", "c_inner.Lc", "c_jib.gx", "c_jib.x0"]
+    assert list(result["optimal"]["actuators"]) == list(EMLA_OF)
+    assert result["recheck"]["id_path"] != result["solver"]["id_path"]
+    assert result["recheck"]["max_violation_scaled"] <= 1e-6
+    assert result["recheck"]["force_difference_between_paths_N"] < 1e-6
+
+
+@pytest.mark.e2e
+def test_simulate_tracks_the_scratch_plan_with_its_predicted_energy(scratch_run: Path, tmp_path: Path) -> None:
+    """Closed loop on four drives: each drive's energy (per-step integral) within 2 % of the plan's quadrature."""
+    flags = ["--no-video", "--no-figures", "--quiet", "--out", str(tmp_path)]
+    assert main(["simulate", str(scratch_run), *flags]) == 0
+    report = json.loads((tmp_path / "simulation.json").read_text())
+    for design in ("initial", "optimal"):
+        summary = report["designs"][design]
+        assert list(summary["actuators"]) == list(EMLA_OF)
+        for name, drive in summary["actuators"].items():
+            predicted = drive["predicted_net_electrical_energy_J"]
+            assert drive["net_electrical_energy_J"] == pytest.approx(predicted, rel=ENERGY_TOLERANCE), (design, name)
+        assert summary["tcp_error_mm"]["max"] < TCP_MAX_MM
+
+
+@pytest.mark.e2e
+def test_render_plays_the_scratch_result_back(scratch_run: Path, tmp_path: Path) -> None:
+    """A 5 fps video of the 4 s move: one frame per 0.2 s from 0 to 4 s, and the machine moves between them."""
+    import mediapy
+
+    video = tmp_path / "playback.mp4"
+    assert main(["render", str(scratch_run), "-o", str(video), "--size", "160x120", "--fps", "5"]) == 0
+    frames = mediapy.read_video(video)
+    assert frames.shape == (21, 120, 160, 3)
+    assert np.mean(np.abs(frames[0].astype(float) - frames[-1].astype(float))) > 0.5
+
+
+@pytest.mark.e2e
+def test_compare_names_the_scratch_machines_variables_and_mounted_actuators(scratch_run: Path, tmp_path: Path) -> None:
+    """The full table's columns are the file's: its five variables, the peaks of the two EMLAs they move (m1, m4).
+
+    Each peak force in the table is the result's own (kN): read back, not recomputed.
+    """
+    assert main(["compare", str(scratch_run), "--out", str(tmp_path)]) == 0
+    with (tmp_path / "comparison.csv").open() as handle:
+        table = list(csv.DictReader(handle))
+    header = list(table[0])
+    assert [h for h in header if h.endswith("[mm]")] == [
+        "c_inner L [mm]", "c_inner Lc0 [mm]", "c_inner Lc [mm]", "c_jib gx [mm]", "c_jib x0 [mm]"
+    ]  # fmt: skip
+    assert [h for h in header if "peak force" in h] == ["m1 peak force [kN]", "m4 peak force [kN]"]
+    result = json.loads((scratch_run / "result.json").read_text())
+    for row in table:
+        for actuator in ("m1", "m4"):
+            peak = result[row["design"]]["actuators"][actuator]["peak_force_N"]
+            assert float(row[f"{actuator} peak force [kN]"]) == pytest.approx(peak / 1e3, rel=1e-15)
+
+
+@pytest.mark.e2e
+def test_two_starts_on_the_scratch_machine_agree_or_report_their_distinct_optima(
+    scratch_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--starts 2`` on a machine file: a second start inside the file's bounds; the optima partition the starts.
+
+    Inside one distinct optimum every start's Xi is within the tolerance of it; two distinct optima differ by more.
+    """
+    study = scratch_run.parent / "study.yaml"
+    flags = ["--no-video", "--no-figures", "--no-report", "--quiet"]
+    assert main(["optimize", str(study), "--starts", "2", "--out", str(tmp_path / "run"), *flags]) == 0
+    multistart = json.loads((tmp_path / "run" / "result.json").read_text())["multistart"]
+    first, second = (np.array(s["initial_lengths"]["values"]) for s in multistart["starts"])
+    machine = load_machine(scratch_run.parent / "three_boom.yaml")
+    low, high = (np.array(b) for b in machine.design_bounds())
+    assert not np.allclose(first, second) and np.all((low <= second) & (second <= high))
+    converged = [s for s in multistart["starts"] if s["success"]]
+    assert multistart["converged_starts"] == len(converged) == 2
+    assert sorted(k for d in multistart["distinct_optima"] for k in d["starts"]) == [0, 1]
+    optimum = {s["start"]: np.array(s["optimal_lengths"]["values"]) for s in converged}
+    tolerance = multistart["tolerance_m"]
+    for d in multistart["distinct_optima"]:
+        assert all(np.max(np.abs(optimum[k] - np.array(d["xi"]))) <= tolerance for k in d["starts"])
+    pairs = itertools.combinations(multistart["distinct_optima"], 2)
+    assert all(np.max(np.abs(np.array(a["xi"]) - np.array(b["xi"]))) > tolerance for a, b in pairs)
+    assert multistart["same_optimum"] == (len(multistart["distinct_optima"]) == 1)
+    assert "Starts: 2 of 2 converged" in capsys.readouterr().out

@@ -17,9 +17,11 @@ from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.motion.workspace import initial_joints, planar_ik
 from hiab_sim.study.references.kinds import PickAndPlace, Spiral, reference_from_mapping, septic_law
 from hiab_sim.study.spec.study_file import load_study
+from hiab_sim.study.spec.tasks import column_names
 
 STUDY = load_study()
 CRANE = STUDY.crane
+NAMES = column_names(STUDY.model)
 KIN = tr.TcpKinematics(CRANE)
 #: Low near the crane base to far out over a 1.2 m high obstacle (the duty-mix study's task).
 TASK = PickAndPlace(
@@ -31,7 +33,7 @@ def test_spiral_from_the_default_study_block_is_the_loaders_spiral() -> None:
     """The default study's reference block read as a ``spiral`` kind is the loader's reference."""
     default = shipped("study", DEFAULT_STUDY)
     block = yaml.safe_load(default.read_text())["reference"]
-    spiral = reference_from_mapping(block, "reference", Path(str(default.file)).parent, STUDY.grid.duration)
+    spiral = reference_from_mapping(block, "reference", Path(str(default.file)).parent, STUDY.grid.duration, NAMES)
     assert isinstance(spiral, Spiral) and spiral.duration == STUDY.grid.duration
     assert spiral == STUDY.reference  # the loader reads the single reference with the same kind
 
@@ -160,4 +162,4 @@ def test_bad_pick_and_place_raises_naming_the_field(change: dict, match: str) ->
     block = {"kind": "pick_and_place", "pick": [1.6, -1.2], "place": [3.6, 0.2], "clearance": 0.8}
     block |= {"telescope": [0.1, 0.8], "move_time": 10.0} | change
     with pytest.raises((InvalidInputError, ConfigError), match=match):
-        reference_from_mapping(block, "reference", Path("."), 6.25)
+        reference_from_mapping(block, "reference", Path("."), 6.25, NAMES)

@@ -14,7 +14,7 @@ from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.references.csv_file import CsvReference
 from hiab_sim.study.references.kinds import PickAndPlace, Spiral
 from hiab_sim.study.spec.study_file import load_study
-from hiab_sim.study.spec.tasks import check_tasks, tasks_from_mapping
+from hiab_sim.study.spec.tasks import check_tasks, column_names, tasks_from_mapping
 
 OPTIMIZE = Path(__file__).resolve().parents[1] / "optimize"
 MIX = yaml.safe_load((OPTIMIZE / "xs031_duty_mix.yaml").read_text())
@@ -23,13 +23,13 @@ KIN = tr.TcpKinematics(STUDY.crane)
 
 
 def _tasks(top: dict) -> tuple:
-    return tasks_from_mapping(top, OPTIMIZE, 6.25, "study")
+    return tasks_from_mapping(top, OPTIMIZE, 6.25, "study", column_names(STUDY.model))
 
 
 def test_single_reference_study_is_one_task_with_the_studys_spiral_and_payload() -> None:
     """Today's ``reference:`` + ``payload: 150`` read as one task: the loader's spiral, a constant 150 kg."""
     top = yaml.safe_load((OPTIMIZE / "xs031_spiral_payload.yaml").read_text())
-    (task,) = tasks_from_mapping(top, OPTIMIZE, STUDY.grid.duration, STUDY.name)
+    (task,) = tasks_from_mapping(top, OPTIMIZE, STUDY.grid.duration, STUDY.name, column_names(STUDY.model))
     assert task.name == STUDY.name and task.weight == 1.0 and isinstance(task.reference, Spiral)
     assert task.payload.mass == STUDY.payload and task.payload.pick is None and task.payload.release is None
     times = STUDY.grid.times()

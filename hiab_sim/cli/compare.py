@@ -2,7 +2,7 @@
 
 Prints a table that fits 100 columns (per run and design: net and battery energy, the smallest
 envelope margin, the largest constraint violation and the saving against the run's own initial
-design). With ``--out DIR`` it also writes the full table (six link lengths, peaks; see
+design). With ``--out DIR`` it also writes the full table (the decision variables, peaks; see
 :mod:`hiab_sim.study.analysis.compare`) as ``comparison.csv`` and ``comparison.txt`` and the figure
 ``comparison.png``; without ``--out`` nothing is written. A folder that is missing or holds no result
 exits 2 with one line.
@@ -56,7 +56,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 def short_table(table: Sequence[Row], width: int = CONSOLE_WIDTH) -> str:
     """The console table: run, design and the :data:`_SHORT` columns, run names shortened to fit ``width``."""
     titles = ["design", *(t for t, _, _ in _SHORT)]
-    cells = [[r.design, *(_cell(f, r.values[i]) for _, i, f in _SHORT)] for r in table]
+    cells = [[r.design, *(_cell(f, r.values.get(key, math.nan)) for _, key, f in _SHORT)] for r in table]
     widths = [max(len(row[k]) for row in [titles, *cells]) for k in range(len(titles))]
     room = width - sum(widths) - 2 * len(widths)
     names = [_shorten(r.run, room) for r in table]

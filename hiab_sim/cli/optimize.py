@@ -21,8 +21,7 @@ from typing import TYPE_CHECKING
 
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.errors import BackendUnavailableError
-from hiab_sim.machine.design import MachineDesign
-from hiab_sim.results.design_values import DesignValues
+from hiab_sim.results.design_values import design_words
 from hiab_sim.study.report.summary import SUMMARY_FILE, summary_text
 
 if TYPE_CHECKING:
@@ -86,17 +85,6 @@ def decomposition_line(d: Decomposition) -> str:
         "from the trajectory (initial lengths): "
         f"{part(d.from_trajectory_J, d.from_trajectory_percent, 'initial_lengths_optimal_trajectory')}, "
         f"interaction {'n/a' if interaction is None else f'{interaction:.1f} J'}"
-    )
-
-
-def design_words(lengths: DesignValues) -> str:
-    """A design in one line: a crane's ``lift L=.. Lc0=.. Lc=..  tilt ... m``, a machine's ``boom.L=.. ... m``."""
-    if isinstance(lengths, MachineDesign):
-        return "  ".join(f"{n}={v:.4f}" for n, v in zip(lengths.names, lengths.values, strict=True)) + " m"
-    lift, tilt = lengths.lift, lengths.tilt
-    return (
-        f"lift L={lift.L:.4f} Lc0={lift.Lc0:.4f} Lc={lift.Lc:.4f}  "
-        f"tilt L={tilt.L:.4f} Lc0={tilt.Lc0:.4f} Lc={tilt.Lc:.4f} m"
     )
 
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
@@ -99,6 +99,11 @@ class LinkLengths:
 
     def __iter__(self) -> Iterator[ChainLengths]:
         return iter((self.lift, self.tilt))
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """``chain.variable`` of each value of :meth:`as_array`, as a machine file's design names them."""
+        return tuple(f"{chain}.{f.name}" for chain in CHAIN_NAMES for f in fields(ChainLengths))
 
     def as_array(self) -> np.ndarray:
         """Return [L, Lc0, Lc] of the lift chain followed by those of the tilt chain."""

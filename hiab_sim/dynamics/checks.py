@@ -28,8 +28,13 @@ def check_joints(crane: Crane, lengths: LinkLengths, joints: JointSamples) -> No
     """Raise :class:`InvalidInputError` naming the joint if a position sample is out of range.
 
     theta1, theta2: :func:`hiab_sim.crane.mechanism.check_joint_samples` [rad]; xt2: the
-    telescope's ``joint_range`` [m]. (Finiteness is checked when :class:`JointSamples` is built.)
+    telescope's ``joint_range`` [m]. (Finiteness is checked when :class:`JointSamples` is built; the
+    samples hold any number of joints, the crane's paths take its three.)
     """
+    if joints.position.shape[1] != len(JOINT_NAMES):
+        raise InvalidInputError(
+            "joints.position", f"shape {joints.position.shape}", f"must have shape (T, {len(JOINT_NAMES)})"
+        )
     for column, chain in enumerate(crane.chains):
         mechanism.check_joint_samples(
             chain, getattr(lengths, chain.name), joints.position[:, column], field=JOINT_NAMES[column]

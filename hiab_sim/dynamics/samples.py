@@ -31,7 +31,7 @@ IdPath = Literal["mujoco", "analytic"]
 
 @dataclass(frozen=True)
 class JointSamples:
-    """Samples of the independent joints: ``position``, ``velocity``, ``acceleration``, each (T, 3)."""
+    """Samples of the independent joints: ``position``, ``velocity``, ``acceleration``, each (T, n joints)."""
 
     position: Array
     velocity: Array
@@ -40,8 +40,8 @@ class JointSamples:
     def __post_init__(self) -> None:
         for name in ("position", "velocity", "acceleration"):
             value = np.asarray(getattr(self, name), dtype=float)
-            if value.ndim != 2 or value.shape[1] != 3:
-                raise InvalidInputError(f"joints.{name}", f"shape {value.shape}", "must have shape (T, 3)")
+            if value.ndim != 2 or value.shape[1] < 1:
+                raise InvalidInputError(f"joints.{name}", f"shape {value.shape}", "must have shape (T, n joints)")
             if not np.all(np.isfinite(value)):
                 raise InvalidInputError(f"joints.{name}", "NaN or inf", "must be finite")
             object.__setattr__(self, name, value)
@@ -50,7 +50,7 @@ class JointSamples:
 
     @classmethod
     def at_rest(cls, position: ArrayLike) -> JointSamples:
-        """Static samples: the given positions (T, 3) with zero velocity and acceleration."""
+        """Static samples: the given positions (T, n joints) with zero velocity and acceleration."""
         p = np.atleast_2d(np.asarray(position, dtype=float))
         return cls(p, np.zeros_like(p), np.zeros_like(p))
 
@@ -60,7 +60,7 @@ class JointSamples:
 
 @dataclass(frozen=True)
 class ActuatorSamples:
-    """Actuator samples, each (T, 3) in the order lift, tilt, telescope.
+    """Actuator samples, each (T, n actuators) in the machine's actuator order.
 
     ``force`` f_x [N], ``velocity`` v_x [m/s], ``acceleration`` dv_x/dt [m/s^2] and
     ``stroke`` x [m].
@@ -73,5 +73,5 @@ class ActuatorSamples:
 
     @property
     def power(self) -> Array:
-        """Mechanical power delivered by each actuator, f_x v_x [W], (T, 3)."""
+        """Mechanical power delivered by each actuator, f_x v_x [W], (T, n actuators)."""
         return self.force * self.velocity

@@ -30,3 +30,15 @@ def crane_lengths(design: DesignValues, where: str = "design") -> LinkLengths:
     if not isinstance(design, LinkLengths):
         raise InvalidInputError(where, type(design).__name__, "this part of hiab-sim needs a crane file's link lengths")
     return design
+
+
+def design_words(design: DesignValues, form: str = ".4f") -> str:
+    """A design in one line, chain by chain, names as the design gives them: ``c1 a=.. b=..  c2 a=.. m`` [m].
+
+    ``form``: the format of each value (``.4f``; ``g`` for a rounded, buildable design).
+    """
+    chains: dict[str, list[str]] = {}
+    for name, value in zip(design.names, design.as_array(), strict=True):
+        chain, variable = name.split(".", 1)
+        chains.setdefault(chain, []).append(f"{variable}={value:{form}}")
+    return "  ".join(f"{chain} {' '.join(words)}" for chain, words in chains.items()) + " m"

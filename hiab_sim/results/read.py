@@ -35,7 +35,7 @@ _HINT = "write one with 'hiab-sim optimize'"
 
 @dataclass(frozen=True)
 class DesignSummary:
-    """One design of a run: lengths [m], energies [J], per-actuator peaks and envelope margins."""
+    """One design of a run: its decision variables [m], energies [J], per-actuator peaks and envelope margins."""
 
     lengths: DesignValues
     net_energy_J: float
@@ -49,13 +49,12 @@ class DesignSummary:
 
 @dataclass(frozen=True)
 class RunSummary:
-    """What other tools need from a result folder: the machine's name, its variables' and actuators' names."""
+    """What other tools need from a result folder."""
 
     folder: Path
     name: str
-    machine: str
-    design_names: tuple[str, ...]
-    actuators: tuple[str, ...]
+    variables: tuple[str, ...]  # ``chain.variable`` of each design value, the machine's names
+    mounted: tuple[str, ...]  # the actuators whose mounting the decision variables move
     designs: dict[str, DesignSummary]
     saved_percent: float  # net energy saved by the optimum [%]
     recheck_max_violation: float  # fine-grid re-check of the optimum (scaled)
@@ -130,10 +129,9 @@ def design_lengths(result: Result, design: str) -> DesignValues:
 
 
 def summarise(run_dir: str | Path) -> RunSummary:
-    """Read a result folder into a :class:`RunSummary`."""
+    """Read a result folder into a :class:`RunSummary`; every name is the result's machine's."""
     folder = Path(run_dir)
     result = read_result(folder)
-    actuators = tuple(result.optimal.actuators)
     designs = {}
     for name in DESIGNS:
         entry = result.optimal if name == "optimal" else result.initial
@@ -143,24 +141,25 @@ def summarise(run_dir: str | Path) -> RunSummary:
             net_energy_J=entry.net_electrical_energy_J,
             drawn_energy_J=entry.drawn_energy_summed_drives_J,
             battery_energy_J=None if energy is None else energy.battery_energy_J,
-            peak_force_N={a: entry.actuators[a].peak_force_N for a in actuators},
-            peak_power_W={a: entry.actuators[a].peak_electrical_power_W for a in actuators},
-            min_envelope_margin={a: entry.actuators[a].min_envelope_margin for a in actuators},
+            peak_force_N={a: p.peak_force_N for a, p in entry.actuators.items()},
+            peak_power_W={a: p.peak_electrical_power_W for a, p in entry.actuators.items()},
+            min_envelope_margin={a: p.min_envelope_margin for a, p in entry.actuators.items()},
             max_violation=entry.max_violation,
         )
-    lengths = result.optimal.lengths
-    if isinstance(lengths, MachineDesign):
-        machine, names = result_machine(folder, result).name, lengths.names
-    else:
-        crane = result_crane(folder, result.crane)
-        machine, names = crane.name, tuple(f"{c.name}.{k}" for c in crane.chains for k in ("L", "Lc0", "Lc"))
     return RunSummary(
         folder=folder,
         name=result.name,
-        machine=machine,
-        design_names=tuple(names),
-        actuators=actuators,
+        variables=tuple(result.optimal.lengths.names),
+        mounted=mounted_actuators(folder, result),
         designs=designs,
         saved_percent=result.improvement.net_energy_saved_percent,
         recheck_max_violation=result.recheck.max_violation_scaled,
     )
+
+
+def mounted_actuators(run_dir: str | Path, result: Result) -> tuple[str, ...]:
+    """The actuators of the chains with decision variables (their EMLA names, as the result's actuators)."""
+    if isinstance(result.optimal.lengths, MachineDesign):
+        chains = result_machine(run_dir, result).chains
+        return tuple(c.actuator.emla or c.name for c in chains if c.variables)
+    return tuple(c.name for c in result_crane(run_dir, result.crane).chains)

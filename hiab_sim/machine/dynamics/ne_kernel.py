@@ -109,7 +109,7 @@ def close_chains(ws: Workspace, pc: Prepared, angles: bool = False) -> None:
         return
     cyl, rod, base = pc.cyl, pc.rod, pc.base
     end, pivot, spare = ws.c("end", 3, k), ws.c("pivot", 3, k), ws.c("spare", 3, k)
-    e, arm, moved, turning = ws.c("e", k), ws.c("arm", k), ws.c("rod motion", 3, k), ws.c("turning", 3, k)
+    e, arm, moved, turning = ws.c("e", k), ws.c("lever arm", k), ws.c("rod motion", 3, k), ws.c("turning", 3, k)
     ws.points(g.tri_end, pc.tri_end, end[:, :n_tri], (arm[:n_tri], spare[:, :n_tri]))
     if k > n_tri:
         end[:, n_tri:] = four_bars(ws, pc, angles)

@@ -41,7 +41,6 @@ from hiab_sim.study.nlp.task_problem import XI_SCALE
 Array = np.ndarray
 #: Scaled margin below which a row counts as active.
 ACTIVE_TOLERANCE = 1e-6
-XI_NAMES = ("lift.L", "lift.Lc0", "lift.Lc", "tilt.L", "tilt.Lc0", "tilt.Lc")
 
 
 def kkt_multipliers(

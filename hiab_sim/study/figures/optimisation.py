@@ -17,7 +17,6 @@ import numpy as np
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.emla import EmlaSet
 from hiab_sim.figure_io import new_figure, save_png
-from hiab_sim.machine.design import MachineDesign
 from hiab_sim.results.analysis_sections import Sensitivity
 from hiab_sim.results.design_values import DesignValues, crane_lengths
 from hiab_sim.results.schema import HistoryRow, Result
@@ -215,9 +214,7 @@ def sensitivity_figure(sensitivity: Sensitivity, path: Path) -> None:
 
 
 def chain_variables(lengths: DesignValues) -> list[tuple[str, list[int], list[str]]]:
-    """Per chain: its name, the indices of its decision variables in Xi and their labels."""
-    if not isinstance(lengths, MachineDesign):
-        return [(c, [3 * j, 3 * j + 1, 3 * j + 2], ["L", "Lc0", "Lc"]) for j, c in enumerate(("lift", "tilt"))]
+    """Per chain: its name, the indices of its decision variables in Xi and their labels (the design's names)."""
     out: dict[str, tuple[list[int], list[str]]] = {}
     for k, name in enumerate(lengths.names):
         chain, variable = name.split(".", 1)

@@ -1,8 +1,9 @@
 """Partials of the inverse dynamics [f_x, v_x, a_x] = ID(theta, dtheta, ddtheta, robot(Xi)) by central differences.
 
-Outputs Y per sample are ordered (f_lift, f_tilt, f_tele, v_lift, v_tilt, v_tele, a_lift, a_tilt,
-a_tele); inputs q9 = (theta1, theta2, xt2, their rates, their accelerations) and Xi = (lift L, Lc0,
-Lc, tilt L, Lc0, Lc) [m]. Steps are relative: h = fd_step * max(1, |value|).
+Outputs Y per sample are ordered (every actuator's force f_x, then every velocity v_x, then every
+acceleration a_x, in the machine's actuator order); inputs (q, dq, ddq) of the machine's joints in
+its joint order, and Xi = (lift L, Lc0, Lc, tilt L, Lc0, Lc) [m] on a crane file. Steps are relative:
+h = fd_step * max(1, |value|).
 """
 
 from __future__ import annotations
@@ -25,25 +26,28 @@ def _outputs(act: ActuatorSamples) -> Array:
 def id_joint_partials(
     model: InverseDynamics, joints: JointSamples, fd_step: float, tcp_force: ArrayLike | None
 ) -> Array:
-    """dY/dq9 per sample by central differences, (K, 9 outputs, 9 inputs).
+    """dY/dq per sample by central differences, (K, 3 m outputs, 3 n inputs) for n joints and m actuators.
 
-    All K samples and all 9 perturbations go into one ID call of 18 K samples: samples are
-    independent, so perturbing them together is exact bookkeeping, not an approximation.
+    The inputs are (q, dq, ddq) of the n joints (9 on the crane). All K samples and all 3 n
+    perturbations go into one ID call of 6 n K samples: samples are independent, so perturbing
+    them together is exact bookkeeping, not an approximation.
     """
-    K = len(joints)
-    base = np.concatenate([joints.position, joints.velocity, joints.acceleration], axis=1)  # (K, 9)
-    h = fd_step * np.maximum(1.0, np.abs(base))  # (K, 9)
-    batch = np.repeat(base[None], 18, axis=0)  # (18, K, 9)
-    for j in range(9):
+    K, n = joints.position.shape
+    base = np.concatenate([joints.position, joints.velocity, joints.acceleration], axis=1)  # (K, 3n)
+    h = fd_step * np.maximum(1.0, np.abs(base))  # (K, 3n)
+    batch = np.repeat(base[None], 6 * n, axis=0)  # (6n, K, 3n)
+    for j in range(3 * n):
         batch[2 * j, :, j] += h[:, j]
         batch[2 * j + 1, :, j] -= h[:, j]
-    flat = batch.reshape(18 * K, 9)
+    flat = batch.reshape(6 * n * K, 3 * n)
     # a constant force (3,) serves every sample; a force per sample (K, 3) is repeated for each perturbation
     stacked = tcp_force
     if tcp_force is not None and np.ndim(tcp_force) == 2:
-        stacked = np.tile(np.asarray(tcp_force, dtype=float), (18, 1))
-    out = _outputs(model(JointSamples(flat[:, 0:3], flat[:, 3:6], flat[:, 6:9]), tcp_force=stacked)).reshape(18, K, 9)
-    d = (out[0::2] - out[1::2]) / (2.0 * h.T[:, :, None])  # (9 inputs, K, 9 outputs)
+        stacked = np.tile(np.asarray(tcp_force, dtype=float), (6 * n, 1))
+    samples = JointSamples(flat[:, :n], flat[:, n : 2 * n], flat[:, 2 * n :])
+    out = _outputs(model(samples, tcp_force=stacked))
+    out = out.reshape(6 * n, K, out.shape[1])
+    d = (out[0::2] - out[1::2]) / (2.0 * h.T[:, :, None])  # (3n inputs, K, 3m outputs)
     return np.transpose(d, (1, 2, 0))
 
 

@@ -2,7 +2,7 @@
 
 The columns are the machine's: the TCP form is ``t, x, y`` and each further tracked coordinate by
 name (the crane's ``xt2``, an excavator's ``tcp_angle``); the joint form ``t`` and every joint by
-name. The crane's names are the defaults.
+name. The names come from the study's machine (its description), never from here.
 
 File format: comma-separated, SI units (s, m, rad), one header row naming the columns (any
 order), then one sample per row; blank lines and lines starting with ``#`` are skipped (use them
@@ -45,8 +45,8 @@ if TYPE_CHECKING:
     from hiab_sim.study.machines.protocol import Kinematics, StudyMachine
 
 Array = NDArray[np.float64]
-#: The crane's tracked coordinates beyond the TCP's x, y and its joints: the default columns.
-CRANE_NAMES = (("xt2",), ("theta1", "theta2", "xt2"))
+#: A machine's column names: its tracked coordinates beyond the TCP's x, y, and its joints (from its description).
+ColumnNames = tuple[tuple[str, ...], tuple[str, ...]]
 
 
 def forms(extra: tuple[str, ...], joints: tuple[str, ...]) -> dict[frozenset[str], str]:
@@ -72,10 +72,11 @@ class CsvTable:
     lines: tuple[int, ...]
 
 
-def read_table(path: Path, names: tuple[tuple[str, ...], tuple[str, ...]] = CRANE_NAMES) -> CsvTable:
+def read_table(path: Path, names: ColumnNames) -> CsvTable:
     """Parse a trajectory file (module docstring); malformed files raise :class:`ConfigError`.
 
-    ``names``: the machine's tracked coordinates beyond x, y and its joints (default: the crane's).
+    ``names``: the machine's tracked coordinates beyond x, y and its joints
+    (:func:`hiab_sim.study.spec.tasks.column_names` of its study machine).
     """
     accepted = forms(*names)
     try:
@@ -120,8 +121,8 @@ class CsvReference:
     """
 
     table: CsvTable
+    names: ColumnNames
     telescope: float | None = None
-    names: tuple[tuple[str, ...], tuple[str, ...]] = CRANE_NAMES
     control_points: int | None = None
     fit_tolerance: float = 5e-3
     kind: ClassVar[str] = "csv"
@@ -255,9 +256,7 @@ class CsvReference:
         check_workspace(model, self.sample(kin, dense_times(self.duration)), where=f"{tab.path} fit")
 
     @classmethod
-    def from_mapping(
-        cls, data: Any, where: str, folder: Path, names: tuple[tuple[str, ...], tuple[str, ...]] = CRANE_NAMES
-    ) -> CsvReference:
+    def from_mapping(cls, data: Any, where: str, folder: Path, names: ColumnNames) -> CsvReference:
         """Read ``{kind: csv, file, telescope?, control_points?, fit_tolerance?}``; ``file`` relative to ``folder``."""
         d = mapping(data, where, {"kind", "file", "telescope", "control_points", "fit_tolerance"}, {"file"})
         path = Path(str(d["file"]))

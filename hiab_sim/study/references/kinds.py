@@ -48,7 +48,7 @@ from hiab_sim.study.motion.workspace import check_workspace, dense_times, initia
 if TYPE_CHECKING:
     from hiab_sim.crane.description import Crane
     from hiab_sim.study.machines.protocol import Kinematics, StudyMachine
-from hiab_sim.study.references.csv_file import CRANE_NAMES, CsvReference
+from hiab_sim.study.references.csv_file import ColumnNames, CsvReference
 from hiab_sim.yaml_fields import mapping, number, positive
 
 Array = NDArray[np.float64]
@@ -308,7 +308,7 @@ def reference_from_mapping(
     where: str,
     folder: Path,
     default_duration: float,
-    names: tuple[tuple[str, ...], tuple[str, ...]] = CRANE_NAMES,
+    names: ColumnNames,
 ) -> TaskReference:
     """Build the reference kind named by ``kind`` (default ``spiral``: today's single reference).
 

@@ -22,7 +22,7 @@ from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.tolerance import buildable_crane, check_tolerance, design_margins, range_cost_deg
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.results.analysis_sections import Buildable, RoundedCheck
-from hiab_sim.results.design_values import crane_lengths
+from hiab_sim.results.design_values import crane_lengths, design_words
 from hiab_sim.results.schema import DesignSummary
 from hiab_sim.study.analysis.buildable import rounded_design
 from hiab_sim.study.nlp.problem import StudyProblem
@@ -100,19 +100,11 @@ def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, c
 
 def buildable_line(b: Buildable) -> str:
     """One stdout line: the rounded design, its checks and energy."""
-    if isinstance(b.lengths, LinkLengths):
-        lift, tilt = b.lengths.lift, b.lengths.tilt
-        design = (
-            f"lift L={lift.L:g} Lc0={lift.Lc0:g} Lc={lift.Lc:g}  tilt L={tilt.L:g} Lc0={tilt.Lc0:g} Lc={tilt.Lc:g} m"
-        )
-        check = "crane check"
-    else:
-        design = " ".join(f"{k}={v:g}" for k, v in zip(b.lengths.names, b.lengths.values, strict=True)) + " m"
-        check = "stroke check"
+    check = "crane check" if isinstance(b.lengths, LinkLengths) else "stroke check"
     ok = all(c.passed for c in (b.crane_check, b.tolerance_check, b.recheck))
     return (
         f"buildable (rounded to {b.tolerance_m * 1e3:g} mm, stroke margin {b.stroke_margin_m * 1e3:g} mm): "
-        f"{design}  "
+        f"{design_words(b.lengths, 'g')}  "
         f"net energy {b.net_electrical_energy_J / 1e3:.3f} kJ ({b.net_energy_change_vs_optimum_J:+.1f} J vs optimum); "
         f"{'checks passed' if ok else 'CHECK FAILED'}: {check} {'ok' if b.crane_check.passed else 'FAILED'}, "
         f"+-{b.tolerance_m * 1e3:g} mm worst margin {b.tolerance_check.margin * 1e3:.3f} mm, "

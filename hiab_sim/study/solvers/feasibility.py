@@ -33,7 +33,6 @@ from scipy.optimize import minimize
 
 from hiab_sim.errors import InfeasibleStudyError, InvalidInputError
 from hiab_sim.results.analysis_sections import FeasibilityPhase
-from hiab_sim.study.analysis.sensitivity import XI_NAMES
 from hiab_sim.study.machines.protocol import Design
 from hiab_sim.study.nlp.blocks import STROKE_SCALE
 from hiab_sim.study.nlp.problem import StudyProblem
@@ -209,12 +208,12 @@ def _least_max_violation(
     return out if better else z
 
 
-def changes(before: Design, after: Design, names: tuple[str, ...] = XI_NAMES) -> tuple[str, ...]:
-    """What the phase changed, one line per moved decision variable [mm] (``names``: the machine's)."""
+def changes(before: Design, after: Design) -> tuple[str, ...]:
+    """What the phase changed, one line per moved decision variable [mm], named as the design names it."""
     a, b = before.as_array(), after.as_array()
     return tuple(
         f"{n}: {x * 1e3:.1f} -> {y * 1e3:.1f} mm ({(y - x) * 1e3:+.1f} mm)"
-        for n, x, y in zip(names, a, b, strict=True)
+        for n, x, y in zip(before.names, a, b, strict=True)
         if abs(y - x) > 1e-6
     )
 
@@ -281,8 +280,7 @@ def feasible_start(
         final_max_violation=problem.max_violation(z),
         lengths_before=before,
         lengths_after=after,
-        changes=changes(before, after, problem.model.design_names)
-        or ("only the trajectory (spline coefficients) changed",),
+        changes=changes(before, after) or ("only the trajectory (spline coefficients) changed",),
         iterations=int(res.nit),
     )
 
@@ -354,6 +352,6 @@ def moved_start_phase(problem: StudyProblem, z: Array) -> FeasibilityPhase | Non
         final_max_violation=problem.max_violation(z),
         lengths_before=before,
         lengths_after=problem.study.initial_lengths,
-        changes=changes(before, problem.study.initial_lengths, problem.model.design_names),
+        changes=changes(before, problem.study.initial_lengths),
         iterations=0,
     )

@@ -20,7 +20,7 @@ from hiab_sim.study.spec.settings import (
     shared_sections,
 )
 from hiab_sim.study.spec.study import Study
-from hiab_sim.study.spec.tasks import study_tasks
+from hiab_sim.study.spec.tasks import column_names, study_tasks
 from hiab_sim.yaml_fields import mapping, number, section
 
 
@@ -66,8 +66,7 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
     )
     grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
     name = str(top.get("name", Path(str(file.file)).stem))
-    names = (tuple(model.tracked_names[2:]), model.joint_names)
-    tasks = study_tasks(top, folder, grid.duration, name, names)
+    tasks = study_tasks(top, folder, grid.duration, name, column_names(model))
     # the spiral and pick-and-place kinds prescribe the third tracked coordinate as a crane's telescope:
     # a machine of three joints whose third tracked coordinate is a joint may use them
     prescribed = len(model.tracked_names) == 3 and model.tracked_names[2] in model.joint_names

@@ -45,7 +45,7 @@ from hiab_sim.study.spec.settings import (
     shared_sections,
 )
 from hiab_sim.study.spec.study import Study
-from hiab_sim.study.spec.tasks import study_tasks
+from hiab_sim.study.spec.tasks import column_names, study_tasks
 from hiab_sim.yaml_fields import mapping, positive, read_yaml, section
 
 _TOP = {
@@ -105,7 +105,7 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
     bounds = bounds_from_mapping(top["bounds"])
     grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
     name = str(top.get("name", Path(str(file.file)).stem))
-    tasks = study_tasks(top, Path(str(file.file)).parent, grid.duration, name)
+    tasks = study_tasks(top, Path(str(file.file)).parent, grid.duration, name, column_names(CraneModel(crane)))
     initial = _lengths(top.get("initial_lengths"), crane, bounds)
     moved = "initial_lengths" not in top and initial != crane.default_lengths
     return Study(

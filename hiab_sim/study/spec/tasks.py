@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.study.references.csv_file import CRANE_NAMES
+from hiab_sim.study.references.csv_file import ColumnNames
 from hiab_sim.study.references.kinds import TaskReference, reference_from_mapping
 from hiab_sim.study.spec.payload import Payload
 from hiab_sim.study.spec.soil_contact import SoilContact
@@ -124,7 +124,7 @@ def tasks_from_mapping(
     folder: Path,
     grid_duration: float,
     study_name: str,
-    names: tuple[tuple[str, ...], tuple[str, ...]] = CRANE_NAMES,
+    names: ColumnNames,
 ) -> tuple[Task, ...]:
     """The study's tasks from its top-level mapping (``tasks:`` or today's ``reference:`` + ``payload:``).
 
@@ -176,7 +176,7 @@ def study_tasks(
     folder: Path,
     grid_duration: float,
     study_name: str,
-    names: tuple[tuple[str, ...], tuple[str, ...]] = CRANE_NAMES,
+    names: ColumnNames,
 ) -> tuple[Task, ...]:
     """A study file's tasks (:func:`tasks_from_mapping`), its single-reference form keeping a plain payload's meaning.
 
@@ -188,6 +188,11 @@ def study_tasks(
     if "tasks" not in top and isinstance(top.get("payload", 0.0), int | float):
         tasks = (replace(tasks[0], payload=replace(tasks[0].payload, inertia=False)),)
     return tasks
+
+
+def column_names(model: StudyMachine) -> ColumnNames:
+    """A trajectory file's column names for ``model``: its tracked coordinates beyond the TCP's x, y, and its joints."""
+    return tuple(model.tracked_names[2:]), tuple(model.joint_names)
 
 
 def check_tasks(tasks: tuple[Task, ...], kin: Kinematics, model: StudyMachine | Crane) -> None:
