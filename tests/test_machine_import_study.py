@@ -26,11 +26,13 @@ import yaml
 from hiab_sim.cli import main
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.paths import MACHINE_ID_PATHS, make_machine_dynamics
-from hiab_sim.machine.loader import load_machine, locate_machine
+from hiab_sim.machine.loader import load_machine
 from hiab_sim.machine_mjcf import machine_mjcf, working_ranges
+from hiab_sim.resources import locate
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_machine_study import EXCAVATOR, REPO, _joint_csv, _machine_form
+from machine_result_helper import EXCAVATOR_STUDY, joint_csv
+from test_machine_study import REPO, _machine_form
 
 #: Relative actuator-force agreement the import must reach (per actuator, of its peak force).
 TOLERANCE = 1e-9
@@ -91,7 +93,7 @@ def _variable_kinds(chains: dict[str, Any]) -> dict[str, set[tuple[str, str | No
 
 
 def _original_yaml(name: str) -> dict[str, Any]:
-    return yaml.safe_load(Path(str(locate_machine(name).file)).read_text(encoding="utf-8"))
+    return yaml.safe_load(Path(str(locate(name, "machine").file)).read_text(encoding="utf-8"))
 
 
 def adopt_original_variables(machine_file: Path, name: str, out: Path) -> Path:
@@ -283,9 +285,9 @@ def test_optimize_and_simulate_run_on_an_imported_machine(
     """
     from hiab_sim.cli.simulate import ENERGY_TOLERANCE
 
-    _joint_csv(tmp_path / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
+    joint_csv(tmp_path / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
     study = tmp_path / "study.yaml"
-    study.write_text(yaml.safe_dump({**EXCAVATOR, "machine": str(imported["exact"][0])}), encoding="utf-8")
+    study.write_text(yaml.safe_dump({**EXCAVATOR_STUDY, "machine": str(imported["exact"][0])}), encoding="utf-8")
     run = tmp_path / "run"
     flags = ("--no-video", "--no-figures", "--quiet")
     assert _cli("optimize", str(study), "--out", str(run), "--no-report", *flags)[0] == 0
