@@ -146,23 +146,26 @@ RESULT_FIELDS: tuple[str, ...] = (
     "cross_evaluation.mix_cost_lost_percent",
 )
 #: The fields of ``simulation.json`` (``hiab-sim simulate``) the pages read.
-SIMULATION_FIELDS: tuple[str, ...] = tuple(
-    f"designs.*.{run}{f}"
-    for run in ("", "nominal.")
-    for f in (
-        "payload_error",
-        "net_electrical_energy_J",
-        "predicted_net_electrical_energy_J",
-        "energy_difference_percent",
-        "tcp_error_mm.rms",
-        "tcp_error_mm.max",
-        "current_limit_fraction",
-        "voltage_limit_fraction",
-        "bandwidth_check.velocity_loop_bandwidth_Hz",
-        "bandwidth_check.first_natural_frequency_Hz",
-        "bandwidth_check.bandwidth_margin",
-    )
-) + ("designs.*.extra_energy_J",)
+SIMULATION_FIELDS: tuple[str, ...] = (
+    *(
+        f"designs.*.{run}{f}"
+        for run in ("", "nominal.")
+        for f in (
+            "payload_error",
+            "net_electrical_energy_J",
+            "predicted_net_electrical_energy_J",
+            "energy_difference_percent",
+            "tcp_error_mm.rms",
+            "tcp_error_mm.max",
+            "current_limit_fraction",
+            "voltage_limit_fraction",
+            "bandwidth_check.velocity_loop_bandwidth_Hz",
+            "bandwidth_check.first_natural_frequency_Hz",
+            "bandwidth_check.bandwidth_margin",
+        )
+    ),
+    "designs.*.extra_energy_J",
+)
 
 
 def select(tree: Any, field: str) -> Any:
@@ -257,7 +260,7 @@ def differences(got: Any, want: Any, path: str = "") -> list[str]:
     return [f"{where}: {got!r}, recorded {want!r}"] if _leaf_differs(path, got, want) else []
 
 
-class NotRecorded(KeyError):
+class NotRecordedError(KeyError):
     """A page asks for a study that has no data file yet (its block says so on the page)."""
 
     def __init__(self, study: str) -> None:
@@ -276,7 +279,7 @@ class RunData:
     def __call__(self, study: str, path: str) -> Any:
         """The value at ``path`` of ``study``'s data; KeyError naming the file and the path when it is absent."""
         if study not in self._data:
-            raise NotRecorded(study)
+            raise NotRecordedError(study)
         node: Any = self._data[study]
         for step in path.split("."):
             if isinstance(node, list) and step.isdigit() and int(step) < len(node):

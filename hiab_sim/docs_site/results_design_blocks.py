@@ -77,7 +77,8 @@ def default_answer(runs: RunData) -> str:
         f"is lift L / Lc0 / Lc = {lengths(b, 'lift')} m, tilt {lengths(b, 'tilt')} m. Net electrical energy on the "
         f"spiral: {kilo(r('initial.net_electrical_energy_J'))} → {kilo(r('optimal.net_electrical_energy_J'))} kJ "
         f"({percent_change(r('initial.net_electrical_energy_J'), r('optimal.net_electrical_energy_J'), 1)}), "
-        f"{r('improvement.decomposition.from_lengths_J'):.0f} J of the saving from the lengths alone. The battery's energy per duty period ({r('energy.duty')}) falls "
+        f"{r('improvement.decomposition.from_lengths_J'):.0f} J of the saving from the lengths alone. "
+        f"The battery's energy per duty period ({r('energy.duty')}) falls "
         f"from {kilo(battery0)} to {kilo(r('energy.optimal.battery_energy_J'))} kJ "
         f"({percent_change(battery0, r('energy.optimal.battery_energy_J'), 1)}; "
         f"{percent_change(battery0, energy('energy.optimal.battery_energy_J'), 1)} to "
@@ -128,7 +129,14 @@ def default_designs(runs: RunData) -> str:
             "",
         )
     )
-    header = ("design", "lift L / Lc0 / Lc [m]", "tilt L / Lc0 / Lc [m]", "net energy", "drawn, summed drives", "copper")
+    header = (
+        "design",
+        "lift L / Lc0 / Lc [m]",
+        "tilt L / Lc0 / Lc [m]",
+        "net energy",
+        "drawn, summed drives",
+        "copper",
+    )
     return table(header, rows)
 
 
@@ -162,7 +170,9 @@ def other_studies(runs: RunData) -> str:
             (
                 label,
                 r("solver.iterations"),
-                before_after(r("initial.net_electrical_energy_J") / 1e3, r("optimal.net_electrical_energy_J") / 1e3, "kJ", 2),
+                before_after(
+                    r("initial.net_electrical_energy_J") / 1e3, r("optimal.net_electrical_energy_J") / 1e3, "kJ", 2
+                ),
                 f"{r('improvement.decomposition.from_lengths_J'):.1f} J",
                 lengths(r("optimal.lengths"), "lift", 4),
                 lengths(r("optimal.lengths"), "tilt", 4),
@@ -184,10 +194,17 @@ def buildable_designs(runs: RunData) -> str:
                 f"{lengths(b, 'lift')}, {lengths(b, 'tilt')}",
                 f"{1e6 * r('buildable.tolerance_check.margin'):+.1f} µm",
                 f"{r('buildable.recheck.margin'):.1e}",
-                f"{r('buildable.net_electrical_energy_J'):.1f} J (optimum {r('optimal.net_electrical_energy_J'):.1f} J)",
+                f"{r('buildable.net_electrical_energy_J'):.1f} J "
+                f"(optimum {r('optimal.net_electrical_energy_J'):.1f} J)",
             )
         )
-    header = ("study", "rounded design (lift, tilt L / Lc0 / Lc) [m]", "±1 mm worst margin", "fine-grid re-check", "net energy")
+    header = (
+        "study",
+        "rounded design (lift, tilt L / Lc0 / Lc) [m]",
+        "±1 mm worst margin",
+        "fine-grid re-check",
+        "net energy",
+    )
     return table(header, rows)
 
 
@@ -206,22 +223,23 @@ def sensitivity(runs: RunData) -> str:
     """The default study's active constraints: objective decrease per unit relaxed, in % of the optimum's."""
     r = runs.result(DEFAULT)
     rows = [
-        (f"`{m['constraint']}`", f"{m['percent_per_unit']:.4f} %/{m['unit']}")
-        for m in r("sensitivity.multipliers")
+        (f"`{m['constraint']}`", f"{m['percent_per_unit']:.4f} %/{m['unit']}") for m in r("sensitivity.multipliers")
     ]
     return table((f"active constraint (objective {r('sensitivity.objective')})", "decrease per unit relaxed"), rows)
 
 
 def mounting(runs: RunData) -> str:
     """The mounting-space study: its rounded optimum and net energy against its start."""
-    r = runs.result("xs031_spiral_mounting")
+    r, default = runs.result("xs031_spiral_mounting"), runs.result(DEFAULT)
     b = r("buildable.lengths")
+    default_change = percent_change(
+        default("initial.net_electrical_energy_J"), default("optimal.net_electrical_energy_J")
+    )
     return (
         f"`xs031_spiral_mounting` (recorded): the optimum rounds to lift {lengths(b, 'lift')} m, tilt "
         f"{lengths(b, 'tilt')} m; net energy "
         f"{before_after(r('initial.net_electrical_energy_J'), r('optimal.net_electrical_energy_J'))}, "
-        f"against {percent_change(runs(DEFAULT, 'result.initial.net_electrical_energy_J'), runs(DEFAULT, 'result.optimal.net_electrical_energy_J'))} "
-        f"for the default study; duty: {r('energy.duty')}."
+        f"against {default_change} for the default study; duty: {r('energy.duty')}."
     )
 
 

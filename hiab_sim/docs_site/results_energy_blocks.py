@@ -155,7 +155,8 @@ def hydraulic(runs: RunData) -> str:
                 f"{kilo(h['emla_battery_energy_J'])} kJ",
                 f"{kilo(ls['input_energy_J'], 1)} kJ ({100 * ls['system_efficiency']:.1f} %)",
                 f"{kilo(cp['input_energy_J'], 1)} kJ ({100 * cp['system_efficiency']:.1f} %)",
-                f"{h['emla_saving_vs_load_sensing_percent']:.1f} % / {h['emla_saving_vs_constant_pressure_percent']:.1f} %",
+                f"{h['emla_saving_vs_load_sensing_percent']:.1f} % / "
+                f"{h['emla_saving_vs_constant_pressure_percent']:.1f} %",
             )
         )
         at = h["at_battery"]

@@ -51,7 +51,8 @@ def mix_tasks(runs: RunData) -> str:
         (
             "mix (weighted)",
             before_after(r("initial.net_electrical_energy_J") / 1e3, r("optimal.net_electrical_energy_J") / 1e3, "kJ"),
-            f"{kilo(r('initial.drawn_energy_summed_drives_J'), 1)} → {kilo(r('optimal.drawn_energy_summed_drives_J'), 1)} kJ",
+            f"{kilo(r('initial.drawn_energy_summed_drives_J'), 1)} → "
+            f"{kilo(r('optimal.drawn_energy_summed_drives_J'), 1)} kJ",
             "",
         )
     )
@@ -76,7 +77,11 @@ def mix_hour(runs: RunData) -> str:
 def mix_designs(runs: RunData) -> str:
     """The spiral's optimum beside the duty mix's."""
     rows = [
-        (label, lengths(runs.result(study)("optimal.lengths"), "lift", 4), lengths(runs.result(study)("optimal.lengths"), "tilt", 4))
+        (
+            label,
+            lengths(runs.result(study)("optimal.lengths"), "lift", 4),
+            lengths(runs.result(study)("optimal.lengths"), "tilt", 4),
+        )
         for label, study in (("spiral alone (the default study)", DEFAULT), ("duty mix", MIX))
     ]
     return table(("design", "lift L / Lc0 / Lc [m]", "tilt L / Lc0 / Lc [m]"), rows)
@@ -87,7 +92,8 @@ def mix_starts(runs: RunData) -> str:
     r = runs.result(MIX)
     iterations = ", ".join(str(s["iterations"]) for s in r("multistart.starts"))
     same = "reach one optimum (Xi within 1e-4 m)" if r("multistart.same_optimum") else "reach different optima"
-    return f"{len(r('multistart.starts'))} starts ({iterations} iterations; {r('multistart.converged_starts')} converged) {same}."
+    converged = r("multistart.converged_starts")
+    return f"{len(r('multistart.starts'))} starts ({iterations} iterations; {converged} converged) {same}."
 
 
 def _cell(value: float | None, digits: int = 1) -> str:
@@ -169,7 +175,9 @@ def excavator_studies(runs: RunData) -> str:
         rows.append(
             (
                 f"`optimize/{study}.yaml`",
-                before_after(r("energy.initial.battery_energy_J") / 1e3, r("energy.optimal.battery_energy_J") / 1e3, "kJ", 3),
+                before_after(
+                    r("energy.initial.battery_energy_J") / 1e3, r("energy.optimal.battery_energy_J") / 1e3, "kJ", 3
+                ),
                 r("solver.iterations"),
                 f"{r('solver.total_wall_time_s'):.0f} s",
                 f"max violation {r('recheck.max_violation_scaled'):.1e}, paths differ by "
@@ -197,7 +205,8 @@ def excavator_energy(runs: RunData) -> str:
     at = r("hydraulic_baseline.optimal.at_battery")
     thermal = r("energy.optimal.thermal")
     torques = ", ".join(
-        f"{m} {t['rms_torque_Nm']:.2f} of {t['continuous_torque_Nm']:.1f} N m ({t['peak_winding_temperature_C']:.1f} °C)"
+        f"{m} {t['rms_torque_Nm']:.2f} of {t['continuous_torque_Nm']:.1f} N m "
+        f"({t['peak_winding_temperature_C']:.1f} °C)"
         for m, t in thermal.items()
     )
     return (

@@ -22,7 +22,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.docs_site.results_data import DATA_DIR, NotRecorded, RunData, load_data, record, write_data
+from hiab_sim.docs_site.results_data import DATA_DIR, NotRecordedError, RunData, load_data, record, write_data
 from hiab_sim.docs_site.results_design_blocks import BLOCKS as DESIGN_BLOCKS
 from hiab_sim.docs_site.results_energy_blocks import BLOCKS as ENERGY_BLOCKS
 from hiab_sim.docs_site.results_machine_blocks import BLOCKS as MACHINE_BLOCKS
@@ -43,7 +43,7 @@ def render_block(name: str, runs: RunData) -> str:
     """One block's Markdown; a block whose study has no data yet says so (and which study) instead."""
     try:
         return BLOCKS[name](runs).strip()
-    except NotRecorded as missing:
+    except NotRecordedError as missing:
         return (
             f"*Not recorded yet: `docs/results/data/{missing.study}.json` does not exist; "
             f"`scripts/results_pages.sh` runs `{missing.study}` and records it.*"
@@ -57,7 +57,7 @@ def not_recorded(runs: RunData, pages_dir: Path | None = None) -> dict[str, str]
         for name in block_names(page.read_text()):
             try:
                 BLOCKS[name](runs)
-            except NotRecorded as missing:
+            except NotRecordedError as missing:
                 out[name] = missing.study
     return out
 
