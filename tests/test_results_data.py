@@ -1,9 +1,11 @@
 """The results pages' data are current: re-run each study, record it as the pages do, compare within the tolerances.
 
 The short studies (seconds each) run in CI; the default study and its closed loop are checked in
-tests/test_default_study.py on that module's run. The long ones (co-design, duty mix, excavator:
-minutes each) run under ``-m slow``; in CI their data are held to tests/data/shipped_optima.json
-instead (tests/test_results_page.py).
+tests/test_default_study.py on that module's run, and the energy map (seconds) here. The long ones
+(co-design, duty mix, excavator, the sweeps and the Pareto front: minutes each) run under ``-m slow``;
+in CI the long studies' data are held to tests/data/shipped_optima.json instead
+(tests/test_results_page.py); the sweeps and the front have no recorded optima, so CI checks only
+that their pages are what their data render.
 """
 
 from __future__ import annotations
@@ -22,10 +24,12 @@ SHORT_STUDIES = ("xs031_spiral_energy", "xs031_spiral_payload", "xs031_spiral_mo
 LONG_STUDIES = ("xs031_codesign", "xs031_duty_mix", "exact_digging", "exact_grading")
 
 
-def _check(study: str, out: Path, starts: int = 1) -> None:
+def _check(study: str, out: Path) -> None:
+    """Run ``study`` with as many starts as its recorded run had, record it and compare."""
     committed = load_data()
     if study not in committed:
         pytest.fail(f"no recorded run of {study} in docs/results/data: run scripts/results_pages.sh")
+    starts = len(committed[study]["result"]["multistart"]["starts"])
     run_study(ROOT / "optimize" / f"{study}.yaml", out, starts=starts, progress=None, figures=False)
     assert differences(record(out), committed[study]) == []
 
@@ -36,8 +40,41 @@ def test_short_study_data_are_current(study: str, tmp_path: Path) -> None:
     _check(study, tmp_path / study)
 
 
+def _check_command(name: str, args: list[str], out: Path) -> None:
+    """Run a hiab-sim command into ``out``, record it and compare with ``docs/results/data/<name>.json``."""
+    from hiab_sim.cli import main
+
+    committed = load_data()
+    if name not in committed:
+        pytest.fail(f"no recorded output of {name} in docs/results/data: run scripts/results_pages.sh")
+    assert main([*args, "--out", str(out)]) == 0
+    assert differences(record(out), committed[name]) == []
+
+
+def test_energy_map_data_are_current(tmp_path: Path) -> None:
+    """A fresh energy map of the default study (its start, 50 x 50 cells, seconds) records the committed data."""
+    _check_command("xs031_spiral_energy_map", ["energy-map", str(ROOT / "optimize" / "xs031_spiral.yaml")], tmp_path)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("name", "args"),
+    [
+        ("xs031_mounting_space", ["sweep", "optimize/sweeps/xs031_mounting_space.yaml", "--workers", "2", "--quiet"]),
+        ("xs031_payload_gear", ["sweep", "optimize/sweeps/xs031_payload_gear.yaml", "--workers", "2", "--quiet"]),
+        ("xs031_spiral_pareto_peak_force", ["pareto", "optimize/xs031_spiral.yaml", "--against", "peak_force"]),
+    ],
+)
+def test_sweep_and_pareto_data_are_current(
+    name: str, args: list[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The shipped sweeps and the default Pareto front (tens of optimisations each) record the committed data."""
+    monkeypatch.chdir(ROOT)
+    _check_command(name, args, tmp_path / name)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("study", LONG_STUDIES)
 def test_long_study_data_are_current(study: str, tmp_path: Path) -> None:
-    """A fresh run of a long study (the duty mix with its three starts) records the committed data."""
-    _check(study, tmp_path / study, starts=3 if study == "xs031_duty_mix" else 1)
+    """A fresh run of a long study (with its recorded number of starts) records the committed data."""
+    _check(study, tmp_path / study)

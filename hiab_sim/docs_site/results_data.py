@@ -79,7 +79,6 @@ _HYDRAULIC = (
 #: The fields of ``result.json`` the pages read (dotted paths, ``*`` for every key or item).
 RESULT_FIELDS: tuple[str, ...] = (
     "name",
-    "study",
     *(f"{design}.{f}" for design in ("initial", "optimal") for f in _DESIGN),
     "improvement.net_energy_saved_J",
     "improvement.net_energy_saved_percent",
@@ -166,6 +165,44 @@ SIMULATION_FIELDS: tuple[str, ...] = (
     ),
     "designs.*.extra_energy_J",
 )
+#: The fields of ``energy_map.json`` (``hiab-sim energy-map``) the pages read.
+ENERGY_MAP_FIELDS: tuple[str, ...] = (
+    "variables",
+    "base",
+    "cells",
+    "feasible_cells",
+    "at_base.objective",
+    "at_base.battery_energy_J",
+    "best_feasible_cell.xi_m",
+    "best_feasible_cell.objective",
+    "best_feasible_cell.battery_energy_J",
+    "infeasible_cells_by_binding_constraint",
+)
+#: The fields of ``pareto.json`` (``hiab-sim pareto``) the pages read.
+PARETO_FIELDS: tuple[str, ...] = (
+    "criterion",
+    "unit",
+    *(f"points.*.{k}" for k in ("epsilon", "criterion", "objective", "objective_unit", "accepted", "iterations")),
+)
+#: The fields of a sweep's table (``hiab-sim sweep``: ``sweep.parquet``, one row per point) the pages read;
+#: ``parameters`` holds each point's grid values by column name.
+SWEEP_FIELDS: tuple[str, ...] = (
+    "rows.*.parameters",
+    *(
+        f"rows.*.{k}"
+        for k in (
+            "status",
+            "message",
+            "iterations",
+            "net_energy_saved_percent",
+            "start_battery_energy_J",
+            "opt_battery_energy_J",
+            "start_net_energy_J",
+            "opt_net_energy_J",
+            *(f"opt_{c}_{k}_m" for c in ("lift", "tilt") for k in ("L", "Lc0", "Lc")),
+        )
+    ),
+)
 
 
 def select(tree: Any, field: str) -> Any:
@@ -207,18 +244,55 @@ def pick(tree: Any, fields: tuple[str, ...]) -> dict[str, Any]:
     return out or {}
 
 
+def _sweep_rows(path: Path) -> dict[str, Any]:
+    """A sweep table as ``{"rows": [...]}``: each row's result columns, its grid values under ``parameters``."""
+    from hiab_sim.sweep.point import RESULT_COLUMNS
+    from hiab_sim.sweep.table import read_table
+
+    frame, _ = read_table(path)
+    rows = []
+    for row in frame.to_dict("records"):
+        clean = {k: None if isinstance(v, float) and math.isnan(v) else v for k, v in row.items()}
+        parameters = {k: v for k, v in clean.items() if k != "key" and k not in RESULT_COLUMNS}
+        rows.append({**{k: clean[k] for k in RESULT_COLUMNS}, "parameters": parameters})
+    return {"rows": rows}
+
+
+#: What a run folder may hold: section of the data -> (file in the folder, its reader, the declared fields).
+SECTIONS: dict[str, tuple[str, Callable[[Path], Any], tuple[str, ...]]] = {
+    "result": ("result.json", lambda path: read_result(path.parent).to_json(), RESULT_FIELDS),
+    "simulation": ("simulation.json", parse_json, SIMULATION_FIELDS),
+    "energy_map": ("energy_map.json", parse_json, ENERGY_MAP_FIELDS),
+    "pareto": ("pareto.json", parse_json, PARETO_FIELDS),
+    "sweep": ("sweep.parquet", _sweep_rows, SWEEP_FIELDS),
+}
+
+
 def record(run_dir: Path) -> dict[str, Any]:
-    """The data of one run folder: ``result`` (and ``simulation`` when ``simulation.json`` exists)."""
-    data = {"result": pick(read_result(run_dir).to_json(), RESULT_FIELDS)}
-    simulation = run_dir / "simulation.json"
-    if simulation.exists():
-        data["simulation"] = pick(parse_json(simulation), SIMULATION_FIELDS)
+    """The data of one run folder: the declared fields of every file of :data:`SECTIONS` it holds.
+
+    An ``optimize`` folder gives ``result`` (and ``simulation`` once ``hiab-sim simulate`` ran on it);
+    an ``energy-map``, ``pareto`` or ``sweep`` folder its own section. A folder with none raises
+    :class:`ValueError` naming the files looked for.
+    """
+    data = {}
+    for section, (name, read, fields) in SECTIONS.items():
+        if (run_dir / name).exists():
+            data[section] = pick(read(run_dir / name), fields)
+    if not data:
+        files = ", ".join(name for name, _, _ in SECTIONS.values())
+        raise ValueError(f"{run_dir}: no run output to record (looked for {files})")
     return data
 
 
-def write_data(data: dict[str, Any], data_dir: Path = DATA_DIR) -> Path:
-    """Write one study's data to ``data_dir/<study name>.json``; return the path."""
-    path = data_dir / f"{data['result']['name']}.json"
+def data_name(data: dict[str, Any], run_dir: Path) -> str:
+    """The data file's name: an optimisation's study name, else the run folder's name."""
+    return str(data["result"]["name"]) if "result" in data else run_dir.name
+
+
+def write_data(data: dict[str, Any], name: str, data_dir: Path = DATA_DIR) -> Path:
+    """Write one run's data to ``data_dir/<name>.json``; return the path."""
+    path = data_dir / f"{name}.json"
     write_atomic(path, json.dumps(data, indent=1) + "\n")
     return path
 
@@ -290,13 +364,17 @@ class RunData:
                 raise KeyError(f"docs/results/data/{study}.json has no {path!r} (is it in RESULT_FIELDS?)")
         return node
 
+    def section(self, study: str, section: str) -> Callable[[str], Any]:
+        """A reader of one section of ``study``'s data (a key of :data:`SECTIONS`)."""
+        return lambda path: self(study, f"{section}.{path}")
+
     def result(self, study: str) -> Callable[[str], Any]:
         """A reader of ``study``'s ``result.json`` fields: ``runs.result("xs031_spiral")("solver.iterations")``."""
-        return lambda path: self(study, f"result.{path}")
+        return self.section(study, "result")
 
     def simulation(self, study: str) -> Callable[[str], Any]:
         """A reader of ``study``'s ``simulation.json`` fields."""
-        return lambda path: self(study, f"simulation.{path}")
+        return self.section(study, "simulation")
 
     def has(self, study: str, path: str) -> bool:
         """Whether ``study``'s data have ``path``."""

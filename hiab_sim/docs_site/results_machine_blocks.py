@@ -88,12 +88,18 @@ def mix_designs(runs: RunData) -> str:
 
 
 def mix_starts(runs: RunData) -> str:
-    """What the duty mix's several starts reached."""
+    """What the duty mix's starts reached (the built crane first, then random feasible ones)."""
     r = runs.result(MIX)
-    iterations = ", ".join(str(s["iterations"]) for s in r("multistart.starts"))
+    starts = r("multistart.starts")
+    iterations = ", ".join(str(s["iterations"]) for s in starts)
+    others = len(starts) - 1
+    which = "the built crane" + (f" and {others} random feasible one{'s' * (others > 1)}" if others else "")
     same = "reach one optimum (Xi within 1e-4 m)" if r("multistart.same_optimum") else "reach different optima"
     converged = r("multistart.converged_starts")
-    return f"{len(r('multistart.starts'))} starts ({iterations} iterations; {converged} converged) {same}."
+    return (
+        f"{len(starts)} start{'s' * (len(starts) > 1)} ({which}; {iterations} iterations, {converged} converged) "
+        f"{same}."
+    )
 
 
 def _cell(value: float | None, digits: int = 1) -> str:

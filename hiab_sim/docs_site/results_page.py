@@ -22,13 +22,22 @@ from collections.abc import Callable
 from pathlib import Path
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.docs_site.results_data import DATA_DIR, NotRecordedError, RunData, load_data, record, write_data
+from hiab_sim.docs_site.results_data import (
+    DATA_DIR,
+    NotRecordedError,
+    RunData,
+    data_name,
+    load_data,
+    record,
+    write_data,
+)
 from hiab_sim.docs_site.results_design_blocks import BLOCKS as DESIGN_BLOCKS
 from hiab_sim.docs_site.results_energy_blocks import BLOCKS as ENERGY_BLOCKS
 from hiab_sim.docs_site.results_machine_blocks import BLOCKS as MACHINE_BLOCKS
+from hiab_sim.docs_site.results_space_blocks import BLOCKS as SPACE_BLOCKS
 
 #: Every generated block by name: a function of the committed data that returns Markdown.
-BLOCKS: dict[str, Callable[[RunData], str]] = {**DESIGN_BLOCKS, **ENERGY_BLOCKS, **MACHINE_BLOCKS}
+BLOCKS: dict[str, Callable[[RunData], str]] = {**DESIGN_BLOCKS, **ENERGY_BLOCKS, **MACHINE_BLOCKS, **SPACE_BLOCKS}
 #: The results pages.
 PAGES_DIR = DATA_DIR.parent
 MARKER = re.compile(r"<!-- results:([a-z0-9-]+):start -->\n(.*?)<!-- results:\1:end -->", re.DOTALL)
@@ -102,7 +111,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.command == "record":
         for run_dir in args.run_dirs:
-            print(f"recorded {write_data(record(run_dir), args.data)} from {run_dir}")
+            data = record(run_dir)
+            print(f"recorded {write_data(data, data_name(data, run_dir), args.data)} from {run_dir}")
         return 0
     runs = RunData(load_data(args.data))
     if args.check:
