@@ -79,6 +79,7 @@ _HYDRAULIC = (
 #: The fields of ``result.json`` the pages read (dotted paths, ``*`` for every key or item).
 RESULT_FIELDS: tuple[str, ...] = (
     "name",
+    "crane",
     *(f"{design}.{f}" for design in ("initial", "optimal") for f in _DESIGN),
     "improvement.net_energy_saved_J",
     "improvement.net_energy_saved_percent",
@@ -122,7 +123,6 @@ RESULT_FIELDS: tuple[str, ...] = (
     "buildable.tolerance_check.margin",
     "buildable.recheck.margin",
     "buildable.net_electrical_energy_J",
-    "buildable.mjcf_command",
     "sensitivity.objective",
     "sensitivity.multipliers.*.constraint",
     "sensitivity.multipliers.*.unit",

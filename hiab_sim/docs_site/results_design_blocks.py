@@ -9,9 +9,11 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from hiab_sim.crane.description import LinkLengths
 from hiab_sim.docs_site.markdown import table
 from hiab_sim.docs_site.results_data import RunData
 from hiab_sim.docs_site.results_format import CHAINS, before_after, kilo, lengths, percent_change
+from hiab_sim.study.report.buildable_section import mjcf_command
 
 DEFAULT = "xs031_spiral"
 
@@ -213,8 +215,11 @@ def buildable_range(runs: RunData) -> str:
     r = runs.result(DEFAULT)
     given = r("buildable.range_given_up_deg")
     parts = [f"{c} {low:.2f}° at the low end and {up:.2f}° at the up end" for c, (low, up) in given.items()]
+    b = r("buildable.lengths")
+    rounded = LinkLengths.from_array([b[c][k] for c in CHAINS for k in ("L", "Lc0", "Lc")])
+    command = mjcf_command(r("crane"), r("buildable.stroke_margin_m"), rounded)
     return (
-        f"`{r('buildable.mjcf_command')}` accepts the default study's rounded design. The "
+        f"`{command}` accepts the default study's rounded design. The "
         f"{1e3 * r('buildable.stroke_margin_m'):.0f} mm stroke margin costs joint range: " + "; ".join(parts) + "."
     )
 
