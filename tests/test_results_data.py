@@ -1,8 +1,8 @@
 """The results pages' data are current: re-run each study, record it as the pages do, compare within the tolerances.
 
 The short studies (seconds each) run in CI; the default study and its closed loop are checked in
-tests/test_default_study.py on that module's run, and the energy map (seconds) here. The long ones
-(co-design, duty mix, excavator, the sweeps and the Pareto front: minutes each) run under ``-m slow``;
+tests/test_default_study.py on that module's run. The long ones (co-design, duty mix, excavator,
+the energy map, the sweeps and the Pareto front: minutes each) run under ``-m slow``;
 in CI the long studies' data are held to tests/data/shipped_optima.json instead
 (tests/test_results_page.py); the sweeps and the front have no recorded optima, so CI checks only
 that their pages are what their data render.
@@ -51,8 +51,9 @@ def _check_command(name: str, args: list[str], out: Path) -> None:
     assert differences(record(out), committed[name]) == []
 
 
+@pytest.mark.slow
 def test_energy_map_data_are_current(tmp_path: Path) -> None:
-    """A fresh energy map of the default study (its start, 50 x 50 cells, seconds) records the committed data."""
+    """A fresh energy map of the default study (its start, 50 x 50 cells; minutes on the real drive) records the data."""
     _check_command("xs031_spiral_energy_map", ["energy-map", str(ROOT / "optimize" / "xs031_spiral.yaml")], tmp_path)
 
 
