@@ -53,7 +53,7 @@ def _check_command(name: str, args: list[str], out: Path) -> None:
 
 @pytest.mark.slow
 def test_energy_map_data_are_current(tmp_path: Path) -> None:
-    """A fresh energy map of the default study (its start, 50 x 50 cells; minutes on the real drive) records the data."""
+    """A fresh energy map of the default study (its start, 50 x 50 cells; minutes on the real drive) is current."""
     _check_command("xs031_spiral_energy_map", ["energy-map", str(ROOT / "optimize" / "xs031_spiral.yaml")], tmp_path)
 
 
