@@ -54,7 +54,9 @@ else
 fi
 folders=()
 for name in "${TARGETS[@]}"; do
-  if [ -d "$RUNS/$name" ]; then folders+=("$RUNS/$name"); else echo "no output of $name in $RUNS: its data are kept"; fi
+  found=""
+  for file in result.json energy_map.json pareto.json sweep.parquet; do [ -f "$RUNS/$name/$file" ] && found=1; done
+  if [ -n "$found" ]; then folders+=("$RUNS/$name"); else echo "no finished output of $name in $RUNS: its data are kept"; fi
 done
 if [ "${#folders[@]}" -gt 0 ]; then "$PY" -m hiab_sim.docs_site.results_page record "${folders[@]}"; fi
 "$PY" -m hiab_sim.docs_site.results_page render
