@@ -146,7 +146,9 @@ def test_documentation_page_renders_in_chromium(site: str) -> None:
     assert page.errors == []
     assert page.images and all(i["complete"] and i["width"] > 0 for i in page.images)
     assert all(url.startswith((site, "data:")) for url in page.requests)
-    block = (ROOT / "docs" / "results" / "default-study.md").read_text().split("<!-- results:start -->")[1]
+    block = (
+        (ROOT / "docs" / "results" / "default-study.md").read_text().split("<!-- results:default-study:start -->")[1]
+    )
     battery = next(line for line in block.splitlines() if line.startswith("| battery energy"))
     assert battery.split("|")[2].strip().split(" J")[0] in page.text
 

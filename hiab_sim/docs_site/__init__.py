@@ -1,1 +1,1 @@
-"""Pages of the documentation site generated from the code: file formats, result schema, CLI, test catalogue."""
+"""Pages of the documentation site generated from the code and from recorded runs (the results pages)."""

@@ -1,12 +1,16 @@
-"""Result pages generated from runs: the default study's numbers, written from its ``result.json`` and checked in CI.
+"""The results pages: every generated block of ``docs/results/*.md`` rendered from the committed run data.
 
-``python -m hiab_sim.docs_site.results_page RUN_DIR [--page docs/results/default-study.md] [--check]``
-replaces the block between ``<!-- results:start -->`` and ``<!-- results:end -->`` with the table
-:func:`results_block` writes from the run; with ``--check`` nothing is written and the exit status is 1
-when the page is stale: the text must be the same and every number within :data:`RELATIVE_TOLERANCE`
-of the fresh one (or one unit of its last printed digit), since a re-run on another CPU moves the last
-digits (SLSQP's stopping point moves with round-off). ``tests/test_default_study.py`` runs the check on
-the default study it optimises.
+A page keeps its explaining prose by hand; each number from a run sits in a block between
+``<!-- results:NAME:start -->`` and ``<!-- results:NAME:end -->`` that :data:`BLOCKS` ``[NAME]``
+renders from ``docs/results/data/*.json`` (:mod:`hiab_sim.docs_site.results_data`). One command
+re-runs the studies and regenerates everything (``scripts/results_pages.sh``); the steps are
+
+    python -m hiab_sim.docs_site.results_page record RUN_DIR...   # run folders -> docs/results/data/<study>.json
+    python -m hiab_sim.docs_site.results_page render [--check]     # data -> every block of every page
+
+``render --check`` writes nothing and exits 1 when a page differs from what the data render (CI runs
+it through ``tests/test_results_page.py``); whether the data are current is a separate check
+(:func:`hiab_sim.docs_site.results_data.differences` against fresh runs, within its stated tolerances).
 """
 
 from __future__ import annotations
@@ -14,110 +18,116 @@ from __future__ import annotations
 import argparse
 import re
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.crane.description import CHAIN_NAMES
-from hiab_sim.results.read import read_result
-from hiab_sim.results.schema import Result
+from hiab_sim.docs_site.results_data import (
+    DATA_DIR,
+    NotRecordedError,
+    RunData,
+    data_name,
+    load_data,
+    record,
+    write_data,
+)
+from hiab_sim.docs_site.results_design_blocks import BLOCKS as DESIGN_BLOCKS
+from hiab_sim.docs_site.results_energy_blocks import BLOCKS as ENERGY_BLOCKS
+from hiab_sim.docs_site.results_machine_blocks import BLOCKS as MACHINE_BLOCKS
+from hiab_sim.docs_site.results_space_blocks import BLOCKS as SPACE_BLOCKS
 
-START, END = "<!-- results:start -->", "<!-- results:end -->"
-#: How far a page's number may be from a fresh run's (relative), beyond one unit of its last digit.
-RELATIVE_TOLERANCE = 2e-3
-NUMBER = re.compile(r"[-+−]?\d+(?:\.\d+)?")
+#: Every generated block by name: a function of the committed data that returns Markdown.
+BLOCKS: dict[str, Callable[[RunData], str]] = {**DESIGN_BLOCKS, **ENERGY_BLOCKS, **MACHINE_BLOCKS, **SPACE_BLOCKS}
+#: The results pages.
+PAGES_DIR = DATA_DIR.parent
+MARKER = re.compile(r"<!-- results:([a-z0-9-]+):start -->\n(.*?)<!-- results:\1:end -->", re.DOTALL)
 
 
-def results_block(result: Result) -> str:
-    """The generated table: design to build, energies at their boundaries, thermal state, hydraulic baseline."""
-    build = result.optimal.lengths if result.buildable is None else result.buildable.lengths
-    rows = []
-    for name in CHAIN_NAMES:
-        before, after = getattr(result.initial.lengths, name), getattr(build, name)
-        rows.append(
-            f"| {name} L / Lc0 / Lc, built → to build | {before.L:.3f} / {before.Lc0:.3f} / {before.Lc:.3f} m "
-            f"→ {after.L:.3f} / {after.Lc0:.3f} / {after.Lc:.3f} m |"
+def block_names(page: str) -> list[str]:
+    """The names of a page's generated blocks, in order."""
+    return [m.group(1) for m in MARKER.finditer(page)]
+
+
+def render_block(name: str, runs: RunData) -> str:
+    """One block's Markdown; a block whose study has no data yet says so (and which study) instead."""
+    try:
+        return BLOCKS[name](runs).strip()
+    except NotRecordedError as missing:
+        return (
+            f"*Not recorded yet: `docs/results/data/{missing.study}.json` does not exist; "
+            f"`scripts/results_pages.sh` runs `{missing.study}` and records it.*"
         )
-    i, o = result.initial, result.optimal
-    rows.append(
-        f"| net electrical energy (drive inputs, DC side with the inverter loss) | {i.net_electrical_energy_J:.1f} → "
-        f"{o.net_electrical_energy_J:.1f} J "
-        f"({-result.improvement.net_energy_saved_percent:.2f} %) |"
-    )
-    if result.energy is not None:
-        e = result.energy
-        rows.append(
-            f"| battery energy per duty period, cycle and rest (at the battery) | {e.initial.battery_energy_J:.1f} → "
-            f"{e.optimal.battery_energy_J:.1f} J ({-e.battery_energy_saved_percent:.2f} %) |"
-        )
-        for motor, t in (e.optimal.thermal or {}).items():
-            rows.append(
-                f"| {motor} motor at the optimum, {e.duty} | RMS torque {t.rms_torque_Nm:.2f} of "
-                f"{t.continuous_torque_Nm:.1f} N m, winding {t.peak_winding_temperature_C:.1f} of "
-                f"{t.max_winding_temperature_C:.0f} °C |"
-            )
-    if result.hydraulic_baseline is not None:
-        h = result.hydraulic_baseline.optimal
-        rows.append(
-            f"| hydraulic cylinders, same motion, at the pump motor input (load sensing / constant pressure) | "
-            f"{h.load_sensing.input_energy_J / 1e3:.2f} / {h.constant_pressure.input_energy_J / 1e3:.2f} kJ |"
-        )
-    d = result.improvement.decomposition
-    if d.from_lengths_J is not None:
-        rows.append(f"| saving from the lengths alone | {d.from_lengths_J:.1f} J |")
-    rows.append(
-        f"| re-check ({result.recheck.id_path}, {result.recheck.grid_points} points): TCP error | "
-        f"{1e3 * result.recheck.tracking_error.position_m:.2f} mm |"
-    )
-    return "\n".join(["| quantity | value |", "|---|---|", *rows])
 
 
-def current_block(page: str) -> str:
-    """The text between the markers."""
-    start, end = page.find(START), page.find(END)
-    if start < 0 or end < start:
-        raise ValueError(f"the page must contain {START} followed by {END}")
-    return page[start + len(START) : end].strip()
-
-
-def _close(old: str, new: str) -> bool:
-    a, b = float(old.replace("−", "-")), float(new.replace("−", "-"))
-    digits = len(new.split(".")[1]) if "." in new else 0
-    return abs(a - b) <= max(RELATIVE_TOLERANCE * abs(b), 10.0**-digits * 1.000001)
-
-
-def differences(written: str, fresh: str) -> list[str]:
-    """Where the page's block differs from a fresh one beyond the tolerance (one message per line)."""
-    old_lines, new_lines = written.strip().splitlines(), fresh.strip().splitlines()
-    if len(old_lines) != len(new_lines):
-        return [f"the page's table has {len(old_lines)} lines, a fresh one {len(new_lines)}"]
-    out = []
-    for row, (old, new) in enumerate(zip(old_lines, new_lines, strict=True), start=1):
-        a, b = NUMBER.findall(old), NUMBER.findall(new)
-        if NUMBER.sub("#", old) != NUMBER.sub("#", new) or len(a) != len(b):
-            out.append(f"line {row}: page {old!r} != fresh {new!r}")
-        elif not all(_close(x, y) for x, y in zip(a, b, strict=True)):
-            out.append(f"line {row}: page {old!r} vs fresh {new!r} (beyond {RELATIVE_TOLERANCE:g} relative)")
+def not_recorded(runs: RunData, pages_dir: Path | None = None) -> dict[str, str]:
+    """The blocks of the pages that cannot render for want of a study's data: block name -> study."""
+    out = {}
+    for page in pages(pages_dir or PAGES_DIR):
+        for name in block_names(page.read_text()):
+            try:
+                BLOCKS[name](runs)
+            except NotRecordedError as missing:
+                out[name] = missing.study
     return out
 
 
+def render_page(page: str, runs: RunData) -> str:
+    """The page with every generated block replaced by what :data:`BLOCKS` renders from ``runs``."""
+    unknown = sorted(set(block_names(page)) - set(BLOCKS))
+    if unknown:
+        raise KeyError(f"no generator for the blocks {unknown}; known: {sorted(BLOCKS)}")
+    opened = page.count("<!-- results:")
+    if opened != 2 * len(block_names(page)):
+        raise ValueError("every <!-- results:NAME:start --> needs its <!-- results:NAME:end --> on a line of its own")
+
+    def fill(match: re.Match[str]) -> str:
+        name = match.group(1)
+        return f"<!-- results:{name}:start -->\n{render_block(name, runs)}\n<!-- results:{name}:end -->"
+
+    return MARKER.sub(fill, page)
+
+
+def pages(pages_dir: Path = PAGES_DIR) -> list[Path]:
+    """The results pages that have generated blocks."""
+    return [p for p in sorted(pages_dir.glob("*.md")) if block_names(p.read_text())]
+
+
+def stale_pages(runs: RunData, pages_dir: Path = PAGES_DIR) -> list[Path]:
+    """The pages whose text differs from what the data render."""
+    return [p for p in pages(pages_dir) if render_page(p.read_text(), runs) != p.read_text()]
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Update or check a results page from a run folder."""
+    """``record RUN_DIR...`` or ``render [--check]`` (module docstring)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("run_dir", type=Path)
-    parser.add_argument("--page", type=Path, default=Path("docs/results/default-study.md"))
-    parser.add_argument("--check", action="store_true", help="exit 1 when the page is stale; write nothing")
+    commands = parser.add_subparsers(dest="command", required=True)
+    rec = commands.add_parser("record", help="write docs/results/data/<study>.json from run folders")
+    rec.add_argument("run_dirs", type=Path, nargs="+")
+    ren = commands.add_parser("render", help="fill every generated block of docs/results/*.md from the data")
+    ren.add_argument("--check", action="store_true", help="exit 1 when a page is stale; write nothing")
+    for sub in (rec, ren):
+        sub.add_argument("--data", type=Path, default=DATA_DIR, help="data folder (default: docs/results/data)")
+    ren.add_argument("--pages", type=Path, default=PAGES_DIR, help="pages folder (default: docs/results)")
     args = parser.parse_args(argv)
-    page = args.page.read_text()
-    fresh = results_block(read_result(args.run_dir))
+    if args.command == "record":
+        for run_dir in args.run_dirs:
+            data = record(run_dir)
+            print(f"recorded {write_data(data, data_name(data, run_dir), args.data)} from {run_dir}")
+        return 0
+    runs = RunData(load_data(args.data))
     if args.check:
-        stale = differences(current_block(page), fresh)
-        for line in stale:
-            print(f"results_page: {args.page} is stale: {line}", file=sys.stderr)
+        stale = stale_pages(runs, args.pages)
+        for page in stale:
+            print(f"results_page: {page} differs from what {args.data} renders (run: render)", file=sys.stderr)
+        for name, study in not_recorded(runs, args.pages).items():
+            print(f"results_page: block {name} waits for a recorded run of {study}", file=sys.stderr)
         return 1 if stale else 0
-    current_block(page)
-    start, end = page.find(START), page.find(END)
-    write_atomic(args.page, page[: start + len(START)] + "\n" + fresh + "\n" + page[end:])
-    print(f"updated {args.page} from {args.run_dir}")
+    for page in pages(args.pages):
+        text = page.read_text()
+        fresh = render_page(text, runs)
+        if fresh != text:
+            write_atomic(page, fresh)
+            print(f"updated {page}")
     return 0
 
 
