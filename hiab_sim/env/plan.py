@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.emla.config import EmlaSet, load_emla_set
+from hiab_sim.emla.duty_energy import DutyOptions
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.results.design_values import crane_lengths
 from hiab_sim.results.read import open_run, result_crane
@@ -44,6 +45,8 @@ class DesignPlan:
         predicted_electrical_power: Planned P_elec per actuator, (K, 3) [W].
         predicted_net_energy: The optimiser's net electrical energy of the design [J].
         payload: Mass hanging at the TCP in the study [kg].
+        duty: The study's duty model of the cycle (hot windings, the rest's hold), or None: the
+            paper's per-sample model (:func:`hiab_sim.study.nlp.task_setup.duty_options`).
 
     """
 
@@ -59,6 +62,7 @@ class DesignPlan:
     predicted_electrical_power: Array
     predicted_net_energy: float
     payload: float
+    duty: DutyOptions | None = None
 
     @property
     def duration(self) -> float:
@@ -79,10 +83,11 @@ def read_plan(result_dir: str | Path, design: str) -> DesignPlan:
     run = open_run(result_dir, Result)
     result, trajectory = run.result, run.trajectory
     summary = result.optimal if design == "optimal" else result.initial
+    emlas, duty = _study_emlas(result.study, trajectory.time())
     return DesignPlan(
         design=design,
         crane=result_crane(run.folder, result.crane),
-        emlas=_study_emlas(result.study),
+        emlas=emlas,
         lengths=crane_lengths(summary.lengths, "result"),
         time=trajectory.time(),
         position=trajectory.design(design, "position"),
@@ -92,12 +97,16 @@ def read_plan(result_dir: str | Path, design: str) -> DesignPlan:
         predicted_electrical_power=trajectory.design(design, "electrical_power"),
         predicted_net_energy=float(summary.net_electrical_energy_J),
         payload=float(result.settings.payload_kg),
+        duty=duty,
     )
 
 
-def _study_emlas(study: str) -> EmlaSet:
-    """The study's EMLA set (the preset when the study file is gone)."""
+def _study_emlas(study: str, time: Array) -> tuple[EmlaSet, DutyOptions | None]:
+    """The study's EMLA set and duty model for a cycle on ``time`` [s] (the preset and none when the file is gone)."""
+    from hiab_sim.study.nlp.task_setup import duty_options
+
     try:
-        return load_study(study).emlas
+        spec = load_study(study)
     except ConfigError:
-        return load_emla_set(None)
+        return load_emla_set(None), None
+    return spec.emlas, duty_options(spec, spec.emlas, float(time[-1] - time[0]))

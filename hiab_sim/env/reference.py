@@ -11,7 +11,7 @@ The TCP reference is interpolated with a cubic spline.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
@@ -21,7 +21,6 @@ from scipy.interpolate import CubicSpline
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla.drive import drive_state
-from hiab_sim.emla.params import EmlaParams
 from hiab_sim.env.plan import DesignPlan
 from hiab_sim.model.mjcf import source_to_world
 
@@ -91,16 +90,11 @@ def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
     tcp_force = None if plan.payload == 0.0 else np.array([0.0, -plan.payload * plan.crane.gravity, 0.0])
     actuators = dynamics(joints, tcp_force)
     qpos, qvel, _ = dynamics.state(joints)
-    # the feedforward inverts the simulated drive: its screw and gearbox are ideal (the plant models no
-    # transmission efficiency), so the planner's transmission losses are left out of the current
+    # the feedforward inverts the simulated drive, which has the EMLA file's screw and gearbox efficiency
+    # (hiab_sim.env.drive_losses): the planner's own drive model, transmission loss included
     current = np.stack(
         [
-            drive_state(
-                ideal_transmission(params),
-                actuators.force[:, i],
-                actuators.velocity[:, i],
-                actuators.acceleration[:, i],
-            ).i_q
+            drive_state(params, actuators.force[:, i], actuators.velocity[:, i], actuators.acceleration[:, i]).i_q
             for i, params in enumerate(plan.emlas)
         ],
         axis=1,
@@ -126,9 +120,3 @@ def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
         reference_tcp=source_to_world(tcp),
         planned_tcp=planned_tcp,
     )
-
-
-def ideal_transmission(params: EmlaParams) -> EmlaParams:
-    """The EMLA with its screw and gearbox efficiency 1 (the closed loop's drive model), other losses kept."""
-    losses = replace(params.losses, transmission_efficiency_forward=1.0, transmission_efficiency_backdriven=1.0)
-    return replace(params, losses=losses)
