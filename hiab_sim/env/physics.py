@@ -37,9 +37,9 @@ from dm_control import mujoco as dm_mujoco
 from numpy.typing import NDArray
 
 from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator, DriveStep
-from hiab_sim.emla.duty_energy import drive_duty
 from hiab_sim.env.drive_losses import DriveLossModel
 from hiab_sim.env.plan import DesignPlan
+from hiab_sim.env.planned_energy import hot_resistance
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.plant.current_loop import DiscreteCurrentLoop
 from hiab_sim.env.plant.drivetrain import TwoMassDriveTrain, coupled_step, drive_train_stiffness
@@ -333,31 +333,6 @@ def crane_physics(
         resistance_schedule=hot_resistance(plan, motion, arrays.resistance),
     )
     return physics
-
-
-def hot_resistance(plan: DesignPlan, motion: PlannedMotion, resistance: Array) -> Array | None:
-    """R_s [ohm] per physics step (N, n) at the plan's periodic winding temperature, or None without hot windings.
-
-    The planner's coupled winding model (:func:`hiab_sim.emla.duty_energy.drive_duty`) on the plan's own
-    fine grid (the motion's samples at the grid's times, the same inverse dynamics), its resistance
-    factor R_s(T_k) / R_s,ref interpolated to the physics steps and applied to ``resistance`` (the
-    drives' R_s,ref, mismatch included).
-    """
-    duty = plan.duty
-    if duty is None or not duty.hot:
-        return None
-    grid = plan.time - plan.time[0]
-    factors = np.ones((len(motion.time), len(resistance)))
-    for i, params in enumerate(plan.emlas):
-        if params.winding is None or params.thermal is None:
-            continue
-        force = np.interp(grid, motion.time, motion.force[:, i])
-        velocity = np.interp(grid, motion.time, motion.rod_velocity[:, i])
-        acceleration = np.interp(grid, motion.time, motion.rod_acceleration[:, i])
-        winding = drive_duty(params, grid, force, velocity, acceleration, duty).winding
-        if winding is not None:
-            factors[:, i] = np.interp(motion.time, grid, winding.resistance_factor)
-    return factors * np.asarray(resistance, dtype=float)[None, :]
 
 
 def _spring_actuators(spec: mujoco.MjSpec) -> None:

@@ -35,6 +35,7 @@ from hiab_sim.env import make_environment
 from hiab_sim.env.loop_design import LoopDesign, design_loop
 from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.plan import DesignPlan
+from hiab_sim.env.planned_energy import resampled_prediction
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.errors import InvalidInputError
 
@@ -89,6 +90,8 @@ class ClosedLoopRun:
         bandwidth_check: The velocity-loop bandwidth against the structure's lowest natural frequency
             (:meth:`hiab_sim.env.loop_design.LoopDesign.check`).
         settle_time_s: Simulated hold before each cycle (:func:`settled_start`) [s], not in ``time``.
+        resampled_prediction: The planner's energy of the plan on a 5 ms grid [J] (:func:`resampled_prediction`),
+            or None.
 
     """
 
@@ -126,6 +129,7 @@ class ClosedLoopRun:
     bandwidth_check: dict[str, object] = field(default_factory=dict)
     settle_time_s: float = 0.0
     actuator_names: tuple[str, ...] = ACTUATOR_NAMES
+    resampled_prediction: float | None = None
 
     @property
     def net_energy(self) -> float:
@@ -184,6 +188,10 @@ class ClosedLoopRun:
             "cycles": list(self.cycles),
             "bandwidth_check": dict(self.bandwidth_check),
             "settle_time_s": self.settle_time_s,
+            "predicted_net_electrical_energy_5ms_grid_J": self.resampled_prediction,
+            "energy_difference_to_5ms_grid_percent": None
+            if self.resampled_prediction is None
+            else 100.0 * (self.net_energy / self.resampled_prediction - 1.0),
         }
 
 
@@ -216,7 +224,7 @@ def run_closed_loop(
     design = replace(design, gains=gains or design.gains)
     drives = DriveArrays.from_params(plan.emlas)
     run = run_environment(env, design, drives, plan.design, payload_error, plan, progress, plant, cycles)
-    return run, env.physics
+    return replace(run, resampled_prediction=resampled_prediction(plan, env.task.motion)), env.physics
 
 
 def run_environment(
