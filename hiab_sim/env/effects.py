@@ -96,9 +96,14 @@ def _entry(summary: dict[str, object]) -> dict[str, object]:
         "net_electrical_energy_J",
         "predicted_net_electrical_energy_J",
         "dc_bus_energy_difference_percent",
+        "predicted_net_electrical_energy_5ms_grid_J",
+        "energy_difference_to_5ms_grid_percent",
         "tcp_error_mm",
         "copper_loss_J",
         "inverter_loss_J",
+        "transmission_loss_J",
+        "brake_coil_energy_J",
+        "motor_terminal_energy_J",
         "drive_train_loss_J",
         "joint_friction_loss_J",
         "winding_temperature_C",
@@ -184,9 +189,9 @@ def effect_study(
 def effect_table(report: dict[str, object]) -> str:
     """Markdown table of the effect study (docs/plant.md's table)."""
     lines = [
-        "| plant | design | DC-bus energy [J] | vs predicted | TCP error rms / max [mm] | peak currents [A] "
-        "| peak voltages [V] | optimal cheaper |",
-        "|---|---|---:|---:|---:|---:|---:|---|",
+        "| plant | design | DC-bus energy [J] | vs predicted | vs 5 ms grid | TCP error rms / max [mm] "
+        "| peak currents [A] | peak voltages [V] | optimal cheaper |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---|",
     ]
     table = report["variants"]
     assert isinstance(table, dict)
@@ -203,9 +208,11 @@ def effect_table(report: dict[str, object]) -> str:
                 if design == "optimal"
                 else ""
             )
+            fine = row.get("energy_difference_to_5ms_grid_percent")
             lines.append(
                 f"| {name} | {design} | {row['dc_bus_energy_J']:.1f} "
                 f"| {row['dc_bus_energy_difference_percent']:+.2f} % "
+                f"| {'' if fine is None else format(fine, '+.2f') + ' %'} "
                 f"| {tcp['rms']:.2f} / {tcp['max']:.2f} | {currents} | {voltages} | {cheaper} |"
             )
     return "\n".join(lines)
