@@ -17,8 +17,13 @@ from hiab_sim.emla import electrical_power, load_emla_set
 from hiab_sim.env.plan import DesignPlan
 
 
-def synthetic_plan(crane: Crane, lengths: LinkLengths | None = None, duration: float = 1.5) -> DesignPlan:
-    """Θ1 0.55 -> 0.65 rad, Θ2 -1.35 -> -1.25 rad, xt2 0.4 -> 0.5 m, quintic rest to rest over ``duration``."""
+def synthetic_plan(
+    crane: Crane, lengths: LinkLengths | None = None, duration: float = 1.5, emla: str = "paper"
+) -> DesignPlan:
+    """Θ1 0.55 -> 0.65 rad, Θ2 -1.35 -> -1.25 rad, xt2 0.4 -> 0.5 m, quintic rest to rest over ``duration``.
+
+    ``emla``: the EMLA set (``paper``: the lossless drive; ``default``: emla_xs031.yaml's real drive).
+    """
     lengths = crane.default_lengths if lengths is None else lengths
     time = np.linspace(0.0, duration, 61)
     tau = time / duration
@@ -28,7 +33,7 @@ def synthetic_plan(crane: Crane, lengths: LinkLengths | None = None, duration: f
     start, delta = np.array([0.55, -1.35, 0.4]), np.array([0.1, 0.1, 0.1])
     joints = JointSamples(start + np.outer(s, delta), np.outer(ds, delta), np.outer(dds, delta))
     actuators = analytic_inverse_dynamics(crane, lengths, joints)
-    emlas = load_emla_set("paper")  # the time-domain drives model the paper's drive: no transmission or inverter loss
+    emlas = load_emla_set(None if emla == "default" else emla)
     power = np.stack(
         [
             electrical_power(p, actuators.force[:, i], actuators.velocity[:, i], actuators.acceleration[:, i])

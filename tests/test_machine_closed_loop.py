@@ -128,7 +128,7 @@ def test_simulate_cli_on_a_machine_result(result: Path, tmp_path: Path, capsys: 
         assert abs(entry["energy_difference_percent"]) < 100 * ENERGY_TOLERANCE
         assert set(entry["actuators"]) == {"boom", "arm", "bucket"}
         assert abs(entry["battery_energy_difference_percent"]) < 100 * ENERGY_TOLERANCE  # through the same battery
-    assert "motor terminals" in report["settings"]["energy"]
+    assert "DC input" in report["settings"]["energy"]
     assert "closed loop uses" in capsys.readouterr().out
     for extra, word in (
         (["--payload-error", "0.2"], "payload-error"),

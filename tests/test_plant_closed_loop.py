@@ -46,12 +46,36 @@ def test_each_effect_alone_completes_the_cycle_and_tracks(crane: Crane, effect: 
 
 
 def test_each_effect_books_its_own_energy(crane: Crane) -> None:
-    """Only the friction effect dissipates in the joints, only the current loop loses in the inverter, and so on."""
+    """Only the friction effect dissipates in the joints, only the drive train in its spring, and so on.
+
+    On the paper's lossless EMLA set no variant has an inverter loss: the plant holds none of its own
+    (the EMLA file's drive_losses are the one inverter model).
+    """
     runs = {effect: _run(crane, REALISTIC.only(effect)) for effect in ("joint_friction", "current_loop", "drive_train")}
     assert runs["joint_friction"].friction_loss > 0.0
-    assert runs["current_loop"].inverter_energy.sum() > 0.0 and runs["current_loop"].friction_loss == 0.0
-    assert runs["drive_train"].drive_train_loss.sum() > 0.0 and runs["drive_train"].inverter_energy.sum() == 0.0
+    assert runs["current_loop"].inverter_energy.sum() == 0.0 and runs["current_loop"].friction_loss == 0.0
+    assert runs["drive_train"].drive_train_loss.sum() > 0.0 and runs["joint_friction"].drive_train_loss.sum() == 0.0
     assert runs["joint_friction"].bus_energy > runs["drive_train"].bus_energy * 0.98
+
+
+def test_the_real_drive_closes_on_the_planners_energy(crane: Crane) -> None:
+    """On emla_xs031.yaml's real drive the ideal closed loop draws the planner's energy at the drives' DC inputs.
+
+    The simulated drive has the screw and gearbox efficiency, the inverter loss and the brake of the
+    EMLA file, and the feedforward inverts it: the TCP stays on the plan and the DC energy equals the
+    planner's energy of the plan (resampled at 5 ms) within 0.1 % (measured: -0.06 %); on the paper's
+    set none of the losses appears.
+    """
+    real, _ = run_closed_loop(synthetic_plan(crane, emla="default"))
+    paper = _run(crane, None)
+    assert real.resampled_prediction is not None
+    assert real.net_energy == pytest.approx(real.resampled_prediction, rel=1e-3)
+    assert real.tcp_error.max() < 1e-3
+    for losses in (real.inverter_energy, real.transmission_loss, real.brake_coil_energy):
+        assert losses is not None and np.all(losses > 0.0)
+    for losses in (paper.inverter_energy, paper.transmission_loss, paper.brake_coil_energy):
+        assert losses is not None and np.all(losses == 0.0)
+    assert real.net_energy > paper.net_energy
 
 
 def test_hot_windings_raise_copper_loss_by_the_resistance_factor(crane: Crane) -> None:

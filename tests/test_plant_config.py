@@ -19,7 +19,7 @@ def test_realistic_preset_states_a_source_for_every_number() -> None:
     """Every number of the shipped plant carries a source whose first word is read, estimate, derived or model."""
     plant = load_plant("realistic")
     assert plant.enabled == EFFECTS
-    assert len(plant.provenance) >= 29  # the drive-train stiffness is the EMLA file's, not the plant's
+    assert len(plant.provenance) >= 25  # the drive-train stiffness and the inverter losses are the EMLA file's
     for key, source in plant.provenance:
         assert source.split(":", 1)[0] in PROVENANCE, key
 
@@ -51,8 +51,8 @@ def test_a_users_file_loads_and_an_unknown_key_is_named(tmp_path: Path) -> None:
     [
         (lambda: DriveTrain(True, 2.0, 0.0, 100.0), "drive_train.damping_ratio"),
         (lambda: DriveTrain(True, 0.05, 0.0, -1.0), "drive_train.rod_side_mass_kg"),
-        (lambda: CurrentLoop(True, 8e3, 3e3, 0.0, 565.0, 1.0, 0.05, 1.8, 20.0), "current_loop.bandwidth_Hz"),
-        (lambda: CurrentLoop(True, 8e3, 500.0, 2e-5, 565.0, 1.0, 0.05, 1.8, 20.0), "current_loop.dead_time_s"),
+        (lambda: CurrentLoop(True, 8e3, 3e3, 0.0, 565.0), "current_loop.bandwidth_Hz"),
+        (lambda: CurrentLoop(True, 8e3, 500.0, 2e-5, 565.0), "current_loop.dead_time_s"),
         (lambda: Sensors(True, 2, 0.1, 0.2, 1e-3), "sensors.encoder_counts_per_rev"),
         (lambda: Sensors(True, 4096, 0.1, 0.2, 1.0), "sensors.delay_s"),
         (lambda: Mismatch(True, 0.1, (0.0, 0.0, 5.0), 0.0, 0.0, 0.0), "mismatch.end_mass_com_offset_m[2]"),
@@ -83,4 +83,16 @@ def test_a_plant_file_that_sets_the_stiffness_is_refused_in_one_line(tmp_path: P
         load_plant(str(bad))
     message = str(error.value)
     assert "drive_train.axial_stiffness_N_per_m" in message and "drive_stiffness" in message
+    assert "\n" not in message
+
+
+def test_a_plant_file_that_sets_inverter_losses_is_refused_in_one_line(tmp_path: Path) -> None:
+    """A plant file with its own inverter loss (current_loop.threshold_voltage_V) is refused: the EMLA file owns it."""
+    text = shipped("plant", "realistic").read_text()
+    bad = tmp_path / "old.yaml"
+    bad.write_text(text.replace("  dead_time_s:", "  threshold_voltage_V: 1.0\n  dead_time_s:", 1))
+    with pytest.raises(ConfigError) as error:
+        load_plant(str(bad))
+    message = str(error.value)
+    assert "current_loop.threshold_voltage_V" in message and "drive_losses" in message
     assert "\n" not in message

@@ -175,14 +175,20 @@ def test_a_bad_plant_exits_2_naming_it(small_result: Path, tmp_path: Path, capsy
 
 @pytest.mark.slow
 def test_default_study_on_the_realistic_plant(tmp_path: Path) -> None:
-    """The default study's both designs complete on the realistic plant within 10 mm, over two cycles; ideal = today."""
+    """The default study's both designs complete on the realistic plant within 10 mm, over two cycles.
+
+    The ideal plant (the EMLA file's real drive, the planner's losses) draws the planner's energy of the
+    plan on a 5 ms grid within 0.06 %, and the optimiser's number within 0.15 % (its 25 ms grid
+    integrates the holding brake's release at the cycle's ends 0.07 % high).
+    """
     result = run_study(None, tmp_path / "run", progress=None, figures=False).folder
     args = ["simulate", str(result), "--plant", "realistic", "--cycles", "2", "--no-video", "--no-figures", "--quiet"]
     assert main(args) == 0
     effects = json.loads((result / "simulation.json").read_text())["plant_effects"]
     for design in ("initial", "optimal"):
         ideal = effects["variants"]["ideal"][design]
-        assert ideal["dc_bus_energy_J"] == pytest.approx(ideal["predicted_net_electrical_energy_J"], rel=6e-4)
+        assert ideal["dc_bus_energy_J"] == pytest.approx(ideal["predicted_net_electrical_energy_5ms_grid_J"], rel=6e-4)
+        assert ideal["dc_bus_energy_J"] == pytest.approx(ideal["predicted_net_electrical_energy_J"], rel=1.5e-3)
         every = effects["variants"]["all"][design]
         assert every["tcp_error_mm"]["max"] <= 10.0
         temperatures = [c["winding_temperature_C"][0] for c in every["cycles"]]

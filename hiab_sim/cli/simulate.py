@@ -5,8 +5,10 @@ dm-control environment of :mod:`hiab_sim.env` (MuJoCo multibody + PMSM drives wi
 loops and limits) under the cascade controller of :mod:`hiab_sim.control`. Written to ``--out``
 (default: RESULT_DIR), each file atomically:
 
-* ``simulation.json``: per design the closed-loop net electrical energy (int 3/2 (v_d i_d + v_q i_q)
-  dt, all drives), the optimiser's predicted one, the TCP error (rms, max) to the study's reference,
+* ``simulation.json``: per design the closed-loop net electrical energy (each drive's DC input: int
+  3/2 (v_d i_d + v_q i_q) dt with the EMLA file's inverter loss and holding brake, all drives;
+  :mod:`hiab_sim.env.drive_losses`), the optimiser's predicted one and the planner's energy of the plan
+  on a 5 ms grid, the TCP error (rms, max) to the study's reference,
   the fractions of time at the current and voltage limits, and ``bandwidth_check``: the
   controller's ``velocity_loop_bandwidth_Hz`` against the structure's ``first_natural_frequency_Hz``
   over the plan, ``bandwidth_margin`` = 1 - f_v / (f_1 / 3) (>= 0 holds;

@@ -23,9 +23,10 @@ from hiab_sim.errors import InvalidInputError
 
 #: What the report says of the energy boundary and the TCP error of a machine's closed loop.
 MACHINE_ENERGY = (
-    "closed loop: int 3/2 (v_d i_d + v_q i_q) dt over the cycle at the motor terminals, summed over the drives "
-    "(the shared DC bus credits one drive's regeneration to the others; no inverter or battery); the prediction "
-    "is the same sum of the plan's P_elec per drive"
+    "closed loop: each drive's DC input over the cycle (int 3/2 (v_d i_d + v_q i_q) dt with the EMLA file's "
+    "drive losses when they are on, hiab_sim.env.drive_losses), summed over the drives (the shared DC bus credits "
+    "one drive's regeneration to the others; no battery); the prediction is the same sum of the plan's P_elec "
+    "per drive"
 )
 MACHINE_TCP = "distance of the simulated TCP to the study's TCP reference (x_tcp, y_tcp) in the machine's plane"
 NO_STRUCTURE = "the structure's natural frequencies are computed for the crane file only, not for a machine file"

@@ -11,9 +11,11 @@ def closing_lines(report: dict[str, object]) -> list[str]:
     for design, entry in designs.items():
         rows = [entry["nominal"], entry] if "nominal" in entry else [entry]
         planned = rows[0]
+        fine = planned.get("energy_difference_to_5ms_grid_percent")
         text = (
-            f"{design}: the closed loop uses {planned['energy_difference_percent']:+.2f} % energy against the plan, "
-            f"tracking within {planned['tcp_error_mm']['max']:.2f} mm"
+            f"{design}: the closed loop uses {planned['energy_difference_percent']:+.2f} % energy against the plan"
+            + ("" if fine is None else f" ({fine:+.2f} % against the planner's energy of the plan on a 5 ms grid)")
+            + f", tracking within {planned['tcp_error_mm']['max']:.2f} mm"
         )
         if len(rows) == 2:
             heavy = rows[1]

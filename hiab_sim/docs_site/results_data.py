@@ -246,15 +246,18 @@ def pick(tree: Any, fields: tuple[str, ...]) -> dict[str, Any]:
 
 def _sweep_rows(path: Path) -> dict[str, Any]:
     """A sweep table as ``{"rows": [...]}``: each row's result columns, its grid values under ``parameters``."""
-    from hiab_sim.sweep.point import RESULT_COLUMNS
+    from hiab_sim.sweep.point import RUN_COLUMNS, VALUE_COLUMNS
     from hiab_sim.sweep.table import read_table
 
     frame, _ = read_table(path)
+    # the result columns: the run's, the optimum's decision variables (opt_<chain>_<variable>_m), the values
+    designs = [c for c in frame.columns if c.startswith("opt_") and c.endswith("_m") and c not in VALUE_COLUMNS]
+    result_columns = (*RUN_COLUMNS, *designs, *VALUE_COLUMNS)
     rows = []
     for row in frame.to_dict("records"):
         clean = {k: None if isinstance(v, float) and math.isnan(v) else v for k, v in row.items()}
-        parameters = {k: v for k, v in clean.items() if k != "key" and k not in RESULT_COLUMNS}
-        rows.append({**{k: clean[k] for k in RESULT_COLUMNS}, "parameters": parameters})
+        parameters = {k: v for k, v in clean.items() if k != "key" and k not in result_columns}
+        rows.append({**{k: clean[k] for k in result_columns}, "parameters": parameters})
     return {"rows": rows}
 
 

@@ -141,7 +141,11 @@ class DriveStep:
         rod_force: k (torque - friction_torque) [N], the force handed to the slide.
         current_limited: The reference was clipped to the current limit.
         voltage_limited: The voltage command left the inverter's circle during the step.
-        inverter_energy: The inverter's loss over the step [J] (0: a lossless inverter, as here).
+        inverter_energy: The inverter's loss over the step [J] (0 here: the EMLA file's inverter loss is
+            charged from the current samples by :mod:`hiab_sim.env.drive_losses`).
+        current_samples: |i_dq| [A] per drive at the step's quadrature nodes, (n, m), or None.
+        sample_weights: The nodes' quadrature weights [s], (m,), summing to the step: int g(|i|) dt over
+            the step is about ``sample_weights @ g(current_samples[j])``.
 
     """
 
@@ -157,6 +161,8 @@ class DriveStep:
     current_limited: NDArray[np.bool_]
     voltage_limited: NDArray[np.bool_]
     inverter_energy: Array | float = 0.0
+    current_samples: Array | None = None
+    sample_weights: Array | None = None
 
 
 class DriveSimulator:
@@ -226,6 +232,8 @@ class DriveSimulator:
         mean_dq = ref_q * e_d * s1 + e_d * e_q * s2
         torque = 1.5 * d.pole_pairs * (d.flux * mean_q + (d.Ld - d.Lq) * mean_dq) / h
         i_d1, i_q1 = e_d * s, ref_q + e_q * s
+        root = math.sqrt(s)  # exp(-w_c h / 2): the unsaturated current at mid-step
+        i_dm, i_qm = e_d * root, ref_q + e_q * root
 
         if saturated.any():
             sat = self._saturated(i_d0, i_q0, np.zeros_like(ref_q), ref_q, omega, h)
@@ -236,8 +244,11 @@ class DriveSimulator:
             energy = np.where(saturated, sat[4], energy)
             copper = np.where(saturated, sat[5], copper)
             torque = np.where(saturated, sat[6], torque)
+            i_dm = np.where(saturated, 0.5 * (i_d0 + i_d1), i_dm)  # the sub-stepped path: the chord's middle
+            i_qm = np.where(saturated, 0.5 * (i_q0 + i_q1), i_qm)
 
         self.i_d, self.i_q = i_d1, i_q1
+        samples = np.stack([np.hypot(i_d0, i_q0), np.hypot(i_dm, i_qm), np.hypot(i_d1, i_q1)], axis=1)
         friction = d.coulomb * np.tanh(omega / d.smoothing)
         return DriveStep(
             i_d=i_d1,
@@ -251,6 +262,8 @@ class DriveSimulator:
             rod_force=d.ratio * (torque - friction),
             current_limited=np.abs(requested) >= limit,
             voltage_limited=saturated,
+            current_samples=samples,
+            sample_weights=np.array([h / 6.0, 4.0 * h / 6.0, h / 6.0]),  # Simpson's rule
         )
 
     def limited_command(

@@ -44,6 +44,7 @@ from numpy.typing import NDArray
 from hiab_sim.control.cascade import CascadeGains
 from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator
 from hiab_sim.env import CURRENT_BANDWIDTH_HZ, PHYSICS_TIMESTEP
+from hiab_sim.env.drive_losses import DriveLossModel
 from hiab_sim.env.loop_design import LoopDesign
 from hiab_sim.env.machine_plan import MachinePlan
 from hiab_sim.env.physics import CranePhysics
@@ -154,6 +155,7 @@ def machine_environment(
     physics = CranePhysics.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
     physics.attach_drives(
         DriveSimulator(DriveArrays.from_params(plan.emlas), bandwidth_hz=current_bandwidth_hz),
+        DriveLossModel(plan.emlas),
         joints=tuple(tree.bodies[b].joint for b in tree.actuated),
         actuators=tuple(plan.machine.actuator_names),
     )

@@ -8,6 +8,13 @@ mass at the TCP, also scaled. :class:`CranePhysics` steps the drives of
 :mod:`hiab_sim.emla.drive_sim` once per physics step, at the speeds of the slides
 (omega_m = k v_x), and applies their rod forces as the actuators' ``ctrl`` before ``mj_step``.
 
+The drives carry the EMLA file's drive losses, the planner's own functions (:mod:`hiab_sim.env.drive_losses`):
+the screw and gearbox efficiency between the motor and the rod, and on the DC side the inverter's loss,
+the holding brake's coil and release factor. ``energy`` is each drive's DC input over the cycle, the
+boundary of the optimiser's energy (``terminal`` the motor terminals' int 3/2 v.i dt). The winding
+resistance is the planner's too: with the study's hot windings (:mod:`hiab_sim.emla.duty_energy`) the
+drives see R_s at the plan's periodic winding temperature, sample by sample (``resistance_schedule``).
+
 A :class:`~hiab_sim.env.plant.config.Plant` adds what the planner leaves out (:mod:`hiab_sim.env.plant`):
 the crane and friction of the mismatch, the hinge and pin friction, a two-mass drive train per EMLA
 (the rotor's reflected inertia and the screw friction then move from the slide to the motor side,
@@ -30,7 +37,9 @@ from dm_control import mujoco as dm_mujoco
 from numpy.typing import NDArray
 
 from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator, DriveStep
+from hiab_sim.env.drive_losses import DriveLossModel
 from hiab_sim.env.plan import DesignPlan
+from hiab_sim.env.planned_energy import hot_resistance
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.plant.current_loop import DiscreteCurrentLoop
 from hiab_sim.env.plant.drivetrain import TwoMassDriveTrain, coupled_step, drive_train_stiffness
@@ -93,24 +102,32 @@ class CranePhysics(dm_mujoco.Physics):
     current_error: CurrentSensorError
     thermal: WindingTemperature | None
     friction: FrictionMeter | None
+    losses: DriveLossModel
+    resistance_schedule: Array | None
 
     def attach_drives(
         self,
         drives: DriveSimulator,
+        losses: DriveLossModel,
         plant: Plant | None = None,
         drive_train: TwoMassDriveTrain | None = None,
         thermal: WindingTemperature | None = None,
         friction: FrictionMeter | None = None,
         joints: tuple[str, ...] = SLIDES,
         actuators: tuple[str, ...] = ACTUATORS,
+        resistance_schedule: Array | None = None,
     ) -> None:
-        """Attach the drives and the plant's parts; clear the energy counters.
+        """Attach the drives, their losses and the plant's parts; clear the energy counters.
 
         ``joints`` are the actuated slides and ``actuators`` their motors, in the drives' order (the
         crane's lift, tilt, telescope by default; a machine's chains, :mod:`hiab_sim.env.machine_env`).
+        ``resistance_schedule`` (N, n) [ohm]: R_s per physics step of the cycle (the plan's hot windings;
+        None: the drives' own R_s), unused while the plant's winding temperature runs.
         """
         _LIVE.add(self)
         self.drives = drives
+        self.losses = losses
+        self.resistance_schedule = resistance_schedule
         self.plant = plant
         self.drive_train = drive_train
         self.thermal = thermal
@@ -139,7 +156,11 @@ class CranePhysics(dm_mujoco.Physics):
         self.last = None
         n = len(self.slide_dofs)
         self.energy = np.zeros(n)
+        self.terminal = np.zeros(n)
         self.copper = np.zeros(n)
+        self.transmission_loss = np.zeros(n)
+        self.brake_coil = np.zeros(n)
+        self.brake_carried = np.zeros(n)
         self.steps = 0
         self.current_limited_steps = np.zeros(n)
         self.voltage_limited_steps = np.zeros(n)
@@ -163,21 +184,46 @@ class CranePhysics(dm_mujoco.Physics):
         model, data = self.model.ptr, self.data.ptr
         h = float(model.opt.timestep)
         ratio = self.drives.drives.ratio
+        losses = self.losses
         with self.check_invalid_state():
             for _ in range(nstep):
-                result = self.drives.step(self.current_reference, ratio * data.qvel[self.slide_dofs], h)
-                data.ctrl[:] = result.rod_force
+                self._scheduled_resistance(h)
+                v = data.qvel[self.slide_dofs].copy()
+                result = self.drives.step(self.current_reference, ratio * v, h)
+                force, tau_tr = result.rod_force, None
+                if losses.transmission_on:
+                    force, tau_tr = losses.rigid_rod_force(force, ratio * v, data.qacc[self.slide_dofs])
+                data.ctrl[self.actuator_ids] = force
                 if self.tcp_load is not None:
                     self.tcp_load.apply(model, data, self.holding)
                 mujoco.mj_step(model, data)
-                self.energy += result.electrical_energy
-                self.copper += result.copper_energy
-                self.current_limited_steps += result.current_limited
-                self.voltage_limited_steps += result.voltage_limited
-                self.steps += 1
-                self.last = result
+                if tau_tr is not None:
+                    self.transmission_loss += tau_tr * ratio * data.qvel[self.slide_dofs] * h
+                self._book(result, v, h)
                 self.sensor.push(data.qpos[self.slide_dofs], data.qvel[self.slide_dofs])
             mujoco.mj_kinematics(model, data)  # site positions of the new state, for observations
+
+    def _scheduled_resistance(self, h: float) -> None:
+        """R_s of the plan's hot windings at this step (none while the plant's own winding model runs)."""
+        schedule = self.resistance_schedule
+        if schedule is None or self.thermal is not None:
+            return
+        k = 0 if self.holding else int(min(max(round(self.data.time / h), 0), len(schedule) - 1))
+        self.drives.drives = replace(self.drives.drives, resistance=schedule[k])
+
+    def _book(self, result: DriveStep, rod_velocity: Array, h: float) -> None:
+        """Add one step's energies: the DC input with the EMLA file's losses, terminals, copper, limits."""
+        dc, inverter, coil, carried = self.losses.dc_energy(result, rod_velocity, h)
+        self.energy += dc
+        self.terminal += result.electrical_energy
+        self.copper += result.copper_energy
+        self.inverter += inverter
+        self.brake_coil += coil
+        self.brake_carried += carried
+        self.current_limited_steps += result.current_limited
+        self.voltage_limited_steps += result.voltage_limited
+        self.steps += 1
+        self.last = result
 
     def _plant_step(self, nstep: int) -> None:
         """:meth:`step` with the plant's effects (module docstring)."""
@@ -185,31 +231,40 @@ class CranePhysics(dm_mujoco.Physics):
         h = float(model.opt.timestep)
         ratio = self.drives.drives.ratio
         train, thermal, friction = self.drive_train, self.thermal, self.friction
+        losses = self.losses
         discrete = isinstance(self.drives, DiscreteCurrentLoop)
         with self.check_invalid_state():
             for _ in range(nstep):
-                v = data.qvel[self.slide_dofs]
+                self._scheduled_resistance(h)
+                v = data.qvel[self.slide_dofs].copy()
                 omega = ratio * (v if train is None else train.velocity)
                 reference = self.current_reference if discrete else self.current_reference - self.current_error.sample()
                 result = self.drives.step(reference, omega, h)
                 if train is None:
-                    data.ctrl[:] = result.rod_force
+                    force, tau_tr = result.rod_force, None
+                    if losses.transmission_on:
+                        force, tau_tr = losses.rigid_rod_force(force, omega, data.qacc[self.slide_dofs])
+                    data.ctrl[:] = force
                     mujoco.mj_step(model, data)
+                    if tau_tr is not None:
+                        self.transmission_loss += tau_tr * ratio * data.qvel[self.slide_dofs] * h
                 else:
-                    loss = coupled_step(train, model, data, self.actuator_ids, self.slide_dofs, result.rod_force, h)
+                    force = result.rod_force
+                    tau_tr = None
+                    if losses.transmission_on:  # the screw force at the step's start: spring plus screw friction
+                        screw = train.spring_force(data.qpos[self.slide_dofs], v) + train.viscous * train.velocity
+                        tau_tr, _ = losses.loss_torque(screw, omega)
+                        force = force - ratio * tau_tr
+                    loss = coupled_step(train, model, data, self.actuator_ids, self.slide_dofs, force, h)
                     self.drive_train_loss += loss
+                    if tau_tr is not None:
+                        self.transmission_loss += tau_tr * ratio * train.velocity * h
                 if friction is not None:
                     self.friction_loss += h * friction.power(model, data)
                 if thermal is not None:
                     thermal.advance(result.copper_energy, h)
                     self.drives.drives = replace(self.drives.drives, resistance=thermal.resistance())
-                self.energy += result.electrical_energy
-                self.copper += result.copper_energy
-                self.inverter += result.inverter_energy
-                self.current_limited_steps += result.current_limited
-                self.voltage_limited_steps += result.voltage_limited
-                self.steps += 1
-                self.last = result
+                self._book(result, v, h)
                 self.sensor.push(*self.motor_state())
             mujoco.mj_kinematics(model, data)  # site positions of the new state, for observations
 
@@ -266,6 +321,7 @@ def crane_physics(
         drives = DriveSimulator(arrays, bandwidth_hz=bandwidth_hz)
     physics.attach_drives(
         drives,
+        DriveLossModel(plan.emlas),
         plant,
         drive_train=None
         if train_data is None or stiffness is None
@@ -274,6 +330,7 @@ def crane_physics(
         if active and active.thermal.enabled
         else None,
         friction=FrictionMeter(physics.model.ptr, joints, tendons) if joints else None,
+        resistance_schedule=hot_resistance(plan, motion, arrays.resistance),
     )
     return physics
 

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.emla.config import EmlaSet, load_emla_set
+from hiab_sim.emla.duty_energy import DutyOptions
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.results.design_values import crane_lengths
 from hiab_sim.results.read import DESIGNS, RunFolder, open_run, result_crane
@@ -70,12 +71,15 @@ class DesignPlan(PlannedDesign):
         crane: The crane description.
         lengths: The design's link lengths Xi [m].
         payload: Mass hanging at the TCP in the study [kg].
+        duty: The study's duty model of the cycle (hot windings, the rest's hold), or None: the
+            paper's per-sample model (:func:`hiab_sim.study.nlp.task_setup.duty_options`).
 
     """
 
     crane: Crane
     lengths: LinkLengths
     payload: float
+    duty: DutyOptions | None = None
 
 
 @dataclass(frozen=True)
@@ -130,18 +134,23 @@ def read_plan(result_dir: str | Path, design: str) -> DesignPlan:
     """
     found = open_design(result_dir, design)
     result = found.run.result
+    emlas, duty = _study_emlas(result.study, found.planned["time"])
     return DesignPlan(
         **found.planned,
         crane=result_crane(found.run.folder, result.crane),
-        emlas=_study_emlas(result.study),
+        emlas=emlas,
         lengths=crane_lengths(found.summary.lengths, "result"),
         payload=float(result.settings.payload_kg),
+        duty=duty,
     )
 
 
-def _study_emlas(study: str) -> EmlaSet:
-    """The study's EMLA set (the preset when the study file is gone)."""
+def _study_emlas(study: str, time: Array) -> tuple[EmlaSet, DutyOptions | None]:
+    """The study's EMLA set and duty model for a cycle on ``time`` [s] (the preset and none when the file is gone)."""
+    from hiab_sim.study.nlp.task_setup import duty_options
+
     try:
-        return load_study(study).emlas
+        spec = load_study(study)
     except ConfigError:
-        return load_emla_set(None)
+        return load_emla_set(None), None
+    return spec.emlas, duty_options(spec, spec.emlas, float(time[-1] - time[0]))

@@ -15,7 +15,7 @@ feedforward inverts and how the reference is read.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
@@ -150,14 +150,8 @@ def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
         qpos, qvel, _ = dynamics.state(joints)
         return actuators, qpos, qvel
 
-    # the feedforward inverts the simulated drive: its screw and gearbox are ideal (the plant models no
-    # transmission efficiency), so the planner's transmission losses are left out of the current
-    drives = [ideal_transmission(params) for params in plan.emlas]
+    # the feedforward inverts the simulated drive, which has the EMLA file's screw and gearbox efficiency
+    # (hiab_sim.env.drive_losses): the planner's own drive model, transmission loss included
+    drives = list(plan.emlas)
     reference = source_to_world(CubicSpline(plan.time, plan.reference_tcp, axis=0)(times))
     return motion_of_plan(plan, times, dynamics.model, crane_dynamics, drives, reference)
-
-
-def ideal_transmission(params: EmlaParams) -> EmlaParams:
-    """The EMLA with its screw and gearbox efficiency 1 (the closed loop's drive model), other losses kept."""
-    losses = replace(params.losses, transmission_efficiency_forward=1.0, transmission_efficiency_backdriven=1.0)
-    return replace(params, losses=losses)

@@ -1,16 +1,17 @@
 """One closed-loop cycle of a design: the cascade controller on the environment, logged and summarised.
 
-Energies come from the drives' exact per-step integrals (:mod:`hiab_sim.emla.drive_sim`): the net
-electrical energy is int 3/2 (v_d i_d + v_q i_q) dt over the cycle, summed over the drives (the DC
-bus credits regeneration of one drive to the others). The predicted energy is the optimiser's number
-for the design (``result.json``); the predicted power is the plan's P_elec on its fine grid.
+Energies come from the drives' exact per-step integrals (:mod:`hiab_sim.emla.drive_sim`) and the EMLA
+file's drive losses (:mod:`hiab_sim.env.drive_losses`): the net electrical energy is each drive's DC
+input (the motor terminals' int 3/2 (v_d i_d + v_q i_q) dt with the brake's release factor, plus the
+inverter's loss and the brake coil's power) over the cycle, summed over the drives (the DC bus credits
+regeneration of one drive to the others): the boundary of the optimiser's number for the design
+(``result.json``), whose predicted power is the plan's P_elec on its fine grid.
 
 The gains follow the design rules of :mod:`hiab_sim.control.cascade` for the plan's crane and the
 plant (:mod:`hiab_sim.env.loop_design`: the structure's lowest natural frequency, a compliant
 drive train's lowest resonance), and every run carries the check of its velocity-loop bandwidth
 against the structure's lowest natural frequency (``bandwidth_check``). With a plant
-(:mod:`hiab_sim.env.plant`) the DC bus also pays the inverters' losses (the DC-bus
-energy is the electrical energy plus them), and ``cycles`` > 1
+(:mod:`hiab_sim.env.plant`) ``cycles`` > 1
 runs the cycle repeatedly with the winding temperature carried over (cooling over the plant's rest
 between cycles); the log is the last cycle's, the per-cycle energies and temperatures are kept.
 """
@@ -34,6 +35,7 @@ from hiab_sim.env import make_environment
 from hiab_sim.env.loop_design import LoopDesign, design_loop
 from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.plan import DesignPlan
+from hiab_sim.env.planned_energy import resampled_prediction
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.errors import InvalidInputError
 
@@ -65,7 +67,7 @@ class ClosedLoopRun:
         plan_error: |p_tcp - p_plan| [m], to the TCP of the planned motion (the controller's own error).
         current_dq, voltage_dq: (d, q) per drive at the end of each step [A, V].
         electrical_power: Mean P_elec per drive over each control step [W].
-        cumulative_energy: int P_elec dt per drive up to each time [J].
+        cumulative_energy: int P_elec dt per drive up to each time [J], at the drive's DC input.
         plan_time, predicted_power: The plan's fine grid [s] and P_elec per actuator there [W].
         predicted_net_energy: The optimiser's net electrical energy [J].
         current_limit, voltage_limit: I_max [A] and V_max = |v_dq| limit [V] per drive.
@@ -74,7 +76,11 @@ class ClosedLoopRun:
         qpos: Joint positions at every control step, for rendering (N, nq).
         wall_time: Wall-clock seconds of the simulation loop.
         plant: Name of the plant (``ideal``: the planner's model).
-        inverter_energy: The inverters' loss per drive over the cycle [J].
+        inverter_energy: The inverters' loss per drive over the cycle [J] (in ``cumulative_energy``).
+        terminal_energy: int 3/2 v.i dt per drive at the motor terminals over the cycle [J].
+        transmission_loss: The screw and gearbox loss per drive over the cycle [J].
+        brake_coil_energy: The released holding brakes' coil energy per drive [J] (in ``cumulative_energy``).
+        brake_carried: Motor-terminal energy the engaged brake saves per drive, (1 - s) E_m [J].
         drive_train_loss: Screw friction and spring damping of the two-mass drive train per drive [J].
         friction_loss: Dissipated in the hinges and pins over the cycle [J].
         winding_temperature: Winding temperature per drive at the end of the cycle [deg C], or None.
@@ -84,6 +90,8 @@ class ClosedLoopRun:
         bandwidth_check: The velocity-loop bandwidth against the structure's lowest natural frequency
             (:meth:`hiab_sim.env.loop_design.LoopDesign.check`).
         settle_time_s: Simulated hold before each cycle (:func:`settled_start`) [s], not in ``time``.
+        resampled_prediction: The planner's energy of the plan on a 5 ms grid [J] (:func:`resampled_prediction`),
+            or None.
 
     """
 
@@ -108,6 +116,10 @@ class ClosedLoopRun:
     wall_time: float
     plant: str = "ideal"
     inverter_energy: Array | None = None
+    terminal_energy: Array | None = None
+    transmission_loss: Array | None = None
+    brake_coil_energy: Array | None = None
+    brake_carried: Array | None = None
     drive_train_loss: Array | None = None
     friction_loss: float = 0.0
     winding_temperature: Array | None = None
@@ -117,16 +129,17 @@ class ClosedLoopRun:
     bandwidth_check: dict[str, object] = field(default_factory=dict)
     settle_time_s: float = 0.0
     actuator_names: tuple[str, ...] = ACTUATOR_NAMES
+    resampled_prediction: float | None = None
 
     @property
     def net_energy(self) -> float:
-        """Closed-loop net electrical energy of all drives at the motor terminals [J]."""
+        """Closed-loop net electrical energy of all drives at their DC inputs (the prediction's boundary) [J]."""
         return float(self.cumulative_energy[-1].sum())
 
     @property
     def bus_energy(self) -> float:
-        """Closed-loop energy drawn from the DC bus: electrical energy plus the inverters' losses [J]."""
-        return self.net_energy + (0.0 if self.inverter_energy is None else float(self.inverter_energy.sum()))
+        """Closed-loop energy drawn from the DC bus [J]: the drives' inputs, inverter losses included."""
+        return self.net_energy
 
     def summary(self) -> dict[str, object]:
         """The numbers of ``simulation.json`` for this run."""
@@ -162,7 +175,11 @@ class ClosedLoopRun:
             "plant": self.plant,
             "dc_bus_energy_J": self.bus_energy,
             "dc_bus_energy_difference_percent": 100.0 * (self.bus_energy / self.predicted_net_energy - 1.0),
-            "inverter_loss_J": 0.0 if self.inverter_energy is None else float(self.inverter_energy.sum()),
+            "inverter_loss_J": _total(self.inverter_energy),
+            "motor_terminal_energy_J": _total(self.terminal_energy),
+            "transmission_loss_J": _total(self.transmission_loss),
+            "brake_coil_energy_J": _total(self.brake_coil_energy),
+            "brake_carried_energy_J": _total(self.brake_carried),
             "drive_train_loss_J": 0.0 if self.drive_train_loss is None else float(self.drive_train_loss.sum()),
             "joint_friction_loss_J": self.friction_loss,
             "winding_temperature_C": None
@@ -171,7 +188,16 @@ class ClosedLoopRun:
             "cycles": list(self.cycles),
             "bandwidth_check": dict(self.bandwidth_check),
             "settle_time_s": self.settle_time_s,
+            "predicted_net_electrical_energy_5ms_grid_J": self.resampled_prediction,
+            "energy_difference_to_5ms_grid_percent": None
+            if self.resampled_prediction is None
+            else 100.0 * (self.net_energy / self.resampled_prediction - 1.0),
         }
+
+
+def _total(values: Array | None) -> float:
+    """Sum over the drives [J] (0 when not logged)."""
+    return 0.0 if values is None else float(np.sum(values))
 
 
 def _trapezoid(y: Array, t: Array) -> float:
@@ -198,7 +224,7 @@ def run_closed_loop(
     design = replace(design, gains=gains or design.gains)
     drives = DriveArrays.from_params(plan.emlas)
     run = run_environment(env, design, drives, plan.design, payload_error, plan, progress, plant, cycles)
-    return run, env.physics
+    return replace(run, resampled_prediction=resampled_prediction(plan, env.task.motion)), env.physics
 
 
 def run_environment(
@@ -229,7 +255,7 @@ def run_environment(
             physics.thermal.rest()
             physics.drives.drives = replace(physics.drives.drives, resistance=physics.thermal.resistance())
         log = _one_cycle(env, physics, controller, steps, progress)
-        bus = float(physics.energy.sum() + physics.inverter.sum())
+        bus = float(physics.energy.sum())
         temperature = None if physics.thermal is None else physics.thermal.temperature.copy()
         history.append(
             {
@@ -265,6 +291,10 @@ def run_environment(
         wall_time=wall,
         plant="ideal" if plant is None else plant.name,
         inverter_energy=physics.inverter.copy(),
+        terminal_energy=physics.terminal.copy(),
+        transmission_loss=physics.transmission_loss.copy(),
+        brake_coil_energy=physics.brake_coil.copy(),
+        brake_carried=physics.brake_carried.copy(),
         drive_train_loss=physics.drive_train_loss.copy(),
         friction_loss=float(physics.friction_loss),
         winding_temperature=None if physics.thermal is None else physics.thermal.temperature.copy(),

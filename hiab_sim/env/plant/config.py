@@ -137,7 +137,11 @@ class Sensors:
 
 @dataclass(frozen=True)
 class CurrentLoop:
-    """The current loop in discrete time at the inverter's rate, with dead time and inverter losses.
+    """The current loop in discrete time at the inverter's rate, with the inverter's dead time.
+
+    The inverter's conduction, switching and standby losses are not plant data: they are the EMLA
+    file's ``drive_losses`` (:func:`hiab_sim.emla.losses.inverter_loss`), charged in every closed loop
+    (:mod:`hiab_sim.env.drive_losses`), so the planner and the plant count them once, the same way.
 
     Attributes:
         enabled: Model the discrete loop (off: the continuous loop of :mod:`hiab_sim.emla.drive_sim`).
@@ -146,10 +150,6 @@ class CurrentLoop:
         bandwidth_Hz: Current-loop bandwidth w_c / 2 pi of the PI design [Hz] > 0, < rate_Hz / 4.
         dead_time_s: Dead time t_d of each inverter leg [s] >= 0, < 0.1 / rate_Hz.
         dc_link_voltage_V: V_dc [V] > 0; the dead-time voltage error is (4/pi) t_d f_s V_dc.
-        threshold_voltage_V: Conduction threshold V_0 of a switch [V] >= 0: (6/pi) V_0 |i_dq| [W].
-        on_resistance_ohm: On-resistance R_on of a switch [ohm] >= 0: 3/2 R_on |i_dq|^2 [W].
-        switching_loss_W_per_A: Switching loss per ampere of |i_dq| at V_dc and f_s [W/A] >= 0.
-        constant_loss_W: Gate drives and control electronics [W] >= 0.
 
     """
 
@@ -158,10 +158,6 @@ class CurrentLoop:
     bandwidth_Hz: float
     dead_time_s: float
     dc_link_voltage_V: float
-    threshold_voltage_V: float
-    on_resistance_ohm: float
-    switching_loss_W_per_A: float
-    constant_loss_W: float
 
     def __post_init__(self) -> None:
         _check(
@@ -172,10 +168,6 @@ class CurrentLoop:
                 "bandwidth_Hz": (1.0, self.rate_Hz / 4.0 if math.isfinite(self.rate_Hz) else None, "Hz"),
                 "dead_time_s": (0.0, 0.1 / self.rate_Hz if math.isfinite(self.rate_Hz) else None, "s"),
                 "dc_link_voltage_V": (1.0, None, "V"),
-                "threshold_voltage_V": (0.0, None, "V"),
-                "on_resistance_ohm": (0.0, None, "ohm"),
-                "switching_loss_W_per_A": (0.0, None, "W/A"),
-                "constant_loss_W": (0.0, None, "W"),
             },
         )
 

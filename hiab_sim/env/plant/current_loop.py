@@ -1,4 +1,4 @@
-"""The drives' current loops in discrete time at the inverter's rate, with dead time and inverter losses.
+"""The drives' current loops in discrete time at the inverter's rate, with the inverter's dead time.
 
 Per drive and PWM period T_s = 1 / f_s (f_s h periods per physics step, the speed omega_m held):
 
@@ -14,11 +14,12 @@ Per drive and PWM period T_s = 1 / f_s (f_s h periods per physics step, the spee
   of :func:`hiab_sim.emla.drive_sim.plant_step`), at T_s and T_s / 2.
 
 Energies per period: electrical int 3/2 v.i dt exact for the held (applied) voltage; copper
-3/2 R_s int |i|^2 dt and the torque by Simpson's rule (start, middle, end); the inverter's loss
-P_inv = c_0 + ((6/pi) V_0 + k_sw) |i_dq| + 3/2 R_on |i_dq|^2 (conduction through a threshold V_0
-and an on-resistance R_on of three legs, switching proportional to the current) by Simpson's rule.
-The DC bus supplies the electrical energy plus the inverter's loss. With a rising f_s the loop
-tends to the continuous one of :mod:`hiab_sim.emla.drive_sim` (the tests check it).
+3/2 R_s int |i|^2 dt and the torque by Simpson's rule (start, middle, end). The inverter's loss is
+the EMLA file's (:func:`hiab_sim.emla.losses.inverter_loss`, charged by :mod:`hiab_sim.env.drive_losses`
+as for the continuous loop): the step hands over |i_dq| at the start, middle and end of every period
+with Simpson's weights, so the loss follows the current's ripple within the step. The plant holds no
+inverter-loss data of its own (one loss model, the planner's). With a rising f_s the loop tends to
+the continuous one of :mod:`hiab_sim.emla.drive_sim` (the tests check it).
 """
 
 from __future__ import annotations
@@ -93,7 +94,12 @@ class DiscreteCurrentLoop(DriveSimulator):
         self.x_q = np.zeros(len(drives.names))
         self.pending_d = np.zeros(len(drives.names))
         self.pending_q = np.zeros(len(drives.names))
-        self.linear_loss = (6.0 / math.pi) * loop.threshold_voltage_V + loop.switching_loss_W_per_A
+        # Simpson's weights of the nodes start, middle, end of every period (shared ends added up) [s].
+        weights = np.zeros(2 * self.periods + 1)
+        weights[0:-1:2] += self.period / 6.0
+        weights[1::2] += 4.0 * self.period / 6.0
+        weights[2::2] += self.period / 6.0
+        self.sample_weights = weights
 
     def reset(self, i_d: ArrayLike, i_q: ArrayLike) -> None:
         """Set the currents; integrators and the pending voltage at the steady state at rest."""
@@ -113,7 +119,8 @@ class DiscreteCurrentLoop(DriveSimulator):
         errors = self.sensor.sample(self.periods)
         noise_d = self.sensor.sample(self.periods) - self.sensor.offset if self.sensor.enabled else errors
         n = len(d.names)
-        out = {key: np.zeros(n) for key in ("id", "iq", "vd", "vq", "energy", "copper", "torque", "inverter")}
+        out = {key: np.zeros(n) for key in ("id", "iq", "vd", "vq", "energy", "copper", "torque")}
+        samples = np.zeros((n, 2 * self.periods + 1))
         saturated = np.zeros(n, dtype=bool)
         loop = self.loop
         T = self.period
@@ -139,7 +146,9 @@ class DiscreteCurrentLoop(DriveSimulator):
             x_d, x_q = float(self.x_d[j]), float(self.x_q[j])
             pend_d, pend_q = float(self.pending_d[j]), float(self.pending_q[j])
             ref = float(ref_q[j])
-            energy = copper = torque = inverter = 0.0
+            energy = copper = torque = 0.0
+            row = samples[j]
+            row[0] = math.hypot(i_d, i_q)
             sat = False
             va_d = va_q = 0.0
             for k in range(self.periods):
@@ -172,20 +181,12 @@ class DiscreteCurrentLoop(DriveSimulator):
                 copper += 1.5 * r * squares
                 products = T * (i_d * i_q + 4.0 * mid_d * mid_q + end_d * end_q) / 6.0
                 torque += 1.5 * p * (flux * int_q + (ld - lq) * products)
-                magnitude = T * (math.sqrt(s0) + 4.0 * math.sqrt(sm) + math.sqrt(s1)) / 6.0
-                inverter += (
-                    loop.constant_loss_W * T + self.linear_loss * magnitude + 1.5 * loop.on_resistance_ohm * squares
-                )
+                row[2 * k + 1], row[2 * k + 2] = math.sqrt(sm), math.sqrt(s1)
                 i_d, i_q = end_d, end_q
             self.x_d[j], self.x_q[j] = x_d, x_q
             self.pending_d[j], self.pending_q[j] = pend_d, pend_q
             out["id"][j], out["iq"][j], out["vd"][j], out["vq"][j] = i_d, i_q, va_d, va_q
-            out["energy"][j], out["copper"][j], out["torque"][j], out["inverter"][j] = (
-                energy,
-                copper,
-                torque / h,
-                inverter,
-            )
+            out["energy"][j], out["copper"][j], out["torque"][j] = energy, copper, torque / h
             saturated[j] = sat
         self.i_d, self.i_q = out["id"], out["iq"]
         friction = d.coulomb * np.tanh(omega / d.smoothing)
@@ -201,5 +202,6 @@ class DiscreteCurrentLoop(DriveSimulator):
             rod_force=d.ratio * (out["torque"] - friction),
             current_limited=np.abs(requested) >= limit,
             voltage_limited=saturated,
-            inverter_energy=out["inverter"],
+            current_samples=samples,
+            sample_weights=self.sample_weights,
         )

@@ -46,6 +46,11 @@ def _value_and_source(raw: Any, key: str) -> tuple[Any, str]:
 #: Keys that moved out of the plant file, with where they live now.
 _MOVED: dict[str, str] = {
     "drive_train.axial_stiffness_N_per_m": "the EMLA file's drive_stiffness section (hiab_sim.emla.drive_stiffness)",
+    **{
+        f"current_loop.{name}": "the EMLA file's drive_losses section (inverter_constant_loss, inverter_current_loss, "
+        "inverter_resistance; hiab_sim.emla.losses)"
+        for name in ("threshold_voltage_V", "on_resistance_ohm", "switching_loss_W_per_A", "constant_loss_W")
+    },
 }
 
 
@@ -54,7 +59,7 @@ def _read_section(cls: type, node: Any, where: str, provenance: list[tuple[str, 
     for key, home in _MOVED.items():
         section, name = key.split(".")
         if where == section and isinstance(node, Mapping) and name in node:
-            raise ConfigError(f"{key}: the drive train's stiffness is read from {home}; remove it from the plant file")
+            raise ConfigError(f"{key}: the plant reads this from {home}; remove it from the plant file")
     hints = typing.get_type_hints(cls)
     data = mapping(node, where, set(hints), {n for n in hints if n != "seed"})
     values: dict[str, Any] = {}
