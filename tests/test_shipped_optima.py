@@ -1,8 +1,10 @@
 """Every shipped study (optimize/*.yaml) reaches its recorded optimum: Xi within 1e-8 m, energies 1e-9, same iterations.
 
 The optima are tests/data/shipped_optima.json: main's before the one study path, and under
-``changed`` the deliberate changes and added studies since with their reason (the duty mix holds
-its Xi-only rows once; seed_faithful is new).
+``changed`` the deliberate changes and added studies since with their reason (among them every
+study on the real drive: the XS 031's default EMLA file and the excavator's with their losses on;
+seed_faithful keeps the paper's lossless model). Record a deliberate change with
+``python scripts/shipped_optima.py record REASON DIR...``.
 """
 
 from __future__ import annotations

@@ -9,10 +9,10 @@ first). At standstill the motor-shaft torque that holds it is tau_h = f_x / k, k
   carries no current. The brake must hold, |tau_h| <= M_4 at the first and the last pose
   (``brake_margin`` = 1 - max |tau_h| / M_4 >= 0). Its coil is energised while the motor moves
   (P_coil over the whole cycle, unless the drive losses of :mod:`hiab_sim.emla.losses` already
-  count it sample by sample: ``brake_coil_power`` > 0 there) and de-energised during the rest. Each period has one release and one
-  engagement: before moving, the motor takes the first pose's load and the coil is energised for the
-  release (opening) time t_2; after the motion the motor holds the last pose for the engage (closing)
-  time t_1 until the brake has closed. Transition energy at the drive:
+  count it sample by sample: ``brake_coil_power`` > 0 there) and de-energised during the rest.
+  Each period has one release and one engagement: before moving, the motor takes the first pose's
+  load and the coil is energised for the release (opening) time t_2; after the motion the motor holds
+  the last pose for the engage (closing) time t_1 until the brake has closed. Transition energy at the drive:
   E_tr = (P_coil + P_cu(tau_first) + P_inv(tau_first)) t_2 + (P_cu(tau_last) + P_inv(tau_last)) t_1.
   The powered drive keeps its standby loss c_0 during the rest.
 * ``hold: motor``: the motor holds the last pose through the rest: torque tau_h, copper loss

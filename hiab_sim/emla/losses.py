@@ -15,7 +15,8 @@ so tau_t omega_m = f_sm v_x / eta_fwd forward and f_sm v_x eta_back backdriven, 
 tau_tr omega_m = |f_sm v_x| (1/eta_fwd - 1) or (1 - eta_back) is never negative. At standstill the
 loss torque is 0: a holding torque f_sm / k lies between the backdriving and forward torques, so
 it holds (standstill is |omega_m| <= 1e-9 omega_eps, round-off of a zero speed included). Smooth form:
-sign(omega_m) -> tanh(omega_m / omega_eps) (the rotor friction's regularisation) and |f_sm| -> sqrt(f_sm^2 + f_eps^2); the loss power stays >= 0 because a >= |b|.
+sign(omega_m) -> tanh(omega_m / omega_eps) (the rotor friction's regularisation) and
+|f_sm| -> sqrt(f_sm^2 + f_eps^2); the loss power stays >= 0 because a >= |b|.
 
 Inverter loss (DC side minus motor terminals), with the phase current amplitude I = |i_q| (i_d = 0):
 
