@@ -5,6 +5,7 @@ lengths Xi within 1e-8 m, the energies within 1e-9 relative and the same number 
 
     python scripts/shipped_optima.py check DIR...           # the recorded optima, deliberate changes included
     python scripts/shipped_optima.py check-baseline DIR...  # main's optima before the change
+    python scripts/shipped_optima.py record REASON DIR...   # record the folders' optima under ``changed``
 
 Each DIR is a result folder written by ``hiab-sim optimize optimize/<study>.yaml --out DIR``; the
 study is the folder's ``name`` field in result.json. The file holds main's optima (recorded on
@@ -75,8 +76,25 @@ def expected(name: str, baseline: bool = False) -> dict[str, Any]:
     return dict(data["main_8440d36"][name])
 
 
+def record(reason: str, folders: list[Path]) -> None:
+    """Write each folder's optimum under ``changed`` with ``reason`` (a deliberate change: say why it moved)."""
+    if not reason.strip() or Path(reason).exists():
+        raise SystemExit("record needs the reason of the change first, then the result folders")
+    data = json.loads(EXPECTED.read_text())
+    for folder in folders:
+        result = json.loads((folder / "result.json").read_text())
+        if result["solver"].get("success") is False:
+            raise SystemExit(f"{folder}: the solver did not converge; an optimum that was not reached is not recorded")
+        data["changed"][result["name"]] = {**summary(result), "reason": reason}
+        print(f"{result['name']}: recorded ({summary(result)['iterations']} iterations)")
+    EXPECTED.write_text(json.dumps(data, indent=1) + "\n")
+
+
 def main(argv: list[str]) -> int:
-    """Check result folders (module docstring); ``check-baseline`` compares with main's optima only."""
+    """Check or record result folders (module docstring); ``check-baseline`` compares with main's optima only."""
+    if argv and argv[0] == "record":
+        record(argv[1], [Path(a) for a in argv[2:]])
+        return 0
     mode, folders = argv[0], [Path(a) for a in argv[1:]]
     results = {}
     for folder in folders:

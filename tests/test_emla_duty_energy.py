@@ -81,6 +81,22 @@ def test_paper_model_brake_hold_adds_the_coil_over_the_cycle() -> None:
     assert d.power - d.reference_power == pytest.approx(np.full(t.size, 21.6), rel=1e-14)
 
 
+def test_default_brake_coil_is_counted_once_over_the_cycle() -> None:
+    """Default file: the brake closes only at rest; the coil's 21.6 W is in every cycle sample once, not twice."""
+    from dataclasses import replace
+
+    from hiab_sim.emla.model import electrical_power
+
+    t, f, v, a = _samples()
+    assert not LIFT.losses.brake_on
+    no_coil = replace(LIFT, losses=replace(LIFT.losses, brake_coil_power=0.0))
+    coil = electrical_power(LIFT, f, v, a) - electrical_power(no_coil, f, v, a)
+    assert coil == pytest.approx(np.full(t.size, 21.6), rel=1e-12)
+    d = drive_duty(LIFT, t, f, v, a, DutyOptions(Duty(6.25, 53.75), "brake", hot=False))
+    assert d.hold is not None and d.hold.cycle_coil_energy == 0.0
+    assert d.power == pytest.approx(d.reference_power, rel=1e-14)
+
+
 def test_brake_hold_needs_brake_data() -> None:
     """hold: brake on an EMLA without a holding_brake section is one line naming the field."""
     t, f, v, a = _samples()

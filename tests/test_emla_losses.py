@@ -101,6 +101,18 @@ def test_exact_transmission_loss_follows_the_forward_and_backdriving_efficiencie
     np.testing.assert_allclose(op.transmission_loss, expected, rtol=1e-13)
 
 
+def test_exact_power_at_standstill_does_not_depend_on_the_sign_of_round_off() -> None:
+    """A rest's speed is zero to round-off (+-1e-16 m/s): the exact power there is the holding one at v = 0."""
+    params = dataclasses.replace(EMLAS.lift, losses=dataclasses.replace(ON, brake_speed=0.0))
+    f = np.full(3, 3e4)
+    p = electrical_power(params, f, np.array([-4e-16, 0.0, 3e-16]), 0.0, exact=True)
+    np.testing.assert_allclose(p, p[1], rtol=1e-12)  # the smooth rotor friction moves it by 1e-15
+    # at v = 0 the motor holds f / k: its copper and inverter loss and the released coil, no transmission loss
+    i = 3e4 / params.transmission_ratio / params.motor.torque_constant
+    hold = 1.5 * params.motor.stator_resistance * i * i + 20.0 + 4.0 * i + 0.075 * i * i + 15.0
+    assert p[1] == pytest.approx(hold, rel=1e-12)
+
+
 def test_smooth_losses_converge_to_the_exact_ones_away_from_standstill() -> None:
     """Away from standstill |P_smooth - P_exact| <= c1 i_eps (+ tanh tails), and -> 0 with the smoothing widths."""
     f = np.array([3e4, -3e4, 2e4, -1e4])

@@ -1,8 +1,10 @@
 """Every shipped study (optimize/*.yaml) reaches its recorded optimum: Xi within 1e-8 m, energies 1e-9, same iterations.
 
 The optima are tests/data/shipped_optima.json: main's before the one study path, and under
-``changed`` the deliberate changes and added studies since with their reason (the duty mix holds
-its Xi-only rows once; seed_faithful is new).
+``changed`` the deliberate changes and added studies since with their reason (among them every
+study on the real drive: the XS 031's default EMLA file and the excavator's with their losses on;
+seed_faithful keeps the paper's lossless model). Record a deliberate change with
+``python scripts/shipped_optima.py record REASON DIR...``.
 """
 
 from __future__ import annotations
@@ -10,8 +12,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 from types import ModuleType
+from unittest.mock import ANY
 
 import pytest
+import yaml
 from script_helper import load_script
 
 from hiab_sim.study.run import run_study
@@ -31,6 +35,18 @@ def test_every_shipped_study_has_a_recorded_optimum() -> None:
     studies = {p.stem for p in (ROOT / "optimize").glob("*.yaml") if "\nname:" in "\n" + p.read_text()}
     crane_or_emla = {p.stem for p in (ROOT / "optimize").glob("*.yaml") if "chains:" in p.read_text()}
     assert set(STUDIES) == studies - crane_or_emla
+
+
+def test_payload_studys_emla_file_is_the_default_but_for_the_lifts_brake() -> None:
+    """optimize/emla_xs031_lift_brake70.yaml: the default EMLA file plus the lift's 70 N m brake, nothing else."""
+    variant = yaml.safe_load((ROOT / "optimize" / "emla_xs031_lift_brake70.yaml").read_text())
+    default = yaml.safe_load((ROOT / "hiab_sim" / "presets" / "emla_xs031.yaml").read_text())
+    lift = variant["actuators"]["lift"]
+    brake = lift.pop("holding_brake")
+    assert brake["holding_torque"]["value"] == 70.0
+    assert lift.pop("drive_losses") == {"brake_coil_power": brake["coil_power"] | {"source": ANY}}
+    assert brake["coil_power"]["value"] == pytest.approx(24.0 * 1.4, rel=1e-12)
+    assert variant == default
 
 
 @pytest.mark.slow

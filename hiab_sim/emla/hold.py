@@ -8,11 +8,11 @@ first). At standstill the motor-shaft torque that holds it is tau_h = f_x / k, k
 * ``hold: brake``: the spring-applied holding brake on the motor shaft carries the load, the motor
   carries no current. The brake must hold, |tau_h| <= M_4 at the first and the last pose
   (``brake_margin`` = 1 - max |tau_h| / M_4 >= 0). Its coil is energised while the motor moves
-  (P_coil over the whole cycle, unless the drive-loss brake of :mod:`hiab_sim.emla.losses` already
-  counts it sample by sample) and de-energised during the rest. Each period has one release and one
-  engagement: before moving, the motor takes the first pose's load and the coil is energised for the
-  release (opening) time t_2; after the motion the motor holds the last pose for the engage (closing)
-  time t_1 until the brake has closed. Transition energy at the drive:
+  (P_coil over the whole cycle, unless the drive losses of :mod:`hiab_sim.emla.losses` already
+  count it sample by sample: ``brake_coil_power`` > 0 there) and de-energised during the rest.
+  Each period has one release and one engagement: before moving, the motor takes the first pose's
+  load and the coil is energised for the release (opening) time t_2; after the motion the motor holds
+  the last pose for the engage (closing) time t_1 until the brake has closed. Transition energy at the drive:
   E_tr = (P_coil + P_cu(tau_first) + P_inv(tau_first)) t_2 + (P_cu(tau_last) + P_inv(tau_last)) t_1.
   The powered drive keeps its standby loss c_0 during the rest.
 * ``hold: motor``: the motor holds the last pose through the rest: torque tau_h, copper loss
@@ -60,7 +60,8 @@ class RestHold:
             pose) at R_s,ref [J], each to be scaled by R_s(T)/R_s,ref of its sample.
         transition_other_energy: Coil and inverter energy of the release and engagement beyond the
             standby already in ``rest_other_power`` [J].
-        cycle_coil_energy: P_coil T_cycle [J] when no sample-by-sample brake model counts it, else 0.
+        cycle_coil_energy: P_coil T_cycle [J] when the drive losses do not count the coil sample by
+            sample (``drive_losses.brake_coil_power`` 0), else 0.
         brake_margin: 1 - max(|tau_first|, |tau_last|) / M_4 [-] (``brake``; None for ``motor``).
         d_rest_copper_loss_ref: d c_r / d f_last [W/N].
         d_rest_other_power: d rest_other_power / d f_last [W/N].
@@ -162,7 +163,7 @@ def rest_hold(params: EmlaParams, mode: str, first_force: float, last_force: flo
         standby_power=standby,
         transition_copper_ref=(cu_first * t_rel, cu_last * t_eng),
         transition_other_energy=(brake.coil_power + inv_first - standby) * t_rel + (inv_last - standby) * t_eng,
-        cycle_coil_energy=0.0 if losses.brake_on else brake.coil_power * cycle_time,
+        cycle_coil_energy=0.0 if losses.brake_coil_power > 0.0 else brake.coil_power * cycle_time,
         brake_margin=1.0 - max(abs(tau_first), abs(tau_last)) / brake.holding_torque,
         d_rest_copper_loss_ref=0.0,
         d_rest_other_power=0.0,

@@ -14,8 +14,9 @@ with the loss torque
 so tau_t omega_m = f_sm v_x / eta_fwd forward and f_sm v_x eta_back backdriven, and the loss power
 tau_tr omega_m = |f_sm v_x| (1/eta_fwd - 1) or (1 - eta_back) is never negative. At standstill the
 loss torque is 0: a holding torque f_sm / k lies between the backdriving and forward torques, so
-it holds. Smooth form: sign(omega_m) -> tanh(omega_m / omega_eps) (the rotor friction's
-regularisation) and |f_sm| -> sqrt(f_sm^2 + f_eps^2); the loss power stays >= 0 because a >= |b|.
+it holds (standstill is |omega_m| <= 1e-9 omega_eps, round-off of a zero speed included). Smooth form:
+sign(omega_m) -> tanh(omega_m / omega_eps) (the rotor friction's regularisation) and
+|f_sm| -> sqrt(f_sm^2 + f_eps^2); the loss power stays >= 0 because a >= |b|.
 
 Inverter loss (DC side minus motor terminals), with the phase current amplitude I = |i_q| (i_d = 0):
 
@@ -51,6 +52,10 @@ from hiab_sim.checks import check_non_negative, check_positive
 from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
+
+#: Motor speeds below this fraction of omega_eps are standstill in the exact transmission loss: there the
+#: smooth form's tanh is below 1e-9, so exact and smooth agree; above round-off of a zero speed (~1e-12 rad/s).
+STANDSTILL_FRACTION = 1e-9
 
 
 def _efficiency(field: str, value: float) -> None:
@@ -150,7 +155,9 @@ def transmission_loss_torque(
     b = 0.5 * ((1.0 / ef - 1.0) - (1.0 - eb))
     f = screw_force
     if exact:
-        sgn = np.sign(motor_speed)
+        # standstill below STANDSTILL_FRACTION omega_eps: a rest of the trajectory is zero only to round-off
+        # (about 1e-12 rad/s), whose sign would pick the forward or the backdriving torque at random
+        sgn = np.where(np.abs(motor_speed) > STANDSTILL_FRACTION * omega_eps, np.sign(motor_speed), 0.0)
         tau = sgn / k * (a * np.abs(f) + b * f * sgn)
         return tau, sgn / k * (a * np.sign(f) + b * sgn), np.zeros_like(f)
     x = motor_speed / omega_eps
