@@ -272,9 +272,9 @@ def test_design_space_modules_hold_no_machine_names_as_literals() -> None:
     """No string constant of the sweep package or its three commands equals a name a shipped machine file gives."""
     import ast
 
-    from test_machine_names import PACKAGE, _shipped_names
+    from test_machine_names import PACKAGE, shipped_names
 
-    names = _shipped_names()
+    names = shipped_names()
     modules = [
         *sorted((PACKAGE / "sweep").glob("*.py")),
         *(PACKAGE / "cli" / f for f in ("energy_map.py", "pareto.py", "sweep.py")),

@@ -50,11 +50,15 @@ CRANE_MODEL = {
     "study/machines/crane_model.py": "the crane file as the study's machine: its fixed names and variables",
     "docs_site/field_specs/crane.py": "documents the crane file's fields, which are named after its chains",
     "docs_site/field_specs/study.py": "documents a crane study's per-chain fields (bounds, initial_lengths)",
+    "docs_site/results_data.py": "records the shipped XS 031 runs' fields for the results pages, by chain",
+    "docs_site/results_design_blocks.py": "renders the shipped XS 031 runs' design tables, by chain",
+    "docs_site/results_energy_blocks.py": "renders the shipped XS 031 runs' energy and thermal tables, by actuator",
+    "docs_site/results_format.py": "formats the shipped XS 031 runs' chain lengths for the results pages",
+    "docs_site/results_machine_blocks.py": "renders the XS 031 rows beside the excavator's on its results page",
 }
 #: (module, literal) pairs where the word has another meaning than the machine's name.
 OTHER_MEANING = {
     ("study/figures/optimisation.py", "alpha"): "matplotlib's opacity keyword",
-    ("sweep/map_output.py", "alpha"): "matplotlib's opacity keyword",
     ("study/references/csv_file.py", "telescope"): "a study key: a TCP file's held third coordinate",
     ("study/references/kinds.py", "telescope"): "a study key of the spiral and pick-and-place kinds",
     ("docs_site/field_specs/references.py", "telescope"): "documents that study key",

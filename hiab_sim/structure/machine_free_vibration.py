@@ -63,7 +63,8 @@ def machine_free_vibration_frequency(
         equality.solref = [2.0 * timestep, 1.0]
     targets = {a.name: a.target for a in spec.actuators}
     tree = inverse.tree
-    for k, name in enumerate(modes.actuator_names):
+    for k, chain in enumerate(machine.chains):  # the modes' actuator columns are in chain order
+        name = chain.name
         joint = spec.joint(targets[name])
         stiffness = float(modes.stiffness_N_per_m[0, k])
         stroke = float(qpos[0, inverse.model.joint(targets[name]).qposadr[0]])

@@ -129,28 +129,33 @@ def machine_natural_frequencies(
     tcp_force: ArrayLike | None = None,
     payload_kg: float = 0.0,
     mass: Array | None = None,
+    tracked: Sequence[str] | None = None,
 ) -> Modes:
     """Locked-rotor natural frequencies and mode shapes of a machine at static poses (T, n) (module docstring).
 
     Args:
         machine: The machine at the design ``inverse`` was built for (its TCP kinematics for a payload).
         inverse: One of the machine's inverse-dynamics paths at that design (bare mechanism).
-        emlas: EMLA set with ``screw`` and ``drive_stiffness`` data for every actuator, by chain name.
+        emlas: EMLA set with ``screw`` and ``drive_stiffness`` data for every actuator (its EMLA name).
         position: Joint samples (T, n) [rad, m] in ``machine.joint_names`` order.
         tcp_force: Force of the environment on the TCP in the world plane [N], (2,) or (T, 2), or None.
         payload_kg: Mass held rigidly at the TCP [kg] (its inertia; its weight belongs in ``tcp_force``).
         mass: Optional mass matrix (T, n, n) from another path (to compare paths).
+        tracked: The tracked coordinates beyond the TCP's x, y of the study (n - 2 names; default
+            ``tcp_angle`` for a three-joint machine): the TCP kinematics a payload's inertia needs.
 
     """
     q = np.atleast_2d(np.asarray(position, dtype=float))
     check_range("payload_kg", payload_kg, 0.0, unit="kg")
     force = None if tcp_force is None else np.asarray(tcp_force, dtype=float)
     jx = actuator_jacobian(inverse, q)
-    kin = TrackedKinematics(machine, ["tcp_angle"] * (len(machine.joint_names) - 2)) if payload_kg > 0.0 else None
+    extra = list(tracked) if tracked is not None else ["tcp_angle"] * (len(machine.joint_names) - 2)
+    kin = TrackedKinematics(machine, extra) if payload_kg > 0.0 else None
     M = mass_matrix(inverse, q, jx, payload_kg, kin) if mass is None else np.asarray(mass, dtype=float)
     zero = np.zeros_like(q)
     rest = inverse(q, zero, zero, tcp_force=force)
-    names = tuple(rest.names)
+    emla_of = {c.name: c.actuator.emla or c.name for c in machine.chains}
+    names = tuple(emla_of[name] for name in rest.names)  # the samples' chains by their EMLAs
     k = drive_stiffness(emlas, names, np.asarray(rest.stroke, dtype=float))
     K = np.einsum("tai,ta,taj->tij", jx, k, jx) + geometric_stiffness(inverse, q, jx, force)
     w2, shape = generalized_eigh(K, M)

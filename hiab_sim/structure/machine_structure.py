@@ -10,7 +10,8 @@ for a design of any machine file, from its inverse dynamics
 * buckling: a chain's screw is a column of its pin-to-pin length s = x0 + x (x0 = Lc0 + Lc, the
   retracted length of a triangle's or linkage's actuator, seed eq. ``qus_a``; a direct actuator's
   ``screw.retracted_length`` + x), P_cr of :func:`hiab_sim.structure.buckling.critical_load` and the
-  utilisation u = n f / P_cr (f > 0 pushes);
+  utilisation u = n f / P_cr (f > 0 pushes); a direct actuator whose screw gives no retracted length
+  has no column and is left out of the summary (the NLP's buckling rows refuse it by name);
 * the lowest locked-rotor natural frequency along the motion and over a grid of the working range
   (:mod:`hiab_sim.structure.machine_modes`), when every actuator has screw and drive-stiffness data.
 """
@@ -24,7 +25,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla.emla_set import EmlaSet
-from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.paths import MachineInverseDynamics
 from hiab_sim.machine.dynamics.planar import close_loops, frames, planar_bodies
@@ -82,19 +82,29 @@ def machine_pin_loads(machine: Machine, position: ArrayLike, pins: PinForces) ->
     return PinLoads(tuple(out), world, local)
 
 
-def column_lengths(machine: Machine, emlas: EmlaSet, names: Sequence[str], stroke: Array) -> Array:
-    """Pin-to-pin column length s (T, n_a) [m] of each actuator with screw data at the strokes (T, n_a)."""
+def emla_names(machine: Machine, chains: Sequence[str]) -> tuple[str, ...]:
+    """The EMLA (actuator) name of each named chain: its ``actuator.emla``, else the chain's name."""
+    of = {c.name: c.actuator.emla or c.name for c in machine.chains}
+    return tuple(of[name] for name in chains)
+
+
+def column_lengths(machine: Machine, emlas: EmlaSet, chains: Sequence[str], stroke: Array) -> Array:
+    """Pin-to-pin column length s (T, n_a) [m] of each chain's actuator with screw data at the strokes (T, n_a).
+
+    NaN where an actuator has no column: no ``screw`` section, or a direct actuator whose screw
+    gives no ``retracted_length`` (its column's zero-stroke length is then unknown).
+    """
     by_chain = {chain.name: chain for chain in machine.chains}
     by_name = {p.name: p for p in emlas}
     out = np.full(stroke.shape, np.nan)
-    for k, name in enumerate(names):
-        screw = by_name[name].screw
+    for k, (name, emla) in enumerate(zip(chains, emla_names(machine, chains), strict=True)):
+        screw = by_name[emla].screw
         if screw is None:
             continue
         chain = by_chain[name]
         if chain.kind == "direct":
             if screw.retracted_length is None:
-                raise InvalidInputError(f"{name}.screw.retracted_length", None, "a direct actuator needs it", "m")
+                continue
             x0 = screw.retracted_length
         else:
             x0 = float(chain.actuator.piston_offset or 0.0) + float(chain.actuator.rod_length or 0.0)
@@ -110,21 +120,25 @@ def machine_buckling(
     force: Array,
     safety_factor: float = DEFAULT_SAFETY_FACTOR,
 ) -> BucklingSamples:
-    """Buckling utilisation of every actuator with screw data, at strokes and forces (T, n_a) [m, N]."""
+    """Buckling utilisation of every actuator with screw data, at strokes and forces (T, n_a) [m, N].
+
+    ``names``: the chains in sample order; the samples are named by their EMLAs.
+    """
     check_safety_factor(safety_factor)
     by_name = {p.name: p for p in emlas}
     length = column_lengths(machine, emlas, names, stroke)
-    cols = [k for k, name in enumerate(names) if by_name[name].screw is not None]
+    actuators = emla_names(machine, names)
+    cols = [k for k in range(len(actuators)) if np.all(np.isfinite(length[:, k]))]  # the actuators with a column
     loads = []
     for k in cols:
-        screw = by_name[names[k]].screw
+        screw = by_name[actuators[k]].screw
         assert screw is not None
         loads.append(critical_load(screw, length[:, k])[0])
     T = stroke.shape[0]
     load = np.stack(loads, axis=1) if loads else np.zeros((T, 0))
     push = force[:, cols]
     return BucklingSamples(
-        tuple(names[k] for k in cols), safety_factor, length[:, cols], load, push, safety_factor * push / load
+        tuple(actuators[k] for k in cols), safety_factor, length[:, cols], load, push, safety_factor * push / load
     )
 
 
@@ -136,6 +150,7 @@ def machine_design_structure(
     tcp_force: ArrayLike | None = None,
     safety_factor: float = DEFAULT_SAFETY_FACTOR,
     payload_kg: float = 0.0,
+    tracked: Sequence[str] | None = None,
 ) -> DesignStructure:
     """Structural summary of one machine design along its motion (module docstring).
 
@@ -147,6 +162,7 @@ def machine_design_structure(
         tcp_force: Force of the environment on the TCP [N], world (x, y[, z]) (only x, y act), (3,) or (T, 3).
         safety_factor: Buckling safety factor n [-].
         payload_kg: Mass held at the TCP for the frequencies [kg] (its weight is in ``tcp_force``).
+        tracked: The study's tracked coordinates beyond the TCP's x, y (the payload's kinematics).
 
     """
     force = None if tcp_force is None else np.asarray(tcp_force, dtype=float)[..., :2]
@@ -172,10 +188,12 @@ def machine_design_structure(
     }
     trajectory_Hz = grid_Hz = None
     if has_stiffness(emlas):
-        on_path = machine_natural_frequencies(machine, inverse, emlas, joints.position, force, payload_kg)
+        on_path = machine_natural_frequencies(
+            machine, inverse, emlas, joints.position, force, payload_kg, tracked=tracked
+        )
         trajectory_Hz = float(np.min(on_path.lowest_Hz))
         poses = machine_working_range_poses(machine, WORKING_GRID_PER_JOINT)
-        grid = machine_natural_frequencies(machine, inverse, emlas, poses, largest(force), payload_kg)
+        grid = machine_natural_frequencies(machine, inverse, emlas, poses, largest(force), payload_kg, tracked=tracked)
         grid_Hz = float(np.min(grid.lowest_Hz))
     return DesignStructure(
         pins=pins,

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from hiab_sim.emla.emla_set import EmlaSet
+from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.dynamics.paths import make_machine_dynamics
 from hiab_sim.structure.buckling import critical_load
 from hiab_sim.structure.machine_modes import machine_natural_frequencies
@@ -54,6 +55,12 @@ class MachineBucklingRows(PerSampleBlock):
         by_name = {p.name: p for p in emlas}
         names = model.actuator_names
         self.columns = tuple(k for k, name in enumerate(names) if by_name[name].screw is not None)
+        for k in self.columns:
+            chain, screw = model.machine.chains[k], by_name[names[k]].screw
+            if chain.kind == "direct" and screw is not None and screw.retracted_length is None:
+                raise InvalidInputError(
+                    f"{names[k]}.screw.retracted_length", None, "a direct actuator's buckling row needs it", "m"
+                )
         self.screws = tuple(by_name[names[k]].screw for k in self.columns)
         self.sample_rows = tuple(f"{names[k]} push <= P_cr / n" for k in self.columns)
 
@@ -64,7 +71,7 @@ class MachineBucklingRows(PerSampleBlock):
         margins = model.stroke_margins(state.lengths, q)
         dq_m, dxi_m = model.stroke_margin_partials(state.lengths, q)
         stroke_row = {name: 3 * c for c, name in enumerate(model.stroke_chains)}
-        chains = {c.name: c for c in machine.chains}
+        chains = {c.actuator.emla or c.name: c for c in machine.chains}  # by EMLA (actuator) name
         K, n, nxi = q.shape[0], q.shape[1], len(model.design_names)
         s = np.zeros((K, len(self.columns)))
         ds_dq = np.zeros((K, len(self.columns), n))
@@ -80,7 +87,7 @@ class MachineBucklingRows(PerSampleBlock):
                 s[:, r] = screw.retracted_length + q[:, j]
                 ds_dq[:, r, j] = 1.0
                 continue
-            row = stroke_row[name]
+            row = stroke_row[chain.name]
             x0 = float(chain.actuator.piston_offset or 0.0) + float(chain.actuator.rod_length or 0.0)
             s[:, r] = x0 + margins[:, row]
             ds_dq[:, r] = dq_m[:, row]
@@ -227,7 +234,9 @@ class MachineFrequencyRows(_DifferencedRows):
         machine = self.model.machine_at(design)
         inverse = make_machine_dynamics(machine, None, "newton_euler")
         force = None if self.tcp_force is None else self.tcp_force[:, :2]
-        modes = machine_natural_frequencies(machine, inverse, self.emlas, position, force, self.payload_kg)
+        modes = machine_natural_frequencies(
+            machine, inverse, self.emlas, position, force, self.payload_kg, tracked=self.model.extra
+        )
         return (modes.lowest_Hz / self.minimum - 1.0)[:, None]
 
     def relaxation(self, values: Array) -> Relaxation:

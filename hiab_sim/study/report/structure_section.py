@@ -32,6 +32,7 @@ def structure_section(fine: TaskProblem, checks: dict[str, DesignCheck]) -> Stru
                 fine.tcp_force,
                 fine.study.structure.buckling_safety_factor,
                 fine.task.payload.mass,
+                tracked=fine.model.extra,
             )
             continue
         out[name] = design_structure(
