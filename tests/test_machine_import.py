@@ -209,6 +209,13 @@ UNSUPPORTED = {
         dict(extra='<equality><weld name="glue" body1="arm" body2="boom"/></equality>'),
         "equality 'glue' (weld)",
     ),
+    "flex": (
+        dict(
+            extra='<deformable><flex name="sheet" dim="2" body="boom arm bucket" vertex="0 0 0 0 0 0 0 0 0" '
+            'element="0 1 2"/></deformable>'
+        ),
+        "flex 'sheet'",
+    ),
 }
 
 
@@ -216,7 +223,7 @@ UNSUPPORTED = {
 def test_every_unsupported_construct_exits_2_with_one_line_naming_it_and_writes_nothing(
     case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """Ball joints, tendons, two slides in a loop, an unlocked slewing hinge, a loop without a slide, a weld: exit 2."""
+    """Ball joints, tendons, flexes, two slides in one loop, an unlocked slewing hinge, a slideless loop, welds."""
     kwargs, needle = UNSUPPORTED[case]
     locks = [] if case == "slewing joint not locked" else ["--lock", "slew=0.3"]
     status, output = _run_import(tmp_path, handmade_mjcf(**kwargs), "--tcp", "teeth", *locks)
