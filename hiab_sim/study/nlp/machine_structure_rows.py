@@ -30,6 +30,7 @@ from hiab_sim.structure.machine_modes import machine_natural_frequencies
 from hiab_sim.structure.machine_structure import machine_pin_loads
 from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.machines.machine_model import MachineModel
+from hiab_sim.study.nlp.differenced_rows import DifferencedRows
 from hiab_sim.study.nlp.interface import Array, PerSampleBlock, Relaxation, SamplePartials, SampleRows, SampleState
 
 
@@ -127,49 +128,7 @@ class MachineBucklingRows(PerSampleBlock):
         return SampleRows(-factor * (df_dq - ratio * dP_dq), -factor * (df_dxi - ratio * dP_dxi))
 
 
-class _DifferencedRows(PerSampleBlock):
-    """Rows g(design, q, dq, ddq) per sample with central-difference partials in q9 and the design."""
-
-    step: float
-    model: MachineModel
-    uses_rates: bool = True
-
-    def _rows(self, design: Any, position: Array, velocity: Array, acceleration: Array) -> Array:
-        raise NotImplementedError
-
-    def values(self, state: SampleState) -> Array:
-        """The rows per sample, sample-major."""
-        j = state.joints
-        return self._rows(state.lengths, j.position, j.velocity, j.acceleration).ravel()
-
-    def jacobian(self, state: SampleState, partials: SamplePartials) -> SampleRows:
-        """Central differences in each of q9 (all samples at once; rates only if they enter) and the design."""
-        j = state.joints
-        q9 = np.concatenate([j.position, j.velocity, j.acceleration], axis=1)
-        K, n, r = q9.shape[0], j.position.shape[1], len(self.sample_rows)
-        dq = np.zeros((K, r, 3 * n))
-        for k in range(3 * n if self.uses_rates else n):
-            h = self.step * np.maximum(1.0, np.abs(q9[:, k]))
-            up, down = q9.copy(), q9.copy()
-            up[:, k] += h
-            down[:, k] -= h
-            rows_up = self._rows(state.lengths, up[:, :n], up[:, n : 2 * n], up[:, 2 * n :])
-            rows_down = self._rows(state.lengths, down[:, :n], down[:, n : 2 * n], down[:, 2 * n :])
-            dq[:, :, k] = (rows_up - rows_down) / (2.0 * h[:, None])
-        values = state.lengths.as_array()
-        dxi = np.zeros((K, r, len(values)))
-        for k in range(len(values)):
-            h = self.step * max(1.0, abs(values[k]))
-            plus, minus = values.copy(), values.copy()
-            plus[k] += h
-            minus[k] -= h
-            rows_up = self._rows(self.model.design(plus), j.position, j.velocity, j.acceleration)
-            rows_down = self._rows(self.model.design(minus), j.position, j.velocity, j.acceleration)
-            dxi[:, :, k] = (rows_up - rows_down) / (2.0 * h)
-        return SampleRows(dq, dxi)
-
-
-class MachinePinLoadRows(_DifferencedRows):
+class MachinePinLoadRows(DifferencedRows):
     """1 - |F_p| / F_max per limited pin and sample (Newton-Euler pin forces of the machine)."""
 
     def __init__(
@@ -205,7 +164,7 @@ class MachinePinLoadRows(_DifferencedRows):
         return Relaxation(("kN",) * len(g), (1.0 - g) * 1e3 / limit)
 
 
-class MachineFrequencyRows(_DifferencedRows):
+class MachineFrequencyRows(DifferencedRows):
     """f_1(q_k, design) / f_min - 1 per sample: the lowest locked-rotor frequency at the sample's pose."""
 
     uses_rates = False

@@ -18,18 +18,19 @@ Each block is a :class:`~hiab_sim.study.nlp.interface.PerSampleBlock` (the same 
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.crane.description import Crane
 from hiab_sim.emla import EmlaSet
 from hiab_sim.results.design_values import crane_lengths
 from hiab_sim.structure.buckling import buckled_actuators, buckling_samples, utilisation_partials
 from hiab_sim.structure.natural_frequency import natural_frequencies
 from hiab_sim.structure.pin_loads import pin_forces, pins
 from hiab_sim.structure.settings import StructureSettings
+from hiab_sim.study.nlp.differenced_rows import DifferencedRows
 from hiab_sim.study.nlp.interface import (
-    N_Q,
-    N_XI,
     Array,
     PerSampleBlock,
     Relaxation,
@@ -82,7 +83,7 @@ class BucklingRows(PerSampleBlock):
         return SampleRows(-du_dq, -du_dxi)
 
 
-class PinLoadRows(PerSampleBlock):
+class PinLoadRows(DifferencedRows):
     """1 - |F_p| / F_max per limited pin and sample (analytic pin forces)."""
 
     def __init__(
@@ -98,14 +99,9 @@ class PinLoadRows(PerSampleBlock):
         self.step = step
         self.sample_rows = tuple(f"{name} |F| <= {value:.6g} N" for name, value in limits)
 
-    def _rows(self, lengths: LinkLengths, position: Array, velocity: Array, acceleration: Array) -> Array:
-        loads = pin_forces(self.crane, lengths, position, velocity, acceleration, self.tcp_force)
+    def _rows(self, design: Any, position: Array, velocity: Array, acceleration: Array) -> Array:
+        loads = pin_forces(self.crane, crane_lengths(design), position, velocity, acceleration, self.tcp_force)
         return 1.0 - loads.magnitude[:, self.index] / self.limit
-
-    def values(self, state: SampleState) -> Array:
-        """1 - |F| / F_max per sample, sample-major."""
-        j = state.joints
-        return self._rows(crane_lengths(state.lengths), j.position, j.velocity, j.acceleration).ravel()
 
     def relaxation(self, values: Array) -> Relaxation:
         """Per kN of a pin's rating: d(1 - |F| / F_max)/dF_max = (1 - g) / F_max, times 1e3 N."""
@@ -113,35 +109,11 @@ class PinLoadRows(PerSampleBlock):
         limit = np.tile(self.limit, len(g) // len(self.limit))
         return Relaxation(("kN",) * len(g), (1.0 - g) * 1e3 / limit)
 
-    def jacobian(self, state: SampleState, partials: SamplePartials) -> SampleRows:
-        """Central differences in each of q9 (all samples at once) and Xi."""
-        j = state.joints
-        q9 = np.concatenate([j.position, j.velocity, j.acceleration], axis=1)
-        K, r = q9.shape[0], len(self.sample_rows)
-        dq = np.zeros((K, r, N_Q))
-        for k in range(N_Q):
-            h = self.step * np.maximum(1.0, np.abs(q9[:, k]))
-            up, down = q9.copy(), q9.copy()
-            up[:, k] += h
-            down[:, k] -= h
-            rows_up = self._rows(crane_lengths(state.lengths), up[:, 0:3], up[:, 3:6], up[:, 6:9])
-            rows_down = self._rows(crane_lengths(state.lengths), down[:, 0:3], down[:, 3:6], down[:, 6:9])
-            dq[:, :, k] = (rows_up - rows_down) / (2.0 * h[:, None])
-        xi = state.lengths.as_array()
-        dxi = np.zeros((K, r, N_XI))
-        for k in range(N_XI):
-            h = self.step * max(1.0, abs(xi[k]))
-            plus, minus = xi.copy(), xi.copy()
-            plus[k] += h
-            minus[k] -= h
-            rows_up = self._rows(LinkLengths.from_array(plus), j.position, j.velocity, j.acceleration)
-            rows_down = self._rows(LinkLengths.from_array(minus), j.position, j.velocity, j.acceleration)
-            dxi[:, :, k] = (rows_up - rows_down) / (2.0 * h)
-        return SampleRows(dq, dxi)
 
-
-class NaturalFrequencyRows(PerSampleBlock):
+class NaturalFrequencyRows(DifferencedRows):
     """f_1(q_k, Xi) / f_min - 1 per sample: the lowest locked-rotor frequency at the sample's pose."""
+
+    uses_rates = False
 
     def __init__(
         self,
@@ -163,45 +135,16 @@ class NaturalFrequencyRows(PerSampleBlock):
         self.step = step
         self.sample_rows = (f"lowest frequency >= {minimum_Hz:.6g} Hz",)
 
-    def _rows(self, lengths: LinkLengths, position: Array) -> Array:
+    def _rows(self, design: Any, position: Array, velocity: Array, acceleration: Array) -> Array:
         modes = natural_frequencies(
-            self.crane, self.emlas, lengths, position, self.tcp_force, payload_kg=self.payload_kg
+            self.crane, self.emlas, crane_lengths(design), position, self.tcp_force, payload_kg=self.payload_kg
         )
-        return modes.lowest_Hz / self.minimum - 1.0
-
-    def values(self, state: SampleState) -> Array:
-        """f_1 / f_min - 1 per sample."""
-        return self._rows(crane_lengths(state.lengths), state.joints.position)
+        return (modes.lowest_Hz / self.minimum - 1.0)[:, None]
 
     def relaxation(self, values: Array) -> Relaxation:
         """Per Hz of the minimum lowered: d(f / f_min - 1)/d(-f_min) = (1 + g) / f_min."""
         g = np.asarray(values, dtype=float)
         return Relaxation(("Hz",) * len(g), (1.0 + g) / self.minimum)
-
-    def jacobian(self, state: SampleState, partials: SamplePartials) -> SampleRows:
-        """Central differences in each position (all samples at once) and in Xi; rates do not enter."""
-        q = state.joints.position
-        K = q.shape[0]
-        dq = np.zeros((K, 1, N_Q))
-        for k in range(q.shape[1]):
-            h = self.step * np.maximum(1.0, np.abs(q[:, k]))
-            up, down = q.copy(), q.copy()
-            up[:, k] += h
-            down[:, k] -= h
-            dq[:, 0, k] = (
-                self._rows(crane_lengths(state.lengths), up) - self._rows(crane_lengths(state.lengths), down)
-            ) / (2.0 * h)
-        xi = state.lengths.as_array()
-        dxi = np.zeros((K, 1, N_XI))
-        for k in range(N_XI):
-            h = self.step * max(1.0, abs(xi[k]))
-            plus, minus = xi.copy(), xi.copy()
-            plus[k] += h
-            minus[k] -= h
-            dxi[:, 0, k] = (
-                self._rows(LinkLengths.from_array(plus), q) - self._rows(LinkLengths.from_array(minus), q)
-            ) / (2.0 * h)
-        return SampleRows(dq, dxi)
 
 
 def structure_blocks(
