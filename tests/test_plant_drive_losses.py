@@ -2,14 +2,19 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from hiab_sim.emla import load_emla_set
 from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator
+from hiab_sim.emla.emla_set import EmlaSet
 from hiab_sim.env.drive_losses import DriveLossModel
 
-EMLAS = load_emla_set()  # emla_xs031.yaml: eta_fwd 0.87, eta_back 0.862, brake below 1 mm/s, 21.6 W coil
+EMLAS = load_emla_set()  # emla_xs031.yaml: eta_fwd 0.87, eta_back 0.862, 21.6 W coil, brake only between cycles
 LOSSES = DriveLossModel(EMLAS)
+#: The same drives with the brake engaging inside the cycle below 1 mm/s (the EMLA file's earlier setting).
+BRAKED = EmlaSet(*(replace(p, losses=replace(p.losses, brake_speed=1e-3)) for p in EMLAS), battery=EMLAS.battery)
 SPEED = np.array([300.0, -200.0, 150.0])  # motor speeds [rad/s], far from the friction smoothing (1 rad/s)
 
 
@@ -41,18 +46,24 @@ def test_the_rotor_inertia_is_outside_the_transmission() -> None:
 def test_the_dc_input_balances_the_terminals_inverter_coil_and_brake() -> None:
     """E_dc = E_motor + E_inverter + E_coil - E_carried, with the brake released while moving and engaged at rest.
 
-    Moving (1 m/s): the coil draws 21.6 W over the step and nothing is carried. At rest: no coil, the
-    motor's whole terminal energy is the brake's, and the inverter draws its standby c0 = 20 W only.
+    The shipped file closes the brake only between cycles: at a standstill inside the cycle the coil
+    still draws 21.6 W and nothing is carried. With the brake engaging below 1 mm/s: moving (1 m/s),
+    the coil draws 21.6 W over the step and nothing is carried; at rest no coil, the motor's whole
+    terminal energy is the brake's, and the inverter draws its standby c0 = 20 W only.
     """
     drives = DriveSimulator(DriveArrays.from_params(EMLAS), 500.0)
     drives.reset(0.0, [20.0, -10.0, 5.0])
     h = 1e-3
     step = drives.step(np.array([20.0, -10.0, 5.0]), SPEED, h)
-    dc, inverter, coil, carried = LOSSES.dc_energy(step, np.ones(3), h)
+    dc, _, coil, carried = LOSSES.dc_energy(step, np.zeros(3), h)  # the shipped file: no brake in the cycle
+    np.testing.assert_allclose(coil, 21.6 * h)  # the coil stays energised at a standstill inside the cycle
+    np.testing.assert_allclose(carried, 0.0, atol=1e-12)
+    braked = DriveLossModel(BRAKED)
+    dc, inverter, coil, carried = braked.dc_energy(step, np.ones(3), h)
     np.testing.assert_allclose(coil, 21.6 * h)
     np.testing.assert_allclose(carried, 0.0, atol=1e-12)
     np.testing.assert_allclose(dc, step.electrical_energy + inverter + coil, rtol=1e-12)
-    dc, inverter, coil, carried = LOSSES.dc_energy(step, np.zeros(3), h)
+    dc, inverter, coil, carried = braked.dc_energy(step, np.zeros(3), h)
     np.testing.assert_allclose(coil, 0.0)
     np.testing.assert_allclose(carried, step.electrical_energy, rtol=1e-12)
     np.testing.assert_allclose(inverter, 20.0 * h, rtol=1e-12)
