@@ -32,7 +32,7 @@ from hiab_sim.machine.dynamics.tree import PinForces, machine_tree, pin_layout
 from hiab_sim.structure.buckling import DEFAULT_SAFETY_FACTOR, BucklingSamples, check_safety_factor, critical_load
 from hiab_sim.structure.machine_modes import machine_natural_frequencies, machine_working_range_poses
 from hiab_sim.structure.pin_loads import Pin, PinLoads
-from hiab_sim.structure.summary import BucklingSummary, DesignStructure, PinSummary, has_stiffness, largest
+from hiab_sim.structure.summary import DesignStructure, buckling_summaries, has_stiffness, largest, pin_summaries
 
 Array = NDArray[np.float64]
 
@@ -168,24 +168,10 @@ def machine_design_structure(
     force = None if tcp_force is None else np.asarray(tcp_force, dtype=float)[..., :2]
     out = inverse(joints.position, joints.velocity, joints.acceleration, tcp_force=force)
     loads = machine_pin_loads(machine, joints.position, out.pins)
-    peak_index = np.argmax(loads.magnitude, axis=0)
-    direction = loads.direction[peak_index, np.arange(len(loads.pins))]
-    peak, vector, magnitude = loads.peak(), loads.vector_range(), loads.magnitude_range()
-    pins = {
-        pin.name: PinSummary(peak[pin.name], vector[pin.name], magnitude[pin.name], float(direction[k]))
-        for k, pin in enumerate(loads.pins)
-    }
+    pins = pin_summaries(loads)
     names = tuple(out.names)
     b = machine_buckling(machine, emlas, names, np.asarray(out.stroke), np.asarray(out.force), safety_factor)
-    buckling = {
-        name: BucklingSummary(
-            float(np.max(b.utilisation[:, k])),
-            float(max(0.0, np.max(b.force[:, k]))),
-            float(np.min(b.critical_load[:, k])),
-            float(np.max(b.length[:, k])),
-        )
-        for k, name in enumerate(b.names)
-    }
+    buckling = buckling_summaries(b)
     trajectory_Hz = grid_Hz = None
     if has_stiffness(emlas):
         on_path = machine_natural_frequencies(

@@ -24,9 +24,9 @@ from numpy.typing import ArrayLike, NDArray
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla.config import EmlaSet
-from hiab_sim.structure.buckling import DEFAULT_SAFETY_FACTOR, buckling_samples
+from hiab_sim.structure.buckling import DEFAULT_SAFETY_FACTOR, BucklingSamples, buckling_samples
 from hiab_sim.structure.natural_frequency import natural_frequencies, working_range_poses
-from hiab_sim.structure.pin_loads import analytic_pin_loads
+from hiab_sim.structure.pin_loads import PinLoads, analytic_pin_loads
 
 Array = NDArray[np.float64]
 
@@ -83,6 +83,30 @@ def has_stiffness(emlas: EmlaSet) -> bool:
     return all(p.screw is not None and p.stiffness is not None for p in emlas)
 
 
+def pin_summaries(loads: PinLoads) -> dict[str, PinSummary]:
+    """Each pin's peak, vector and magnitude ranges [N] and the peak's direction in its bracket frame [rad]."""
+    peak_index = np.argmax(loads.magnitude, axis=0)
+    direction = loads.direction[peak_index, np.arange(len(loads.pins))]
+    peak, vector, magnitude = loads.peak(), loads.vector_range(), loads.magnitude_range()
+    return {
+        pin.name: PinSummary(peak[pin.name], vector[pin.name], magnitude[pin.name], float(direction[k]))
+        for k, pin in enumerate(loads.pins)
+    }
+
+
+def buckling_summaries(b: BucklingSamples) -> dict[str, BucklingSummary]:
+    """Each screw's largest utilisation [-], largest push [N], smallest P_cr [N] and longest column [m]."""
+    return {
+        name: BucklingSummary(
+            float(np.max(b.utilisation[:, k])),
+            float(max(0.0, np.max(b.force[:, k]))),
+            float(np.min(b.critical_load[:, k])),
+            float(np.max(b.length[:, k])),
+        )
+        for k, name in enumerate(b.names)
+    }
+
+
 def design_structure(
     crane: Crane,
     emlas: EmlaSet,
@@ -101,23 +125,8 @@ def design_structure(
     in ``tcp_force``).
     """
     loads = analytic_pin_loads(crane, lengths, joints, tcp_force)
-    peak_index = np.argmax(loads.magnitude, axis=0)
-    direction = loads.direction[peak_index, np.arange(len(loads.pins))]
-    peak, vector, magnitude = loads.peak(), loads.vector_range(), loads.magnitude_range()
-    pins = {
-        pin.name: PinSummary(peak[pin.name], vector[pin.name], magnitude[pin.name], float(direction[k]))
-        for k, pin in enumerate(loads.pins)
-    }
-    b = buckling_samples(crane, emlas, lengths, joints.position, force, safety_factor)
-    buckling = {
-        name: BucklingSummary(
-            float(np.max(b.utilisation[:, k])),
-            float(max(0.0, np.max(b.force[:, k]))),
-            float(np.min(b.critical_load[:, k])),
-            float(np.max(b.length[:, k])),
-        )
-        for k, name in enumerate(b.names)
-    }
+    pins = pin_summaries(loads)
+    buckling = buckling_summaries(buckling_samples(crane, emlas, lengths, joints.position, force, safety_factor))
     trajectory_Hz = grid_Hz = None
     if has_stiffness(emlas):
         external = None if tcp_force is None else np.asarray(tcp_force, dtype=float)

@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
@@ -28,6 +29,7 @@ from hiab_sim.study.analysis.buildable import rounded_design
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.report.design_check import design_summary, other_path
 from hiab_sim.study.report.weighted import weighted_summary
+from hiab_sim.study.spec.study import Study
 
 Array = np.ndarray
 
@@ -48,23 +50,15 @@ def mjcf_command(study_crane: str, stroke_margin: float, lengths: LinkLengths) -
     return f"hiab-sim mjcf --crane {study_crane} --stroke-margin {stroke_margin:g} --lengths {xi}"
 
 
-def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, crane_label: str) -> Buildable:
-    """Round the optimum z to the study's tolerance and re-check it (module docstring)."""
-    study = problem.study
-    t, margin = study.build.tolerance, study.build.stroke_margin
-    rounded, z_rounded = rounded_point(problem, z)
-    short = buildable_crane(study.crane, margin)
-    try:
-        mechanism.check_lengths(short, rounded)
-        crane_check = RoundedCheck(True, "check_lengths over the buildable working range", 0.0, "m")
-    except InvalidInputError as error:
-        crane_check = RoundedCheck(False, str(error), float("nan"), "m")
-    lengths = crane_lengths(problem.unpack(z)[0])
-    tol = check_tolerance(design_margins(short, study.mounting), lengths, t)
-    label, row, value = tol.worst()
-    tolerance_check = RoundedCheck(tol.ok, f"{row} at the {label} design", value, "m")
+def rounded_recheck(problem: StudyProblem, study: Study, z_rounded: Array) -> tuple[StudyProblem, Any, RoundedCheck]:
+    """The fine-grid re-check of a rounded design z_rounded on the other ID path: its problem, summary and check.
+
+    ``study`` is the one the re-check's nominal rows come from (a crane file's with its buildable
+    range); every task on its fine grid, the energy weighted by the tasks' weights, the violation the
+    worst over the tasks (passed at <= 1e-6 scaled).
+    """
     fine = StudyProblem(
-        replace(study, crane_description=short),
+        study,
         emlas=problem.emlas,
         id_path=other_path(problem.id_path),
         tightened=False,
@@ -81,6 +75,25 @@ def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, c
         summary.max_violation,
         "scaled max violation",
     )
+    return fine, summary, recheck
+
+
+def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, crane_label: str) -> Buildable:
+    """Round the optimum z to the study's tolerance and re-check it (module docstring)."""
+    study = problem.study
+    t, margin = study.build.tolerance, study.build.stroke_margin
+    rounded, z_rounded = rounded_point(problem, z)
+    short = buildable_crane(study.crane, margin)
+    try:
+        mechanism.check_lengths(short, rounded)
+        crane_check = RoundedCheck(True, "check_lengths over the buildable working range", 0.0, "m")
+    except InvalidInputError as error:
+        crane_check = RoundedCheck(False, str(error), float("nan"), "m")
+    lengths = crane_lengths(problem.unpack(z)[0])
+    tol = check_tolerance(design_margins(short, study.mounting), lengths, t)
+    label, row, value = tol.worst()
+    tolerance_check = RoundedCheck(tol.ok, f"{row} at the {label} design", value, "m")
+    fine, summary, recheck = rounded_recheck(problem, replace(study, crane_description=short), z_rounded)
     return Buildable(
         tolerance_m=t,
         stroke_margin_m=margin,

@@ -27,8 +27,7 @@ from hiab_sim.results.schema import DesignSummary
 from hiab_sim.study.analysis.buildable import buildable_working_range, rounded_values
 from hiab_sim.study.machines.machine_model import MachineModel
 from hiab_sim.study.nlp.problem import StudyProblem
-from hiab_sim.study.report.design_check import design_summary, other_path
-from hiab_sim.study.report.weighted import weighted_summary
+from hiab_sim.study.report.buildable_section import rounded_recheck
 
 Array = np.ndarray
 
@@ -83,25 +82,7 @@ def machine_buildable_section(problem: StudyProblem, z: Array, optimum: DesignSu
         if m < worst[0]:
             worst = (m, name, where)
     tolerance_check = RoundedCheck(worst[0] >= 0.0, f"{worst[1]} at the {worst[2]} design", worst[0], "m")
-    fine = StudyProblem(
-        study,
-        emlas=problem.emlas,
-        id_path=other_path(problem.id_path),
-        tightened=False,
-        fine=True,
-        cost_scales=[p.cost_scale for p in problem.problems],
-    )
-    z_rounded = problem.with_lengths(z, rounded)
-    names = [task.name for task in study.tasks]
-    summaries = [design_summary(p, fine.task_z(z_rounded, k)).summary for k, p in enumerate(fine.problems)]
-    summary = weighted_summary(summaries, fine.weights, names)
-    worst_row = summary.worst_constraint
-    recheck = RoundedCheck(
-        summary.max_violation <= 1e-6,
-        worst_row.name if worst_row is not None else "none",
-        summary.max_violation,
-        "scaled max violation",
-    )
+    fine, summary, recheck = rounded_recheck(problem, study, problem.with_lengths(z, rounded))
     full = model.joint_ranges()
     given_up: dict[str, tuple[float, ...]] = {
         chain: (math.degrees(r[0] - full[j][0]), math.degrees(full[j][1] - r[1]))
