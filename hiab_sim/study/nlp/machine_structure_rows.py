@@ -32,6 +32,7 @@ from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.machines.machine_model import MachineModel
 from hiab_sim.study.nlp.differenced_rows import DifferencedRows
 from hiab_sim.study.nlp.interface import Array, PerSampleBlock, Relaxation, SamplePartials, SampleRows, SampleState
+from hiab_sim.study.nlp.structure_rows import buckling_relaxation, frequency_relaxation, pin_load_relaxation
 
 
 def _retracted_partials(model: MachineModel, chain: Any) -> Array:
@@ -108,8 +109,7 @@ class MachineBucklingRows(PerSampleBlock):
 
     def relaxation(self, values: Array) -> Relaxation:
         """Per % of the buckling load: (1 - g)(1 - 1 / 1.01), as the crane's rows."""
-        g = np.asarray(values, dtype=float)
-        return Relaxation(("%",) * len(g), (1.0 - g) * (1.0 - 1.0 / 1.01))
+        return buckling_relaxation(values)
 
     def jacobian(self, state: SampleState, partials: SamplePartials) -> SampleRows:
         """-du/dq (positions, rates, accelerations) and -du/dXi (exact; module docstring)."""
@@ -159,9 +159,7 @@ class MachinePinLoadRows(DifferencedRows):
 
     def relaxation(self, values: Array) -> Relaxation:
         """Per kN of a pin's rating: (1 - g) 1e3 / F_max."""
-        g = np.asarray(values, dtype=float)
-        limit = np.tile(self.limit, len(g) // len(self.limit))
-        return Relaxation(("kN",) * len(g), (1.0 - g) * 1e3 / limit)
+        return pin_load_relaxation(values, self.limit)
 
 
 class MachineFrequencyRows(DifferencedRows):
@@ -200,8 +198,7 @@ class MachineFrequencyRows(DifferencedRows):
 
     def relaxation(self, values: Array) -> Relaxation:
         """Per Hz of the minimum lowered: (1 + g) / f_min."""
-        g = np.asarray(values, dtype=float)
-        return Relaxation(("Hz",) * len(g), (1.0 + g) / self.minimum)
+        return frequency_relaxation(values, self.minimum)
 
 
 def machine_structure_blocks(

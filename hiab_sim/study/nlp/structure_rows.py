@@ -40,6 +40,24 @@ from hiab_sim.study.nlp.interface import (
 )
 
 
+def buckling_relaxation(values: Array) -> Relaxation:
+    """Per % of the buckling load: 1 - n f / (1.01 P_cr) - (1 - n f / P_cr) = (1 - g)(1 - 1 / 1.01)."""
+    g = np.asarray(values, dtype=float)
+    return Relaxation(("%",) * len(g), (1.0 - g) * (1.0 - 1.0 / 1.01))
+
+
+def pin_load_relaxation(values: Array, limit: Array) -> Relaxation:
+    """Per kN of a pin's rating: d(1 - |F| / F_max)/dF_max = (1 - g) / F_max, times 1e3 N (``limit`` per pin)."""
+    g = np.asarray(values, dtype=float)
+    return Relaxation(("kN",) * len(g), (1.0 - g) * 1e3 / np.tile(limit, len(g) // len(limit)))
+
+
+def frequency_relaxation(values: Array, minimum: float) -> Relaxation:
+    """Per Hz of the minimum lowered: d(f / f_min - 1)/d(-f_min) = (1 + g) / f_min."""
+    g = np.asarray(values, dtype=float)
+    return Relaxation(("Hz",) * len(g), (1.0 + g) / minimum)
+
+
 class BucklingRows(PerSampleBlock):
     """1 - n f / P_cr per actuator with screw data and sample (:mod:`hiab_sim.structure.buckling`)."""
 
@@ -65,8 +83,7 @@ class BucklingRows(PerSampleBlock):
 
     def relaxation(self, values: Array) -> Relaxation:
         """Per % of the buckling load: 1 - n f / (1.01 P_cr) - (1 - n f / P_cr) = (1 - g)(1 - 1 / 1.01)."""
-        g = np.asarray(values, dtype=float)
-        return Relaxation(("%",) * len(g), (1.0 - g) * (1.0 - 1.0 / 1.01))
+        return buckling_relaxation(values)
 
     def jacobian(self, state: SampleState, partials: SamplePartials) -> SampleRows:
         """-du/dq9 and -du/dXi (exact P_cr partials, the ID's force partials)."""
@@ -105,9 +122,7 @@ class PinLoadRows(DifferencedRows):
 
     def relaxation(self, values: Array) -> Relaxation:
         """Per kN of a pin's rating: d(1 - |F| / F_max)/dF_max = (1 - g) / F_max, times 1e3 N."""
-        g = np.asarray(values, dtype=float)
-        limit = np.tile(self.limit, len(g) // len(self.limit))
-        return Relaxation(("kN",) * len(g), (1.0 - g) * 1e3 / limit)
+        return pin_load_relaxation(values, self.limit)
 
 
 class NaturalFrequencyRows(DifferencedRows):
@@ -143,8 +158,7 @@ class NaturalFrequencyRows(DifferencedRows):
 
     def relaxation(self, values: Array) -> Relaxation:
         """Per Hz of the minimum lowered: d(f / f_min - 1)/d(-f_min) = (1 + g) / f_min."""
-        g = np.asarray(values, dtype=float)
-        return Relaxation(("Hz",) * len(g), (1.0 + g) / self.minimum)
+        return frequency_relaxation(values, self.minimum)
 
 
 def structure_blocks(
