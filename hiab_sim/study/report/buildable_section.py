@@ -50,12 +50,12 @@ def mjcf_command(study_crane: str, stroke_margin: float, lengths: LinkLengths) -
     return f"hiab-sim mjcf --crane {study_crane} --stroke-margin {stroke_margin:g} --lengths {xi}"
 
 
-def rounded_recheck(problem: StudyProblem, study: Study, z_rounded: Array) -> tuple[StudyProblem, Any, RoundedCheck]:
-    """The fine-grid re-check of a rounded design z_rounded on the other ID path: its problem, summary and check.
+def rounded_recheck(problem: StudyProblem, study: Study, z_rounded: Array, optimum: DesignSummary) -> dict[str, Any]:
+    """The fine-grid re-check of a rounded design z_rounded on the other ID path: the ``Buildable`` fields it fills.
 
     ``study`` is the one the re-check's nominal rows come from (a crane file's with its buildable
     range); every task on its fine grid, the energy weighted by the tasks' weights, the violation the
-    worst over the tasks (passed at <= 1e-6 scaled).
+    worst over the tasks (passed at <= 1e-6 scaled), the energy change against ``optimum``'s.
     """
     fine = StudyProblem(
         study,
@@ -69,13 +69,19 @@ def rounded_recheck(problem: StudyProblem, study: Study, z_rounded: Array) -> tu
     summaries = [design_summary(p, fine.task_z(z_rounded, k)).summary for k, p in enumerate(fine.problems)]
     summary = weighted_summary(summaries, fine.weights, names)
     worst = summary.worst_constraint
-    recheck = RoundedCheck(
-        summary.max_violation <= 1e-6,
-        worst.name if worst is not None else "none",
-        summary.max_violation,
-        "scaled max violation",
-    )
-    return fine, summary, recheck
+    return {
+        "recheck": RoundedCheck(
+            summary.max_violation <= 1e-6,
+            worst.name if worst is not None else "none",
+            summary.max_violation,
+            "scaled max violation",
+        ),
+        "recheck_id_path": fine.id_path,
+        "recheck_grid_points": sum(len(p.times) for p in fine.problems),
+        "net_electrical_energy_J": summary.net_electrical_energy_J,
+        "drawn_energy_summed_drives_J": summary.drawn_energy_summed_drives_J,
+        "net_energy_change_vs_optimum_J": summary.net_electrical_energy_J - optimum.net_electrical_energy_J,
+    }
 
 
 def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, crane_label: str) -> Buildable:
@@ -93,7 +99,6 @@ def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, c
     tol = check_tolerance(design_margins(short, study.mounting), lengths, t)
     label, row, value = tol.worst()
     tolerance_check = RoundedCheck(tol.ok, f"{row} at the {label} design", value, "m")
-    fine, summary, recheck = rounded_recheck(problem, replace(study, crane_description=short), z_rounded)
     return Buildable(
         tolerance_m=t,
         stroke_margin_m=margin,
@@ -101,13 +106,8 @@ def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, c
         lengths=rounded,
         crane_check=crane_check,
         tolerance_check=tolerance_check,
-        recheck=recheck,
-        recheck_id_path=fine.id_path,
-        recheck_grid_points=sum(len(p.times) for p in fine.problems),
-        net_electrical_energy_J=summary.net_electrical_energy_J,
-        drawn_energy_summed_drives_J=summary.drawn_energy_summed_drives_J,
-        net_energy_change_vs_optimum_J=summary.net_electrical_energy_J - optimum.net_electrical_energy_J,
         mjcf_command=mjcf_command(crane_label, margin, rounded),
+        **rounded_recheck(problem, replace(study, crane_description=short), z_rounded, optimum),
     )
 
 

@@ -82,7 +82,6 @@ def machine_buildable_section(problem: StudyProblem, z: Array, optimum: DesignSu
         if m < worst[0]:
             worst = (m, name, where)
     tolerance_check = RoundedCheck(worst[0] >= 0.0, f"{worst[1]} at the {worst[2]} design", worst[0], "m")
-    fine, summary, recheck = rounded_recheck(problem, study, problem.with_lengths(z, rounded))
     full = model.joint_ranges()
     given_up: dict[str, tuple[float, ...]] = {
         chain: (math.degrees(r[0] - full[j][0]), math.degrees(full[j][1] - r[1]))
@@ -96,11 +95,6 @@ def machine_buildable_section(problem: StudyProblem, z: Array, optimum: DesignSu
         lengths=rounded,
         crane_check=stroke_check,
         tolerance_check=tolerance_check,
-        recheck=recheck,
-        recheck_id_path=fine.id_path,
-        recheck_grid_points=sum(len(p.times) for p in fine.problems),
-        net_electrical_energy_J=summary.net_electrical_energy_J,
-        drawn_energy_summed_drives_J=summary.drawn_energy_summed_drives_J,
-        net_energy_change_vs_optimum_J=summary.net_electrical_energy_J - optimum.net_electrical_energy_J,
         mjcf_command=f"hiab-sim mjcf --machine {label} --design {items}",
+        **rounded_recheck(problem, study, problem.with_lengths(z, rounded), optimum),
     )
