@@ -17,6 +17,7 @@ parabolic interpolation of the log magnitude around the peak bin).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import mujoco
 import numpy as np
@@ -44,6 +45,56 @@ def spectrum_peak_Hz(signal: ArrayLike, sample_time: float, pad: int = 64) -> fl
     a, b, c = np.log(magnitude[k - 1 : k + 2])
     shift = 0.5 * (a - c) / (a - 2.0 * b + c)
     return float((k + shift) / (n * sample_time))
+
+
+def spring_mounted_model(
+    spec: mujoco.MjSpec,
+    timestep: float,
+    actuators: Sequence[str],
+    stiffness: Array,
+    force: Array,
+    id_model: mujoco.MjModel,
+    qpos: Array,
+) -> mujoco.MjModel:
+    """The spec with a spring of stiffness k_a [N/m] on each named actuator's joint, pushing f_a [N] at ``qpos``.
+
+    RK4 at ``timestep`` [s], the loops' ``solref`` (2 dt, 1), and per actuator (in the columns' order of
+    ``stiffness`` and ``force``) ``springref`` = x_a + f_a / k_a with x_a its joint's coordinate in
+    ``qpos`` of ``id_model`` (the model the state was solved on; module docstring).
+    """
+    spec.option.timestep = timestep
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    for equality in spec.equalities:
+        equality.solref = [2.0 * timestep, 1.0]
+    targets = {a.name: a.target for a in spec.actuators}
+    for k, name in enumerate(actuators):
+        joint = spec.joint(targets[name])
+        k_a = float(stiffness[k])
+        stroke = float(qpos[id_model.joint(targets[name]).qposadr[0]])
+        joint.stiffness = [k_a, 0.0, 0.0]
+        joint.springref = stroke + float(force[k]) / k_a
+    return spec.compile()
+
+
+def modal_peak_Hz(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    weights: Array,
+    independent: Array,
+    q0: Array,
+    omega: float,
+    timestep: float,
+    periods: float,
+) -> float:
+    """Run the released model freely; the FFT peak [Hz] of the modal coordinate weights . (q_i - q0)."""
+    period = 2.0 * math.pi / omega
+    record_every = max(1, int(period / (40.0 * timestep)))
+    samples = int(periods * period / (record_every * timestep))
+    y = np.empty(samples)
+    for i in range(samples):
+        y[i] = weights @ (data.qpos[independent] - q0)
+        mujoco.mj_step(model, data, nstep=record_every)
+    return spectrum_peak_Hz(y, record_every * timestep)
 
 
 def free_vibration_frequency(
@@ -77,20 +128,11 @@ def free_vibration_frequency(
         load.mass = payload_kg
         load.ipos = [0.0, 0.0, 0.0]
         load.inertia = [1e-9, 1e-9, 1e-9]
-    spec.option.timestep = timestep
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_RK4
-    for equality in spec.equalities:
-        equality.solref = [2.0 * timestep, 1.0]
     inverse = MujocoInverseDynamics(crane, lengths)
     qpos, _, _ = inverse.state(JointSamples.at_rest(q0))
-    targets = {a.name: a.target for a in spec.actuators}
-    for k, name in enumerate(modes.actuator_names):
-        joint = spec.joint(targets[name])
-        stiffness = float(modes.stiffness_N_per_m[0, k])
-        stroke = float(qpos[0, inverse.model.joint(targets[name]).qposadr[0]])
-        joint.stiffness = [stiffness, 0.0, 0.0]
-        joint.springref = stroke + float(force[k]) / stiffness
-    model = spec.compile()
+    model = spring_mounted_model(
+        spec, timestep, modes.actuator_names, modes.stiffness_N_per_m[0], force, inverse.model, qpos[0]
+    )
     data = mujoco.MjData(model)
     data.qpos[:] = qpos[0]
     mujoco.mj_fwdPosition(model, data)
@@ -100,11 +142,4 @@ def free_vibration_frequency(
     mass, _ = mujoco_mass_matrix(crane, lengths, q0)
     weights = phi @ mass[0]  # the crane's M without the payload still picks this mode out
     independent = np.array([model.joint(name).qposadr[0] for name in JOINT_NAMES])
-    period = 2.0 * math.pi / omega
-    record_every = max(1, int(period / (40.0 * timestep)))
-    samples = int(periods * period / (record_every * timestep))
-    y = np.empty(samples)
-    for i in range(samples):
-        y[i] = weights @ (data.qpos[independent] - q0[0])
-        mujoco.mj_step(model, data, nstep=record_every)
-    return spectrum_peak_Hz(y, record_every * timestep)
+    return modal_peak_Hz(model, data, weights, independent, q0[0], omega, timestep, periods)

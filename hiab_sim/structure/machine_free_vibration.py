@@ -26,7 +26,7 @@ from hiab_sim.emla.emla_set import EmlaSet
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.mjcf_build import build_machine_spec
 from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
-from hiab_sim.structure.free_vibration import spectrum_peak_Hz
+from hiab_sim.structure.free_vibration import modal_peak_Hz, spring_mounted_model
 from hiab_sim.structure.machine_modes import actuator_jacobian, machine_natural_frequencies, mass_matrix, static_forces
 
 
@@ -56,33 +56,17 @@ def machine_free_vibration_frequency(
         [inverse.state(q0, np.eye(n)[i : i + 1], np.zeros_like(q0))[1][0] for i in range(n)], axis=1
     )  # (nv, n): full rates per unit independent rate
 
+    # the modes' actuator columns are in chain order, the spec's actuators named after the chains
+    chains = [chain.name for chain in machine.chains]
     spec = build_machine_spec(machine)
-    spec.option.timestep = timestep
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_RK4
-    for equality in spec.equalities:
-        equality.solref = [2.0 * timestep, 1.0]
-    targets = {a.name: a.target for a in spec.actuators}
-    tree = inverse.tree
-    for k, chain in enumerate(machine.chains):  # the modes' actuator columns are in chain order
-        name = chain.name
-        joint = spec.joint(targets[name])
-        stiffness = float(modes.stiffness_N_per_m[0, k])
-        stroke = float(qpos[0, inverse.model.joint(targets[name]).qposadr[0]])
-        joint.stiffness = [stiffness, 0.0, 0.0]
-        joint.springref = stroke + float(force[k]) / stiffness
-    model = spec.compile()
+    model = spring_mounted_model(spec, timestep, chains, modes.stiffness_N_per_m[0], force, inverse.model, qpos[0])
     data = mujoco.MjData(model)
     data.qpos[:] = qpos[0]
     rate = omega * stroke_amplitude / float(np.max(np.abs(modes.actuator_shape[0][:, mode])))
     data.qvel[:] = Z @ (phi * rate)
     mass = mass_matrix(inverse, q0, actuator_jacobian(inverse, q0))[0]
     weights = phi @ mass
+    tree = inverse.tree
     independent = np.array([model.joint(tree.bodies[b].joint).qposadr[0] for b in tree.independent])
-    period = 2.0 * math.pi / omega
-    record_every = max(1, int(period / (40.0 * timestep)))
-    samples = int(periods * period / (record_every * timestep))
-    y = np.empty(samples)
-    for i in range(samples):
-        y[i] = weights @ (data.qpos[independent] - q0[0])
-        mujoco.mj_step(model, data, nstep=record_every)
-    return spectrum_peak_Hz(y, record_every * timestep), float(modes.frequency_Hz[0, mode])
+    simulated = modal_peak_Hz(model, data, weights, independent, q0[0], omega, timestep, periods)
+    return simulated, float(modes.frequency_Hz[0, mode])
