@@ -160,12 +160,11 @@ def run_import(args: argparse.Namespace) -> int:
     """Import the MJCF, check it, print the round trip, then write the file (nothing written on failure)."""
     import sys
 
-    import yaml
-
     from hiab_sim.atomic_io import write_atomic
     from hiab_sim.machine.loader import machine_from_dict
     from hiab_sim.machine.mjcf_import.importer import UnsupportedMJCFError, import_mjcf
     from hiab_sim.machine.mjcf_import.round_trip import fit_ranges, machine_yaml, round_trip
+    from hiab_sim.yaml_fields import parse_yaml
 
     try:
         imported = import_mjcf(args.model, tcp=args.tcp, locks=_locks(args.lock), plane=args.plane)
@@ -176,7 +175,7 @@ def run_import(args: argparse.Namespace) -> int:
     machine = fit_ranges(imported)
     command = " ".join(["hiab-sim machine import", str(args.model), *(f"--lock {x}" for x in args.lock)])
     text = machine_yaml(imported, command + (f" --tcp {args.tcp}" if args.tcp else ""))
-    machine = machine_from_dict(yaml.safe_load(text), origin=str(args.output), check_assembly=False)  # as written
+    machine = machine_from_dict(parse_yaml(text), origin=str(args.output), check_assembly=False)  # as written
     failures = check_machine(machine)
     for failure in failures:
         print(f"hiab-sim machine import: FAIL {failure}", file=sys.stderr)

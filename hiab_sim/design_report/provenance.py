@@ -9,10 +9,9 @@ import subprocess
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
-import yaml
-
 from hiab_sim.design_report.page import section, table
 from hiab_sim.results.schema import RESULT_FILE, Result
+from hiab_sim.yaml_fields import parse_yaml
 
 PACKAGES = ("hiab-sim", "numpy", "scipy", "mujoco", "dm-control", "casadi")
 
@@ -53,7 +52,7 @@ def study_emla(result: Result) -> str:
     path = Path(result.study)
     if not path.is_file():
         return "unknown (the study file is no longer there)"
-    data = yaml.safe_load(path.read_text())
+    data = parse_yaml(path.read_text())
     return str(data.get("emla") or "default") if isinstance(data, dict) else "unknown"
 
 

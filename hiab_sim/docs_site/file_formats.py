@@ -8,7 +8,9 @@ loader accepts (:func:`hiab_sim.docs_site.probe.accepted_keys`).
 from __future__ import annotations
 
 import copy
+import dataclasses
 import re
+from collections.abc import Callable
 from typing import Any
 
 from hiab_sim.docs_site.field_specs import KEYS, Key
@@ -96,6 +98,32 @@ def _compare(fmt: FileFormat, keys: list[Key], form: Form | None) -> list[str]:
     return out
 
 
+def _memoized(load: Callable[[Any], object]) -> Callable[[Any], object]:
+    """``load`` that answers a document it has seen (same keys, order and values) from memory.
+
+    The probe loads the same document many times (once per mapping it checks, and the unchanged
+    documents each time); a loader is a function of its document, so its answer (success or the error
+    it raised) is the same each time.
+    """
+    seen: dict[str, HiabSimError | None] = {}
+
+    def load_once(document: Any) -> object:
+        key = repr(document)
+        if key not in seen:
+            try:
+                load(document)
+            except HiabSimError as error:
+                seen[key] = error
+                raise
+            seen[key] = None
+        error = seen[key]
+        if error is not None:
+            raise error
+        return None
+
+    return load_once
+
+
 def discrepancies(name: str) -> list[str]:
     """Where the documented keys of format ``name`` and the keys its loader accepts differ (empty: none).
 
@@ -104,6 +132,7 @@ def discrepancies(name: str) -> list[str]:
     for other forms only must make the loader fail when added to this form's documents.
     """
     fmt, keys = FORMATS[name], KEYS[name]()
+    fmt = dataclasses.replace(fmt, load=_memoized(fmt.load))
     out = []
     for form in fmt.forms or (None,):
         out += _compare(fmt, keys, form)

@@ -15,6 +15,7 @@ from typing import Any
 import yaml
 
 from hiab_sim.resources import Source, shipped, shipped_names
+from hiab_sim.yaml_fields import parse_yaml
 
 
 @dataclass(frozen=True)
@@ -47,7 +48,7 @@ class FileFormat:
 
 
 def _parsed(source: Source) -> Any:
-    return yaml.safe_load(source.read_text())
+    return parse_yaml(source.read_text())
 
 
 def _load_crane(document: Any) -> object:

@@ -26,7 +26,7 @@ from hiab_sim.machine.description import Link, Machine
 from hiab_sim.machine.kinematics.assembly import check_machine
 from hiab_sim.machine.parts import IDENTITY, Matrix3, Pose, RigidBody, Vector3, rot_z
 from hiab_sim.resources import Source, locate, shipped_names
-from hiab_sim.yaml_fields import integer, mapping, number, text, vector
+from hiab_sim.yaml_fields import SafeLoader, integer, mapping, number, parse_yaml, text, vector
 
 #: Shipped machines' names (files in hiab_sim/presets/, :mod:`hiab_sim.resources` kind ``machine``).
 PRESETS: tuple[str, ...] = tuple(shipped_names("machine"))
@@ -42,7 +42,7 @@ _BODY = {"mass", "com", "inertia", "inertia_zz"}
 _VARIABLE = {"kind", "pivot", "bounds"}
 
 
-class _UniqueKeyLoader(yaml.SafeLoader):
+class _UniqueKeyLoader(SafeLoader):  # type: ignore[misc,valid-type]
     """YAML safe loader that refuses a key given twice in one mapping (two links of one name)."""
 
 
@@ -62,7 +62,7 @@ _UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG,
 def read_machine_yaml(source: Source) -> Any:
     """Parse a machine file; malformed YAML or a duplicate key raises :class:`ConfigError`."""
     try:
-        return yaml.load(source.read_text(), Loader=_UniqueKeyLoader)  # a SafeLoader subclass
+        return parse_yaml(source.read_text(), _UniqueKeyLoader)
     except yaml.YAMLError as error:
         raise ConfigError(f"{source.label}: not valid YAML: {' '.join(str(error).split())}") from None
 
