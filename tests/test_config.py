@@ -150,6 +150,7 @@ def test_unknown_preset_is_a_config_error() -> None:
         load_crane("no-such-crane")
 
 
+@pytest.mark.e2e
 def test_cli_bad_crane_file_exits_2_without_traceback(tmp_path: Path) -> None:
     """The CLI prints the named-field message and exits with status 2, no traceback."""
     bad = tmp_path / "bad.yaml"
@@ -165,6 +166,7 @@ def test_cli_bad_crane_file_exits_2_without_traceback(tmp_path: Path) -> None:
     assert "Traceback" not in result.stderr
 
 
+@pytest.mark.e2e
 def test_cli_help_lists_subcommands_and_version() -> None:
     """--help lists every subcommand; --version prints the package version."""
     result = subprocess.run([sys.executable, "-m", "hiab_sim", "--help"], capture_output=True, text=True, check=True)

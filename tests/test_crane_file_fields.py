@@ -81,6 +81,7 @@ def test_non_positive_hydraulic_cylinder_size_is_rejected_naming_it(path: tuple[
     assert ".".join(map(str, path)) in str(error.value)
 
 
+@pytest.mark.e2e
 def test_cli_rejects_a_nan_cylinder_length_with_exit_2_and_writes_nothing(tmp_path: Path) -> None:
     """``hiab-sim mjcf --crane`` with ``pin_to_pin_at_zero: .nan`` exits 2, one line, no file written."""
     crane = tmp_path / "crane.yaml"

@@ -109,6 +109,7 @@ def test_voltage_limit_engages_at_high_speed_and_caps_the_current() -> None:
     assert errors[80] < errors[20] / 2.5 and errors[80] < 0.05
 
 
+@pytest.mark.sim
 def test_power_balance_of_a_drive_turning_a_rotor() -> None:
     """Electrical energy = load work + copper + rotor friction + kinetic and magnetic energy change, to 1e-5.
 

@@ -29,6 +29,7 @@ class CraneEnvironmentConformance(test_utils.EnvironmentTestMixin, absltest.Test
             yield motion.current[min(k, len(motion.time) - 1)]
 
 
+@pytest.mark.sim
 def test_closed_loop_energy_matches_the_steady_state_model() -> None:
     """Cascade control on the simulated drives draws the steady-state model's energy within 1 % and tracks to 0.5 mm.
 
@@ -43,6 +44,7 @@ def test_closed_loop_energy_matches_the_steady_state_model() -> None:
     assert np.all(run.current_limit_fraction == 0) and np.all(run.voltage_limit_fraction == 0)
 
 
+@pytest.mark.sim
 def test_heavier_end_mass_costs_energy_and_is_still_tracked() -> None:
     """With the end mass 20 % heavier than planned the cycle completes, tracked within 20 mm, at a higher energy."""
     plan = synthetic_plan(CRANE)

@@ -48,6 +48,7 @@ def plan(result: Path) -> MachinePlan:
     return read_machine_plan(result, "optimal")
 
 
+@pytest.mark.sim
 def test_excavator_closed_loop_tracks_the_plan_and_uses_its_energy(plan: MachinePlan) -> None:
     """Ideal plant = the planner's model: the energy within the CLI's 2 % and the TCP on the plan's path.
 
@@ -69,6 +70,7 @@ def test_excavator_closed_loop_tracks_the_plan_and_uses_its_energy(plan: Machine
     assert run.time[-1] == pytest.approx(plan.duration, abs=0.01)
 
 
+@pytest.mark.sim
 def test_load_mass_is_twice_the_kinetic_energy_of_a_unit_slide_rate(plan: MachinePlan) -> None:
     """m_L,a from G^T M G against mj_energyVel of the machine moving slide a at 1 m/s, the others held."""
     env = machine_environment(plan)
@@ -110,6 +112,7 @@ def _open_loop_drift(plan: MachinePlan, with_load: bool) -> float:
     return drift
 
 
+@pytest.mark.sim
 def test_the_tcp_load_holds_the_start_on_the_planners_model(plan: MachinePlan) -> None:
     """Feedforward current and the plan's TCP force hold the start pose in equilibrium; without the force it sags."""
     held = _open_loop_drift(plan, with_load=True)
@@ -118,6 +121,7 @@ def test_the_tcp_load_holds_the_start_on_the_planners_model(plan: MachinePlan) -
     assert unloaded > 100 * held
 
 
+@pytest.mark.sim
 def test_simulate_cli_on_a_machine_result(result: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "sim"
     code = main(["simulate", str(result), "--no-video", "--no-figures", "--quiet", "--out", str(out)])

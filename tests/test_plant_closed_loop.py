@@ -25,6 +25,7 @@ def _run(crane: Crane, plant, **kwargs):  # type: ignore[no-untyped-def]
     return run
 
 
+@pytest.mark.sim
 def test_ideal_plant_reproduces_todays_closed_loop_exactly(crane: Crane) -> None:
     """Every effect off gives the closed loop without a plant, sample for sample (energy, TCP error, currents)."""
     today = _run(crane, None)
@@ -35,6 +36,7 @@ def test_ideal_plant_reproduces_todays_closed_loop_exactly(crane: Crane) -> None
     assert ideal.gains == today.gains
 
 
+@pytest.mark.sim
 @pytest.mark.parametrize("effect", EFFECTS)
 def test_each_effect_alone_completes_the_cycle_and_tracks(crane: Crane, effect: str) -> None:
     """With one effect on, the cycle completes within 5 mm of the reference, costing -2 % to +80 % of today's energy."""
@@ -45,6 +47,7 @@ def test_each_effect_alone_completes_the_cycle_and_tracks(crane: Crane, effect: 
     assert -0.02 < run.bus_energy / today.net_energy - 1.0 < 0.8
 
 
+@pytest.mark.sim
 def test_each_effect_books_its_own_energy(crane: Crane) -> None:
     """Only the friction effect dissipates in the joints, only the drive train in its spring, and so on.
 
@@ -58,6 +61,7 @@ def test_each_effect_books_its_own_energy(crane: Crane) -> None:
     assert runs["joint_friction"].bus_energy > runs["drive_train"].bus_energy * 0.98
 
 
+@pytest.mark.sim
 def test_the_real_drive_closes_on_the_planners_energy(crane: Crane) -> None:
     """On emla_xs031.yaml's real drive the ideal closed loop draws the planner's energy at the drives' DC inputs.
 
@@ -78,6 +82,7 @@ def test_the_real_drive_closes_on_the_planners_energy(crane: Crane) -> None:
     assert real.net_energy > paper.net_energy
 
 
+@pytest.mark.sim
 def test_hot_windings_raise_copper_loss_by_the_resistance_factor(crane: Crane) -> None:
     """Windings started at 120 deg C carry the planned currents at R_ref (1 + 0.00393 (T - 20)): copper x 1.39.
 
@@ -114,6 +119,7 @@ def test_winding_temperature_matches_an_ode_solution() -> None:
         assert model.temperature[i] == pytest.approx(sol.y[0, -1], rel=1e-8)
 
 
+@pytest.mark.sim
 def test_cycles_carry_the_winding_temperature_over_the_rest(crane: Crane) -> None:
     """Three cycles with a 1 s rest: the windings warm cycle by cycle and the energy rises with R_s."""
     thermal = dataclasses.replace(REALISTIC.thermal, rest_between_cycles_s=1.0, initial_temperature_C=40.0)

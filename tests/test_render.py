@@ -89,6 +89,7 @@ def _saturated(image: np.ndarray) -> np.ndarray:
     return (rgb.max(axis=-1) - rgb.min(axis=-1)) > 60
 
 
+@pytest.mark.sim
 def test_clip_has_one_frame_per_tick_at_the_video_size(frames: np.ndarray) -> None:
     """A 1 s study at 12 fps gives 13 RGB frames of 320x240 (real-time playback)."""
     assert frames.shape == (FRAMES, SIZE[1], SIZE[0], 3)
@@ -96,6 +97,7 @@ def test_clip_has_one_frame_per_tick_at_the_video_size(frames: np.ndarray) -> No
     assert len(frame_times(np.array([0.0, DURATION]), FPS)) == FRAMES
 
 
+@pytest.mark.sim
 def test_frames_show_both_cranes(frames: np.ndarray) -> None:
     """Every frame is lit (not black); each half holds crane pixels, the right half's tinted green (optimal)."""
     half = SIZE[0] // 2
@@ -109,12 +111,14 @@ def test_frames_show_both_cranes(frames: np.ndarray) -> None:
         assert green_over_blue[1] - green_over_blue[0] > 20  # the right crane is the green one
 
 
+@pytest.mark.sim
 def test_consecutive_frames_differ_where_the_crane_moves(frames: np.ndarray) -> None:
     """The crane moves all along the trajectory, so every frame changes many pixels."""
     changed = np.any(frames[1:] != frames[:-1], axis=-1).sum(axis=(1, 2))
     assert np.all(changed > 200), changed
 
 
+@pytest.mark.sim
 def test_trail_follows_the_reference_in_mujoco_world(result_dir: Path) -> None:
     """The model's TCP site over the kinematic playback lies on the reference mapped (x, y, z) -> (x, -z, y)."""
     data = load_playback(result_dir)
@@ -125,6 +129,7 @@ def test_trail_follows_the_reference_in_mujoco_world(result_dir: Path) -> None:
             assert np.max(np.abs(design.tcp - reference)) < 2e-3
 
 
+@pytest.mark.sim
 def test_simulated_playback_tracks_the_plan(result_dir: Path) -> None:
     """Forward simulation under the inverse-dynamics forces keeps the TCP within 5 mm of the plan."""
     data = load_playback(result_dir)
@@ -135,6 +140,7 @@ def test_simulated_playback_tracks_the_plan(result_dir: Path) -> None:
                 assert np.max(np.linalg.norm(simulated.tcp - planned.tcp, axis=1)) < 5e-3
 
 
+@pytest.mark.sim
 def test_overlay_draws_both_designs_in_one_view(result_dir: Path) -> None:
     """Overlaid, one full-width view holds the opaque optimal crane and the ghost of the initial one."""
     with playback_renderer(load_playback(result_dir), fps=FPS, size=SIZE, layout="overlay") as renderer:
@@ -144,6 +150,7 @@ def test_overlay_draws_both_designs_in_one_view(result_dir: Path) -> None:
     assert _saturated(image[30:]).sum() > 600
 
 
+@pytest.mark.sim
 def test_stacked_layout_puts_one_design_above_the_other(result_dir: Path) -> None:
     """Stacked, the frame keeps its size and each half (top: initial, bottom: optimal) holds crane pixels."""
     with playback_renderer(load_playback(result_dir), fps=FPS, size=SIZE, layout="stacked") as renderer:
@@ -174,6 +181,7 @@ def _luminance(rgb: np.ndarray) -> np.ndarray:
     return linear @ np.array([0.2126, 0.7152, 0.0722])
 
 
+@pytest.mark.sim
 def test_dressed_frame_spans_the_machine_and_its_captions_read(result_dir: Path) -> None:
     """A 640x480 overlay frame shows the whole machine and readable captions.
 
@@ -268,6 +276,7 @@ def test_mp4_holds_every_frame_and_no_temporary_file(result_dir: Path, tmp_path:
     assert sorted(p.name for p in tmp_path.iterdir()) == ["clip.mp4"]
 
 
+@pytest.mark.sim
 def test_still_frame_is_a_png_of_the_requested_size(result_dir: Path, tmp_path: Path) -> None:
     """--still writes one PNG frame."""
     import mediapy
@@ -276,6 +285,7 @@ def test_still_frame_is_a_png_of_the_requested_size(result_dir: Path, tmp_path: 
     assert mediapy.read_image(path).shape == (SIZE[1], SIZE[0], 3)
 
 
+@pytest.mark.sim
 def test_failed_render_leaves_no_video(result_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """An error while frames are written removes the partial file: the output never exists half-written."""
 

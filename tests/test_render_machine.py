@@ -20,6 +20,7 @@ def run_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return excavator_result(tmp_path_factory.mktemp("excavator"))
 
 
+@pytest.mark.sim
 def test_replayed_qpos_close_every_loop_and_put_the_tcp_where_the_kinematics_does(run_dir: Path) -> None:
     """Every frame's qpos holds the connect equalities and the TCP site sits on the forward kinematics' TCP."""
     from hiab_sim.render.machine_playback import load_machine_playback, machine_model_and_qpos
@@ -38,6 +39,7 @@ def test_replayed_qpos_close_every_loop_and_put_the_tcp_where_the_kinematics_doe
             np.testing.assert_allclose(state.site("tcp").xpos, tcp[k], atol=1e-12)
 
 
+@pytest.mark.sim
 def test_render_frames_writes_pngs_of_both_designs(
     run_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -52,6 +54,7 @@ def test_render_frames_writes_pngs_of_both_designs(
     assert np.mean(np.abs(images[0].astype(float) - images[1].astype(float))) > 0.5  # the machine moved
 
 
+@pytest.mark.sim
 def test_render_still_side_by_side(run_dir: Path, tmp_path: Path) -> None:
     """A still of the side-by-side layout: the two viewports show different designs (the halves differ)."""
     import mediapy
@@ -63,6 +66,7 @@ def test_render_still_side_by_side(run_dir: Path, tmp_path: Path) -> None:
     assert np.mean(np.abs(left - right)) > 0.5
 
 
+@pytest.mark.sim
 def test_render_refuses_simulate_on_a_machine_result(
     run_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -73,6 +77,7 @@ def test_render_refuses_simulate_on_a_machine_result(
     assert not out.exists()
 
 
+@pytest.mark.sim
 @pytest.mark.parametrize("design", ["initial", "optimal"])
 def test_mjcf_from_machine_result_is_that_design(run_dir: Path, design: str, tmp_path: Path) -> None:
     """``mjcf --from-result RUN --design D`` writes the design the result stores (pins where the builder puts them)."""

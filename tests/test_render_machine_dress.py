@@ -60,6 +60,7 @@ def playback(machine: Machine) -> MachinePlayback:
     return MachinePlayback(machine, time, tcp, motions, payload, BATTERY, "cycle", GROUND)
 
 
+@pytest.mark.sim
 def test_dressed_excavator_frame_spans_the_machine_and_its_captions_read(playback: MachinePlayback) -> None:
     """A 640x480 overlay frame shows the whole arm, its pins, the payload in the bucket and readable captions.
 
@@ -102,6 +103,7 @@ def test_dressed_excavator_frame_spans_the_machine_and_its_captions_read(playbac
     assert (box + 0.05) / (text + 0.05) > 4.5
 
 
+@pytest.mark.sim
 def test_ground_and_base_stand_at_the_studys_ground_level(playback: MachinePlayback, machine: Machine) -> None:
     """The base block's bottom and the ground slab's top are the ground level; the base reaches up to the chassis."""
     model, _ = machine_model_and_qpos(machine, machine.design_values(), playback.designs[0].position[:1])
@@ -143,6 +145,7 @@ def test_actuator_radii_come_from_the_cylinder_data_or_the_bodies(machine: Machi
         assert r == pytest.approx(0.06 if dress.kind[g] == "barrel" else 0.025, rel=1e-9)
 
 
+@pytest.mark.sim
 def test_payload_sits_in_the_bucket_at_its_centre_of_mass(playback: MachinePlayback, machine: Machine) -> None:
     """The payload cube (soil, side (m / rho)^(1/3)) is centred at the bucket's centre of mass (kinematics)."""
     from hiab_sim.render.dress import payload_box

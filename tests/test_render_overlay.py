@@ -47,6 +47,7 @@ def loaded(tmp_path_factory: pytest.TempPathFactory, crane: Crane) -> Path:
     return _with_energy_and_payload(tmp_path_factory.mktemp("overlay") / "result", crane)
 
 
+@pytest.mark.sim
 def test_overlay_states_each_designs_battery_energy_from_the_result(loaded: Path) -> None:
     """Every frame's note names the battery energy of result.json with its boundary, per design."""
     with playback_renderer(load_playback(loaded), fps=12.0, size=SIZE, layout="overlay") as renderer:
@@ -78,6 +79,7 @@ def _payload_boxes(scene: Any) -> list[np.ndarray]:
     return found
 
 
+@pytest.mark.sim
 def test_payload_is_in_the_scene_only_while_held(loaded: Path) -> None:
     """Frames before the pick and after the release have no payload box; frames between have one.
 
@@ -104,6 +106,7 @@ def test_payload_is_in_the_scene_only_while_held(loaded: Path) -> None:
         assert t == pytest.approx(DURATION)
 
 
+@pytest.mark.sim
 def test_a_run_writes_the_payload_schedule_and_the_battery_energy(tmp_path: Path) -> None:
     """``hiab-sim optimize``'s folder gives the video the held mass at each frame and the result's battery energy."""
     payload = {"mass": 150.0, "pick": 1.0, "release": 5.0}

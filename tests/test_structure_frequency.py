@@ -59,6 +59,7 @@ def test_drive_stiffness_falls_with_stroke_and_stays_below_each_part(a: float, b
     assert k_low < p.stiffness.nut_stiffness
 
 
+@pytest.mark.sim
 @pytest.mark.parametrize("pose", [(0.5, -1.0, 0.5), (1.2, -0.5, 1.0)])
 def test_lowest_frequency_matches_a_free_vibration_in_mujoco(crane: Crane, emlas: EmlaSet, pose: tuple) -> None:
     """The FFT peak of the spring-mounted MuJoCo model's free vibration is within 1 % of the eigenvalue's frequency."""
@@ -67,6 +68,7 @@ def test_lowest_frequency_matches_a_free_vibration_in_mujoco(crane: Crane, emlas
     assert simulated == pytest.approx(float(modes.lowest_Hz[0]), rel=0.01)
 
 
+@pytest.mark.sim
 def test_payload_held_at_the_tcp_matches_a_free_vibration_with_a_point_mass(crane: Crane, emlas: EmlaSet) -> None:
     """300 kg at the TCP (a body in MuJoCo; mass and weight in the eigenproblem): frequencies agree within 1 %."""
     pose = (0.5, -1.0, 0.5)

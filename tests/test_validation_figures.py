@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 from matplotlib.image import imread
 
 from hiab_sim.crane.loader import load_crane
@@ -18,6 +19,7 @@ from hiab_sim.validation import DEFAULT_CASES, load_cases, mujoco_path, run_case
 ROOT = Path(__file__).resolve().parents[1]
 
 
+@pytest.mark.sim
 def test_docs_figures_script_writes_the_validation_figures(tmp_path: Path) -> None:
     """`ONLY=validation bash scripts/docs_figures.sh` (4 samples per case) writes both PNGs, each a drawn image."""
     env = {
@@ -45,6 +47,7 @@ def test_validation_page_shows_both_figures() -> None:
         assert (ROOT / "docs" / "figures" / name).is_file(), name
 
 
+@pytest.mark.sim
 def test_figure_data_are_the_measurements_the_validation_table_reports() -> None:
     """Per case, the largest plotted force difference and balance residuals equal run_case's maxima."""
     crane = load_crane("xs031")
