@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from hiab_sim.design_report.analysis import structure
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.results.design_values import crane_lengths
 from hiab_sim.results.read import read_result
@@ -113,6 +114,9 @@ def test_mix_envelope_is_the_worst_over_each_tasks_own_structure(mix_run: tuple[
     assert per_task.splitlines()[0].endswith("| spiral | second | envelope |")
     for png in ("structure_initial_vs_optimal.png", "structure_natural_frequency.png"):
         assert (run / png).stat().st_size > 10_000
+    page = structure(result, run)  # the design report's section
+    assert "set by task, optimal" in page and "task (optimal design)" in page
+    assert "Smallest buckling margin" in page and all(f"<td>{name}</td>" in page for name in names)
 
 
 @pytest.mark.e2e

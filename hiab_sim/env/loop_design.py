@@ -75,7 +75,7 @@ class LoopDesign:
             "lowest_drive_train_resonance_Hz": self.lowest_resonance_hz,
             "definition": (
                 "bandwidth_margin = 1 - f_v / (f_1 / 3), >= 0 holds: the velocity loop's bandwidth f_v (the "
-                "crossover on the reflected rotor plus the crane's mass at each slide) at most a third of the "
+                "crossover on the reflected rotor plus the mechanism's mass at each slide) at most a third of the "
                 "structure's lowest locked-rotor natural frequency f_1 over the plan's samples"
             ),
         }
