@@ -29,7 +29,7 @@ MACHINE_ENERGY = (
     "per drive"
 )
 MACHINE_TCP = "distance of the simulated TCP to the study's TCP reference (x_tcp, y_tcp) in the machine's plane"
-NO_STRUCTURE = "the structure's natural frequencies are computed for the crane file only, not for a machine file"
+NO_STRUCTURE = "the EMLA file lacks screw or drive_stiffness data for the machine's natural frequencies"
 
 
 BATTERY_NOTE = (
@@ -108,7 +108,8 @@ def run_machine(args: argparse.Namespace, designs: tuple[str, ...], plant: Plant
     predicted = predicted_battery_energy(args.result_dir)
     for run in runs:
         entry = entries[run.design]
-        entry["bandwidth_check"]["note"] = NO_STRUCTURE
+        if entry["bandwidth_check"].get("first_natural_frequency_Hz") is None:
+            entry["bandwidth_check"]["note"] = NO_STRUCTURE
         entry.update(battery_entry(run, plans[0].emlas, predicted.get(run.design)))
     settings["battery_energy"] = BATTERY_NOTE
     from hiab_sim.atomic_io import write_atomic

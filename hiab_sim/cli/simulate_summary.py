@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import Any
+
 
 def closing_lines(report: dict[str, object]) -> list[str]:
     """The answer in words: per design the closed loop against the plan, and what a heavier end mass costs."""
@@ -26,21 +29,28 @@ def closing_lines(report: dict[str, object]) -> list[str]:
             )
         lines.append(text + ".")
         check = planned.get("bandwidth_check") or {}
-        if check.get("bandwidth_margin") is not None:
-            margin = check["bandwidth_margin"]
-            lines.append(
-                f"{design}: velocity loop {check['velocity_loop_bandwidth_Hz']:.2f} Hz against the structure's lowest "
-                f"natural frequency {check['first_natural_frequency_Hz']:.2f} Hz on the plan: bandwidth_margin "
-                f"{margin:+.2f} ({'holds' if margin >= 0.0 else 'FAILS'}: 1 - f_v / (f_1 / 3) >= 0)."
-            )
-        elif check:
-            reason = check.get(
-                "note", "the EMLA file has no screw and drive_stiffness data for the natural frequencies"
-            )
-            lines.append(
-                f"{design}: velocity loop {check['velocity_loop_bandwidth_Hz']:.2f} Hz; no bandwidth check ({reason})."
-            )
+        if check:
+            lines.append(bandwidth_line(design, check))
     boundary = report.get("energy_boundary")
     if boundary is not None:
         lines.append(f"Energy boundary: {boundary}.")
     return lines
+
+
+def bandwidth_line(design: str, check: Mapping[str, Any]) -> str:
+    """One line of a run's ``bandwidth_check``: f_v against f_1, their ratio and whether 1 - f_v / (f_1 / 3) >= 0."""
+    f_v = float(check["velocity_loop_bandwidth_Hz"])
+    margin, f_1 = check.get("bandwidth_margin"), check.get("first_natural_frequency_Hz")
+    if margin is None or f_1 is None:
+        reason = check.get("note", "the EMLA file has no screw and drive_stiffness data for the natural frequencies")
+        return f"{design}: velocity loop {f_v:.2f} Hz; no bandwidth check ({reason})."
+    margin, f_1 = float(margin), float(f_1)
+    verdict = (
+        "holds: 1 - f_v / (f_1 / 3) >= 0"
+        if margin >= 0.0
+        else f"FAILS 1 - f_v / (f_1 / 3) >= 0: too close to the structure's resonance, at most {f_1 / 3.0:.2f} Hz"
+    )
+    return (
+        f"{design}: velocity loop {f_v:.2f} Hz against the structure's lowest natural frequency {f_1:.2f} Hz on "
+        f"the plan (ratio {f_v / f_1:.2f}, at most 1/3): bandwidth_margin {margin:+.2f} ({verdict})."
+    )

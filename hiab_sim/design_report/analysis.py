@@ -199,16 +199,30 @@ def duty_mix(result: Result, folder: Path) -> str:
 
 
 def structure(result: Result, folder: Path) -> str:
-    """Pin loads, screw buckling and natural frequencies of both designs (the result's ``structure`` section)."""
+    """Pin loads, screw buckling and natural frequencies of both designs (the result's ``structure`` section).
+
+    A duty mix's section is the envelope over its tasks: every table names the task that sets the
+    optimal design's value, and a last table lists each task's own worst values.
+    """
     s = result.structure
     if s is None:
         return ""
+    e = s.optimal.envelope
+
+    def task(kind: dict[str, str] | str | None, key: str = "") -> tuple[str, ...]:
+        if e is None:
+            return ()
+        name = kind.get(key) if isinstance(kind, dict) else kind
+        return (name or "–",)
+
+    mix = () if e is None else ("set by task, optimal",)
     pins = [
         (
             name,
             f"{s.initial.pins[name].peak_N / 1e3:.1f} kN",
             f"{pin.peak_N / 1e3:.1f} kN",
             f"{pin.magnitude_range_N / 1e3:.1f} kN",
+            *task(None if e is None else e.pin_peak_task, name),
         )
         for name, pin in s.optimal.pins.items()
     ]
@@ -218,29 +232,63 @@ def structure(result: Result, folder: Path) -> str:
             f"{s.initial.buckling[name].max_utilisation:.3f}",
             f"{b.max_utilisation:.3f}",
             f"{b.min_critical_load_N / 1e3:.0f} kN at {b.max_column_length_m:.2f} m",
+            *task(None if e is None else e.buckling_task, name),
         )
         for name, b in s.optimal.buckling.items()
     ]
+    path_task = None if e is None else e.lowest_frequency_trajectory_task
+    grid_task = None if e is None else e.lowest_frequency_working_range_task
     freq = [
-        (where, num(getattr(s.initial, key), ".2f", " Hz"), num(getattr(s.optimal, key), ".2f", " Hz"))
-        for where, key in (
-            ("along the motion", "lowest_frequency_trajectory_Hz"),
-            ("over the working range", "lowest_frequency_working_range_Hz"),
+        (where, num(getattr(s.initial, key), ".2f", " Hz"), num(getattr(s.optimal, key), ".2f", " Hz"), *task(t))
+        for where, key, t in (
+            ("along the motion", "lowest_frequency_trajectory_Hz", path_task),
+            ("over the working range", "lowest_frequency_working_range_Hz", grid_task),
         )
     ]
     most = s.optimal.most_loaded_pin
-    return section(
-        "Structure: pins, screws, natural frequency",
+    where = "" if e is None else f" (task {e.pin_peak_task[most]}, the envelope over the duty mix's tasks)"
+    margin = ""
+    if e is not None and e.smallest_buckling_margin is not None:
+        margin = (
+            f" Smallest buckling margin 1 - n f / P_cr over the tasks: {e.smallest_buckling_margin:.3f} "
+            f"({e.smallest_buckling_margin_screw} screw, task {e.smallest_buckling_margin_task})."
+        )
+    parts = [
         paragraph(
-            f"Most loaded pin of the optimal design: {most}, {s.optimal.pins[most].peak_N / 1e3:.1f} kN peak. "
-            f"Safety factor of the buckling utilisation n = {s.optimal.buckling_safety_factor:g}. Boundaries: "
+            f"Most loaded pin of the optimal design: {most}, {s.optimal.pins[most].peak_N / 1e3:.1f} kN peak{where}. "
+            f"Safety factor of the buckling utilisation n = {s.optimal.buckling_safety_factor:g}.{margin} Boundaries: "
             + s.note
             + "."
         ),
-        table(("pin", "peak, initial", "peak, optimal", "magnitude range, optimal"), pins, numeric=(1, 2, 3)),
+        table(("pin", "peak, initial", "peak, optimal", "magnitude range, optimal", *mix), pins, numeric=(1, 2, 3)),
         table(
-            ("screw", "utilisation, initial", "utilisation, optimal", "smallest P_cr, optimal"), screws, numeric=(1, 2)
+            ("screw", "utilisation, initial", "utilisation, optimal", "smallest P_cr, optimal", *mix),
+            screws,
+            numeric=(1, 2),
         ),
-        table(("lowest natural frequency", "initial", "optimal"), freq, numeric=(1, 2)),
-        figure(folder / "structure_natural_frequency.png", "Lowest natural frequency over the working range"),
-    )
+        table(("lowest natural frequency", "initial", "optimal", *mix), freq, numeric=(1, 2)),
+    ]
+    if result.tasks is not None:
+        rows = []
+        for t in result.tasks:
+            if t.structure is None:
+                continue
+            d = t.structure.optimal
+            worst = max(d.buckling.values(), key=lambda b: b.max_utilisation, default=None)
+            rows.append(
+                (
+                    t.name,
+                    f"{d.most_loaded_pin}, {d.pins[d.most_loaded_pin].peak_N / 1e3:.1f} kN",
+                    num(None if worst is None else worst.max_utilisation, ".3f"),
+                    num(d.lowest_frequency_trajectory_Hz, ".2f", " Hz"),
+                )
+            )
+        parts.append(
+            table(
+                ("task (optimal design)", "most loaded pin", "largest n f / P_cr", "lowest frequency on its motion"),
+                rows,
+                numeric=(2, 3),
+            )
+        )
+    parts.append(figure(folder / "structure_natural_frequency.png", "Lowest natural frequency over the working range"))
+    return section("Structure: pins, screws, natural frequency", *parts)

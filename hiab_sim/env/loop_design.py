@@ -62,19 +62,20 @@ class LoopDesign:
     first_natural_frequency_Hz: float | None
 
     def check(self) -> dict[str, object]:
-        """The bandwidth check of ``simulation.json``: bandwidth, f_1 and the margin, with their definition."""
+        """The bandwidth check of ``simulation.json``: f_v, f_1, their ratio and the margin, with their definition."""
         f_v = self.gains.velocity_Hz
         f_1 = self.first_natural_frequency_Hz
         return {
             "velocity_loop_bandwidth_Hz": f_v,
             "first_natural_frequency_Hz": f_1,
+            "bandwidth_ratio": None if f_1 is None else f_v / f_1,
             "bandwidth_margin": None if f_1 is None else bandwidth_margin(f_v, f_1),
             "max_bandwidth_ratio": MAX_BANDWIDTH_RATIO,
             "design_ratio": DESIGN_RATIO,
             "lowest_drive_train_resonance_Hz": self.lowest_resonance_hz,
             "definition": (
                 "bandwidth_margin = 1 - f_v / (f_1 / 3), >= 0 holds: the velocity loop's bandwidth f_v (the "
-                "crossover on the reflected rotor plus the crane's mass at each slide) at most a third of the "
+                "crossover on the reflected rotor plus the mechanism's mass at each slide) at most a third of the "
                 "structure's lowest locked-rotor natural frequency f_1 over the plan's samples"
             ),
         }

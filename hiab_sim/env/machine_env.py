@@ -23,9 +23,9 @@ the Physics (:class:`~hiab_sim.env.physics.CranePhysics`), the tracking task
 * **Load mass.** m_L,a = (J_x^-T G^T M G J_x^-1)_aa: M the open tree's mass matrix (``mj_fullM``),
   G = d qvel / d dq the loop-consistent velocity map of the independent joints (columns from unit
   rates), J_x = rows of G at the rod slides; the crane's rule (:mod:`hiab_sim.env.loop_design`).
-* **Gains.** :meth:`~hiab_sim.control.cascade.CascadeGains.design` of a rigid train: the
-  structure's natural frequencies are the crane's (:mod:`hiab_sim.structure`), not computed for
-  a machine file, so the run's ``bandwidth_check`` has no f_1.
+* **Gains.** :meth:`~hiab_sim.control.cascade.CascadeGains.design` of a rigid train against the
+  machine's lowest locked-rotor natural frequency f_1 over the plan, and the run's
+  ``bandwidth_check`` of the velocity loop against it (:mod:`hiab_sim.env.machine_loop_design`).
 
 Only the ideal plant: the plant effects of :mod:`hiab_sim.env.plant` are built on the crane's
 model and names.
@@ -45,7 +45,7 @@ from hiab_sim.control.cascade import CascadeGains
 from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator
 from hiab_sim.env import CURRENT_BANDWIDTH_HZ, PHYSICS_TIMESTEP
 from hiab_sim.env.drive_losses import DriveLossModel
-from hiab_sim.env.loop_design import LoopDesign
+from hiab_sim.env.machine_loop_design import machine_loop_design
 from hiab_sim.env.machine_plan import MachinePlan
 from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.reference import PlannedMotion, motion_of_plan, physics_times
@@ -175,7 +175,7 @@ def run_machine_closed_loop(
     """One cycle of a machine design's plan under the cascade controller; the log and the Physics (free it)."""
     env = machine_environment(plan)
     motion = env.task.motion
-    design = LoopDesign(gains or CascadeGains.design(), machine_load_mass(plan, motion), None, None, None)
+    design = machine_loop_design(plan, machine_load_mass(plan, motion), gains)
     drives = DriveArrays.from_params(plan.emlas)
     run = run_environment(
         env, design, drives, plan.design, 0.0, plan, progress, None, 1, actuator_names=plan.actuator_names

@@ -42,11 +42,17 @@ class MachinePlan(PlannedDesign):
     Attributes:
         machine: The machine with the design's decision variables set.
         tcp_force: The force on the TCP the plan's inverse dynamics took, (K, 3) [N] in {W}.
+        payload_kg: The first task's payload mass [kg], held at the TCP for the natural frequencies
+            (its weight is in ``tcp_force``).
+        tracked: The study's tracked coordinates beyond the TCP's x, y (the payload's kinematics), or
+            None: ``tcp_angle`` for each.
 
     """
 
     machine: Machine
     tcp_force: Array
+    payload_kg: float = 0.0
+    tracked: tuple[str, ...] | None = None
 
     @property
     def actuator_names(self) -> tuple[str, ...]:
@@ -89,4 +95,6 @@ def read_machine_plan(result_dir: str | Path, design: str) -> MachinePlan:
         machine=machine,
         emlas=study.emlas,
         tcp_force=np.asarray(tcp_force, dtype=float),
+        payload_kg=task.payload.mass,
+        tracked=getattr(study.model, "extra", None),
     )

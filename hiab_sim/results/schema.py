@@ -267,6 +267,7 @@ class TaskResult:
     optimal: DesignSummary
     recheck: Recheck
     energy: EnergyReport | None = optional()  # battery energy, costf2, thermal at the study's duty
+    structure: StructureSummary | None = optional()  # the task's own pin loads, buckling, natural frequencies
 
 
 @dataclass(frozen=True)
@@ -298,7 +299,7 @@ class Result:
     buildable: Buildable | None = optional()
     feasibility: tuple[FeasibilityPhase, ...] | None = optional()
     sensitivity: Sensitivity | None = optional()
-    structure: StructureSummary | None = optional()  # pin loads, buckling, natural frequencies
+    structure: StructureSummary | None = optional()  # pin loads, buckling, frequencies (a mix: over its tasks)
     extra: dict[str, Any] = field(default_factory=dict)  # keys of a newer writer, kept verbatim
 
     def __post_init__(self) -> None:

@@ -11,11 +11,15 @@ the actuator forces of the inverse dynamics, the TCP force):
   design's working range (:mod:`hiab_sim.structure.natural_frequency`), when every actuator has
   drive-stiffness data.
 
-The dataclasses are the ``structure`` section of ``result.json`` (SI units, names carry them).
+The dataclasses are the ``structure`` section of ``result.json`` (SI units, names carry them). A
+duty mix's section is the envelope over its tasks (:func:`structure_envelope`): each task loads the
+structure with its own motion and payload, and the design must hold all of them, so each value is
+the worst over the tasks and :class:`TaskEnvelope` names the task that sets it.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +28,8 @@ from numpy.typing import ArrayLike, NDArray
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla.config import EmlaSet
+from hiab_sim.errors import InvalidInputError
+from hiab_sim.results.codec import optional
 from hiab_sim.structure.buckling import DEFAULT_SAFETY_FACTOR, BucklingSamples, buckling_samples
 from hiab_sim.structure.natural_frequency import natural_frequencies, working_range_poses
 from hiab_sim.structure.pin_loads import PinLoads, analytic_pin_loads
@@ -55,8 +61,40 @@ class BucklingSummary:
 
 
 @dataclass(frozen=True)
+class TaskEnvelope:
+    """Which task of a duty mix sets each value of a design's envelope (:func:`structure_envelope`).
+
+    Attributes:
+        tasks: The mix's task names, in the study's order.
+        pin_peak_task: Per pin, the task whose motion gives its peak force.
+        buckling_task: Per screw, the task whose motion gives its largest utilisation n f / P_cr.
+        smallest_buckling_margin: 1 - max n f / P_cr over every screw and task [-] (>= 0 holds), or
+            None without screw data.
+        smallest_buckling_margin_screw: The screw of that margin, or None.
+        smallest_buckling_margin_task: The task of that margin, or None.
+        lowest_frequency_trajectory_task: The task of the lowest frequency on its motion, or None
+            without drive-stiffness data.
+        lowest_frequency_working_range_task: The task of the lowest frequency over the working range
+            (each task's grid carries its own largest TCP force), or None.
+
+    """
+
+    tasks: tuple[str, ...]
+    pin_peak_task: dict[str, str]
+    buckling_task: dict[str, str]
+    smallest_buckling_margin: float | None
+    smallest_buckling_margin_screw: str | None
+    smallest_buckling_margin_task: str | None
+    lowest_frequency_trajectory_task: str | None
+    lowest_frequency_working_range_task: str | None
+
+
+@dataclass(frozen=True)
 class DesignStructure:
-    """Pins, screws and the lowest natural frequency of one design (None where data are missing)."""
+    """Pins, screws and the lowest natural frequency of one design (None where data are missing).
+
+    ``envelope``: a duty mix's design only, the tasks that set its values (module docstring).
+    """
 
     pins: dict[str, PinSummary]
     most_loaded_pin: str
@@ -64,6 +102,7 @@ class DesignStructure:
     buckling_safety_factor: float
     lowest_frequency_trajectory_Hz: float | None
     lowest_frequency_working_range_Hz: float | None
+    envelope: TaskEnvelope | None = optional()
 
 
 @dataclass(frozen=True)
@@ -76,6 +115,14 @@ class StructureSummary:
         "pin forces of the member on its bracket (analytic Newton-Euler, equal to MuJoCo's to round-off); "
         "buckling utilisation n f / P_cr (Euler / Johnson, <= 1 holds); locked-rotor natural frequencies"
     )
+
+
+#: The note of a duty mix's section: what its envelope takes of the tasks.
+MIX_NOTE = (
+    StructureSummary.note + "; a duty mix: the envelope over its tasks, each pin's peak and range, each screw's "
+    "utilisation and push the largest and its P_cr the smallest, the frequencies the lowest over the tasks "
+    "(ranges within one task's cycle), envelope naming the task that sets each"
+)
 
 
 def has_stiffness(emlas: EmlaSet) -> bool:
@@ -150,3 +197,88 @@ def largest(tcp_force: Array | None) -> Array | None:
     if tcp_force is None or tcp_force.ndim == 1:
         return tcp_force
     return np.asarray(tcp_force[int(np.argmax(np.linalg.norm(tcp_force, axis=1)))])
+
+
+def _worst(values: Sequence[float | None], largest: bool) -> tuple[float | None, int | None]:
+    """The largest (or smallest) value and its first index; (None, None) where any value is missing."""
+    if any(v is None for v in values):
+        return None, None
+    numbers = np.asarray(values, dtype=float)
+    k = int(np.argmax(numbers) if largest else np.argmin(numbers))
+    return float(numbers[k]), k
+
+
+def structure_envelope(sections: Sequence[DesignStructure], tasks: Sequence[str]) -> DesignStructure:
+    """One design's structure over every task of a duty mix (module docstring), the tasks in study order.
+
+    Per pin the largest peak (its direction that task's), vector and magnitude range; per screw the
+    largest utilisation and push, the smallest P_cr and the longest column; the lowest frequencies.
+    Ties go to the first task. Raises :class:`InvalidInputError` unless there is one section per
+    task, all of the same pins and screws.
+    """
+    if not sections or len(sections) != len(tasks):
+        raise InvalidInputError("sections", len(sections), f"must be one per task ({len(tasks)}), at least one")
+    first = sections[0]
+    for name, section in zip(tasks, sections, strict=True):
+        if set(section.pins) != set(first.pins) or set(section.buckling) != set(first.buckling):
+            raise InvalidInputError(f"sections.{name}", sorted(section.pins), "must have the first task's pins, screws")
+    pins: dict[str, PinSummary] = {}
+    pin_task: dict[str, str] = {}
+    for pin in first.pins:
+        own = [s.pins[pin] for s in sections]
+        _, k = _worst([p.peak_N for p in own], largest=True)
+        assert k is not None
+        pins[pin] = PinSummary(
+            own[k].peak_N,
+            max(p.vector_range_N for p in own),
+            max(p.magnitude_range_N for p in own),
+            own[k].peak_direction_rad,
+        )
+        pin_task[pin] = tasks[k]
+    buckling: dict[str, BucklingSummary] = {}
+    screw_task: dict[str, str] = {}
+    for screw in first.buckling:
+        own_b = [s.buckling[screw] for s in sections]
+        u, k = _worst([b.max_utilisation for b in own_b], largest=True)
+        assert u is not None and k is not None
+        buckling[screw] = BucklingSummary(
+            u,
+            max(b.peak_push_N for b in own_b),
+            min(b.min_critical_load_N for b in own_b),
+            max(b.max_column_length_m for b in own_b),
+        )
+        screw_task[screw] = tasks[k]
+    margin: float | None = None
+    weakest = margin_task = None
+    if buckling:
+        weakest = max(buckling, key=lambda name: buckling[name].max_utilisation)
+        margin, margin_task = 1.0 - buckling[weakest].max_utilisation, screw_task[weakest]
+    on_path, k_path = _worst([s.lowest_frequency_trajectory_Hz for s in sections], largest=False)
+    grid, k_grid = _worst([s.lowest_frequency_working_range_Hz for s in sections], largest=False)
+    return DesignStructure(
+        pins=pins,
+        most_loaded_pin=max(pins, key=lambda name: pins[name].peak_N),
+        buckling=buckling,
+        buckling_safety_factor=first.buckling_safety_factor,
+        lowest_frequency_trajectory_Hz=on_path,
+        lowest_frequency_working_range_Hz=grid,
+        envelope=TaskEnvelope(
+            tasks=tuple(tasks),
+            pin_peak_task=pin_task,
+            buckling_task=screw_task,
+            smallest_buckling_margin=margin,
+            smallest_buckling_margin_screw=weakest,
+            smallest_buckling_margin_task=margin_task,
+            lowest_frequency_trajectory_task=None if k_path is None else tasks[k_path],
+            lowest_frequency_working_range_task=None if k_grid is None else tasks[k_grid],
+        ),
+    )
+
+
+def mix_structure(sections: Sequence[StructureSummary], tasks: Sequence[str]) -> StructureSummary:
+    """A duty mix's ``structure`` section: the envelope of the initial and of the optimal design over its tasks."""
+    return StructureSummary(
+        initial=structure_envelope([s.initial for s in sections], tasks),
+        optimal=structure_envelope([s.optimal for s in sections], tasks),
+        note=MIX_NOTE,
+    )

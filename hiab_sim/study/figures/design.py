@@ -66,11 +66,12 @@ def structure_overlay(
     pose: Array,
     pose_label: str,
     most_loaded: tuple[str, float] | None = None,
+    over: str = "the motion",
 ) -> None:
     """Both designs on one axes at ``pose``, each base pivot's shift as an arrow labelled in mm.
 
-    ``most_loaded``: (pin name ``<chain>.<pin>``, its peak force [N] over the motion) of the last design,
-    ringed and labelled at its place in the pose.
+    ``most_loaded``: (pin name ``<chain>.<pin>``, its peak force [N] over ``over``) of the last design,
+    ringed and labelled at its place in the pose (a duty mix: over its tasks, naming the task).
     """
     pivots: dict[str, dict[str, Array]] = {}
     for name, lengths in designs.items():
@@ -98,7 +99,7 @@ def structure_overlay(
                 arrowprops={"arrowstyle": "-", "color": "0.5", "linewidth": 0.6},
             )
     if most_loaded is not None:
-        _mark_pin(ax, crane, designs[names[-1]], pose, *most_loaded)
+        _mark_pin(ax, crane, designs[names[-1]], pose, *most_loaded, over=over)
     ax.set_aspect("equal")
     ax.grid(alpha=0.3)
     ax.set_xlabel("horizontal distance from the column [m]")
@@ -107,8 +108,10 @@ def structure_overlay(
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), fontsize=8, frameon=False)
 
 
-def _mark_pin(ax: Axes, crane: Crane, lengths: LinkLengths, pose: Array, pin: str, peak_N: float) -> None:
-    """Ring the pin ``<chain>.<kind>`` at ``pose`` and label it with its peak force in kN."""
+def _mark_pin(
+    ax: Axes, crane: Crane, lengths: LinkLengths, pose: Array, pin: str, peak_N: float, over: str = "the motion"
+) -> None:
+    """Ring the pin ``<chain>.<kind>`` at ``pose`` and label it with its peak force over ``over`` in kN."""
     from hiab_sim.structure.pin_loads import chain_links
 
     chain, kind = pin.split(".", 1)
@@ -118,7 +121,7 @@ def _mark_pin(ax: Axes, crane: Crane, lengths: LinkLengths, pose: Array, pin: st
     x, y = f.position[link][0, :2]
     ax.plot([x], [y], "o", markersize=14, markerfacecolor="none", markeredgecolor="tab:red", markeredgewidth=2)
     ax.annotate(
-        f"most loaded pin: {chain} {kind.replace('_', ' ')}\n{peak_N / 1e3:.1f} kN peak over the motion",
+        f"most loaded pin: {chain} {kind.replace('_', ' ')}\n{peak_N / 1e3:.1f} kN peak over {over}",
         xy=(x, y),
         xytext=(40, 20),
         textcoords="offset points",

@@ -92,13 +92,14 @@ def structure_figure(
     path: Path,
     label: str,
     most_loaded: tuple[str, float] | None = None,
+    over: str = "the motion",
 ) -> None:
     """Both structures overlaid in one pose, pivot shifts dimensioned (seed Fig. Initial_Structure_Modified).
 
-    ``most_loaded``: the optimal design's most loaded pin and its peak force [N], marked.
+    ``most_loaded``: the optimal design's most loaded pin and its peak force [N] over ``over``, marked.
     """
     fig = new_figure((8.0, 6.4))
-    structure_overlay(fig.add_subplot(), crane, designs, pose, label, most_loaded)
+    structure_overlay(fig.add_subplot(), crane, designs, pose, label, most_loaded, over)
     save_png(fig, path)
 
 
@@ -252,21 +253,26 @@ def write_figures(
     if crane is None:  # a machine file's study: the crane's structure and spiral drawings do not apply
         del paths["structure"], paths["spiral"]
     else:
-        joints = arrays["optimal_position"]
-        mid = len(joints) // 2
-        label = f"t = {arrays['time'][mid]:.2f} s of the optimal motion"
         loads = result.structure
-        most = None
+        most, over, prefix, of_task = None, "the motion", "", ""
         if loads is not None:
             pin = loads.optimal.most_loaded_pin
             most = (pin, loads.optimal.pins[pin].peak_N)
+            envelope = loads.optimal.envelope
+            if envelope is not None:  # a duty mix: drawn in the motion of the task that sets the peak
+                task = envelope.pin_peak_task[pin]
+                prefix, of_task = f"task{envelope.tasks.index(task)}_", f" of task {task}"
+                over = f"the tasks (task {task})"
+        drawn = arrays[f"{prefix}optimal_position"]
+        mid = len(drawn) // 2
+        label = f"t = {arrays[f'{prefix}time'][mid]:.2f} s of the optimal motion{of_task}"
         structure_figure(
-            crane, {k: crane_lengths(v) for k, v in designs.items()}, joints[mid], paths["structure"], label, most
+            crane, {k: crane_lengths(v) for k, v in designs.items()}, drawn[mid], paths["structure"], label, most, over
         )
         spiral_figure(
             crane,
             crane_lengths(designs["optimal"]),
-            joints,
+            arrays["optimal_position"],
             arrays["reference_tcp"],
             arrays["optimal_tcp"],
             paths["spiral"],

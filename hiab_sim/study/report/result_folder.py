@@ -10,7 +10,9 @@ task k under ``task<k>_<key>``. Every file is written atomically.
 One builder for any number of tasks: each task is evaluated by :mod:`hiab_sim.study.report.design_check`
 (fine grid, re-check on the other ID path, energy section), and the study's sections combine them
 (:mod:`hiab_sim.study.report.weighted`: a single task of weight 1 is reported as itself). With several
-tasks ``tasks`` holds each task's sections and ``cross_evaluation`` the designs x tasks table.
+tasks ``tasks`` holds each task's sections (its own ``structure`` among them), ``structure`` their
+envelope (:func:`hiab_sim.structure.summary.mix_structure`) and ``cross_evaluation`` the designs x
+tasks table.
 Every ``cost_W2s`` is eq. ``costf2`` [W^2 s] whatever the objective; the objective's own value is
 in ``energy`` (battery energy [J]), ``sensitivity.objective_value`` and the history.
 """
@@ -37,6 +39,7 @@ from hiab_sim.results.schema import (
     TaskResult,
 )
 from hiab_sim.results.trajectory_file import write_trajectory
+from hiab_sim.structure.summary import mix_structure
 from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.report.design_check import (
@@ -94,7 +97,7 @@ def build_result(
     task_results: list[TaskResult] = []
     arrays: dict[str, Array] = {}
     first_checks: dict[str, DesignCheck] = {}
-    decompositions, fines, energies = [], [], []
+    decompositions, fines, energies, structures = [], [], [], []
     for k, (task, p) in enumerate(zip(problem.tasks, problem.problems, strict=True)):
         z0, z1 = problem.task_z(main.z0, k), problem.task_z(main.z, k)
         checks, fine, recheck = task_checks(p, z0, z1)
@@ -108,6 +111,7 @@ def build_result(
             for name, z in (("initial", z0), ("optimal", z1))
         }
         energies.append(energy_report(fine, checks["initial"].evaluation, checks["optimal"].evaluation))
+        structures.append(structure_section(fine, checks))  # the task's own motion and payload
         task_results.append(
             TaskResult(
                 name=task.name,
@@ -122,6 +126,7 @@ def build_result(
                 optimal=designs["optimal"],
                 recheck=recheck_section(checks, recheck),
                 energy=energies[-1],
+                structure=structures[-1],
             )
         )
         decompositions.append(energy_decomposition(p, fine, z0, z1))
@@ -203,8 +208,8 @@ def build_result(
         ),
         tasks=tuple(task_results) if problem.n_tasks > 1 else None,
         cross_evaluation=cross,
-        # the structure of the one task's motion; a mix's tasks load the structure differently (not reported yet)
-        structure=structure_section(fines[0], first_checks) if one else None,
+        # one task: its own section; a mix: the envelope over its tasks (each task's own under tasks)
+        structure=structures[0] if problem.n_tasks == 1 else mix_structure(structures, names),
     )
     return result, arrays, first_checks
 
