@@ -205,7 +205,7 @@ SWEEP_FIELDS: tuple[str, ...] = (
 )
 
 #: The fields of a model-effects table (``python -m hiab_sim.study.analysis.model_effects``) the pages read.
-_EFFECT_ROW = ("key", "label", "compared_with", "status", "message", "iterations", "duty", "lengths")
+_EFFECT_ROW = ("key", "label", "emla", "hold", "compared_with", "status", "message", "iterations", "duty", "lengths")
 _EFFECT_NUMBERS = ("initial_battery_energy_J", "battery_energy_J", "battery_energy_saved_percent")
 MODEL_EFFECT_FIELDS = (
     "study",
