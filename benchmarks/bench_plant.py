@@ -3,7 +3,8 @@
 Usage: ``python benchmarks/bench_plant.py [RESULT_DIR] [--plant realistic|FILE] [--repeat N]`` (without
 RESULT_DIR the default study is optimised first, outside the timing). The cycle is exactly what
 ``hiab-sim simulate --plant realistic`` runs per design and variant. The parts are timed in the same
-process on the same Physics, as many calls as the cycle made: MuJoCo's ``mj_step`` (with the drive
+process on the same Physics, as many calls as the run made (the settled start's hold before the cycle
+included, and counted in the simulated time of the real-time factor): MuJoCo's ``mj_step`` (with the drive
 train's springs), the discrete current loops, the friction meter, the winding temperature (update and
 R_s hand-over), the encoder and delay line; the rest (controller, observations, dm-control, the
 drive train's Python side) is the remainder; the environment's build is timed on its own. Best of
@@ -43,9 +44,11 @@ def main() -> None:
     total = best_of(args.repeat, cycle)
     total = (total[0] - build[0], total[1] - build[1])
     run, physics = holder["run"], holder["physics"]
-    steps = physics.steps  # type: ignore[attr-defined]
     model, data = physics.model.ptr, physics.data.ptr  # type: ignore[attr-defined]
     h = float(model.opt.timestep)
+    # the run simulates the settled start's hold (settle_time_s) before the cycle; its steps count too
+    held = float(run.settle_time_s)  # type: ignore[attr-defined]
+    steps = physics.steps + round(held / h)  # type: ignore[attr-defined]
     drives = physics.drives  # type: ignore[attr-defined]
     refs, speeds = np.array([20.0, -10.0, 3.0]), np.array([300.0, -200.0, 100.0])
     parts: list[tuple[str, Callable[[], object]]] = [
@@ -68,8 +71,11 @@ def main() -> None:
     parts.append(("encoder and delay", lambda: [sensor.push(*physics.motor_state()) for _ in range(steps)]))  # type: ignore[attr-defined]
     timed = [(label, best_of(args.repeat, fn)) for label, fn in parts]
     physics.free()  # type: ignore[attr-defined]
-    simulated = float(run.time[-1])  # type: ignore[attr-defined]
-    print(f"{plant.name} plant, effects {', '.join(plant.enabled)}: {simulated:.2f} s simulated, {steps} physics steps")
+    simulated = float(run.time[-1]) + held  # type: ignore[attr-defined]
+    print(
+        f"{plant.name} plant, effects {', '.join(plant.enabled)}: {simulated:.2f} s simulated "
+        f"({held:.2f} s settled start + the cycle), {steps} physics steps"
+    )
     print(f"{'':44s} {'wall [s]':>9s} {'CPU [s]':>9s} {'CPU share':>9s}")
     print(f"{'environment build (plan -> ID at 1 kHz -> model)':44s} {build[0]:9.3f} {build[1]:9.3f}")
     print(f"{'closed-loop cycle (build excluded)':44s} {total[0]:9.3f} {total[1]:9.3f}")

@@ -124,3 +124,20 @@ def test_default_run_report_is_self_contained_and_states_the_design(run: RunOutp
     most = result.structure.optimal.most_loaded_pin
     peak = result.structure.optimal.pins[most].peak_N
     assert f"Most loaded pin of the optimal design: {most}, {peak / 1e3:.1f} kN peak" in html
+
+
+def test_the_model_effects_default_row_is_this_run(run: RunOutput) -> None:
+    """The effect table's ``hold_brake`` row, made from this run of the default study, is the recorded one.
+
+    The row is built by :func:`~hiab_sim.study.analysis.model_effects.row` from this run's result and
+    compared with docs/results/data/xs031_spiral_model_effects.json within the data's tolerances.
+    """
+    from hiab_sim.docs_site.results_data import differences, load_data
+    from hiab_sim.study.analysis.model_effects import LEVELS, row
+
+    committed = load_data().get("xs031_spiral_model_effects")
+    if committed is None:
+        pytest.fail("no recorded xs031_spiral_model_effects in docs/results/data: run scripts/results_pages.sh")
+    level = next(level for level in LEVELS if level.key == "hold_brake")
+    recorded = next(r for r in committed["model_effects"]["rows"] if r["key"] == "hold_brake")
+    assert differences(row(level, run.result.to_json()), recorded) == []

@@ -2,10 +2,11 @@
 
 The short studies (seconds each) run in CI; the default study and its closed loop are checked in
 tests/test_default_study.py on that module's run. The long ones (co-design, duty mix, excavator,
-the energy map, the sweeps and the Pareto front: minutes each) run under ``-m slow``;
-in CI the long studies' data are held to tests/data/shipped_optima.json instead
-(tests/test_results_page.py); the sweeps and the front have no recorded optima, so CI checks only
-that their pages are what their data render.
+the energy map, the sweeps, the Pareto front and the model-effects table: minutes each) run under
+``-m slow``; in CI the long studies' data are held to tests/data/shipped_optima.json instead
+(tests/test_results_page.py, and the model-effects table's rows in tests/test_model_effects.py); the
+sweeps and the front have no recorded optima, so CI checks only that their pages are what their data
+render.
 """
 
 from __future__ import annotations
@@ -49,6 +50,19 @@ def _check_command(name: str, args: list[str], out: Path) -> None:
         pytest.fail(f"no recorded output of {name} in docs/results/data: run scripts/results_pages.sh")
     assert main([*args, "--out", str(out)]) == 0
     assert differences(record(out), committed[name]) == []
+
+
+@pytest.mark.slow
+def test_model_effects_data_are_current(tmp_path: Path) -> None:
+    """A fresh effect table of the default study (five optimisations, a minute or more) records the committed data."""
+    from hiab_sim.study.analysis.model_effects import run_model_effects
+
+    name = "xs031_spiral_model_effects"
+    committed = load_data()
+    if name not in committed:
+        pytest.fail(f"no recorded output of {name} in docs/results/data: run scripts/results_pages.sh")
+    run_model_effects(ROOT / "optimize" / "xs031_spiral.yaml", tmp_path / name)
+    assert differences(record(tmp_path / name), committed[name]) == []
 
 
 @pytest.mark.slow

@@ -178,8 +178,9 @@ def test_default_study_on_the_realistic_plant(tmp_path: Path) -> None:
     """The default study's both designs complete on the realistic plant within 10 mm, over two cycles.
 
     The ideal plant (the EMLA file's real drive, the planner's losses) draws the planner's energy of the
-    plan on a 5 ms grid within 0.06 %, and the optimiser's number within 0.15 % (its 25 ms grid
-    integrates the holding brake's release at the cycle's ends 0.07 % high).
+    plan on a 5 ms grid within 0.06 %, and the optimiser's number (25 ms grid) within 0.06 % too: the
+    brake closes only for the rest, so no release inside the cycle separates the two grids (measured
+    -0.03 % / -0.04 % on the initial design, -0.03 % / -0.03 % on the optimal one).
     """
     result = run_study(None, tmp_path / "run", progress=None, figures=False).folder
     args = ["simulate", str(result), "--plant", "realistic", "--cycles", "2", "--no-video", "--no-figures", "--quiet"]
@@ -188,7 +189,7 @@ def test_default_study_on_the_realistic_plant(tmp_path: Path) -> None:
     for design in ("initial", "optimal"):
         ideal = effects["variants"]["ideal"][design]
         assert ideal["dc_bus_energy_J"] == pytest.approx(ideal["predicted_net_electrical_energy_5ms_grid_J"], rel=6e-4)
-        assert ideal["dc_bus_energy_J"] == pytest.approx(ideal["predicted_net_electrical_energy_J"], rel=1.5e-3)
+        assert ideal["dc_bus_energy_J"] == pytest.approx(ideal["predicted_net_electrical_energy_J"], rel=6e-4)
         every = effects["variants"]["all"][design]
         assert every["tcp_error_mm"]["max"] <= 10.0
         temperatures = [c["winding_temperature_C"][0] for c in every["cycles"]]

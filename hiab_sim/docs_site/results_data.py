@@ -204,6 +204,14 @@ SWEEP_FIELDS: tuple[str, ...] = (
     ),
 )
 
+#: The fields of a model-effects table (``python -m hiab_sim.study.analysis.model_effects``) the pages read.
+_EFFECT_ROW = ("key", "label", "emla", "hold", "compared_with", "status", "message", "iterations", "duty", "lengths")
+_EFFECT_NUMBERS = ("initial_battery_energy_J", "battery_energy_J", "battery_energy_saved_percent")
+MODEL_EFFECT_FIELDS = (
+    "study",
+    *(f"rows.*.{k}" for k in (*_EFFECT_ROW, *_EFFECT_NUMBERS, "peak_winding_temperature_C")),
+)
+
 
 def select(tree: Any, field: str) -> Any:
     """The part of ``tree`` a dotted field names, in the tree's own shape; None where the path is absent."""
@@ -268,6 +276,7 @@ SECTIONS: dict[str, tuple[str, Callable[[Path], Any], tuple[str, ...]]] = {
     "energy_map": ("energy_map.json", parse_json, ENERGY_MAP_FIELDS),
     "pareto": ("pareto.json", parse_json, PARETO_FIELDS),
     "sweep": ("sweep.parquet", _sweep_rows, SWEEP_FIELDS),
+    "model_effects": ("model_effects.json", parse_json, MODEL_EFFECT_FIELDS),
 }
 
 
@@ -275,7 +284,7 @@ def record(run_dir: Path) -> dict[str, Any]:
     """The data of one run folder: the declared fields of every file of :data:`SECTIONS` it holds.
 
     An ``optimize`` folder gives ``result`` (and ``simulation`` once ``hiab-sim simulate`` ran on it);
-    an ``energy-map``, ``pareto`` or ``sweep`` folder its own section. A folder with none raises
+    an ``energy-map``, ``pareto``, ``sweep`` or model-effects folder its own section. A folder with none raises
     :class:`ValueError` naming the files looked for.
     """
     data = {}

@@ -14,6 +14,8 @@ from hiab_sim.docs_site.results_data import RunData
 from hiab_sim.docs_site.results_format import kilo, lengths, percent_change
 
 DEFAULT, ENERGY, CODESIGN, PAYLOAD = "xs031_spiral", "xs031_spiral_energy", "xs031_codesign", "xs031_spiral_payload"
+#: The default study re-optimised per EMLA model level (:mod:`hiab_sim.study.analysis.model_effects`).
+MODEL_EFFECTS = "xs031_spiral_model_effects"
 
 
 def objectives(runs: RunData) -> str:
@@ -193,6 +195,41 @@ def hydraulic(runs: RunData) -> str:
     return f"{first}\n\n{second}"
 
 
+def _infeasible_reason(message: str) -> str:
+    """The violated limit of a feasibility phase's message (the text after its last ``): ``), else all of it."""
+    return message.rsplit("): ", 1)[-1].strip()
+
+
+def model_effects(runs: RunData) -> str:
+    """The default study re-optimised per EMLA model level: battery energy, change, lift winding, saving."""
+    rows_data = runs(MODEL_EFFECTS, "model_effects.rows")
+    energy = {r["key"]: r["battery_energy_J"] for r in rows_data if r["status"] == "optimised"}
+    rows: list[tuple[object, ...]] = []
+    for r in rows_data:
+        if r["status"] != "optimised":
+            rows.append((r["label"], f"infeasible: {_infeasible_reason(r['message'])}", "", "", ""))
+            continue
+        battery, before = r["battery_energy_J"], energy.get(r.get("compared_with") or "")
+        change = "" if before is None else f"{(battery - before) / 1e3:+.3f} kJ ({percent_change(before, battery, 1)})"
+        rows.append(
+            (
+                r["label"],
+                f"{battery / 1e3:.3f} kJ",
+                change,
+                f"{r['peak_winding_temperature_C']['lift']:.1f} °C",
+                f"{r['battery_energy_saved_percent']:.2f} %",
+            )
+        )
+    header = (
+        "model",
+        "battery energy per duty period at the optimum",
+        "change",
+        "lift winding (peak)",
+        "optimum's saving vs the built crane",
+    )
+    return table(header, rows)
+
+
 BLOCKS: dict[str, Callable[[RunData], str]] = {
     "energy-objectives": objectives,
     "energy-drawn": drawn,
@@ -201,4 +238,5 @@ BLOCKS: dict[str, Callable[[RunData], str]] = {
     "energy-codesign": codesign,
     "energy-drive-losses": drive_losses,
     "energy-hydraulic": hydraulic,
+    "energy-model-effects": model_effects,
 }
