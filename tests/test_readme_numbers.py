@@ -1,0 +1,35 @@
+"""The README's tables of measured numbers are the recorded runs' numbers, rounded as printed."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "docs" / "results" / "data"
+
+
+def _row(label: str) -> list[str]:
+    """The cells after the first of the README table row whose first cell starts with ``label``."""
+    for line in (ROOT / "README.md").read_text().splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if line.startswith("|") and cells[0].startswith(label):
+            return cells[1:]
+    raise AssertionError(f"README has no table row starting {label!r}")
+
+
+def test_the_model_effect_row_is_the_recorded_re_optimised_runs() -> None:
+    """Each model level's battery energy [kJ] and saving [%] in the README equals the recorded row."""
+    rows = json.loads((DATA / "xs031_spiral_model_effects.json").read_text())["model_effects"]["rows"]
+    by_key = {r["key"]: r for r in rows}
+    printed = _row("energy (saving")
+    levels = ("paper", "drive_losses", "hot_windings", "hold_brake")
+    assert len(printed) == len(levels)
+    for cell, key in zip(printed, levels, strict=True):
+        match = re.fullmatch(r"([0-9.]+) kJ \(([0-9.]+) %\)", cell)
+        assert match is not None, cell
+        row = by_key[key]
+        assert match.group(1) == f"{row['battery_energy_J'] / 1e3:.2f}", key
+        assert match.group(2) == f"{row['battery_energy_saved_percent']:.1f}", key
+    assert by_key["hold_motor"]["status"] == "infeasible"
