@@ -20,6 +20,7 @@ def test_failed_points_sit_on_a_strip_outside_the_axes_at_their_own_x(
             "gear": [3.0, 4.0, 5.0, 6.0],
             "status": ["ok", "ok", "ok", "failed"],
             "net_energy_saved_percent": [2.0, 3.0, 4.0, np.nan],
+            "start_net_energy_J": [4.2e3, 4.1e3, 4.0e3, np.nan],
             "opt_net_energy_J": [4e3, 3.9e3, 3.8e3, np.nan],
         }
     )
