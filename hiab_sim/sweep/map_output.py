@@ -184,9 +184,11 @@ def figure_png(m: EnergyMap, per: str = "cycle") -> bytes:
     battery energy (at the battery: shared DC bus, regeneration credited), the boundary of the answer.
 
     Where most cells are infeasible, a note in the figure says which limit binds and which
-    variables to map instead (:func:`infeasible_note`); without a feasible cell the value panels
-    get no colour bar (it would have no values to show).
+    variables to map instead (:func:`infeasible_note`); without a feasible cell there are no values
+    to show: one panel shows the limit each cell breaks, with no colour bar.
     """
+    import textwrap
+
     from matplotlib import colormaps
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
@@ -203,13 +205,15 @@ def figure_png(m: EnergyMap, per: str = "cycle") -> bytes:
     category = np.full(feasible.shape, np.nan)
     for n, name in enumerate(labels):
         category[(~feasible) & (binding == v.names.index(name))] = n
-    fig = new_figure((13, 5.6))
-    axes = fig.subplots(1, 2)
     what = OBJECTIVE_AXIS.get(m.objective, m.objective.replace("_", " "))
     panels = (
         (v.objective, f"{what} / its value at the study's start [-]"),
         (v.battery_energy / 1e3, f"battery energy [kJ per {per}" + ("]" if len(m.tasks) == 1 else ", weighted]")),
     )
+    if not feasible.any():  # nothing to colour: one panel of the limits the cells break
+        panels = ((v.objective, "no feasible mounting on this map: the limit each cell breaks"),)
+    fig = new_figure((13, 5.6) if len(panels) == 2 else (8.0, 6.2))
+    axes = fig.subplots(1, len(panels), squeeze=False)[0]
     for ax, (values, title) in zip(axes, panels, strict=True):
         grid = np.ma.masked_where(~feasible, m.grid(values))
         mesh = ax.pcolormesh(m.axes[0], m.axes[1], grid.T, shading="nearest", cmap="viridis")
@@ -234,11 +238,9 @@ def figure_png(m: EnergyMap, per: str = "cycle") -> bytes:
         ax.plot([lo[0], hi[0], hi[0], lo[0], lo[0]], [lo[1], lo[1], hi[1], hi[1], lo[1]], "k--", lw=1, label="bounds")
         ax.set_xlabel(variable_words(m.variables[0]))
         ax.set_ylabel(variable_words(m.variables[1]))
-        ax.set_title(title if feasible.any() else f"{title}: no feasible cell to colour", fontsize=10)
+        ax.set_title(title, fontsize=10)
     note = infeasible_note(m)
     if note is not None:
-        import textwrap
-
         wrapped = "\n".join(textwrap.fill(part, 58) for part in note.split("\n"))
         for ax in axes:
             ax.text(
@@ -248,12 +250,16 @@ def figure_png(m: EnergyMap, per: str = "cycle") -> bytes:
     handles, names = axes[0].get_legend_handles_labels()
     handles += [Patch(color=palette(n % 10), alpha=0.35) for n in range(len(labels))]
     names += [f"infeasible: {limit_in_words(name)}" for name in labels]
-    fig.legend(handles, names, loc="outside lower center", ncol=2, fontsize=8)
+    fig.legend(handles, names, loc="outside lower center", ncol=len(panels), fontsize=8)
     title = (
         f"Energy map over {m.variables[0]} and {m.variables[1]}; the other decision variables and the trajectory "
-        f"at the {m.base.source}\nbattery energy at the battery (shared DC bus, regeneration credited)"
+        f"at the {m.base.source}"
     )
+    if len(panels) == 2:
+        title += "\nbattery energy at the battery (shared DC bus, regeneration credited)"
     if len(m.tasks) > 1:
         title += "\nduty mix, objective and energies weighted: " + " + ".join(f"{w:g} x {n}" for n, w in m.tasks)
-    fig.suptitle(title, fontsize=10)
+    fig.suptitle(
+        "\n".join(textwrap.fill(part, 150 if len(panels) == 2 else 95) for part in title.split("\n")), fontsize=10
+    )
     return png_bytes(fig)

@@ -177,20 +177,28 @@ def actuator_figure(time: np.ndarray, checks: dict[str, DesignCheck], path: Path
 
 def efficiency_figure(emlas: EmlaSet, checks: dict[str, DesignCheck], path: Path) -> None:
     """Operating points (initial, optimal) over each actuator's efficiency map."""
-    from hiab_sim.emla.maps import efficiency_map, plot_efficiency_map
+    from hiab_sim.emla.maps import EFFICIENCY_LABEL, efficiency_map, plot_efficiency_map
 
-    fig = new_figure((6.3 * len(emlas), 6.0))
+    fig = new_figure((5.6 * len(emlas) + 1.0, 6.0))
     axes = fig.subplots(1, len(emlas), squeeze=False)[0]
+    losses = {p.losses.describe() for p in emlas}
+    shared = len(losses) == 1  # the same drive losses on every map: named once, over the figure
+    filled = None
     for i, (ax, params) in enumerate(zip(axes, emlas, strict=True)):
         emap = efficiency_map(params, n_force=81, n_velocity=81)
         ini = checks["initial"].evaluation.actuators
         opt = checks["optimal"].evaluation.actuators
         designs = {"initial": (ini.force[:, i], ini.velocity[:, i]), "optimal": (opt.force[:, i], opt.velocity[:, i])}
-        plot_efficiency_map(emap, ax=ax, designs=designs)
+        plot_efficiency_map(emap, ax=ax, designs=designs, losses_in_title=not shared, colorbar=False)
+        filled = ax.collections[0] if filled is None else filled
         if i > 0:  # one legend for the three maps: they share every entry
             legend = ax.get_legend()
             if legend is not None:
                 legend.remove()
+    if filled is not None:  # one colour bar: the maps share their levels and colours
+        fig.colorbar(filled, ax=list(axes), label=EFFICIENCY_LABEL, shrink=0.9)
+    if shared:
+        fig.suptitle(next(iter(losses)), fontsize=9)
     save_png(fig, path)
 
 
