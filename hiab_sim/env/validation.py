@@ -96,9 +96,10 @@ def simulation_report(
             entry.update(battery_entry(run, emlas.battery, predicted.get(run.design)))
         match = next((n for n in nominal if n.design == run.design), None)
         if match is not None:
-            entry["nominal"] = match.summary()
+            nominal_entry = match.summary()
             if emlas is not None:
-                entry["nominal"].update(battery_entry(match, emlas.battery, predicted.get(match.design)))
+                nominal_entry.update(battery_entry(match, emlas.battery, predicted.get(match.design)))
+            entry["nominal"] = nominal_entry
             entry["extra_energy_J"] = run.net_energy - match.net_energy
             entry["extra_energy_vs_predicted_J"] = run.net_energy - run.predicted_net_energy
         designs[run.design] = entry

@@ -112,7 +112,7 @@ def summary_figures(
         for (yi, xi), v in np.ndenumerate(grid):
             if np.isfinite(v):
                 ax.text(float(xs[xi]), float(ys[yi]), f"{v:.1f} %", ha="center", va="center", fontsize=9, c="w",
-                        bbox={"boxstyle": "round", "fc": "black", "alpha": 0.35, "lw": 0})  # fmt: skip
+                        bbox={"boxstyle": "round", "fc": (0.0, 0.0, 0.0, 0.35), "lw": 0})  # fmt: skip
         for _, row_ in frame[~ok].iterrows():
             ax.text(row_[numeric[0]], row_[numeric[1]], "failed:\nno result", ha="center", va="center", fontsize=8,
                     c="red")  # fmt: skip

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.sweep.energy_map import FEASIBILITY_TOLERANCE, EnergyMap
@@ -206,7 +207,7 @@ def figure_png(m: EnergyMap, per: str = "cycle") -> bytes:
     for n, name in enumerate(labels):
         category[(~feasible) & (binding == v.names.index(name))] = n
     what = OBJECTIVE_AXIS.get(m.objective, m.objective.replace("_", " "))
-    panels = (
+    panels: tuple[tuple[NDArray[np.float64], str], ...] = (
         (v.objective, f"{what} / its value at the study's start [-]"),
         (v.battery_energy / 1e3, f"battery energy [kJ per {per}" + ("]" if len(m.tasks) == 1 else ", weighted]")),
     )
@@ -260,6 +261,6 @@ def figure_png(m: EnergyMap, per: str = "cycle") -> bytes:
     if len(m.tasks) > 1:
         title += "\nduty mix, objective and energies weighted: " + " + ".join(f"{w:g} x {n}" for n, w in m.tasks)
     fig.suptitle(
-        "\n".join(textwrap.fill(part, 150 if len(panels) == 2 else 95) for part in title.split("\n")), fontsize=10
+        "\n".join(textwrap.fill(part, 180 if len(panels) == 2 else 95) for part in title.split("\n")), fontsize=10
     )
     return png_bytes(fig)

@@ -92,7 +92,7 @@ def structure_overlay(
             ax.annotate(
                 f"{chain.name} base pivot\nmoves {shift * 1e3:.0f} mm",
                 xy=(0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])),
-                xytext=(-95, -30 if chain.name == "lift" else 25),
+                xytext=(40, 60) if chain.name == "lift" else (60, -60),  # right of the pivot: inside the axes
                 textcoords="offset points",
                 fontsize=8,
                 arrowprops={"arrowstyle": "-", "color": "0.5", "linewidth": 0.6},
