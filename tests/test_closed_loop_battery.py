@@ -12,7 +12,7 @@ from hiab_sim.crane.loader import load_crane
 from hiab_sim.emla.battery import BatteryParams
 from hiab_sim.env.closed_loop_battery import battery_entry, battery_notes, cumulative_battery_energy
 from hiab_sim.env.rollout import ClosedLoopRun, run_closed_loop
-from hiab_sim.env.validation import FPS, frame_times
+from hiab_sim.env.validation import FPS, closed_loop_frame_times
 
 
 @pytest.fixture(scope="module")
@@ -51,13 +51,13 @@ def test_the_overlays_last_number_is_the_reported_battery_energy(
 ) -> None:
     """Every frame states the cycle's total, ``simulation.json``'s ``battery_energy_J``; the last frame reaches it.
 
-    The frames are the video's (:func:`hiab_sim.env.validation.frame_times`, over the run's duration):
+    The frames are the video's (:func:`hiab_sim.env.validation.closed_loop_frame_times`, over the run's duration):
     the first says 0, the last the total, and the frames between are 1 / ``FPS`` apart.
     """
     run, battery = run_and_battery
     reported = battery_entry(run, battery, None)["battery_energy_J"]
     assert reported is not None
-    at = frame_times(float(run.time[-1]))
+    at = closed_loop_frame_times(float(run.time[-1]))
     notes = battery_notes(run, battery, at)
     pattern = re.compile(r"t = +([\d.]+) s   battery energy (-?[\d.]+) of (-?[\d.]+) kJ per cycle \(DC bus\)")
     parsed = [pattern.fullmatch(note) for note in notes]

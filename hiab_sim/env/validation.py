@@ -182,7 +182,7 @@ def table(report: dict[str, object]) -> str:
     return "\n".join(lines)
 
 
-def frame_times(duration: float) -> Array:
+def closed_loop_frame_times(duration: float) -> Array:
     """The closed-loop video's frame instants [s]: 0, 1/FPS, ... and ``duration`` itself last.
 
     Real time at ``FPS``; when ``duration`` is not a whole number of frames the last frame is the
@@ -218,7 +218,7 @@ def render_video(
 
     width, height = VIEWPORT
     colours = {"initial": INITIAL_RGBA, "optimal": OPTIMAL_RGBA}
-    at = frame_times(min(run.time[-1] for run in runs))
+    at = closed_loop_frame_times(min(run.time[-1] for run in runs))
     frames = len(at)
     models = {run.design: item.model.ptr for run, item in zip(runs, physics, strict=True)}
     marks = tuple(f"{chain.name}_base_pivot" for chain in crane.chains)
