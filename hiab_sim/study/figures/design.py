@@ -26,7 +26,16 @@ from hiab_sim.study.report.summary import limit_in_words
 from hiab_sim.style import colour
 
 Array = np.ndarray
-ENERGY_LABELS = ("mechanical\nf v", "copper", "rotor\nfriction", "screw\nviscous", "inertial", "net\nelectrical")
+#: The bars of :func:`energy_bars`: the breakdown's parts, the drive train's (:func:`drive_train_energy`), the total.
+ENERGY_LABELS = (
+    "mechanical\nf v",
+    "copper",
+    "rotor\nfriction",
+    "screw\nviscous",
+    "inertial",
+    "drive train:\nscrew, gear,\ninverter, brake",
+    "net\nelectrical",
+)
 
 
 def draw_crane(ax: Axes, crane: Crane, lengths: LinkLengths, joints: Array, colour: str, alpha: float = 1.0) -> None:
@@ -153,7 +162,7 @@ def decision_panels(
 
 
 def energy_bars(ax: Axes, breakdown: dict[str, tuple[float, ...]]) -> None:
-    """Energy breakdown per design [kJ] with the value on every bar."""
+    """Energy breakdown per design [kJ] with the value on every bar, one value per :data:`ENERGY_LABELS`."""
     x = np.arange(len(ENERGY_LABELS))
     width = 0.8 / len(breakdown)
     for k, (name, parts) in enumerate(breakdown.items()):
