@@ -13,7 +13,7 @@ from hiab_sim.study.spec.study_file import study_from_dict
 
 @pytest.mark.parametrize("emla", ["default", "paper"])
 def test_the_bars_balance_the_electrical_energy(emla: str) -> None:
-    """mechanical + motor losses + drive train = electrical, on the real drive (losses on) and the paper's (none).
+    """Mechanical work, motor losses and drive train add up to the electrical energy, real drive and paper drive.
 
     The breakdown's parts come from the design summary (``result.json``'s ``energy_breakdown_J``), the
     drive train's bar from the EMLA file's loss terms; the electrical energy is the drive model's own
