@@ -10,6 +10,7 @@ never at a value that would read as data.
 from __future__ import annotations
 
 import re
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +25,7 @@ FAILED_STRIP = 1.05
 _GEAR = re.compile(r"^emla\.(\w+)\.gear_ratio$")
 _BOUND = re.compile(r"^bounds\.(\w+)\.(low|up)\[(\d)\]$")
 _LENGTH_FIELDS = ("L", "Lc0", "Lc")
+_PER_ACTUATOR = re.compile(r"^(brake|thermal)\.(\w+) (.*)$")
 
 
 def axis_words(parameter: str) -> str:
@@ -45,6 +47,24 @@ def axis_words(parameter: str) -> str:
         return f"{chain} {length} ({LENGTH_WORDS[length]}): {side_words} bound [m]"
     words = parameter.replace(".", " ").replace("_", " ")
     return words.removesuffix(" percent") + " [%]" if words.endswith(" percent") else words
+
+
+def failed_reason(message: str) -> str:
+    """Why a point failed, in words, from its table message (the feasibility phase names the binding row).
+
+    The text after the least-violation point (``...m): <row> ...``): its own words after ``": "`` where
+    the row gives them ("the TCP leaves its tracking band by 9 % of the band"), else the row with its
+    actuator first ("brake.lift holding torque ..." -> "lift brake holding torque ..."); a message of
+    another form keeps its last clause.
+    """
+    tail = message.rsplit("): ", 1)[-1]
+    if ": " in tail:
+        return tail.split(": ", 1)[1]
+    match = _PER_ACTUATOR.match(tail)
+    if match:
+        kind, actuator, rest = match.groups()
+        return f"{actuator} {'brake' if kind == 'brake' else 'motor'} {rest}"
+    return tail.replace("_", " ")
 
 
 def summary_figures(
@@ -105,7 +125,7 @@ def summary_figures(
         grid = np.full((len(ys), len(xs)), np.nan)  # every point of the grid, failed ones left blank
         for k, row_ in frame[ok].iterrows():
             grid[np.searchsorted(ys, row_[numeric[1]]), np.searchsorted(xs, row_[numeric[0]])] = saved[k]
-        fig = new_figure((6.8, 4.8))
+        fig = new_figure((7.6, 5.6))
         ax = fig.add_subplot()
         mesh = ax.pcolormesh(xs, ys, np.ma.masked_invalid(grid), shading="nearest", cmap="viridis")
         fig.colorbar(mesh, ax=ax, label=f"{what} saved by the optimisation [%]")
@@ -113,15 +133,17 @@ def summary_figures(
             if np.isfinite(v):
                 ax.text(float(xs[xi]), float(ys[yi]), f"{v:.1f} %", ha="center", va="center", fontsize=9, c="w",
                         bbox={"boxstyle": "round", "fc": (0.0, 0.0, 0.0, 0.35), "lw": 0})  # fmt: skip
-        for _, row_ in frame[~ok].iterrows():
-            ax.text(row_[numeric[0]], row_[numeric[1]], "failed:\nno result", ha="center", va="center", fontsize=8,
+        for _, row_ in frame[~ok].iterrows():  # no value: why, in words
+            why = textwrap.fill(failed_reason(str(row_["message"])), 26)
+            ax.text(row_[numeric[0]], row_[numeric[1]], f"failed:\n{why}", ha="center", va="center", fontsize=6.5,
                     c="red")  # fmt: skip
         ax.set_xticks(xs)
         ax.set_yticks(ys)
         ax.set_xlabel(axis_words(numeric[0]))
         ax.set_ylabel(axis_words(numeric[1]))
         ax.set_title(
-            f"{title}: {what} saved by the optimisation [%]\n{boundary}; failed: no feasible start, or the solver",
+            f"{title}: {what} saved by the optimisation [%]\n{boundary}\nfailed: no feasible start (the limit "
+            "broken least named) or the solver",
             fontsize=9,
         )
         paths.append(save_png(fig, out / "sweep_saving_map.png"))
