@@ -242,9 +242,9 @@ def energy_figure(
         bars[n] = (*parts[:-1], drive_train_energy(emlas, checks[n], time), parts[-1])
     energy_bars(left, bars)
     cold = ", windings at their reference resistance" if hot_windings else ""
-    left.set_title(f"Where the energy goes (all actuators{cold})", fontsize=10)
+    left.set_title(f"Where the energy goes\n(all actuators{cold})", fontsize=10)
     cumulative_energy(right, time, {n: checks[n].evaluation.power for n in names})
-    hot = " (hot windings, the study's duty model)" if hot_windings else ""
+    hot = "\n(hot windings: the study's duty model)" if hot_windings else ""
     right.set_title(f"Cumulative net electrical energy{hot}", fontsize=10)
     save_png(fig, path)
 
