@@ -5,7 +5,7 @@
 # the energy map, and three frames of the eXact excavator's digging video (excavator_<start|middle|end>.png).
 # With SLOW=1 also the sweeps and the Pareto front (tens of optimisations). Run after scripts/setup.sh.
 # ONLY=validation makes the validation figures only (seconds), ONLY=excavator the excavator's frames only
-# (its optimisation: minutes); FIGURES_DIR (default docs/figures), VALIDATION_SAMPLES (default: the case
+# (its optimisation: minutes), ONLY=crane everything but the excavator's frames; FIGURES_DIR (default docs/figures), VALIDATION_SAMPLES (default: the case
 # file's), PYTHON (default .venv/bin/python) and HIAB_SIM (default .venv/bin/hiab-sim) change where they go,
 # how many samples per case and which interpreter and command run them (the test uses the first three).
 set -euo pipefail
@@ -75,6 +75,10 @@ if [ "${SLOW:-0}" = "1" ]; then
   $HS sweep sweeps/xs031_payload_gear --out "$RUN/sweep_payload_gear" >/dev/null
   cp "$RUN/sweep_payload_gear/sweep_summary.png" "$OUT/sweep_payload_gear.png"
   cp "$RUN/sweep_payload_gear/sweep_saving_map.png" "$OUT/sweep_payload_gear_map.png"
+fi
+if [ "${ONLY:-}" = "crane" ]; then
+  echo "re-made $OUT from $RUN (the excavator's frames kept)"
+  exit 0
 fi
 excavator_frames
 echo "re-made $OUT from $RUN and $EXCAVATOR_RUN"

@@ -31,7 +31,7 @@ def small_result(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def test_simulate_writes_the_validation_of_one_design(
     small_result: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """simulation.json holds closed-loop and predicted energies, TCP errors, limit fractions and the bandwidth check.
+    """simulation.json holds closed-loop and predicted energies (drives and battery), TCP errors, limits, bandwidth.
 
     The check's lowest natural frequency is the study's own (``result.json``'s structure section,
     computed by the optimiser on the same fine grid), the margin is 1 - f_v / (f_1 / 3) of the
@@ -54,6 +54,9 @@ def test_simulate_writes_the_validation_of_one_design(
     assert entry["net_electrical_energy_J"] == pytest.approx(predicted, rel=0.02)
     assert entry["tcp_error_mm"]["rms"] <= 2.0 and entry["tcp_error_mm"]["max"] <= 5.0
     assert entry["current_limit_fraction"] == 0.0 and entry["voltage_limit_fraction"] == 0.0
+    # the battery's boundary: the planner's cycle battery energy and the closed loop's through the same battery
+    assert entry["predicted_battery_energy_J"] == result["energy"]["optimal"]["battery_energy_J"]
+    assert entry["battery_energy_J"] == pytest.approx(entry["predicted_battery_energy_J"], rel=0.02)
     assert sorted(p.name for p in out.glob("closed_loop_*.png")) == [
         "closed_loop_drives.png",
         "closed_loop_energy.png",

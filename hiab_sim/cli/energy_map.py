@@ -60,10 +60,10 @@ def run(args: argparse.Namespace) -> int:
     with StatusLine(f"evaluating {args.grid} x {args.grid} mountings on {problem.n_tasks} task(s) ..."):
         m = energy_map(problem, base, variables, args.grid)
     out = Path(args.out) if args.out else Path("runs") / study.name / "energy_map"
-    paths = write_map(m, out)
-    s = summary(m)
     duty = problem.problems[0].duty_options is not None
     per = "cycle" if not duty else "duty period (the cycle and the rest's hold)"
+    paths = write_map(m, out, per.split(" (")[0])
+    s = summary(m)
     if problem.n_tasks > 1:
         per = f"{per} of each task, {energy_words(m)}"
     answer = map_answer(m, s, study.name, per, out, [*(p.name for p in paths), ANSWER_FILE])

@@ -138,8 +138,10 @@ def run(args: argparse.Namespace) -> int:
 
             written.append(effect_figure(out / "closed_loop_plant_effects.png", effects).name)
     if not args.no_video:
-        crane = read_plan(args.result_dir, runs[0].design).crane
-        video = render_video(out / "closed_loop.mp4", runs, physics, crane, nominal or None, quiet=args.quiet)
+        plan = read_plan(args.result_dir, runs[0].design)
+        video = render_video(
+            out / "closed_loop.mp4", runs, physics, plan.crane, plan.emlas.battery, nominal or None, quiet=args.quiet
+        )
         written.append(video.name)
     for item in physics:
         item.free()

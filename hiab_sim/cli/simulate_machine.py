@@ -14,11 +14,7 @@ import json
 import sys
 from pathlib import Path
 
-import numpy as np
-
-from hiab_sim.emla.config import EmlaSet
 from hiab_sim.env.plant.config import Plant
-from hiab_sim.env.rollout import ClosedLoopRun
 from hiab_sim.errors import InvalidInputError
 
 #: What the report says of the energy boundary and the TCP error of a machine's closed loop.
@@ -30,37 +26,6 @@ MACHINE_ENERGY = (
 )
 MACHINE_TCP = "distance of the simulated TCP to the study's TCP reference (x_tcp, y_tcp) in the machine's plane"
 NO_STRUCTURE = "the EMLA file lacks screw or drive_stiffness data for the machine's natural frequencies"
-
-
-BATTERY_NOTE = (
-    "battery_energy_J: the closed loop's drive powers (mean over each control step) through the EMLA file's "
-    "inverters and battery on the shared DC bus (hiab_sim.emla.battery: h_inv per drive, summed, h_bat), "
-    "summed over the steps; predicted_battery_energy_J: the result's cycle battery energy of the design "
-    "(result.json energy.<design>.battery_energy_J, the same model on the plan's fine grid)"
-)
-
-
-def predicted_battery_energy(result_dir: str | Path) -> dict[str, float]:
-    """The result's cycle battery energy per design [J] (empty where the result has no energy section)."""
-    from hiab_sim.results.read import read_result
-
-    energy = read_result(result_dir).energy
-    if energy is None:
-        return {}
-    return {"initial": energy.initial.battery_energy_J, "optimal": energy.optimal.battery_energy_J}
-
-
-def battery_entry(run: ClosedLoopRun, emlas: EmlaSet, predicted: float | None) -> dict[str, float | None]:
-    """A run's closed-loop battery energy [J] (:data:`BATTERY_NOTE`), the prediction and their difference [%]."""
-    from hiab_sim.emla.battery import battery_power
-
-    _, p_bat, _, _ = battery_power(run.electrical_power[:-1], emlas.battery)
-    energy = float(np.sum(p_bat * np.diff(run.time)))
-    return {
-        "battery_energy_J": energy,
-        "predicted_battery_energy_J": predicted,
-        "battery_energy_difference_percent": None if predicted is None else 100.0 * (energy / predicted - 1.0),
-    }
 
 
 def refuse_crane_only(args: argparse.Namespace, plant: Plant | None) -> None:
@@ -105,13 +70,10 @@ def run_machine(args: argparse.Namespace, designs: tuple[str, ...], plant: Plant
     settings["tcp_load"] = "the plan's TCP force F(t) of the study's first task, applied at site tcp"
     entries = report["designs"]
     assert isinstance(entries, dict)
-    predicted = predicted_battery_energy(args.result_dir)
     for run in runs:
         entry = entries[run.design]
         if entry["bandwidth_check"].get("first_natural_frequency_Hz") is None:
             entry["bandwidth_check"]["note"] = NO_STRUCTURE
-        entry.update(battery_entry(run, plans[0].emlas, predicted.get(run.design)))
-    settings["battery_energy"] = BATTERY_NOTE
     from hiab_sim.atomic_io import write_atomic
 
     write_atomic(out / "simulation.json", json.dumps(report, indent=2) + "\n")

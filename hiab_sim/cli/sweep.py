@@ -45,8 +45,13 @@ def run(args: argparse.Namespace) -> int:
     with make_executor(args.workers, args.dask) as executor:
         outcome = run_sweep(sweep, out, executor, resume=args.resume, progress=not args.quiet)
     frame, _ = read_table(outcome.table)
-    figures = summary_figures(frame, list(sweep.axes), out, sweep.name)
     ok = frame["status"] == "ok"
+    per = "cycle"
+    if ok.any():  # every point runs the same study's duty model: a finished point's result says which period
+        energy = read_result(out / "points" / str(frame.loc[ok, "key"].iloc[0])).energy
+        if energy is not None and energy.optimal.duty is not None:
+            per = "duty period (the cycle and the rest's hold)"
+    figures = summary_figures(frame, list(sweep.axes), out, sweep.name, per.split(" (")[0])
     details = [
         f"sweep {sweep.name}: {len(sweep.points)} points of {sweep.study_file.name} on {where}",
         f"ran {len(outcome.ran)} point(s), skipped {len(outcome.skipped)} finished, {len(outcome.failed)} failed now; "
@@ -57,10 +62,5 @@ def run(args: argparse.Namespace) -> int:
         details.append(f"net energy saved: {saving.min():.2f} .. {saving.max():.2f} % over the ok points")
     details += [f"  failed {row['key']}: {row['message']}" for _, row in frame[~ok].iterrows()]
     files = [outcome.table.name, "points/<key>/result.json", *(p.name for p in figures), ANSWER_FILE]
-    per = "cycle"
-    if ok.any():  # every point runs the same study's duty model: a finished point's result says which period
-        energy = read_result(out / "points" / str(frame.loc[ok, "key"].iloc[0])).energy
-        if energy is not None and energy.optimal.duty is not None:
-            per = "duty period (the cycle and the rest's hold)"
     publish_answer(sweep_answer(frame, list(sweep.axes), sweep.name, out, files, per), out, details)
     return 0

@@ -25,6 +25,10 @@ from hiab_sim.emla.model import operating_point, peak_force, top_speed
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.style import colour
 
+#: The envelope's limits in words (names of :data:`hiab_sim.emla.envelope.ENVELOPE_LIMIT_NAMES`).
+ENVELOPE_WORDS = {"peak_torque": "motor peak torque", "rated_speed": "rated speed", "voltage": "drive voltage"}
+#: The colour bar's label: the efficiency in each quadrant.
+EFFICIENCY_LABEL = "efficiency: $f_x v_x / P_{elec}$ motoring, $P_{elec} / f_x v_x$ generating"
 #: Filled efficiency levels of the map; the labelled contour lines are a subset.
 EFFICIENCY_LEVELS: tuple[float, ...] = (0.0, 0.3, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.92, 0.94, 0.96, 1.0)
 LABELLED_LEVELS: tuple[float, ...] = (0.5, 0.7, 0.8, 0.85, 0.9, 0.92, 0.94)
@@ -114,6 +118,8 @@ def plot_efficiency_map(
     operating_points: tuple[ArrayLike, ArrayLike] | None = None,
     ax: Axes | None = None,
     designs: Mapping[str, tuple[ArrayLike, ArrayLike]] | None = None,
+    losses_in_title: bool = True,
+    colorbar: bool = True,
 ) -> Figure:
     """Draw the efficiency map: filled contours with labelled levels, the envelope and references.
 
@@ -128,7 +134,11 @@ def plot_efficiency_map(
         ax: Axes to draw into; a new Agg-backed figure is made when None.
         designs: Optional design name (``initial``, ``optimal``, ``rounded``...) -> (f_x [N],
             v_x [m/s]): each design's operating points in its colour and marker of
-            :mod:`hiab_sim.style`, over a light-grey efficiency field.
+            :mod:`hiab_sim.style`, over a light efficiency field; the initial design's line is drawn
+            over the optimal one (thinner, dash-dot), so both show where they coincide.
+        losses_in_title: Name the drive losses in the axes' title (False: the caller names them once
+            for several maps).
+        colorbar: Draw the efficiency colour bar (False: the caller draws one for several maps).
 
     Returns:
         The figure holding the axes.
@@ -151,7 +161,8 @@ def plot_efficiency_map(
     if np.any(drawing):
         ax.contourf(v, f_kn, drawing.astype(float), levels=[0.5, 1.5], colors="0.6", hatches=["///"], alpha=0.9)
     ax.contour(v, f_kn, emap.margins.min(axis=0), levels=[0.0], colors="black", linewidths=2.0)
-    ax.plot([], [], color="black", linewidth=2.0, label="envelope (" + ", ".join(ENVELOPE_LIMIT_NAMES) + ")")
+    limits = ", ".join(ENVELOPE_WORDS.get(n, n.replace("_", " ")) for n in ENVELOPE_LIMIT_NAMES)
+    ax.plot([], [], color="black", linewidth=2.0, label=f"envelope ({limits})")
     if np.any(drawing):
         ax.fill_between([], [], color="0.6", hatch="///", label="generating, drive still draws power")
     if emap.hydraulic_push_force is not None:
@@ -165,8 +176,9 @@ def plot_efficiency_map(
     for name, points in (designs or {}).items():  # the motion's path through the map: a line per design
         f_op, v_op = _points(points, f"designs[{name!r}]")
         ax.plot(
-            v_op, f_op / 1e3, color=colour(name), linewidth=2.4 if name == "optimal" else 1.6,
-            linestyle="-" if name == "optimal" else "-.", label=f"{name} design: operating points over the motion",
+            v_op, f_op / 1e3, color=colour(name), linewidth=2.6 if name == "optimal" else 1.4,
+            linestyle="-" if name == "optimal" else "-.", zorder=3 if name == "optimal" else 4,  # dashed: hydraulic
+            label=f"{name} design: operating points over the motion",
         )  # fmt: skip
     ax.axhline(0.0, color="0.3", linewidth=0.5)
     ax.axvline(0.0, color="0.3", linewidth=0.5)
@@ -182,14 +194,14 @@ def plot_efficiency_map(
         )  # fmt: skip
     ax.set_xlabel("rod velocity $v_x$ [m/s]")
     ax.set_ylabel("load force $f_x$ [kN]")
-    title = (
-        f"EMLA efficiency, {emap.actuator}: peak {emap.peak_force / 1e3:.1f} kN, top {emap.top_speed:.3f} m/s\n"
-        + "\n".join(textwrap.wrap(emap.loss_options, 95))
-    )
+    title = f"EMLA efficiency, {emap.actuator}: peak {emap.peak_force / 1e3:.1f} kN, top {emap.top_speed:.3f} m/s"
+    if losses_in_title:
+        title += "\n" + "\n".join(textwrap.wrap(emap.loss_options, 95))
     ax.set_title(title, fontsize=9)
     title_lines = title.count("\n") + 1
     ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.035 + 0.035 * title_lines), ncol=2, fontsize=7, frameon=False)
-    fig.colorbar(filled, ax=ax, label="efficiency: $f_x v_x / P_{elec}$ motoring, $P_{elec} / f_x v_x$ generating")
+    if colorbar:
+        fig.colorbar(filled, ax=ax, label=EFFICIENCY_LABEL)
     return fig
 
 

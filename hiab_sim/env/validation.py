@@ -10,16 +10,26 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 from tqdm import tqdm
 
 from hiab_sim.control.cascade import CascadeGains
 from hiab_sim.crane.description import Crane
+from hiab_sim.emla.battery import BatteryParams
 from hiab_sim.emla.config import EmlaSet
 from hiab_sim.env import CURRENT_BANDWIDTH_HZ, PHYSICS_TIMESTEP
+from hiab_sim.env.closed_loop_battery import (
+    BATTERY_NOTE,
+    battery_entry,
+    battery_notes,
+    predicted_cycle_battery_energy,
+)
 from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.plan import read_plan
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.rollout import ClosedLoopRun, run_closed_loop
+
+Array = NDArray[np.float64]
 
 #: Video frame rate [1/s] and the size of one design's viewport (width, height) [px].
 FPS = 30.0
@@ -71,13 +81,25 @@ def simulate_designs(
 def simulation_report(
     result_dir: str | Path, runs: list[ClosedLoopRun], nominal: list[ClosedLoopRun], emlas: EmlaSet | None = None
 ) -> dict[str, object]:
-    """The content of ``simulation.json``; ``emlas`` the runs' EMLA set (None: the crane result's, read from it)."""
+    """The content of ``simulation.json``; ``emlas`` the runs' EMLA set (None: the crane result's, read from it).
+
+    Every run's entry carries its battery energy (:func:`hiab_sim.env.closed_loop_battery.battery_entry`)
+    against the result's battery energy of one cycle; a nominal run's against the same plan.
+    """
+    if emlas is None and runs:
+        emlas = read_plan(result_dir, runs[0].design).emlas
+    predicted = predicted_cycle_battery_energy(result_dir) if runs else {}
     designs: dict[str, object] = {}
     for run in runs:
         entry = run.summary()
+        if emlas is not None:
+            entry.update(battery_entry(run, emlas.battery, predicted.get(run.design)))
         match = next((n for n in nominal if n.design == run.design), None)
         if match is not None:
-            entry["nominal"] = match.summary()
+            nominal_entry = match.summary()
+            if emlas is not None:
+                nominal_entry.update(battery_entry(match, emlas.battery, predicted.get(match.design)))
+            entry["nominal"] = nominal_entry
             entry["extra_energy_J"] = run.net_energy - match.net_energy
             entry["extra_energy_vs_predicted_J"] = run.net_energy - run.predicted_net_energy
         designs[run.design] = entry
@@ -97,11 +119,10 @@ def simulation_report(
             "energy": "closed loop: each drive's DC input over the cycle (int 3/2 (v_d i_d + v_q i_q) dt with the "
             "EMLA file's inverter loss and holding brake, hiab_sim.env.drive_losses), summed over the drives",
             "tcp_error": "distance of the simulated TCP to the study's TCP reference at the same time",
+            "battery_energy": BATTERY_NOTE,
             "plant": runs[0].plant if runs else "ideal",
         },
     }
-    if emlas is None and runs:
-        emlas = read_plan(result_dir, runs[0].design).emlas
     boundary = energy_boundary(emlas) if emlas is not None else None
     if boundary is not None:
         report["energy_boundary"] = boundary
@@ -161,11 +182,22 @@ def table(report: dict[str, object]) -> str:
     return "\n".join(lines)
 
 
+def closed_loop_frame_times(duration: float) -> Array:
+    """The closed-loop video's frame instants [s]: 0, 1/FPS, ... and ``duration`` itself last.
+
+    Real time at ``FPS``; when ``duration`` is not a whole number of frames the last frame is the
+    cycle's end (less than one frame after the one before), so it shows the cycle's total energy.
+    """
+    at = np.arange(int(np.floor(duration * FPS + 1e-9)) + 1) / FPS
+    return at if duration - at[-1] < 1e-9 else np.append(at, duration)
+
+
 def render_video(
     path: Path,
     runs: list[ClosedLoopRun],
     physics: list[CranePhysics],
     crane: Crane,
+    battery: BatteryParams,
     nominal: list[ClosedLoopRun] | None = None,
     quiet: bool = False,
 ) -> Path:
@@ -173,9 +205,11 @@ def render_video(
 
     One panel per end-mass condition (the planned mass when ``nominal`` runs are given, then the
     runs' own), each overlaying the optimal design (opaque) on the initial one (ghost), the
-    machine dressed from ``crane``, with the time and each design's cumulative drive energy
-    int sum_i P_elec,i dt [kJ] of the closed loop. A nominal run is drawn with its design's
-    model of ``physics`` (the end-mass error changes inertia, not geometry).
+    machine dressed from ``crane``, with the time and each design's battery energy so far of the
+    cycle against its total [kJ] (:func:`hiab_sim.env.closed_loop_battery.battery_notes`, the
+    battery ``battery`` of the EMLA file; the total is ``simulation.json``'s ``battery_energy_J``).
+    A nominal run is drawn with its design's model of ``physics`` (the end-mass error changes
+    inertia, not geometry).
     """
     from hiab_sim.render.backend import video_sink
     from hiab_sim.render.decor import INITIAL_RGBA, OPTIMAL_RGBA
@@ -184,21 +218,15 @@ def render_video(
 
     width, height = VIEWPORT
     colours = {"initial": INITIAL_RGBA, "optimal": OPTIMAL_RGBA}
-    duration = min(run.time[-1] for run in runs)
-    frames = int(np.floor(duration * FPS)) + 1
-    at = np.arange(frames) / FPS
+    at = closed_loop_frame_times(min(run.time[-1] for run in runs))
+    frames = len(at)
     models = {run.design: item.model.ptr for run, item in zip(runs, physics, strict=True)}
     marks = tuple(f"{chain.name}_base_pivot" for chain in crane.chains)
     panels = [nominal, runs] if nominal else [runs]
 
     def design(run: ClosedLoopRun) -> Design:
         index = np.clip(np.searchsorted(run.time, at), 0, len(run.time) - 1)
-        energy = run.cumulative_energy.sum(axis=1) if run.cumulative_energy.ndim == 2 else run.cumulative_energy
-        total = float(energy[-1]) / 1e3
-        notes = tuple(
-            f"t = {t:5.2f} s   drive energy {energy[k] / 1e3:.3f} of {total:.3f} kJ"
-            for t, k in zip(at, index, strict=True)
-        )
+        notes = battery_notes(run, battery, at)
         mass = "planned end mass" if run.payload_error == 0 else f"end mass +{100 * run.payload_error:g} %"
         caption = f"{run.design}, {mass}" if run.design != "initial" else "initial (ghost)"
         model = models[run.design]

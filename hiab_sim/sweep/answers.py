@@ -26,7 +26,7 @@ import pandas as pd
 from hiab_sim.study.report.summary import BATTERY_BOUNDARY, NET_BOUNDARY, before_after, files_line, limit_in_words
 from hiab_sim.sweep.energy_map import EnergyMap
 from hiab_sim.sweep.map_output import infeasible_note, objective_words
-from hiab_sim.sweep.pareto import CRITERIA, FrontPoint
+from hiab_sim.sweep.pareto import CRITERIA, CRITERION_AXIS, FrontPoint
 
 #: The study objectives in words (names of :data:`hiab_sim.study.nlp.objectives.OBJECTIVES`).
 OBJECTIVE_WORDS = {
@@ -34,7 +34,7 @@ OBJECTIVE_WORDS = {
     "battery_energy": f"the battery energy {BATTERY_BOUNDARY}, as the optimiser evaluates it",
 }
 #: Criteria of a front in words.
-CRITERION_WORDS = {"peak_force": "peak actuator force", "rms_torque": "rms motor torque"}
+CRITERION_WORDS = CRITERION_AXIS
 
 
 def _short(source: str) -> str:
@@ -184,7 +184,7 @@ def front_answer(
     return lines
 
 
-def _energy_column(frame: pd.DataFrame, ok: pd.Series) -> tuple[str, str, str]:
+def energy_columns(frame: pd.DataFrame, ok: pd.Series) -> tuple[str, str, str]:
     """(optimum's column, start's column, boundary in words): the battery's where every finished point has it."""
     column = "opt_battery_energy_J"
     if column in frame and ok.any() and np.isfinite(frame.loc[ok, column].to_numpy(dtype=float)).all():
@@ -206,7 +206,7 @@ def sweep_answer(
         lines.append(f"No point finished: all {len(frame)} failed (messages below).")
         lines += ["", files_line(folder, files)]
         return lines
-    column, start_column, boundary = _energy_column(frame, ok)
+    column, start_column, boundary = energy_columns(frame, ok)
     done = frame[ok]
     best = done.loc[done[column].astype(float).idxmin()]
     values = ", ".join(f"{a} = {best[a]}" for a in axes)
@@ -218,10 +218,11 @@ def sweep_answer(
         + "."
     )
     energy = done[column].astype(float) / 1e3
-    saving = done["net_energy_saved_percent"].astype(float)
+    saving = 100.0 * (1.0 - done[column].astype(float) / done[start_column].astype(float))
     lines.append(
-        f"Spread over the {int(ok.sum())} finished point(s): energy at the optimum {energy.min():.3f} .. "
-        f"{energy.max():.3f} kJ; net energy saved by the optimisation {saving.min():.2f} .. {saving.max():.2f} %."
+        f"Spread over the {int(ok.sum())} finished point(s), at the same boundary: energy at the optimum "
+        f"{energy.min():.3f} .. {energy.max():.3f} kJ; saved by the optimisation {saving.min():.2f} .. "
+        f"{saving.max():.2f} %."
     )
     failed = int((~ok).sum())
     lines.append(f"{failed} of {len(frame)} points failed (messages below)." if failed else "No point failed.")

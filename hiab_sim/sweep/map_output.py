@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.sweep.energy_map import FEASIBILITY_TOLERANCE, EnergyMap
@@ -17,6 +18,19 @@ TRAJECTORY_NOTE = (
     "inverse-kinematics fit); tracking, joint-range and joint-velocity rows depend on it only and hold over the "
     "whole map"
 )
+
+
+#: The objectives in words, for axis labels (names of :data:`hiab_sim.study.nlp.objectives.OBJECTIVES`).
+OBJECTIVE_AXIS = {"costf2": "squared-power cost", "battery_energy": "battery energy"}
+
+
+def variable_words(name: str) -> str:
+    """A decision variable (``lift.L``) as a label in words with its unit (``lift L, base pivot to boom hinge [m]``)."""
+    from hiab_sim.study.report.summary import LENGTH_WORDS
+
+    chain, _, field = name.partition(".")
+    words = LENGTH_WORDS.get(field)
+    return f"{chain} {field}, {words} [m]" if words else f"{name.replace('.', ' ')} [m]"
 
 
 def objective_words(m: EnergyMap) -> str:
@@ -102,8 +116,12 @@ def summary(m: EnergyMap) -> dict[str, Any]:
     }
 
 
-def write_map(m: EnergyMap, out: Path) -> list[Path]:
-    """Write energy_map.json, energy_map.npz and energy_map.png into ``out`` (atomically); return the paths."""
+def write_map(m: EnergyMap, out: Path, per: str = "cycle") -> list[Path]:
+    """Write energy_map.json, energy_map.npz and energy_map.png into ``out`` (atomically); return the paths.
+
+    ``per`` names the period the battery energy covers (``"cycle"``, or ``"duty period"`` with the
+    study's duty model), for the figure's label.
+    """
     out.mkdir(parents=True, exist_ok=True)
     v = m.values
     arrays = {
@@ -125,7 +143,7 @@ def write_map(m: EnergyMap, out: Path) -> list[Path]:
     paths = [out / "energy_map.json", out / "energy_map.npz", out / "energy_map.png"]
     write_atomic(paths[0], json.dumps(summary(m), indent=2) + "\n")
     write_atomic(paths[1], buffer.getvalue())
-    write_atomic(paths[2], figure_png(m))
+    write_atomic(paths[2], figure_png(m, per))
     return paths
 
 
@@ -160,13 +178,18 @@ def infeasible_note(m: EnergyMap) -> str | None:
     )
 
 
-def figure_png(m: EnergyMap) -> bytes:
-    """PNG of two panels (objective, net energy) with infeasible cells coloured by binding constraint.
+def figure_png(m: EnergyMap, per: str = "cycle") -> bytes:
+    """PNG of two panels (objective, battery energy per ``per``) with infeasible cells coloured by binding constraint.
+
+    One quantity and one boundary per panel: the study's objective relative to its start, and the
+    battery energy (at the battery: shared DC bus, regeneration credited), the boundary of the answer.
 
     Where most cells are infeasible, a note in the figure says which limit binds and which
-    variables to map instead (:func:`infeasible_note`); without a feasible cell the value panels
-    get no colour bar (it would have no values to show).
+    variables to map instead (:func:`infeasible_note`); without a feasible cell there are no values
+    to show: one panel shows the limit each cell breaks, with no colour bar.
     """
+    import textwrap
+
     from matplotlib import colormaps
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
@@ -183,12 +206,15 @@ def figure_png(m: EnergyMap) -> bytes:
     category = np.full(feasible.shape, np.nan)
     for n, name in enumerate(labels):
         category[(~feasible) & (binding == v.names.index(name))] = n
-    fig = new_figure((13, 5.6))
-    axes = fig.subplots(1, 2)
-    panels = (
-        (v.objective, f"objective ({m.objective}, {m.objective_unit}) / its value at the study's start"),
-        (v.net_energy / 1e3, "net electrical energy " + ("per cycle" if len(m.tasks) == 1 else "weighted") + " [kJ]"),
+    what = OBJECTIVE_AXIS.get(m.objective, m.objective.replace("_", " "))
+    panels: tuple[tuple[NDArray[np.float64], str], ...] = (
+        (v.objective, f"{what} / its value at the study's start [-]"),
+        (v.battery_energy / 1e3, f"battery energy [kJ per {per}" + ("]" if len(m.tasks) == 1 else ", weighted]")),
     )
+    if not feasible.any():  # nothing to colour: one panel of the limits the cells break
+        panels = ((v.objective, "no feasible mounting on this map: the limit each cell breaks"),)
+    fig = new_figure((13, 5.6) if len(panels) == 2 else (8.0, 6.2))
+    axes = fig.subplots(1, len(panels), squeeze=False)[0]
     for ax, (values, title) in zip(axes, panels, strict=True):
         grid = np.ma.masked_where(~feasible, m.grid(values))
         mesh = ax.pcolormesh(m.axes[0], m.axes[1], grid.T, shading="nearest", cmap="viridis")
@@ -211,13 +237,11 @@ def figure_png(m: EnergyMap) -> bytes:
         ax.plot(m.start_xi[i], m.start_xi[j], "wo", mec="k", ms=5, label="start")
         lo, hi = m.low[[i, j]], m.up[[i, j]]
         ax.plot([lo[0], hi[0], hi[0], lo[0], lo[0]], [lo[1], lo[1], hi[1], hi[1], lo[1]], "k--", lw=1, label="bounds")
-        ax.set_xlabel(f"{m.variables[0]} [m]")
-        ax.set_ylabel(f"{m.variables[1]} [m]")
-        ax.set_title(title if feasible.any() else f"{title}: no feasible cell to colour", fontsize=10)
+        ax.set_xlabel(variable_words(m.variables[0]))
+        ax.set_ylabel(variable_words(m.variables[1]))
+        ax.set_title(title, fontsize=10)
     note = infeasible_note(m)
     if note is not None:
-        import textwrap
-
         wrapped = "\n".join(textwrap.fill(part, 58) for part in note.split("\n"))
         for ax in axes:
             ax.text(
@@ -227,12 +251,16 @@ def figure_png(m: EnergyMap) -> bytes:
     handles, names = axes[0].get_legend_handles_labels()
     handles += [Patch(color=palette(n % 10), alpha=0.35) for n in range(len(labels))]
     names += [f"infeasible: {limit_in_words(name)}" for name in labels]
-    fig.legend(handles, names, loc="outside lower center", ncol=2, fontsize=8)
+    fig.legend(handles, names, loc="outside lower center", ncol=len(panels), fontsize=8)
     title = (
-        f"Energy map over {m.variables[0]} x {m.variables[1]}; the other decision variables and the trajectory at "
-        f"the {m.base.source}"
+        f"Energy map over {m.variables[0]} and {m.variables[1]}; the other decision variables and the trajectory "
+        f"at the {m.base.source}"
     )
+    if len(panels) == 2:
+        title += "\nbattery energy at the battery (shared DC bus, regeneration credited)"
     if len(m.tasks) > 1:
         title += "\nduty mix, objective and energies weighted: " + " + ".join(f"{w:g} x {n}" for n, w in m.tasks)
-    fig.suptitle(title, fontsize=10)
+    fig.suptitle(
+        "\n".join(textwrap.fill(part, 180 if len(panels) == 2 else 95) for part in title.split("\n")), fontsize=10
+    )
     return png_bytes(fig)

@@ -26,7 +26,16 @@ from hiab_sim.study.report.summary import limit_in_words
 from hiab_sim.style import colour
 
 Array = np.ndarray
-ENERGY_LABELS = ("mechanical\nf v", "copper", "rotor\nfriction", "screw\nviscous", "inertial", "net\nelectrical")
+#: The bars of :func:`energy_bars`: the breakdown's parts, the drive train's (:func:`drive_train_energy`), the total.
+ENERGY_LABELS = (
+    "mechanical\nf v",
+    "copper",
+    "rotor\nfriction",
+    "screw\nviscous",
+    "inertial",
+    "drive train:\nscrew, gear,\ninverter, brake",
+    "net\nelectrical",
+)
 
 
 def draw_crane(ax: Axes, crane: Crane, lengths: LinkLengths, joints: Array, colour: str, alpha: float = 1.0) -> None:
@@ -93,7 +102,7 @@ def structure_overlay(
             ax.annotate(
                 f"{chain.name} base pivot\nmoves {shift * 1e3:.0f} mm",
                 xy=(0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])),
-                xytext=(-95, -30 if chain.name == "lift" else 25),
+                xytext=(40, 60) if chain.name == "lift" else (60, -60),  # right of the pivot: inside the axes
                 textcoords="offset points",
                 fontsize=8,
                 arrowprops={"arrowstyle": "-", "color": "0.5", "linewidth": 0.6},
@@ -156,7 +165,7 @@ def decision_panels(
 
 
 def energy_bars(ax: Axes, breakdown: dict[str, tuple[float, ...]]) -> None:
-    """Energy breakdown per design [kJ] with the value on every bar."""
+    """Energy breakdown per design [kJ] with the value on every bar, one value per :data:`ENERGY_LABELS`."""
     x = np.arange(len(ENERGY_LABELS))
     width = 0.8 / len(breakdown)
     for k, (name, parts) in enumerate(breakdown.items()):

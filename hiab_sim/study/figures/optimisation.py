@@ -178,32 +178,75 @@ def actuator_figure(time: np.ndarray, checks: dict[str, DesignCheck], path: Path
 
 def efficiency_figure(emlas: EmlaSet, checks: dict[str, DesignCheck], path: Path) -> None:
     """Operating points (initial, optimal) over each actuator's efficiency map."""
-    from hiab_sim.emla.maps import efficiency_map, plot_efficiency_map
+    from hiab_sim.emla.maps import EFFICIENCY_LABEL, efficiency_map, plot_efficiency_map
 
-    fig = new_figure((6.3 * len(emlas), 6.0))
+    fig = new_figure((5.6 * len(emlas) + 1.0, 6.0))
     axes = fig.subplots(1, len(emlas), squeeze=False)[0]
+    losses = {p.losses.describe() for p in emlas}
+    shared = len(losses) == 1  # the same drive losses on every map: named once, over the figure
+    filled = None
     for i, (ax, params) in enumerate(zip(axes, emlas, strict=True)):
         emap = efficiency_map(params, n_force=81, n_velocity=81)
         ini = checks["initial"].evaluation.actuators
         opt = checks["optimal"].evaluation.actuators
         designs = {"initial": (ini.force[:, i], ini.velocity[:, i]), "optimal": (opt.force[:, i], opt.velocity[:, i])}
-        plot_efficiency_map(emap, ax=ax, designs=designs)
+        plot_efficiency_map(emap, ax=ax, designs=designs, losses_in_title=not shared, colorbar=False)
+        filled = ax.collections[0] if filled is None else filled
         if i > 0:  # one legend for the three maps: they share every entry
             legend = ax.get_legend()
             if legend is not None:
                 legend.remove()
+    if filled is not None:  # one colour bar: the maps share their levels and colours
+        fig.colorbar(filled, ax=list(axes), label=EFFICIENCY_LABEL, shrink=0.9)
+    if shared:
+        fig.suptitle(next(iter(losses)), fontsize=9)
     save_png(fig, path)
 
 
-def energy_figure(time: np.ndarray, checks: dict[str, DesignCheck], path: Path) -> None:
-    """Energy breakdown with values on the bars, and the cumulative net electrical energy, initial vs optimal."""
-    fig = new_figure((12.0, 4.4))
-    left, right = fig.subplots(1, 2, width_ratios=(1.3, 1.0))
+def drive_train_energy(emlas: EmlaSet, check: DesignCheck, time: np.ndarray) -> float:
+    """What the breakdown's parts leave out with the EMLA file's drive losses on [J], summed over the actuators.
+
+    The screw and gearbox loss, the inverter loss, the brake coil's power and the load power the engaged
+    brake carries (negative), integrated over ``time`` (the fine grid) at the breakdown's own operating
+    points (:func:`hiab_sim.study.report.design_check.design_summary`: the same call of
+    :func:`hiab_sim.emla.operating_point`), so that mechanical + copper + rotor friction + screw viscous +
+    inertial + this = the breakdown's electrical energy; 0 for the paper's drive.
+    """
+    from hiab_sim.emla import operating_point
+    from hiab_sim.quadrature import trapezoid
+
+    act = check.evaluation.actuators
+    total = 0.0
+    for i, params in enumerate(emlas):
+        op = operating_point(params, act.force[:, i], act.velocity[:, i], act.acceleration[:, i])
+        total += float(
+            trapezoid(op.transmission_loss + op.inverter_loss + op.brake_coil_power + op.brake_held_power, time)
+        )
+    return total
+
+
+def energy_figure(
+    time: np.ndarray, checks: dict[str, DesignCheck], path: Path, emlas: EmlaSet, hot_windings: bool = False
+) -> None:
+    """Where the energy goes (the breakdown's parts, the drive train's, their total) and the cumulative net energy.
+
+    Both charts are the motors' net electrical energy over the motion (regeneration credited), all actuators,
+    fine grid. The breakdown is at the windings' reference resistance; with ``hot_windings`` (the study's duty
+    model) the cumulative energy is the study's, at the hot windings' R_s(T), and the right title says so.
+    """
+    fig = new_figure((13.0, 4.6))
+    left, right = fig.subplots(1, 2, width_ratios=(1.45, 1.0))
     names = ("initial", "optimal")
-    energy_bars(left, {n: checks[n].summary.energy_breakdown_J.as_tuple() for n in names})
-    left.set_title("Energy breakdown (all actuators, fine grid)")
+    bars = {}
+    for n in names:
+        parts = checks[n].summary.energy_breakdown_J.as_tuple()
+        bars[n] = (*parts[:-1], drive_train_energy(emlas, checks[n], time), parts[-1])
+    energy_bars(left, bars)
+    cold = ", windings at their reference resistance" if hot_windings else ""
+    left.set_title(f"Where the energy goes\n(all actuators{cold})", fontsize=10)
     cumulative_energy(right, time, {n: checks[n].evaluation.power for n in names})
-    right.set_title("Cumulative net electrical energy")
+    hot = "\n(hot windings: the study's duty model)" if hot_windings else ""
+    right.set_title(f"Cumulative net electrical energy{hot}", fontsize=10)
     save_png(fig, path)
 
 
@@ -280,7 +323,9 @@ def write_figures(
         )
     actuator_figure(arrays["time"], checks, paths["actuators"])
     efficiency_figure(emlas, checks, paths["maps"])
-    energy_figure(arrays["time"], checks, paths["energy"])
+    duty = result.energy.optimal.duty if result.energy is not None else None
+    hot = duty is not None and duty.hot_winding_extra_J != 0.0
+    energy_figure(arrays["time"], checks, paths["energy"], emlas, hot_windings=hot)
     if result.sensitivity is not None:
         paths["sensitivity"] = out / "sensitivity.png"
         sensitivity_figure(result.sensitivity, paths["sensitivity"])
