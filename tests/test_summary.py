@@ -93,7 +93,8 @@ def test_rerun_removes_the_earlier_simulation_too_and_says_so(
             "lift cylinder fully retracted over the working range at the lower",
         ),
         ("bound tilt.L up = 1.3 m", "tilt base pivot to boom hinge at its upper bound (1300 mm)"),
-        ("tracking.position.x_tcp <= band", "TCP tracking band (position), x tcp"),
+        ("tracking.position.x_tcp <= band", "TCP tracking band (position), TCP x (horizontal)"),
+        ("tracking.velocity.xt2 >= band", "tracking band (velocity), joint xt2"),
     ],
 )
 def test_constraint_rows_read_in_words(row: str, words: str) -> None:

@@ -44,6 +44,8 @@ _STROKE_WORDS = {
     "x <= stroke": "end of stroke",
 }
 _TRACKING = re.compile(r"^tracking\.(\w+)\.(\S+)")
+#: The tool point's tracked coordinates in words; any other tracked coordinate is a joint of the machine.
+_COORDINATE_WORDS = {"x_tcp": "TCP x (horizontal)", "y_tcp": "TCP y (vertical)"}
 _BOUND = re.compile(r"^bound (\w+)\.(\w+) (low|up) = (\S+) m$")
 
 
@@ -62,7 +64,11 @@ def limit_in_words(name: str, detail: bool = True) -> str:
     match = _TRACKING.match(name)
     if match:
         band = f"TCP tracking band ({match.group(1)})"
-        return f"{band}, {match.group(2).replace('_', ' ')}" if detail else band
+        if not detail:
+            return band
+        if match.group(2) in _COORDINATE_WORDS:
+            return f"{band}, {_COORDINATE_WORDS[match.group(2)]}"
+        return f"tracking band ({match.group(1)}), joint {match.group(2)}"
     block, _, rest = name.partition(".")
     if block == "envelope":
         actuator, _, limit = rest.partition(".")
