@@ -50,9 +50,12 @@ ENERGY_PARTS = ("mechanical", "copper", "rotor_friction", "screw_viscous", "iner
 
 @dataclass(frozen=True)
 class EnergyBreakdown:
-    """Energy over the motion by power flow (:func:`hiab_sim.emla.operating_point`) [J].
+    """Energy over the motion by power flow (:func:`hiab_sim.emla.operating_point`) [J], summed over the drives.
 
-    electrical = mechanical + copper + rotor_friction + screw_viscous + inertial.
+    At the reference (cold) winding resistance: the hot windings' extra copper loss is the duty's
+    ``hot_winding_extra_J``. electrical = mechanical + copper + rotor_friction + screw_viscous +
+    inertial + the drive train's losses (screw and gearbox efficiency, inverter, brake coil), which
+    no field here names: they are electrical minus the sum of the five parts (zero on the paper model).
     """
 
     mechanical: float
