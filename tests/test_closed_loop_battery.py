@@ -24,6 +24,7 @@ def run_and_battery() -> tuple[ClosedLoopRun, BatteryParams]:
     return run, plan.emlas.battery
 
 
+@pytest.mark.sim
 def test_a_lossless_battery_passes_the_logged_dc_energy(run_and_battery: tuple[ClosedLoopRun, BatteryParams]) -> None:
     """With every efficiency 1 the battery energy is, at every logged time, the drives' DC energy the physics logged.
 
@@ -36,6 +37,7 @@ def test_a_lossless_battery_passes_the_logged_dc_energy(run_and_battery: tuple[C
     np.testing.assert_allclose(energy, run.cumulative_energy.sum(axis=1), rtol=1e-9, atol=1e-6)
 
 
+@pytest.mark.sim
 def test_the_battery_costs_its_discharge_loss(run_and_battery: tuple[ClosedLoopRun, BatteryParams]) -> None:
     """The real battery (eta_dis 0.975) delivers more than the bus takes, at most the drawn energy / eta_dis."""
     run, battery = run_and_battery
@@ -46,6 +48,7 @@ def test_the_battery_costs_its_discharge_loss(run_and_battery: tuple[ClosedLoopR
     assert run.net_energy < energy <= drawn / battery.discharge_efficiency
 
 
+@pytest.mark.sim
 def test_the_overlays_last_number_is_the_reported_battery_energy(
     run_and_battery: tuple[ClosedLoopRun, BatteryParams],
 ) -> None:

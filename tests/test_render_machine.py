@@ -93,6 +93,7 @@ def test_mjcf_from_machine_result_is_that_design(run_dir: Path, design: str, tmp
     np.testing.assert_allclose(written.body_pos, expected.body_pos, atol=1e-15)
 
 
+@pytest.mark.sim
 def test_render_frames_of_a_crane_result(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """``--frames`` also serves a crane file's result: N PNGs, the first and last frames differ."""
     import mediapy
@@ -109,6 +110,7 @@ def test_render_frames_of_a_crane_result(tmp_path: Path, capsys: pytest.CaptureF
     assert np.mean(np.abs(first - last)) > 0.5
 
 
+@pytest.mark.sim
 def test_render_frames_needs_an_existing_folder(
     run_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
