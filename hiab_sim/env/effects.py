@@ -32,6 +32,7 @@ import sys
 import tempfile
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from tqdm import tqdm
@@ -51,6 +52,7 @@ from hiab_sim.env.rollout import ClosedLoopRun, run_closed_loop
 from hiab_sim.figure_io import new_figure, save_png
 from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
 from hiab_sim.machine.dynamics.tree import MachineActuatorSamples
+from hiab_sim.study.spec.study import Study
 from hiab_sim.style import COLOURS
 
 
@@ -104,13 +106,38 @@ def true_mass_prediction(plan: DesignPlan | MachinePlan, plant: Plant) -> float:
     return float(0.5 * np.sum((total[1:] + total[:-1]) * np.diff(plan.time)))
 
 
-def replanned_prediction(result_dir: str | Path, plant: Plant) -> dict[str, object]:
-    """The result's study optimised again with the mismatch's true masses: its optimum's predicted energy [J].
+def true_study(study: Study, plant: Plant) -> Study:
+    """The study with the mismatch's true masses (the true machine and payload, or the true crane).
 
-    Returns a mapping with ``predicted_J`` (and ``predicted_battery_J`` where the study has a battery)
-    and ``lengths`` of the re-optimised design, or with ``skipped`` saying why (the study is a mix of
-    tasks). A machine file's study gets :func:`~hiab_sim.env.plant.mismatch.true_machine` and the
-    payload x (1 + e_end), a crane file's the true crane.
+    A machine file's study gets :func:`~hiab_sim.env.plant.mismatch.true_machine` and its first
+    task's payload x (1 + e_end); a crane file's :func:`~hiab_sim.env.plant.mismatch.true_crane`.
+    """
+    if study.machine is not None:
+        task = study.tasks[0]
+        payload = replace(task.payload, mass=task.payload.mass * payload_factor(plant.mismatch))
+        tasks = (replace(task, payload=payload), *study.tasks[1:])
+        return replace(study, machine=true_machine(study.machine, plant.mismatch), tasks=tasks)
+    return replace(study, crane_description=true_crane(study.crane, plant.mismatch))
+
+
+def replanned_summary(result: dict[str, Any]) -> dict[str, object]:
+    """``predicted_J``, ``lengths`` (and ``predicted_battery_J`` with a battery) of a re-planned ``result.json``."""
+    optimal = result["optimal"]
+    replanned: dict[str, object] = {
+        "predicted_J": float(optimal["net_electrical_energy_J"]),
+        "lengths": optimal.get("lengths"),
+    }
+    energy = result.get("energy")
+    if isinstance(energy, dict) and "optimal" in energy:
+        replanned["predicted_battery_J"] = float(energy["optimal"]["battery_energy_J"])
+    return replanned
+
+
+def replanned_prediction(result_dir: str | Path, plant: Plant) -> dict[str, object]:
+    """The result's study optimised again with the mismatch's true masses (:func:`true_study`): its optimum's energy.
+
+    Returns :func:`replanned_summary`'s mapping of the re-optimised design, or one with ``skipped``
+    saying why (the study is a mix of tasks).
 
     Raises:
         ConfigError: the study file is gone.
@@ -123,26 +150,21 @@ def replanned_prediction(result_dir: str | Path, plant: Plant) -> dict[str, obje
     study = load_study(read_result(result_dir).study)
     if len(study.tasks) != 1:
         return {"skipped": f"the study has {len(study.tasks)} tasks; re-planning is done for single-task studies"}
-    if study.machine is not None:
-        task = study.tasks[0]
-        payload = replace(task.payload, mass=task.payload.mass * payload_factor(plant.mismatch))
-        true_study = replace(
-            study, machine=true_machine(study.machine, plant.mismatch), tasks=(replace(task, payload=payload),)
-        )
-    else:
-        true_study = replace(study, crane_description=true_crane(study.crane, plant.mismatch))
     with tempfile.TemporaryDirectory(prefix="hiab_sim_replan_") as folder:
-        out = run_study(true_study, Path(folder) / "replan", progress=None, figures=False, force=True, cross=False)
-        result = json.loads((out.folder / "result.json").read_text(encoding="utf-8"))
-    optimal = result["optimal"]
-    replanned: dict[str, object] = {
-        "predicted_J": float(optimal["net_electrical_energy_J"]),
-        "lengths": optimal.get("lengths"),
-    }
-    energy = result.get("energy")
-    if isinstance(energy, dict) and "optimal" in energy:
-        replanned["predicted_battery_J"] = float(energy["optimal"]["battery_energy_J"])
-    return replanned
+        out = run_study(
+            true_study(study, plant), Path(folder) / "replan", progress=None, figures=False, force=True, cross=False
+        )
+        return replanned_summary(json.loads((out.folder / "result.json").read_text(encoding="utf-8")))
+
+
+def attach_replanned(report: dict[str, Any], replanned: dict[str, object]) -> None:
+    """Put the re-planned prediction into an effect study's report, beside each design's mismatch split."""
+    report["mismatch_replanned"] = replanned
+    for row in report["mismatch_split"].values():
+        if "predicted_J" in replanned:
+            row["replanned_optimum_predicted_J"] = float(replanned["predicted_J"])  # type: ignore[arg-type]
+        if "closed_loop_battery_J" in row and "predicted_battery_J" in replanned:
+            row["replanned_optimum_predicted_battery_J"] = float(replanned["predicted_battery_J"])  # type: ignore[arg-type]
 
 
 def _entry(summary: dict[str, object]) -> dict[str, object]:
@@ -180,8 +202,13 @@ def effect_study(
     cycles: int = 1,
     designs: tuple[str, ...] = ("initial", "optimal"),
     quiet: bool = False,
+    replan: bool = True,
 ) -> dict[str, object]:
-    """The ``plant_effects`` section of ``simulation.json`` (module docstring)."""
+    """The ``plant_effects`` section of ``simulation.json`` (module docstring).
+
+    ``replan`` False leaves the re-planned prediction out (the study's optimisation again, minutes;
+    :func:`attach_replanned` adds one computed elsewhere).
+    """
     plans = {design: read_any_plan(result_dir, design) for design in designs}
     battery = predicted_battery_energy(result_dir)
     table: dict[str, dict[str, object]] = {}
@@ -234,18 +261,14 @@ def effect_study(
                 "cost_of_heavier_load_J": true - plan.predicted_net_energy,
                 "cost_of_mismatch_J": closed - true,
             }
-        replanned = replanned_prediction(result_dir, plant)
-        report["mismatch_replanned"] = replanned
         for design, row in split.items():
-            if "predicted_J" in replanned:
-                row["replanned_optimum_predicted_J"] = float(replanned["predicted_J"])  # type: ignore[arg-type]
             mismatch = table["mismatch"][design]
             if "battery_energy_J" in mismatch:  # type: ignore[operator]
                 row["closed_loop_battery_J"] = float(mismatch["battery_energy_J"])  # type: ignore[index]
                 row["predicted_battery_J"] = float(battery[design])
-                if "predicted_battery_J" in replanned:
-                    row["replanned_optimum_predicted_battery_J"] = float(replanned["predicted_battery_J"])  # type: ignore[arg-type]
         report["mismatch_split"] = split
+        if replan:
+            attach_replanned(report, replanned_prediction(result_dir, plant))
     return report
 
 

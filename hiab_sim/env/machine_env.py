@@ -58,9 +58,9 @@ from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.planned_energy import resampled_prediction
 from hiab_sim.env.plant.assembly import (
     active_plant,
-    attach_plant,
     compliant_stiffness,
     drive_train_resonance,
+    plant_parts,
     spring_actuators,
 )
 from hiab_sim.env.plant.config import Plant
@@ -218,7 +218,8 @@ def machine_environment(
         friction = add_joint_friction(spec, active.joint_friction, hinges=machine.joint_names)
     physics = CranePhysics.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
     joints = tuple(tree.bodies[b].joint for b in tree.actuated)
-    attach_plant(physics, plan, motion, arrays, plant, stiffness, friction, joints, actuators, current_bandwidth_hz)
+    parts = plant_parts(physics.model.ptr, plan, motion, arrays, plant, stiffness, friction, current_bandwidth_hz)
+    physics.attach_parts(parts, plant, joints, actuators)
     if active is not None and active.mismatch.enabled:
         payload = _to_world(_at(physics_times(plan, physics_timestep), plan, plan.payload_force)[:, :2])
         offset = np.asarray(active.mismatch.end_mass_com_offset_m, dtype=float)

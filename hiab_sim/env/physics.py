@@ -39,7 +39,7 @@ from numpy.typing import NDArray
 from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator, DriveStep
 from hiab_sim.env.drive_losses import DriveLossModel
 from hiab_sim.env.plan import DesignPlan
-from hiab_sim.env.plant.assembly import active_plant, attach_plant, compliant_stiffness, spring_actuators
+from hiab_sim.env.plant.assembly import PlantParts, active_plant, compliant_stiffness, plant_parts, spring_actuators
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.plant.current_loop import DiscreteCurrentLoop
 from hiab_sim.env.plant.drivetrain import TwoMassDriveTrain, coupled_step
@@ -144,6 +144,22 @@ class CranePhysics(dm_mujoco.Physics):
         if isinstance(drives, DiscreteCurrentLoop):
             drives.sensor = self.current_error
         self.reset_counters()
+
+    def attach_parts(
+        self, parts: PlantParts, plant: Plant | None, joints: tuple[str, ...], actuators: tuple[str, ...]
+    ) -> None:
+        """:meth:`attach_drives` with the parts of :func:`hiab_sim.env.plant.assembly.plant_parts`."""
+        self.attach_drives(
+            parts.drives,
+            parts.losses,
+            plant,
+            drive_train=parts.drive_train,
+            thermal=parts.thermal,
+            friction=parts.friction,
+            joints=joints,
+            actuators=actuators,
+            resistance_schedule=parts.resistance_schedule,
+        )
 
     def motor_state(self) -> tuple[Array, Array]:
         """Motor-side stroke [m] and rate [m/s] at the rod (the rod's own when the drive train is rigid)."""
@@ -313,7 +329,8 @@ def crane_physics(
     _add_payload(spec, plan, payload_error)
     _add_view(spec, motion)
     physics = CranePhysics.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
-    attach_plant(physics, plan, motion, arrays, plant, stiffness, friction, SLIDES, ACTUATORS, bandwidth_hz)
+    parts = plant_parts(physics.model.ptr, plan, motion, arrays, plant, stiffness, friction, bandwidth_hz)
+    physics.attach_parts(parts, plant, SLIDES, ACTUATORS)
     return physics
 
 

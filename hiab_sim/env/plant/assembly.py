@@ -11,15 +11,16 @@ passes (nothing here knows a machine's names):
   ``drive_stiffness`` at the planned mean stroke, :func:`~hiab_sim.env.plant.drivetrain.drive_train_stiffness`),
   checked against the physics step; the builder then moves the rotor off the slide (armature
   ``rod_side_mass_kg``, no damping) and makes the slides' motors the springs (:func:`spring_actuators`);
-* :func:`attach_plant`: the drives (the continuous loop, or the discrete one of
+* :func:`plant_parts`: the drives (the continuous loop, or the discrete one of
   :mod:`hiab_sim.env.plant.current_loop`), the EMLA file's drive losses, the two-mass trains, the
-  winding temperature, the friction meter and the plan's hot-winding resistance on the Physics.
+  winding temperature, the friction meter and the plan's hot-winding resistance, which
+  :meth:`hiab_sim.env.physics.CranePhysics.attach_parts` puts on the Physics.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import TYPE_CHECKING
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
@@ -36,9 +37,6 @@ from hiab_sim.env.plant.friction import FrictionMeter
 from hiab_sim.env.plant.sensors import CurrentSensorError
 from hiab_sim.env.plant.thermal import WindingTemperature
 from hiab_sim.env.reference import PlannedMotion
-
-if TYPE_CHECKING:
-    from hiab_sim.env.physics import CranePhysics
 
 Array = NDArray[np.float64]
 
@@ -94,53 +92,60 @@ def spring_actuators(spec: mujoco.MjSpec, actuators: Iterable[str]) -> None:
         actuator.biasprm[:3] = [0.0, 0.0, 0.0]
 
 
-def attach_plant(
-    physics: CranePhysics,
+@dataclass(frozen=True)
+class PlantParts:
+    """What :meth:`hiab_sim.env.physics.CranePhysics.attach_parts` puts on a Physics (module docstring)."""
+
+    drives: DriveSimulator
+    losses: DriveLossModel
+    drive_train: TwoMassDriveTrain | None
+    thermal: WindingTemperature | None
+    friction: FrictionMeter | None
+    resistance_schedule: Array | None
+
+
+def plant_parts(
+    model: mujoco.MjModel,
     plan: DutyPlan,
     motion: PlannedMotion,
     arrays: DriveArrays,
     plant: Plant | None,
     stiffness: Array | None,
     friction: tuple[tuple[str, ...], tuple[str, ...]],
-    joints: tuple[str, ...],
-    actuators: tuple[str, ...],
     bandwidth_hz: float,
-) -> None:
-    """Attach the drives and the plant's parts to a compiled Physics (module docstring).
+) -> PlantParts:
+    """The drives and the plant's parts for a compiled model (module docstring).
 
     Args:
-        physics: The :class:`~hiab_sim.env.physics.CranePhysics` of the compiled model.
+        model: The compiled MuJoCo model (its physics step; the friction meter's joints and tendons).
         plan: The plan (its EMLA set and duty: the drive losses and the hot windings' R_s).
         motion: The planned motion at the physics rate.
         arrays: The simulated drives' parameters (the mismatch's friction included).
         plant: The plant; None or every effect off: the planner's model.
         stiffness: k_s per drive of :func:`compliant_stiffness`, or None (rigid drive trains).
         friction: The joints and tendons with friction (:func:`~hiab_sim.env.plant.friction.add_joint_friction`).
-        joints: The actuated slides, in the drives' order.
-        actuators: Their motors (the springs of a compliant train), in the same order.
         bandwidth_hz: The continuous current loop's bandwidth [Hz].
 
     """
     active = active_plant(plant)
-    timestep = float(physics.model.opt.timestep)
+    timestep = float(model.opt.timestep)
     drives: DriveSimulator
     if active is not None and active.current_loop.enabled:
-        drives = DiscreteCurrentLoop(arrays, active.current_loop, CurrentSensorError(None, len(joints), 1.0), timestep)
+        count = len(arrays.names)
+        drives = DiscreteCurrentLoop(arrays, active.current_loop, CurrentSensorError(None, count, 1.0), timestep)
     else:
         drives = DriveSimulator(arrays, bandwidth_hz=bandwidth_hz)
     train = None
     if active is not None and stiffness is not None:
         train = TwoMassDriveTrain(active.drive_train, stiffness, arrays.reflected_inertia, arrays.viscous)
-    physics.attach_drives(
-        drives,
-        DriveLossModel(plan.emlas),
-        plant,
+    thermal = None
+    if active is not None and active.thermal.enabled:
+        thermal = WindingTemperature(active.thermal, plan.emlas.as_tuple())
+    return PlantParts(
+        drives=drives,
+        losses=DriveLossModel(plan.emlas),
         drive_train=train,
-        thermal=WindingTemperature(active.thermal, plan.emlas.as_tuple())
-        if active is not None and active.thermal.enabled
-        else None,
-        friction=FrictionMeter(physics.model.ptr, *friction) if friction[0] else None,
-        joints=joints,
-        actuators=actuators,
+        thermal=thermal,
+        friction=FrictionMeter(model, *friction) if friction[0] else None,
         resistance_schedule=hot_resistance(plan, motion, arrays.resistance),
     )
