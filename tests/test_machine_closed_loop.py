@@ -136,7 +136,6 @@ def test_simulate_cli_on_a_machine_result(result: Path, tmp_path: Path, capsys: 
     assert "closed loop uses" in capsys.readouterr().out
     for extra, word in (
         (["--payload-error", "0.2"], "payload-error"),
-        (["--plant", "realistic"], "plant"),
         ([], "video"),
     ):
         args = ["simulate", str(result), "--quiet", "--out", str(out), *extra]
@@ -146,11 +145,12 @@ def test_simulate_cli_on_a_machine_result(result: Path, tmp_path: Path, capsys: 
         assert word in capsys.readouterr().err
 
 
-def test_refusals_name_the_effect() -> None:
+def test_refusals_name_the_option() -> None:
+    """What a machine file's closed loop does not simulate is refused naming the option; the plant is not refused."""
     from hiab_sim.cli.simulate_machine import refuse_crane_only
-    from hiab_sim.env.plant import load_plant
 
-    args = argparse.Namespace(payload_error=0.0, cycles=1, no_video=True)
-    refuse_crane_only(args, load_plant("ideal"))
-    with pytest.raises(InvalidInputError, match="drive_train"):
-        refuse_crane_only(args, load_plant("realistic"))
+    refuse_crane_only(argparse.Namespace(payload_error=0.0, cycles=3, no_video=True))
+    with pytest.raises(InvalidInputError, match="payload-error"):
+        refuse_crane_only(argparse.Namespace(payload_error=0.2, cycles=1, no_video=True))
+    with pytest.raises(InvalidInputError, match="no-video"):
+        refuse_crane_only(argparse.Namespace(payload_error=0.0, cycles=1, no_video=False))

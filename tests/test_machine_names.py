@@ -43,7 +43,6 @@ CRANE_MODEL = {
     "dynamics/replay.py": "replays the crane MJCF: its chains' sites by name",
     "model/mjcf.py": "builds the crane file's MJCF: bodies, joints and sites named after the crane",
     "env/physics.py": "the crane file's closed-loop physics: adds the payload to the crane MJCF's telescope rod",
-    "env/plant/friction.py": "the plant effects act on the crane MJCF's boom hinges (another session's area)",
     "env/plant/mismatch.py": "the end-mass mismatch acts on the crane file's end_mass body (another session's area)",
     "hydraulics/cylinders.py": "the crane file's hydraulic_cylinders section, keyed by its actuators",
     "study/figures/design.py": "draws a crane file's design from the crane's closed-form frames",

@@ -12,7 +12,7 @@ from hiab_sim.env.plant.config import JointFriction
 from hiab_sim.env.plant.friction import FrictionMeter, add_joint_friction
 from hiab_sim.env.reference import planned_motion
 from hiab_sim.model.drives import HomePose, SlideDrives
-from hiab_sim.model.mjcf import SLIDES, build_spec
+from hiab_sim.model.mjcf import JOINTS, SLIDES, build_spec
 
 
 def _swing(crane: Crane, friction: JointFriction, h: float) -> tuple[float, float, float, float]:
@@ -31,7 +31,7 @@ def _swing(crane: Crane, friction: JointFriction, h: float) -> tuple[float, floa
     force = (float(motion.force[k0, 0]), float(motion.force[k0, 1]), float(motion.force[k0, 2]))
     home = HomePose(qpos={n: float(motion.qpos[k0, i]) for i, n in enumerate(names)}, force=force)
     spec = build_spec(crane, plan.lengths, slides, home)
-    joints, tendons = add_joint_friction(spec, friction)
+    joints, tendons = add_joint_friction(spec, friction, hinges=JOINTS)
     spec.option.timestep = h
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
@@ -58,7 +58,7 @@ def _swing(crane: Crane, friction: JointFriction, h: float) -> tuple[float, floa
 def test_friction_sits_on_the_hinges_pins_and_rod_pin_tendons(crane: Crane) -> None:
     """Each closed chain gets friction on its boom hinge and base pin, and a rod-pin tendon q_boom - q_barrel."""
     spec = build_spec(crane)
-    joints, tendons = add_joint_friction(spec, JointFriction(True, 150.0, 50.0, 100.0, 20.0))
+    joints, tendons = add_joint_friction(spec, JointFriction(True, 150.0, 50.0, 100.0, 20.0), hinges=JOINTS)
     model = spec.compile()
     assert len(joints) == 4 and len(tendons) == 2
     for name in joints:

@@ -26,8 +26,9 @@ prints its table and writes ``closed_loop_plant_effects.png``. ``--cycles N`` ru
 winding temperature carried over; the energies are the last cycle's.
 
 A machine file's result (:mod:`hiab_sim.machine`, e.g. the excavator) runs through
-:mod:`hiab_sim.cli.simulate_machine`: the same report for the ideal plant, each chain's EMLA drive on
-the machine's generic MJCF (:mod:`hiab_sim.env.machine_env`); the crane-only options are refused.
+:mod:`hiab_sim.cli.simulate_machine`: the same report, plant and effect study, each chain's EMLA
+drive on the machine's generic MJCF (:mod:`hiab_sim.env.machine_env`); the crane-only options
+(``--payload-error``, the video) are refused.
 """
 
 from __future__ import annotations
@@ -147,10 +148,12 @@ def run(args: argparse.Namespace) -> int:
         item.free()
     print(table(report))
     if effects is not None:
-        from hiab_sim.env.effects import effect_table
+        from hiab_sim.env.effects import effect_lines, effect_table
 
         print()
         print(effect_table(effects))
+        for line in effect_lines(effects):
+            print(line)
     print()
     for line in closing_lines(report):
         print(line)

@@ -1,10 +1,13 @@
 """``hiab-sim simulate`` on a machine file's result: each design in closed loop on :mod:`hiab_sim.env.machine_env`.
 
 The same ``simulation.json``, table, figures and closing lines as the crane's
-(:mod:`hiab_sim.cli.simulate`), for the ideal plant: the EMLA drives' current dynamics per chain
-under the cascade controller with the plan's feedforward. What is built on the crane's model is
-refused with one line (exit 2) naming it: ``--payload-error`` (the crane's end-mass body), plant
-effects (:mod:`hiab_sim.env.plant`) and the video (drawn with the crane's dressing).
+(:mod:`hiab_sim.cli.simulate`): the EMLA drives' current dynamics per chain under the cascade
+controller with the plan's feedforward, on the plant of ``--plant`` (the ideal one by default; the
+effects of :mod:`hiab_sim.env.plant` on the machine's own parts, :mod:`hiab_sim.env.machine_env`)
+for ``--cycles`` cycles, and with effects on the effect study of :mod:`hiab_sim.env.effects`
+(``plant_effects``, its table and ``closed_loop_plant_effects.png``). What is built on the crane's
+model is refused with one line (exit 2) naming it: ``--payload-error`` (the crane's end-mass body;
+the plant's ``mismatch`` scales a machine's payload) and the video (drawn with the crane's dressing).
 """
 
 from __future__ import annotations
@@ -28,20 +31,14 @@ MACHINE_TCP = "distance of the simulated TCP to the study's TCP reference (x_tcp
 NO_STRUCTURE = "the EMLA file lacks screw or drive_stiffness data for the machine's natural frequencies"
 
 
-def refuse_crane_only(args: argparse.Namespace, plant: Plant | None) -> None:
+def refuse_crane_only(args: argparse.Namespace) -> None:
     """One line naming what a machine file's closed loop does not simulate (exit 2 through the CLI)."""
     if args.payload_error != 0.0:
         raise InvalidInputError(
-            "--payload-error", args.payload_error, "must be 0 for a machine file's result (the crane's end-mass body)"
+            "--payload-error",
+            args.payload_error,
+            "must be 0 for a machine file's result (the crane's end-mass body; --plant's mismatch scales a payload)",
         )
-    if plant is not None and plant.enabled:
-        raise InvalidInputError(
-            "--plant",
-            ", ".join(plant.enabled),
-            "plant effects are built on the crane's model; a machine file's result runs the ideal plant only",
-        )
-    if args.cycles != 1:
-        raise InvalidInputError("--cycles", args.cycles, "must be 1 for a machine file's result (no thermal plant)")
     if not args.no_video:
         raise InvalidInputError(
             "--no-video", False, "is needed for a machine file's result (closed_loop.mp4 draws the crane)"
@@ -55,12 +52,12 @@ def run_machine(args: argparse.Namespace, designs: tuple[str, ...], plant: Plant
     from hiab_sim.env.machine_plan import read_machine_plan
     from hiab_sim.env.validation import simulation_report, table
 
-    refuse_crane_only(args, plant)
+    refuse_crane_only(args)
     plans = [read_machine_plan(args.result_dir, design) for design in designs]  # bad input fails first
     out.mkdir(parents=True, exist_ok=True)
     runs = []
     for plan in plans:
-        run, physics = run_machine_closed_loop(plan)
+        run, physics = run_machine_closed_loop(plan, plant=plant, cycles=args.cycles)
         physics.free()
         runs.append(run)
     report = simulation_report(args.result_dir, runs, [], emlas=plans[0].emlas)
@@ -74,6 +71,12 @@ def run_machine(args: argparse.Namespace, designs: tuple[str, ...], plant: Plant
         entry = entries[run.design]
         if entry["bandwidth_check"].get("first_natural_frequency_Hz") is None:
             entry["bandwidth_check"]["note"] = NO_STRUCTURE
+    effects = None
+    if plant is not None and plant.enabled:
+        from hiab_sim.env.effects import effect_study
+
+        effects = effect_study(args.result_dir, plant, args.cycles, designs, quiet=args.quiet)
+        report["plant_effects"] = effects
     from hiab_sim.atomic_io import write_atomic
 
     write_atomic(out / "simulation.json", json.dumps(report, indent=2) + "\n")
@@ -82,7 +85,18 @@ def run_machine(args: argparse.Namespace, designs: tuple[str, ...], plant: Plant
         from hiab_sim.env.figures import write_figures
 
         written += [p.name for p in write_figures(out, runs, [])]
+        if effects is not None:
+            from hiab_sim.env.effects import effect_figure
+
+            written.append(effect_figure(out / "closed_loop_plant_effects.png", effects).name)
     print(table(report))
+    if effects is not None:
+        from hiab_sim.env.effects import effect_lines, effect_table
+
+        print()
+        print(effect_table(effects))
+        for line in effect_lines(effects):
+            print(line)
     print()
     for line in closing_lines(report):
         print(line)

@@ -116,9 +116,9 @@ def _memoized(load: Callable[[Any], object]) -> Callable[[Any], object]:
                 seen[key] = error
                 raise
             seen[key] = None
-        error = seen[key]
-        if error is not None:
-            raise error
+        failed = seen[key]
+        if failed is not None:
+            raise failed
         return None
 
     return load_once

@@ -15,6 +15,14 @@ into the cost of the heavier load (true-mass prediction - prediction) and the co
 without knowing it (closed loop - true-mass prediction). Beside them stands the plan re-optimised
 for the true masses (:func:`replanned_prediction`: the study solved again with the true crane), the
 energy a planner that knew the load would have predicted for its own optimum.
+
+One code path for a crane file's result and a machine file's (:func:`read_any_plan`,
+:func:`run_plan`): on a machine file the true masses are :func:`~hiab_sim.env.plant.mismatch.true_machine`'s
+and the true payload the planned one x (1 + e_end) (its weight through the TCP force, at the TCP:
+the centre-of-mass offset is simulated, not predicted, as the planner's TCP load is a force at
+the TCP), and the re-planned study is the machine study with that machine and payload. Where the
+result has a battery (``result.json`` ``energy``), each entry also holds the closed loop's battery
+energy against the result's (:mod:`hiab_sim.env.closed_loop_battery`: one cycle, the rest between cycles left out).
 """
 
 from __future__ import annotations
@@ -24,19 +32,27 @@ import sys
 import tempfile
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from tqdm import tqdm
 
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
-from hiab_sim.dynamics.samples import JointSamples
+from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.emla import electrical_power
 from hiab_sim.emla.duty_energy import drive_duty
+from hiab_sim.env.closed_loop_battery import BATTERY_NOTE, battery_entry, predicted_cycle_battery_energy
+from hiab_sim.env.machine_env import run_machine_closed_loop
+from hiab_sim.env.machine_plan import MachinePlan, is_machine_result, read_machine_plan
+from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.plan import DesignPlan, read_plan
 from hiab_sim.env.plant.config import Plant
-from hiab_sim.env.plant.mismatch import true_crane
-from hiab_sim.env.rollout import run_closed_loop
+from hiab_sim.env.plant.mismatch import payload_factor, true_crane, true_machine
+from hiab_sim.env.rollout import ClosedLoopRun, run_closed_loop
 from hiab_sim.figure_io import new_figure, save_png
+from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
+from hiab_sim.machine.dynamics.tree import MachineActuatorSamples
+from hiab_sim.study.spec.study import Study
 from hiab_sim.style import COLOURS
 
 
@@ -48,13 +64,34 @@ def variants(plant: Plant) -> list[Plant]:
     return out
 
 
-def true_mass_prediction(plan: DesignPlan, plant: Plant) -> float:
-    """Predicted net electrical energy [J] of the planned motion at the mismatch's true masses (module docstring)."""
+def read_any_plan(result_dir: str | Path, design: str) -> DesignPlan | MachinePlan:
+    """One design's plan of a crane file's result (:func:`read_plan`) or a machine file's (``read_machine_plan``)."""
+    return read_machine_plan(result_dir, design) if is_machine_result(result_dir) else read_plan(result_dir, design)
+
+
+def run_plan(plan: DesignPlan | MachinePlan, plant: Plant, cycles: int) -> tuple[ClosedLoopRun, CranePhysics]:
+    """``cycles`` closed-loop cycles of a crane's or a machine's plan on ``plant`` (the log and the Physics)."""
+    if isinstance(plan, MachinePlan):
+        return run_machine_closed_loop(plan, plant=plant, cycles=cycles)
+    return run_closed_loop(plan, plant=plant, cycles=cycles)
+
+
+def _true_actuators(plan: DesignPlan | MachinePlan, plant: Plant) -> ActuatorSamples | MachineActuatorSamples:
+    """The planned motion's actuator samples on the plan's grid at the mismatch's true masses (module docstring)."""
+    if isinstance(plan, MachinePlan):
+        machine = true_machine(plan.machine, plant.mismatch)
+        force = plan.tcp_force + (payload_factor(plant.mismatch) - 1.0) * plan.payload_force
+        return MujocoMachineDynamics(machine)(plan.position, plan.velocity, plan.acceleration, tcp_force=force[:, :2])
     crane = true_crane(plan.crane, plant.mismatch)
     joints = JointSamples(plan.position, plan.velocity, plan.acceleration)
     dynamics = MujocoInverseDynamics(crane, plan.lengths)
     tcp_force = None if plan.payload == 0.0 else np.array([0.0, -plan.payload * crane.gravity, 0.0])
-    actuators = dynamics(joints, tcp_force)
+    return dynamics(joints, tcp_force)
+
+
+def true_mass_prediction(plan: DesignPlan | MachinePlan, plant: Plant) -> float:
+    """Predicted net electrical energy [J] of the planned motion at the mismatch's true masses (module docstring)."""
+    actuators = _true_actuators(plan, plant)
     samples = [
         (actuators.force[:, i], actuators.velocity[:, i], actuators.acceleration[:, i]) for i in range(len(plan.emlas))
     ]
@@ -69,11 +106,42 @@ def true_mass_prediction(plan: DesignPlan, plant: Plant) -> float:
     return float(0.5 * np.sum((total[1:] + total[:-1]) * np.diff(plan.time)))
 
 
-def replanned_prediction(result_dir: str | Path, plant: Plant) -> dict[str, object]:
-    """The result's study optimised again with the mismatch's true crane: its optimum's predicted energy [J].
+def true_study(study: Study, plant: Plant) -> Study:
+    """The study with the mismatch's true masses (the true machine and payload, or the true crane).
 
-    Returns a mapping with ``predicted_J`` and ``lengths`` of the re-optimised design, or with
-    ``skipped`` saying why (the study file is gone, or the study is a mix of tasks).
+    A machine file's study gets :func:`~hiab_sim.env.plant.mismatch.true_machine` and its first
+    task's payload x (1 + e_end); a crane file's :func:`~hiab_sim.env.plant.mismatch.true_crane`.
+    """
+    if study.machine is not None:
+        task = study.tasks[0]
+        payload = replace(task.payload, mass=task.payload.mass * payload_factor(plant.mismatch))
+        tasks = (replace(task, payload=payload), *study.tasks[1:])
+        return replace(study, machine=true_machine(study.machine, plant.mismatch), tasks=tasks)
+    return replace(study, crane_description=true_crane(study.crane, plant.mismatch))
+
+
+def replanned_summary(result: dict[str, Any]) -> dict[str, object]:
+    """``predicted_J``, ``lengths`` (and ``predicted_battery_J`` with a battery) of a re-planned ``result.json``."""
+    optimal = result["optimal"]
+    replanned: dict[str, object] = {
+        "predicted_J": float(optimal["net_electrical_energy_J"]),
+        "lengths": optimal.get("lengths"),
+    }
+    energy = result.get("energy")
+    if isinstance(energy, dict) and "optimal" in energy:
+        replanned["predicted_battery_J"] = float(energy["optimal"]["battery_energy_J"])
+    return replanned
+
+
+def replanned_prediction(result_dir: str | Path, plant: Plant) -> dict[str, object]:
+    """The result's study optimised again with the mismatch's true masses (:func:`true_study`): its optimum's energy.
+
+    Returns :func:`replanned_summary`'s mapping of the re-optimised design, or one with ``skipped``
+    saying why (the study is a mix of tasks).
+
+    Raises:
+        ConfigError: the study file is gone.
+
     """
     from hiab_sim.results.read import read_result
     from hiab_sim.study.run import run_study
@@ -82,12 +150,21 @@ def replanned_prediction(result_dir: str | Path, plant: Plant) -> dict[str, obje
     study = load_study(read_result(result_dir).study)
     if len(study.tasks) != 1:
         return {"skipped": f"the study has {len(study.tasks)} tasks; re-planning is done for single-task studies"}
-    true_study = replace(study, crane_description=true_crane(study.crane, plant.mismatch))
     with tempfile.TemporaryDirectory(prefix="hiab_sim_replan_") as folder:
-        out = run_study(true_study, Path(folder) / "replan", progress=None, figures=False, force=True, cross=False)
-        result = json.loads((out.folder / "result.json").read_text(encoding="utf-8"))
-    optimal = result["optimal"]
-    return {"predicted_J": float(optimal["net_electrical_energy_J"]), "lengths": optimal.get("lengths")}
+        out = run_study(
+            true_study(study, plant), Path(folder) / "replan", progress=None, figures=False, force=True, cross=False
+        )
+        return replanned_summary(json.loads((out.folder / "result.json").read_text(encoding="utf-8")))
+
+
+def attach_replanned(report: dict[str, Any], replanned: dict[str, object]) -> None:
+    """Put the re-planned prediction into an effect study's report, beside each design's mismatch split."""
+    report["mismatch_replanned"] = replanned
+    for row in report["mismatch_split"].values():
+        if "predicted_J" in replanned:
+            row["replanned_optimum_predicted_J"] = float(replanned["predicted_J"])  # type: ignore[arg-type]
+        if "closed_loop_battery_J" in row and "predicted_battery_J" in replanned:
+            row["replanned_optimum_predicted_battery_J"] = float(replanned["predicted_battery_J"])  # type: ignore[arg-type]
 
 
 def _entry(summary: dict[str, object]) -> dict[str, object]:
@@ -125,25 +202,38 @@ def effect_study(
     cycles: int = 1,
     designs: tuple[str, ...] = ("initial", "optimal"),
     quiet: bool = False,
+    replan: bool = True,
 ) -> dict[str, object]:
-    """The ``plant_effects`` section of ``simulation.json`` (module docstring)."""
-    plans = {design: read_plan(result_dir, design) for design in designs}
+    """The ``plant_effects`` section of ``simulation.json`` (module docstring).
+
+    ``replan`` False leaves the re-planned prediction out (the study's optimisation again, minutes;
+    :func:`attach_replanned` adds one computed elsewhere).
+    """
+    plans = {design: read_any_plan(result_dir, design) for design in designs}
+    battery = predicted_cycle_battery_energy(result_dir)
     table: dict[str, dict[str, object]] = {}
     runs = [(variant, design) for variant in variants(plant) for design in designs]
     for variant, design in tqdm(runs, desc="plant effects", disable=quiet, file=sys.stderr, leave=False):
-        run, physics = run_closed_loop(plans[design], plant=variant, cycles=cycles)
+        run, physics = run_plan(plans[design], variant, cycles)
         physics.free()
-        table.setdefault(variant.name, {})[design] = _entry(run.summary())
+        entry = _entry(run.summary())
+        if design in battery:
+            entry.update(battery_entry(run, plans[design].emlas.battery, battery[design]))
+        table.setdefault(variant.name, {})[design] = entry
         table[variant.name]["gains_rad_per_s"] = {
             "position": run.gains.position,
             "velocity": run.gains.velocity,
             "integral": run.gains.integral,
         }
         table[variant.name]["lowest_drive_train_resonance_Hz"] = run.lowest_resonance_hz
+    keys = ["dc_bus_energy_J"]
+    if all("battery_energy_J" in entry[d] for entry in table.values() for d in designs):  # type: ignore[operator]
+        keys.append("battery_energy_J")
     for entry in table.values():
         if all(d in entry for d in ("initial", "optimal")):
-            energy = {d: float(entry[d]["dc_bus_energy_J"]) for d in ("initial", "optimal")}  # type: ignore[index]
-            entry["optimal_below_initial"] = energy["optimal"] < energy["initial"]
+            for key in keys:
+                energy = {d: float(entry[d][key]) for d in ("initial", "optimal")}  # type: ignore[index]
+                entry[_CHEAPER[key]] = energy["optimal"] < energy["initial"]
     report: dict[str, object] = {
         "plant": plant.name,
         "cycles": cycles,
@@ -153,18 +243,12 @@ def effect_study(
         "loss and holding brake), all drives, last cycle",
         "provenance": dict(plant.provenance),
     }
+    if "battery_energy_J" in keys:
+        report["battery_energy"] = BATTERY_NOTE
     top = "all" if "all" in table else (plant.enabled[0] if plant.enabled else None)
     if top is not None:
-        shares: dict[str, dict[str, float]] = {}
-        for design in designs:
-            ideal = float(table["ideal"][design]["dc_bus_energy_J"])  # type: ignore[index]
-            whole = float(table[top][design]["dc_bus_energy_J"]) - ideal  # type: ignore[index]
-            shares[design] = {
-                name: (float(table[name][design]["dc_bus_energy_J"]) - ideal) / whole  # type: ignore[index]
-                for name in plant.enabled
-                if whole != 0.0
-            }
-        report["share_of_energy_difference"] = shares
+        for key in keys:
+            report[_SHARE[key]] = _shares(table, designs, plant.enabled, top, key)
     if plant.mismatch.enabled:
         split: dict[str, dict[str, float]] = {}
         for design, plan in plans.items():
@@ -177,24 +261,49 @@ def effect_study(
                 "cost_of_heavier_load_J": true - plan.predicted_net_energy,
                 "cost_of_mismatch_J": closed - true,
             }
-        replanned = replanned_prediction(result_dir, plant)
-        report["mismatch_replanned"] = replanned
-        if "predicted_J" in replanned:
-            for row in split.values():
-                row["replanned_optimum_predicted_J"] = float(replanned["predicted_J"])  # type: ignore[arg-type]
+        for design, row in split.items():
+            mismatch = table["mismatch"][design]
+            if "battery_energy_J" in mismatch:  # type: ignore[operator]
+                row["closed_loop_battery_J"] = float(mismatch["battery_energy_J"])  # type: ignore[index]
+                row["predicted_battery_J"] = float(battery[design])
         report["mismatch_split"] = split
+        if replan:
+            attach_replanned(report, replanned_prediction(result_dir, plant))
     return report
+
+
+#: Per energy: the key of "the optimal design draws less than the initial one" and of the effects' shares.
+_CHEAPER = {"dc_bus_energy_J": "optimal_below_initial", "battery_energy_J": "optimal_below_initial_battery"}
+_SHARE = {"dc_bus_energy_J": "share_of_energy_difference", "battery_energy_J": "share_of_battery_energy_difference"}
+
+
+def _shares(
+    table: dict[str, dict[str, object]], designs: tuple[str, ...], enabled: tuple[str, ...], top: str, key: str
+) -> dict[str, dict[str, float]]:
+    """Per design and effect (E_effect - E_ideal) / (E_top - E_ideal) of the energy ``key`` (module docstring)."""
+    shares: dict[str, dict[str, float]] = {}
+    for design in designs:
+        ideal = float(table["ideal"][design][key])  # type: ignore[index]
+        whole = float(table[top][design][key]) - ideal  # type: ignore[index]
+        shares[design] = {
+            name: (float(table[name][design][key]) - ideal) / whole  # type: ignore[index]
+            for name in enabled
+            if whole != 0.0
+        }
+    return shares
 
 
 def effect_table(report: dict[str, object]) -> str:
     """Markdown table of the effect study (docs/plant.md's table)."""
-    lines = [
-        "| plant | design | DC-bus energy [J] | vs predicted | vs 5 ms grid | TCP error rms / max [mm] "
-        "| peak currents [A] | peak voltages [V] | optimal cheaper |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---|",
-    ]
     table = report["variants"]
     assert isinstance(table, dict)
+    battery = "battery_energy" in report
+    lines = [
+        "| plant | design | DC-bus energy [J] | vs predicted | vs 5 ms grid | TCP error rms / max [mm] "
+        "| peak currents [A] | peak voltages [V] | optimal cheaper |"
+        + (" battery energy [J] | vs predicted | optimal cheaper at the battery |" if battery else ""),
+        "|---|---|---:|---:|---:|---:|---:|---:|---|" + ("---:|---:|---|" if battery else ""),
+    ]
     for name, entry in table.items():
         for design in ("initial", "optimal"):
             if design not in entry:
@@ -209,13 +318,59 @@ def effect_table(report: dict[str, object]) -> str:
                 else ""
             )
             fine = row.get("energy_difference_to_5ms_grid_percent")
-            lines.append(
+            line = (
                 f"| {name} | {design} | {row['dc_bus_energy_J']:.1f} "
                 f"| {row['dc_bus_energy_difference_percent']:+.2f} % "
                 f"| {'' if fine is None else format(fine, '+.2f') + ' %'} "
                 f"| {tcp['rms']:.2f} / {tcp['max']:.2f} | {currents} | {voltages} | {cheaper} |"
             )
+            if battery:
+                difference = row["battery_energy_difference_percent"]
+                at_battery = (
+                    {True: "yes", False: "**no**"}.get(entry.get("optimal_below_initial_battery"), "")
+                    if design == "optimal"
+                    else ""
+                )
+                versus = "" if difference is None else format(difference, "+.2f") + " %"
+                line += f" {row['battery_energy_J']:.1f} | {versus} | {at_battery} |"
+            lines.append(line)
     return "\n".join(lines)
+
+
+def effect_lines(report: dict[str, object]) -> list[str]:
+    """The effect study in words: each effect's share of the energy difference, the mismatch's split and re-plan."""
+    lines = []
+    for key, what in (("share_of_energy_difference", "DC-bus"), ("share_of_battery_energy_difference", "battery")):
+        shares = report.get(key)
+        if not isinstance(shares, dict):
+            continue
+        for design, row in shares.items():
+            parts = ", ".join(f"{name} {100 * share:+.0f} %" for name, share in row.items())
+            lines.append(f"{design}: share of the all-effects {what} energy difference to the ideal plant: {parts}.")
+    split = report.get("mismatch_split")
+    if isinstance(split, dict):
+        for design, row in split.items():
+            text = (
+                f"{design}, mismatch: predicted {row['predicted_J']:.1f} J, at the true masses "
+                f"{row['predicted_at_true_masses_J']:.1f} J, closed loop {row['closed_loop_J']:.1f} J"
+            )
+            if "replanned_optimum_predicted_J" in row:
+                text += (
+                    f"; the study re-planned for the true masses predicts {row['replanned_optimum_predicted_J']:.1f} J"
+                )
+            text += " (net electrical energy)"
+            if "closed_loop_battery_J" in row:
+                text += (
+                    f"; at the battery: predicted {row['predicted_battery_J']:.1f} J, closed loop "
+                    f"{row['closed_loop_battery_J']:.1f} J"
+                )
+                if "replanned_optimum_predicted_battery_J" in row:
+                    text += f", re-planned {row['replanned_optimum_predicted_battery_J']:.1f} J"
+            lines.append(text + ".")
+    replanned = report.get("mismatch_replanned")
+    if isinstance(replanned, dict) and "skipped" in replanned:
+        lines.append(f"mismatch: no re-plan ({replanned['skipped']}).")
+    return lines
 
 
 def effect_figure(path: Path, report: dict[str, object]) -> Path:

@@ -27,13 +27,21 @@ the Physics (:class:`~hiab_sim.env.physics.CranePhysics`), the tracking task
   machine's lowest locked-rotor natural frequency f_1 over the plan, and the run's
   ``bandwidth_check`` of the velocity loop against it (:mod:`hiab_sim.env.machine_loop_design`).
 
-Only the ideal plant: the plant effects of :mod:`hiab_sim.env.plant` are built on the crane's
-model and names.
+* **Plant.** The effects of :mod:`hiab_sim.env.plant` on the machine's own parts, through the
+  crane's code (:mod:`hiab_sim.env.plant.assembly`): the mismatch on the machine description and
+  the payload's share of the TCP force (:func:`~hiab_sim.env.plant.mismatch.true_machine`,
+  :class:`TcpLoad`), the two-mass drive train on each chain's rod slide with the EMLA file's
+  ``drive_stiffness`` (the rotor off the slide: armature = the plant's rod-side mass, no damping),
+  hinge friction on the machine's joints and pin friction on the chains' hinges and loop pins
+  (:func:`~hiab_sim.env.plant.friction.add_joint_friction`), sensors, the discrete current loop and
+  the winding temperature. With every effect off the model is the ideal one, step for step; the
+  study's hot windings set R_s as on the crane (:func:`hiab_sim.env.planned_energy.hot_resistance`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import mujoco
 import numpy as np
@@ -42,12 +50,22 @@ from dm_control.rl import control
 from numpy.typing import NDArray
 
 from hiab_sim.control.cascade import CascadeGains
-from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator
+from hiab_sim.emla.drive_sim import DriveArrays
 from hiab_sim.env import CURRENT_BANDWIDTH_HZ, PHYSICS_TIMESTEP
-from hiab_sim.env.drive_losses import DriveLossModel
 from hiab_sim.env.machine_loop_design import machine_loop_design
 from hiab_sim.env.machine_plan import MachinePlan
 from hiab_sim.env.physics import CranePhysics
+from hiab_sim.env.planned_energy import resampled_prediction
+from hiab_sim.env.plant.assembly import (
+    active_plant,
+    compliant_stiffness,
+    drive_train_resonance,
+    plant_parts,
+    spring_actuators,
+)
+from hiab_sim.env.plant.config import Plant
+from hiab_sim.env.plant.friction import add_joint_friction
+from hiab_sim.env.plant.mismatch import friction_factor, payload_factor, true_drive_arrays, true_machine
 from hiab_sim.env.reference import PlannedMotion, motion_of_plan, physics_times
 from hiab_sim.env.rollout import ClosedLoopRun, run_environment
 from hiab_sim.env.task import CraneTrackingTask
@@ -76,10 +94,15 @@ def _to_world(points: Array) -> Array:
     return source_to_world(full)
 
 
+def _at(times: Array, plan: MachinePlan, force: Array) -> Array:
+    """A (K, 3) force of the plan's fine grid at ``times`` (N, 3) [N], linear interpolation."""
+    return np.stack([np.interp(times, plan.time, force[:, i]) for i in range(3)], axis=1)
+
+
 def machine_motion(plan: MachinePlan, timestep: float) -> tuple[PlannedMotion, Array]:
     """The plan every ``timestep`` [s] (module docstring) and the TCP force there, MuJoCo world (N, 3) [N]."""
     times = physics_times(plan, timestep)
-    force = np.stack([np.interp(times, plan.time, plan.tcp_force[:, i]) for i in range(3)], axis=1)
+    force = _at(times, plan, plan.tcp_force)
     dynamics = MujocoMachineDynamics(plan.machine)
 
     def loaded_dynamics(pos: Array, vel: Array, acc: Array) -> tuple[MachineActuatorSamples, Array, Array]:
@@ -117,21 +140,44 @@ def machine_load_mass(plan: MachinePlan, motion: PlannedMotion) -> Array:
 
 
 class TcpLoad:
-    """The plan's TCP force applied at site ``tcp`` each physics step (module docstring)."""
+    """The plan's TCP force applied at site ``tcp`` each physics step (module docstring).
 
-    def __init__(self, model: mujoco.MjModel, force: Array, timestep: float) -> None:
+    With a payload mismatch (``payload``: the payload's share P of the force, MuJoCo world (N, 3)
+    [N]) the true load is the rest F - P at the site and (1 + e_end) P at the site shifted by
+    ``offset`` [m] in the site's frame (:mod:`hiab_sim.env.plant.mismatch`).
+    """
+
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        force: Array,
+        timestep: float,
+        payload: Array | None = None,
+        factor: float = 1.0,
+        offset: Array | None = None,
+    ) -> None:
         self.site = int(model.site("tcp").id)
         self.body = int(model.site_bodyid[self.site])
         self.force = force
         self.timestep = timestep
+        self.payload = payload
+        self.factor = factor
+        self.offset = np.zeros(3) if offset is None else np.asarray(offset, dtype=float)
 
     def apply(self, model: mujoco.MjModel, data: mujoco.MjData, holding: bool) -> None:
         """Set ``xfrc_applied`` of the TCP's body to F at the site (force and moment about the com)."""
         k = 0 if holding else int(min(max(round(data.time / self.timestep), 0), len(self.force) - 1))
         force = self.force[k]
         arm = data.site_xpos[self.site] - data.xipos[self.body]
-        data.xfrc_applied[self.body, :3] = force
-        data.xfrc_applied[self.body, 3:] = np.cross(arm, force)
+        if self.payload is None:
+            data.xfrc_applied[self.body, :3] = force
+            data.xfrc_applied[self.body, 3:] = np.cross(arm, force)
+            return
+        rest = force - self.payload[k]
+        true = self.factor * self.payload[k]
+        lever = arm + data.site_xmat[self.site].reshape(3, 3) @ self.offset
+        data.xfrc_applied[self.body, :3] = rest + true
+        data.xfrc_applied[self.body, 3:] = np.cross(arm, rest) + np.cross(lever, true)
 
 
 def machine_environment(
@@ -140,26 +186,48 @@ def machine_environment(
     physics_timestep: float = PHYSICS_TIMESTEP,
     control_timestep: float = 2 * PHYSICS_TIMESTEP,
     current_bandwidth_hz: float = CURRENT_BANDWIDTH_HZ,
+    plant: Plant | None = None,
 ) -> control.Environment:
-    """Closed-loop environment of a machine design's plan (the ideal plant, module docstring)."""
+    """Closed-loop environment of a machine design's plan on ``plant`` (None: the ideal plant; module docstring)."""
     if not (0.0 < physics_timestep <= 0.01):
         raise InvalidInputError("physics_timestep", physics_timestep, "must lie in (0, 0.01]", "s")
     n_sub = round(control_timestep / physics_timestep)
     if n_sub < 1 or abs(n_sub * physics_timestep - control_timestep) > 1e-9:
         raise InvalidInputError("control_timestep", control_timestep, "must be a multiple of the physics step", "s")
     motion, force = machine_motion(plan, physics_timestep)
-    tree = machine_tree(plan.machine)
-    spec = spec_of_tree(tree, _extras(plan))
+    active = active_plant(plant)
+    machine, arrays, extras = plan.machine, DriveArrays.from_params(plan.emlas), _extras(plan)
+    if active is not None and active.mismatch.enabled:
+        machine = true_machine(machine, active.mismatch)
+        arrays = true_drive_arrays(arrays, active.mismatch)
+        factor = friction_factor(active.mismatch)
+        extras = SimulationExtras(extras.armature_kg, tuple(d * factor for d in extras.damping_Ns_per_m))
+    stiffness = compliant_stiffness(plan.emlas, motion, plant, physics_timestep)
+    if active is not None and stiffness is not None:  # the rotor and the screw friction move to the motor side
+        count = len(extras.armature_kg)
+        extras = SimulationExtras((active.drive_train.rod_side_mass_kg,) * count, (0.0,) * count)
+    tree = machine_tree(machine)
+    spec = spec_of_tree(tree, extras)
     spec.option.timestep = physics_timestep
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # implicit in the slides' damping
+    actuators = tuple(plan.machine.actuator_names)
+    if stiffness is not None:
+        spring_actuators(spec, actuators)
+    friction: tuple[tuple[str, ...], tuple[str, ...]] = ((), ())
+    if active is not None and active.joint_friction.enabled:
+        friction = add_joint_friction(spec, active.joint_friction, hinges=machine.joint_names)
     physics = CranePhysics.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
-    physics.attach_drives(
-        DriveSimulator(DriveArrays.from_params(plan.emlas), bandwidth_hz=current_bandwidth_hz),
-        DriveLossModel(plan.emlas),
-        joints=tuple(tree.bodies[b].joint for b in tree.actuated),
-        actuators=tuple(plan.machine.actuator_names),
-    )
-    physics.tcp_load = TcpLoad(physics.model.ptr, force, physics_timestep)
+    joints = tuple(tree.bodies[b].joint for b in tree.actuated)
+    parts = plant_parts(physics.model.ptr, plan, motion, arrays, plant, stiffness, friction, current_bandwidth_hz)
+    physics.attach_parts(parts, plant, joints, actuators)
+    if active is not None and active.mismatch.enabled:
+        payload = _to_world(_at(physics_times(plan, physics_timestep), plan, plan.payload_force)[:, :2])
+        offset = np.asarray(active.mismatch.end_mass_com_offset_m, dtype=float)
+        physics.tcp_load = TcpLoad(
+            physics.model.ptr, force, physics_timestep, payload, payload_factor(active.mismatch), offset
+        )
+    else:
+        physics.tcp_load = TcpLoad(physics.model.ptr, force, physics_timestep)
     task = CraneTrackingTask(plan, motion, physics.drives.drives.current_limit)  # type: ignore[arg-type]
     steps = round(plan.duration / control_timestep)
     return control.Environment(
@@ -171,13 +239,18 @@ def run_machine_closed_loop(
     plan: MachinePlan,
     gains: CascadeGains | None = None,
     progress: Callable[[int, int], None] | None = None,
+    plant: Plant | None = None,
+    cycles: int = 1,
 ) -> tuple[ClosedLoopRun, CranePhysics]:
-    """One cycle of a machine design's plan under the cascade controller; the log and the Physics (free it)."""
-    env = machine_environment(plan)
+    """``cycles`` cycles of a machine design's plan on ``plant`` under the cascade; the last log and the Physics."""
+    if isinstance(cycles, bool) or not isinstance(cycles, int) or cycles < 1:
+        raise InvalidInputError("cycles", cycles, "must be an integer >= 1")
+    env = machine_environment(plan, plant=plant)
     motion = env.task.motion
-    design = machine_loop_design(plan, machine_load_mass(plan, motion), gains)
+    stiffness, lowest = drive_train_resonance(plan.emlas, motion, plant)
+    design = machine_loop_design(plan, machine_load_mass(plan, motion), gains, stiffness, lowest)
     drives = DriveArrays.from_params(plan.emlas)
     run = run_environment(
-        env, design, drives, plan.design, 0.0, plan, progress, None, 1, actuator_names=plan.actuator_names
+        env, design, drives, plan.design, 0.0, plan, progress, plant, cycles, actuator_names=plan.actuator_names
     )
-    return run, env.physics
+    return replace(run, resampled_prediction=resampled_prediction(plan, motion)), env.physics

@@ -8,7 +8,9 @@ the study's EMLA set in chain order, the planned independent-joint trajectory on
 study's reference, the predicted P_elec per drive and net electrical energy, and the study's TCP
 force F(t) of its first task (:meth:`hiab_sim.study.spec.tasks.Task.id_force`: the payload's
 weight, a scheduled or inertial payload, soil), the same force the optimiser's inverse dynamics
-took, so that the ideal plant is the planner's own model.
+took, so that the ideal plant is the planner's own model, and the payload's share of it (F(t)
+less the soil's force: what a payload mismatch scales, :mod:`hiab_sim.env.plant.mismatch`), and
+the study's duty model of the cycle (hot windings, the rest's hold), as a crane file's plan has it.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.emla.duty_energy import DutyOptions
 from hiab_sim.env.plan import PlannedDesign, open_design
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.machine.description import Machine
@@ -46,13 +49,18 @@ class MachinePlan(PlannedDesign):
             (its weight is in ``tcp_force``).
         tracked: The study's tracked coordinates beyond the TCP's x, y (the payload's kinematics), or
             None: ``tcp_angle`` for each.
+        payload_force: The payload's share of ``tcp_force`` (without the soil's), (K, 3) [N] in {W}.
+        duty: The study's duty model of the cycle, or None: the paper's per-sample model
+            (:func:`hiab_sim.study.nlp.task_setup.duty_options`).
 
     """
 
     machine: Machine
     tcp_force: Array
+    payload_force: Array
     payload_kg: float = 0.0
     tracked: tuple[str, ...] | None = None
+    duty: DutyOptions | None = None
 
     @property
     def actuator_names(self) -> tuple[str, ...]:
@@ -88,13 +96,25 @@ def read_machine_plan(result_dir: str | Path, design: str) -> MachinePlan:
         ) from error
     time = found.planned["time"]
     task = study.tasks[0]
-    force = task.id_force(study.model.kinematics, study.model.gravity, time)
-    tcp_force = np.zeros((len(time), 3)) if force is None else np.broadcast_to(force, (len(time), 3)).copy()
+    kinematics, gravity = study.model.kinematics, study.model.gravity
+    tcp_force = _samples(task.id_force(kinematics, gravity, time), len(time))
+    payload = tcp_force - _samples(task.soil_force(kinematics, gravity, time), len(time))
+    from hiab_sim.study.nlp.task_setup import duty_options
+
     return MachinePlan(
         **found.planned,
         machine=machine,
         emlas=study.emlas,
-        tcp_force=np.asarray(tcp_force, dtype=float),
+        tcp_force=tcp_force,
+        payload_force=payload,
         payload_kg=task.payload.mass,
         tracked=getattr(study.model, "extra", None),
+        duty=duty_options(study, study.emlas, float(time[-1] - time[0])),
     )
+
+
+def _samples(force: Array | None, count: int) -> Array:
+    """A force of None, (3,) or (K, 3) as (K, 3) samples [N] (zero for None)."""
+    if force is None:
+        return np.zeros((count, 3))
+    return np.asarray(np.broadcast_to(force, (count, 3)), dtype=float).copy()

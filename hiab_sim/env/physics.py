@@ -39,10 +39,10 @@ from numpy.typing import NDArray
 from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator, DriveStep
 from hiab_sim.env.drive_losses import DriveLossModel
 from hiab_sim.env.plan import DesignPlan
-from hiab_sim.env.planned_energy import hot_resistance
+from hiab_sim.env.plant.assembly import PlantParts, active_plant, compliant_stiffness, plant_parts, spring_actuators
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.plant.current_loop import DiscreteCurrentLoop
-from hiab_sim.env.plant.drivetrain import TwoMassDriveTrain, coupled_step, drive_train_stiffness
+from hiab_sim.env.plant.drivetrain import TwoMassDriveTrain, coupled_step
 from hiab_sim.env.plant.friction import FrictionMeter, add_joint_friction
 from hiab_sim.env.plant.mismatch import true_crane, true_drives
 from hiab_sim.env.plant.sensors import CurrentSensorError, MotionSensor
@@ -145,6 +145,22 @@ class CranePhysics(dm_mujoco.Physics):
             drives.sensor = self.current_error
         self.reset_counters()
 
+    def attach_parts(
+        self, parts: PlantParts, plant: Plant | None, joints: tuple[str, ...], actuators: tuple[str, ...]
+    ) -> None:
+        """:meth:`attach_drives` with the parts of :func:`hiab_sim.env.plant.assembly.plant_parts`."""
+        self.attach_drives(
+            parts.drives,
+            parts.losses,
+            plant,
+            drive_train=parts.drive_train,
+            thermal=parts.thermal,
+            friction=parts.friction,
+            joints=joints,
+            actuators=actuators,
+            resistance_schedule=parts.resistance_schedule,
+        )
+
     def motor_state(self) -> tuple[Array, Array]:
         """Motor-side stroke [m] and rate [m/s] at the rod (the rod's own when the drive train is rigid)."""
         if self.drive_train is None:
@@ -244,7 +260,9 @@ class CranePhysics(dm_mujoco.Physics):
                     force, tau_tr = result.rod_force, None
                     if losses.transmission_on:
                         force, tau_tr = losses.rigid_rod_force(force, omega, data.qacc[self.slide_dofs])
-                    data.ctrl[:] = force
+                    data.ctrl[self.actuator_ids] = force
+                    if self.tcp_load is not None:
+                        self.tcp_load.apply(model, data, self.holding)
                     mujoco.mj_step(model, data)
                     if tau_tr is not None:
                         self.transmission_loss += tau_tr * ratio * data.qvel[self.slide_dofs] * h
@@ -255,6 +273,8 @@ class CranePhysics(dm_mujoco.Physics):
                         screw = train.spring_force(data.qpos[self.slide_dofs], v) + train.viscous * train.velocity
                         tau_tr, _ = losses.loss_torque(screw, omega)
                         force = force - ratio * tau_tr
+                    if self.tcp_load is not None:
+                        self.tcp_load.apply(model, data, self.holding)
                     loss = coupled_step(train, model, data, self.actuator_ids, self.slide_dofs, force, h)
                     self.drive_train_loss += loss
                     if tau_tr is not None:
@@ -280,20 +300,16 @@ def crane_physics(
     """Build the simulation Physics of a design at its plan's start (module docstring)."""
     if not (np.isfinite(payload_error) and 0.0 <= payload_error <= 2.0):
         raise InvalidInputError("payload_error", payload_error, "must lie in [0, 2] (end mass heavier than planned)")
-    active = plant if plant is not None and plant.enabled else None
+    active = active_plant(plant)
     slides = SlideDrives.from_emla(plan.emlas)
     arrays = DriveArrays.from_params(plan.emlas)
     crane = plan.crane
     if active is not None:
         crane = true_crane(crane, active.mismatch)
         arrays, slides = true_drives(arrays, slides, active.mismatch)
-    train_data = active.drive_train if active is not None and active.drive_train.enabled else None
-    compliant = train_data is not None
-    stiffness = None
-    if train_data is not None:  # the rotor and the screw friction move to the motor side of the spring
-        stiffness = drive_train_stiffness(plan.emlas, motion.stroke)  # the EMLA file's k_s
-        train_data.check_step(timestep, float(stiffness.max()))
-        rod_side = train_data.rod_side_mass_kg
+    stiffness = compliant_stiffness(plan.emlas, motion, plant, timestep)
+    if active is not None and stiffness is not None:  # the rotor and the screw friction move to the motor side
+        rod_side = active.drive_train.rod_side_mass_kg
         slides = replace(slides, armature=(rod_side, rod_side, rod_side), damping=(0.0, 0.0, 0.0))
     spec = build_spec(crane, plan.lengths, slides)
     names = [spec.joints[i].name for i in range(len(spec.joints))]
@@ -305,50 +321,17 @@ def crane_physics(
     spec.option.timestep = timestep
     # Implicit in the velocity-dependent forces (the slides' damping); 3x cheaper than the template's RK4.
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    if compliant:
-        _spring_actuators(spec)
-    joints: tuple[str, ...] = ()
-    tendons: tuple[str, ...] = ()
+    if stiffness is not None:
+        spring_actuators(spec, ACTUATORS)
+    friction: tuple[tuple[str, ...], tuple[str, ...]] = ((), ())
     if active is not None and active.joint_friction.enabled:
-        joints, tendons = add_joint_friction(spec, active.joint_friction)
+        friction = add_joint_friction(spec, active.joint_friction, hinges=JOINTS)
     _add_payload(spec, plan, payload_error)
     _add_view(spec, motion)
     physics = CranePhysics.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
-    drives: DriveSimulator
-    if active is not None and active.current_loop.enabled:
-        drives = DiscreteCurrentLoop(arrays, active.current_loop, CurrentSensorError(None, len(SLIDES), 1.0), timestep)
-    else:
-        drives = DriveSimulator(arrays, bandwidth_hz=bandwidth_hz)
-    physics.attach_drives(
-        drives,
-        DriveLossModel(plan.emlas),
-        plant,
-        drive_train=None
-        if train_data is None or stiffness is None
-        else TwoMassDriveTrain(train_data, stiffness, arrays.reflected_inertia, arrays.viscous),
-        thermal=WindingTemperature(active.thermal, plan.emlas.as_tuple())
-        if active and active.thermal.enabled
-        else None,
-        friction=FrictionMeter(physics.model.ptr, joints, tendons) if joints else None,
-        resistance_schedule=hot_resistance(plan, motion, arrays.resistance),
-    )
+    parts = plant_parts(physics.model.ptr, plan, motion, arrays, plant, stiffness, friction, bandwidth_hz)
+    physics.attach_parts(parts, plant, SLIDES, ACTUATORS)
     return physics
-
-
-def _spring_actuators(spec: mujoco.MjSpec) -> None:
-    """Make the slides' actuators the drive train's springs: f = ctrl - k_c x - c_c v, unlimited.
-
-    The limits of the EMLA are the motor's (its current limit); the spring carries what the motor
-    side and the load make of it. (k_c, c_c) are set every step (:mod:`hiab_sim.env.plant.drivetrain`).
-    """
-    for name in ACTUATORS:
-        actuator = spec.actuator(name)
-        actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
-        actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_FALSE
-        actuator.gaintype = mujoco.mjtGain.mjGAIN_FIXED
-        actuator.gainprm[0] = 1.0
-        actuator.biastype = mujoco.mjtBias.mjBIAS_AFFINE
-        actuator.biasprm[:3] = [0.0, 0.0, 0.0]
 
 
 def _add_view(spec: mujoco.MjSpec, motion: PlannedMotion) -> None:

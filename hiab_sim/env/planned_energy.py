@@ -7,18 +7,33 @@ plan), so the closed loop is compared with the same model, not with a copy of it
 
 from __future__ import annotations
 
+from typing import Protocol
+
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.emla.duty_energy import drive_duty
+from hiab_sim.emla.config import EmlaSet
+from hiab_sim.emla.duty_energy import DutyOptions, drive_duty
 from hiab_sim.emla.model import electrical_power
-from hiab_sim.env.plan import DesignPlan
 from hiab_sim.env.reference import PlannedMotion
 
 Array = NDArray[np.float64]
 
 
-def hot_resistance(plan: DesignPlan, motion: PlannedMotion, resistance: Array) -> Array | None:
+class DutyPlan(Protocol):
+    """What the planner's energy model needs of a plan, a crane file's or a machine file's."""
+
+    @property
+    def time(self) -> Array: ...  # noqa: D102
+
+    @property
+    def emlas(self) -> EmlaSet: ...  # noqa: D102
+
+    @property
+    def duty(self) -> DutyOptions | None: ...  # noqa: D102
+
+
+def hot_resistance(plan: DutyPlan, motion: PlannedMotion, resistance: Array) -> Array | None:
     """R_s [ohm] per physics step (N, n) at the plan's periodic winding temperature, or None without hot windings.
 
     The planner's coupled winding model (:func:`hiab_sim.emla.duty_energy.drive_duty`) on the plan's own
@@ -47,7 +62,7 @@ def hot_resistance(plan: DesignPlan, motion: PlannedMotion, resistance: Array) -
 RESAMPLE_STEPS = 5
 
 
-def resampled_prediction(plan: DesignPlan, motion: PlannedMotion) -> float:
+def resampled_prediction(plan: DutyPlan, motion: PlannedMotion) -> float:
     """The planner's energy [J] of the planned motion on a 5 ms grid instead of the optimiser's fine grid.
 
     The same model as ``result.json``'s number (:func:`hiab_sim.emla.duty_energy.drive_duty` with the

@@ -1,13 +1,19 @@
-"""Coulomb and viscous friction in the boom hinges and the actuators' pins, added to the MuJoCo model.
+"""Coulomb and viscous friction in the hinges and the actuators' pins of any MJCF mechanism with loop pins.
 
-Every closed chain's ``connect`` equality names the rod-end site (on the rod, whose parent body is
-the actuator's barrel, hinged at its base pin) and the boom pivot site (on the boom, hinged at the
-boom hinge). Friction is placed on the three rotations of the chain:
+Every closed loop of the model is a site-based ``connect`` equality (the crane MJCF's rod-end pins,
+:mod:`hiab_sim.model.mjcf`; a machine file's loop pins, :mod:`hiab_sim.machine.dynamics.mjcf_build`):
+site 1 on body a, site 2 on body b. Friction sits on every rotation of the loop it closes:
 
-* boom hinge: joint friction on the boom's hinge (``frictionloss`` T_c [N m], ``damping`` c [N m s/rad]);
-* base pin: the same on the barrel's hinge;
-* rod-end pin: its rotation rate is the boom's minus the barrel's angular rate (both hinge on the same
-  parent about parallel axes), a fixed tendon ``<equality>_rod_pin`` = q_boom - q_barrel carries it.
+* every hinge joint on the tree path between body a and body b: a joint named in ``hinges`` (the
+  machine's own joints: the crane's boom hinges, a machine file's link joints) gets the hinge
+  friction (``frictionloss`` T_c [N m], ``damping`` c [N m s/rad]); any other hinge on the path (an
+  actuator's base pin, a linkage's rocker and coupler pins) gets the pin friction;
+* the loop pin itself: its rotation rate is body b's angular rate minus body a's. All hinge axes
+  of a planar mechanism are parallel to one normal n, so that rate is the fixed tendon
+  ``<equality>_rod_pin`` = sum_j s_j qdot_j over the path's hinges, s_j = +-1 (n . axis_j) on b's
+  side, -+1 on a's side (n: the first hinge's axis on b's side); slides do not turn.
+
+On the crane each chain's path is the boom hinge (b) and the barrel's base pin (a): q_boom - q_barrel.
 
 MuJoCo treats ``frictionloss`` as a constraint (static friction included, no regularisation) and
 the damping implicitly, so the model stays stable at the physics step. The power they dissipate is
@@ -19,6 +25,8 @@ rate at the step's start would miscount a light body's step-to-step reversals).
 
 from __future__ import annotations
 
+from collections.abc import Collection
+
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
@@ -28,44 +36,91 @@ from hiab_sim.errors import ConfigError
 
 Array = NDArray[np.float64]
 
-
-def _hinge_of(body: mujoco.MjsBody, what: str) -> mujoco.MjsJoint:
-    hinges = [j for j in body.joints if j.type == mujoco.mjtJoint.mjJNT_HINGE]
-    if len(hinges) != 1:
-        raise ConfigError(f"{what} body '{body.name}' must have exactly one hinge joint, has {len(hinges)}")
-    return hinges[0]
+#: |n . axis| below 1 by more than this: the mechanism is not planar (its hinges are not parallel).
+PARALLEL_TOLERANCE = 1e-9
 
 
-def add_joint_friction(spec: mujoco.MjSpec, friction: JointFriction) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    """Add the friction of every closed chain to ``spec`` (module docstring).
+def _ancestors(model: mujoco.MjModel, body: int) -> list[int]:
+    """The body and its ancestors up to the world body (0), child first."""
+    out = [body]
+    while out[-1] != 0:
+        out.append(int(model.body_parentid[out[-1]]))
+    return out
+
+
+def _hinges_below(model: mujoco.MjModel, data: mujoco.MjData, body: int, top: int) -> list[tuple[str, Array]]:
+    """(hinge name, world axis) of every body from ``body`` up to, not including, ``top``, child first."""
+    out = []
+    for node in _ancestors(model, body):
+        if node == top:
+            break
+        for j in range(model.body_jntadr[node], model.body_jntadr[node] + model.body_jntnum[node]):
+            if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE:
+                out.append((model.joint(j).name, data.xaxis[j].copy()))
+    return out
+
+
+def loop_path(model: mujoco.MjModel, data: mujoco.MjData, site_a: str, site_b: str) -> list[tuple[str, float]]:
+    """(hinge, s_j) on the tree path between the bodies of two sites, b's side first (module docstring).
+
+    ``data`` holds the kinematics of ``model`` (``mj_kinematics``) for the hinges' world axes.
+
+    Raises:
+        ConfigError: no hinge on the path, or a hinge not parallel to the others (not planar).
+
+    """
+    body_a, body_b = int(model.site(site_a).bodyid[0]), int(model.site(site_b).bodyid[0])
+    above_a = set(_ancestors(model, body_a))
+    common = next(node for node in _ancestors(model, body_b) if node in above_a)
+    side_b = _hinges_below(model, data, body_b, common)
+    side_a = _hinges_below(model, data, body_a, common)
+    if not side_b and not side_a:
+        raise ConfigError(f"pin {site_a} - {site_b}: no hinge between its two bodies for the pin's rotation")
+    normal = (side_b or side_a)[0][1]
+    path = []
+    for sign, side in ((1.0, side_b), (-1.0, side_a)):
+        for name, axis in side:
+            alignment = float(normal @ axis)
+            if abs(abs(alignment) - 1.0) > PARALLEL_TOLERANCE:
+                raise ConfigError(f"pin {site_a} - {site_b}: hinge '{name}' is not parallel to the loop's other hinges")
+            path.append((name, sign * float(np.sign(alignment))))
+    return path
+
+
+def add_joint_friction(
+    spec: mujoco.MjSpec, friction: JointFriction, hinges: Collection[str]
+) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """Add the friction of every loop pin's path to ``spec``; ``hinges`` the machine's own joints (module docstring).
 
     Returns:
-        The names of the joints with friction and of the rod-pin tendons.
+        The names of the joints with friction and of the loop-pin tendons.
 
     """
     joints: list[str] = []
     tendons: list[str] = []
-    for equality in spec.equalities:
-        if equality.type != mujoco.mjtEq.mjEQ_CONNECT or equality.objtype != mujoco.mjtObj.mjOBJ_SITE:
-            continue
-        rod = spec.site(equality.name1).parent
-        boom = spec.site(equality.name2).parent
-        barrel = rod.parent
-        pin = _hinge_of(barrel, "barrel")
-        hinge = _hinge_of(boom, "boom")
-        if barrel.parent.name != boom.parent.name:
-            raise ConfigError(f"{equality.name}: barrel and boom must hinge on the same body for the rod-pin friction")
-        hinge.frictionloss = friction.hinge_coulomb_N_m
-        hinge.damping = [friction.hinge_viscous_N_m_s_per_rad, 0.0, 0.0]
-        pin.frictionloss = friction.pin_coulomb_N_m
-        pin.damping = [friction.pin_viscous_N_m_s_per_rad, 0.0, 0.0]
+    pins = [e for e in spec.equalities if e.type == mujoco.mjtEq.mjEQ_CONNECT and e.objtype == mujoco.mjtObj.mjOBJ_SITE]
+    if not pins:
+        return (), ()
+    model = spec.compile()  # the topology and the hinges' world axes of the mechanism as built
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    for equality in pins:
+        path = loop_path(model, data, equality.name1, equality.name2)
+        for name, _ in path:
+            if name in joints:
+                continue
+            joint = spec.joint(name)
+            main = name in hinges
+            joint.frictionloss = friction.hinge_coulomb_N_m if main else friction.pin_coulomb_N_m
+            viscous = friction.hinge_viscous_N_m_s_per_rad if main else friction.pin_viscous_N_m_s_per_rad
+            joint.damping = [viscous, 0.0, 0.0]
+            joints.append(name)
         tendon = spec.add_tendon(name=f"{equality.name}_rod_pin")
-        tendon.wrap_joint(hinge.name, 1.0)
-        tendon.wrap_joint(pin.name, -1.0)
+        for name, coefficient in path:
+            tendon.wrap_joint(name, coefficient)
         tendon.frictionloss = friction.pin_coulomb_N_m
         tendon.damping = [friction.pin_viscous_N_m_s_per_rad, 0.0, 0.0]
         tendons.append(tendon.name)
-        joints += [hinge.name, pin.name]
     return tuple(joints), tuple(tendons)
 
 
