@@ -62,7 +62,7 @@ def test_the_overlays_last_number_is_the_reported_battery_energy(
     assert reported is not None
     at = closed_loop_frame_times(float(run.time[-1]))
     notes = battery_notes(run, battery, at)
-    pattern = re.compile(r"t = +([\d.]+) s   battery energy (-?[\d.]+) of (-?[\d.]+) kJ per cycle \(DC bus\)")
+    pattern = re.compile(r"t = +([\d.]+) s   battery energy (-?[\d.]+) of (-?[\d.]+) kJ per cycle \(at the battery\)")
     parsed = [pattern.fullmatch(note) for note in notes]
     assert all(parsed)
     totals = {float(m.group(3)) for m in parsed if m}

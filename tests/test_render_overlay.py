@@ -52,7 +52,7 @@ def test_overlay_states_each_designs_battery_energy_from_the_result(loaded: Path
     """Every frame's note names the battery energy of result.json with its boundary, per design."""
     with playback_renderer(load_playback(loaded), fps=12.0, size=SIZE, layout="overlay") as renderer:
         for design in renderer.designs:
-            want = f"battery energy {BATTERY[design.name] / 1e3:.3f} kJ per cycle (DC bus)"
+            want = f"battery energy {BATTERY[design.name] / 1e3:.3f} kJ per cycle (at the battery)"
             assert design.notes and all(want in note for note in design.notes)
 
 
@@ -63,7 +63,7 @@ def test_a_result_without_a_battery_figure_says_what_it_shows() -> None:
     assert notes[-1].endswith("drives' net electrical energy 2.000 of 2.000 kJ (no battery figure)")
     assert "no energy figure" in energy_notes(time, np.array([0.5]), None)[0]
     assert energy_notes(time, np.array([0.5]), None, 3000.0, "duty period")[0].endswith(
-        "battery energy 3.000 kJ per duty period (DC bus)"
+        "battery energy 3.000 kJ per duty period (at the battery)"
     )
 
 

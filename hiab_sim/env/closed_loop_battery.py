@@ -75,6 +75,6 @@ def battery_notes(run: ClosedLoopRun, battery: BatteryParams, at: Array) -> tupl
     total = float(energy[-1]) / 1e3
     index = np.clip(np.searchsorted(run.time, at), 0, len(run.time) - 1)
     return tuple(
-        f"t = {t:5.2f} s   battery energy {energy[k] / 1e3:.3f} of {total:.3f} kJ per cycle (DC bus)"
+        f"t = {t:5.2f} s   battery energy {energy[k] / 1e3:.3f} of {total:.3f} kJ per cycle (at the battery)"
         for t, k in zip(at, index, strict=True)
     )

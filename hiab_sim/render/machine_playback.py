@@ -34,7 +34,7 @@ from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
 from hiab_sim.machine_mjcf import machine_mjcf, posed_qpos, result_design
 from hiab_sim.model.mjcf import source_to_world
 from hiab_sim.results.read import RESULT_FILE, read_result, result_machine
-from hiab_sim.results.trajectory_file import read_trajectory
+from hiab_sim.results.trajectory_file import battery_powers, read_trajectory
 
 Array = NDArray[np.float64]
 DESIGNS = ("initial", "optimal")
@@ -62,6 +62,7 @@ class MachinePlayback:
     battery_energy_J: dict[str, float] | None = None
     battery_period: str = "cycle"
     ground: float | None = None  # the soil's ground level in the description's world y [m]; None: none given
+    battery_power: dict[str, Array] | None = None  # each design's battery power over the cycle (K,) [W]
 
 
 def is_machine_result(result_dir: str | Path) -> bool:
@@ -117,8 +118,9 @@ def load_machine_playback(result_dir: str | Path) -> MachinePlayback:
         battery = {"initial": result.energy.initial.battery_energy_J, "optimal": result.energy.optimal.battery_energy_J}
         period = "duty period" if result.energy.optimal.duty is not None else "cycle"
     return MachinePlayback(
-        machine, time, reference, tuple(motions), payload, battery, period, study_ground(result.study)
-    )
+        machine, time, reference, tuple(motions), payload, battery, period, study_ground(result.study),
+        battery_powers(trajectory),
+    )  # fmt: skip
 
 
 def study_ground(study: str) -> float | None:

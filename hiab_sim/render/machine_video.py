@@ -29,7 +29,7 @@ from hiab_sim.render.machine_playback import (
     machine_reference,
 )
 from hiab_sim.render.playback import frame_times, resample
-from hiab_sim.render.video import DEFAULT_LAYOUT, VIDEO_NAME, energy_notes, held_payload
+from hiab_sim.render.video import DEFAULT_LAYOUT, VIDEO_NAME, design_texts, held_payload
 
 _COLOURS = {"initial": INITIAL_RGBA, "optimal": OPTIMAL_RGBA}
 
@@ -50,9 +50,7 @@ def machine_renderer(
     payload = held_payload(data, at)
     for motion in data.designs:
         model, qpos = machine_model_and_qpos(data.machine, motion.design, resample(data.time, motion.position, at))
-        caption = f"{motion.name} design" + (", ghost" if layout == "overlay" and motion.name == "initial" else "")
-        battery = None if data.battery_energy_J is None else data.battery_energy_J.get(motion.name)
-        notes = energy_notes(data.time, at, motion.power, battery, data.battery_period)
+        caption, notes = design_texts(motion.name, layout, data, at, motion.power)
         dress = machine_file_dress(model, data.machine.with_design(motion.design), data.ground)
         designs.append(
             Design(

@@ -5,7 +5,8 @@ A result folder (written by ``hiab-sim optimize``) holds ``result.json`` with th
 designs and, where the study has a battery model, their battery energy (``energy``), and
 ``trajectory.npz`` with ``time`` (K,), ``reference_tcp`` (K, 3) in the source world {W} (y up),
 per design d ``{d}_position``, ``{d}_velocity``, ``{d}_acceleration`` (K, 3) of (theta1, theta2,
-xt2) and, in results that have it, ``payload_mass`` (K,), the payload held at the TCP.
+xt2) and, in results that have them, ``{d}_battery_power`` (K,), the battery's power over the cycle
+(the overlay's cumulative battery energy), and ``payload_mass`` (K,), the payload held at the TCP.
 
 Two playback modes:
 
@@ -32,7 +33,7 @@ from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.results.playback_view import PlaybackView
 from hiab_sim.results.read import open_run, result_crane
-from hiab_sim.results.trajectory_file import Trajectory
+from hiab_sim.results.trajectory_file import Trajectory, battery_powers
 
 Array = NDArray[np.float64]
 Mode = Literal["kinematic", "simulate"]
@@ -65,6 +66,8 @@ class PlaybackData:
     battery_energy_J: dict[str, float] | None = None
     #: The period that battery energy covers: "cycle", or "duty period" with the study's duty model (cycle + rest).
     battery_period: str = "cycle"
+    #: Each design's battery power over the cycle at ``time`` (K,) [W] (``<design>_battery_power``); None: none.
+    battery_power: dict[str, Array] | None = None
 
 
 def load_playback(result_dir: str | Path) -> PlaybackData:
@@ -93,7 +96,7 @@ def load_playback(result_dir: str | Path) -> PlaybackData:
     if view.energy is not None:
         battery = {name: getattr(view.energy, name).battery_energy_J for name in DESIGNS}
         period = "duty period" if view.energy.optimal.duty is not None else "cycle"
-    return PlaybackData(crane, time, reference, tuple(designs), payload, battery, period)
+    return PlaybackData(crane, time, reference, tuple(designs), payload, battery, period, battery_powers(trajectory))
 
 
 def _columns(trajectory: Trajectory, value: Array, key: str) -> Array:

@@ -80,12 +80,9 @@ def playback_renderer(
             qpos = planned_qpos(data.crane, motion.lengths, resample(data.time, motion.joints.position, at))
         else:
             qpos = resample(*simulated_qpos(data.crane, motion.lengths, data.time, motion.joints), at)
-        caption = f"{motion.name} design" + (" (simulated)" if mode != "kinematic" else "")
-        if layout == "overlay" and motion.name == "initial":
-            caption += ", ghost"
         power = None if energy is None else energy.get(motion.name)
-        battery = None if data.battery_energy_J is None else data.battery_energy_J.get(motion.name)
-        notes = energy_notes(data.time, at, power, battery, data.battery_period)
+        suffix = " (simulated)" if mode != "kinematic" else ""
+        caption, notes = design_texts(motion.name, layout, data, at, power, suffix)
         designs.append(
             Design(
                 motion.name, model, qpos, _COLOURS.get(motion.name, OPTIMAL_RGBA), caption, notes,
@@ -124,26 +121,89 @@ def held_payload(data: HeldPayload, at: Array) -> tuple[float, ...]:
     return tuple(float(m) for m in data.payload_mass[index])
 
 
+class EnergyTexts(Protocol):
+    """What :func:`design_texts` reads of a playback: its times and each design's battery figures."""
+
+    @property
+    def time(self) -> Array:
+        """Sample times (K,) [s], increasing."""
+        ...
+
+    @property
+    def battery_energy_J(self) -> dict[str, float] | None:
+        """Each design's battery energy of ``result.json`` per ``battery_period`` [J]; None: none."""
+        ...
+
+    @property
+    def battery_period(self) -> str:
+        """``cycle`` or ``duty period``."""
+        ...
+
+    @property
+    def battery_power(self) -> dict[str, Array] | None:
+        """Each design's battery power over the cycle (K,) [W]; None: not in the result."""
+        ...
+
+
+def design_texts(
+    name: str, layout: str, data: EnergyTexts, at: Array, power: Array | None, suffix: str = ""
+) -> tuple[str, tuple[str, ...]]:
+    """A design's caption and per-frame notes (:func:`energy_notes`) in a playback of layout ``layout``.
+
+    The caption names the design (``suffix`` after it; ", ghost" for the initial design overlaid) and,
+    where the notes accumulate the cycle's battery energy and the result has a duty model, the
+    result's battery energy per duty period (cycle and rest), the figure its summary answers in.
+    """
+    caption = f"{name} design{suffix}" + (", ghost" if layout == "overlay" and name == "initial" else "")
+    battery = None if data.battery_energy_J is None else data.battery_energy_J.get(name)
+    trace = None if data.battery_power is None else data.battery_power.get(name)
+    if trace is not None and battery is not None and data.battery_period != "cycle":
+        caption += f": {battery / 1e3:.2f} kJ per {data.battery_period}"
+    return caption, energy_notes(data.time, at, power, battery, data.battery_period, trace)
+
+
 def energy_notes(
-    time: Array, at: Array, power: Array | None, battery_J: float | None = None, period: str = "cycle"
+    time: Array,
+    at: Array,
+    power: Array | None,
+    battery_J: float | None = None,
+    period: str = "cycle",
+    battery_power: Array | None = None,
 ) -> tuple[str, ...]:
     """Per-frame texts: time [s] and the energy, named with its boundary.
 
-    With ``battery_J`` (the result's battery energy [J] per ``period``) that figure; else, with
-    ``power`` (W at ``time``), the drives' cumulative net electrical energy and its total [kJ],
-    saying that no battery figure exists; else the time alone.
+    With ``battery_power`` (the power the battery delivers at ``time`` [W], the trajectory's
+    ``<design>_battery_power``) the battery energy of the cycle so far (trapezoid rule, the result's
+    own quadrature) and its total [kJ], the closed loop's wording
+    (:func:`hiab_sim.env.closed_loop_battery.battery_notes`); else with ``battery_J`` (the result's
+    figure per ``period``) that figure; else, with
+    ``power`` (W at ``time``), the drives' cumulative net electrical energy and its total [kJ], saying
+    that no battery figure exists; else the time alone.
     """
+    if battery_power is not None:
+        so_far = _cumulative(time, battery_power)
+        cycle = so_far[-1] / 1e3
+        return tuple(
+            f"t = {t:5.2f} s   battery energy {e / 1e3:.3f} of {cycle:.3f} kJ per cycle (at the battery)"
+            for t, e in zip(at, np.interp(at, time, so_far), strict=True)
+        )
     if battery_J is not None:
-        return tuple(f"t = {t:5.2f} s   battery energy {battery_J / 1e3:.3f} kJ per {period} (DC bus)" for t in at)
+        text = f"battery energy {battery_J / 1e3:.3f} kJ per {period} (at the battery)"
+        return tuple(f"t = {t:5.2f} s   {text}" for t in at)
     if power is None:
         return tuple(f"t = {t:5.2f} s   (no energy figure in this result)" for t in at)
-    steps = 0.5 * (power[1:] + power[:-1]) * np.diff(time)
-    cumulative = np.concatenate([[0.0], np.cumsum(steps)])
+    cumulative = _cumulative(time, power)
     total = cumulative[-1] / 1e3
     return tuple(
         f"t = {t:5.2f} s   drives' net electrical energy {e / 1e3:.3f} of {total:.3f} kJ (no battery figure)"
         for t, e in zip(at, np.interp(at, time, cumulative), strict=True)
     )
+
+
+def _cumulative(time: Array, power: Array) -> Array:
+    """int_t0^t_k power dt [J] at every sample (trapezoid rule), 0 at the first."""
+    steps = 0.5 * (power[1:] + power[:-1]) * np.diff(time)
+    return np.concatenate([[0.0], np.cumsum(steps)])
 
 
 def load_power(result_dir: str | Path, data: PlaybackData) -> dict[str, Array]:

@@ -75,7 +75,16 @@ ARRAYS: tuple[ArraySpec, ...] = (
         "{design}_electrical_power",
         "K, A",
         "W",
-        "electrical power of each EMLA drive at its DC-bus terminals (per drive, > 0 drawn from the bus)",
+        "electrical power of each EMLA drive at its input (per drive, > 0 drawn): at its DC-bus terminals where the "
+        "EMLA file models the inverter in drive_losses (battery.inverter_efficiency 1), else at the motor terminals",
+    ),
+    ArraySpec(
+        "{design}_battery_power",
+        "K",
+        "W",
+        "power the battery delivers over the cycle (at the battery, > 0 discharging): every drive through its "
+        "inverter and the shared DC bus, at the winding temperature of the study's duty; its trapezoid integral "
+        "is energy.<design>.duty.cycle_battery_energy_J (without a duty: energy.<design>.battery_energy_J)",
     ),
     ArraySpec("payload_mass", "K", "kg", "payload carried at the TCP, m(t) of the task's schedule (0 while not held)"),
 )
@@ -168,3 +177,14 @@ def read_trajectory(folder: str | Path) -> Trajectory:
             f"{path}: {VERSION_KEY} {version} is newer than this hiab-sim reads ({SCHEMA_VERSION}): upgrade hiab-sim"
         )
     return Trajectory(path, version, arrays)
+
+
+def battery_powers(trajectory: Trajectory) -> dict[str, Array] | None:
+    """Each design's ``<design>_battery_power`` (K,) [W] of ``trajectory``; None where a file predates the array."""
+    if not all(f"{name}_battery_power" in trajectory.arrays for name in DESIGNS):
+        return None
+    out = {name: trajectory.get(f"{name}_battery_power") for name in DESIGNS}
+    for name, value in out.items():
+        if value.ndim != 1:
+            raise ConfigError(f"{trajectory.path}: array '{name}_battery_power' has shape {value.shape}, expected (K,)")
+    return out

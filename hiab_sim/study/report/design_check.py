@@ -34,6 +34,7 @@ from hiab_sim.results.schema import (
 from hiab_sim.study.motion.workspace import tracked_units
 from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.task_problem import Evaluation, TaskProblem
+from hiab_sim.study.report.energy_section import cycle_battery_power
 from hiab_sim.study.spec.study_file import Study
 
 Array = NDArray[np.float64]
@@ -158,6 +159,7 @@ def trajectory_arrays(fine: TaskProblem, checks: dict[str, DesignCheck], prefix:
         arrays[f"{prefix}{name}_actuator_velocity"] = ev.actuators.velocity
         arrays[f"{prefix}{name}_actuator_stroke"] = ev.actuators.stroke
         arrays[f"{prefix}{name}_electrical_power"] = ev.power
+        arrays[f"{prefix}{name}_battery_power"] = cycle_battery_power(fine, ev)
     return arrays
 
 

@@ -26,7 +26,8 @@ from hiab_sim.results.energy_sections import DutyEnergy, MotorDuty
 from hiab_sim.study.nlp.interface import SampleState
 
 
-def _drives(emlas: EmlaSet, state: SampleState, options: DutyOptions) -> list[DriveDuty]:
+def duty_drives(emlas: EmlaSet, state: SampleState, options: DutyOptions) -> list[DriveDuty]:
+    """Each drive's duty model over ``state``'s samples (hot windings and the rest's hold of ``options``, exact)."""
     act, t = state.actuators, state.joints.time
     return [
         drive_duty(p, t, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], options, exact=True)
@@ -44,7 +45,7 @@ def _battery(emlas: EmlaSet, t: np.ndarray, drives: list[DriveDuty]) -> tuple[fl
 def duty_energy(emlas: EmlaSet, state: SampleState, options: DutyOptions) -> DutyEnergy:
     """The duty section of one design (see the module docstring)."""
     t = state.joints.time
-    drives = _drives(emlas, state, options)
+    drives = duty_drives(emlas, state, options)
     cycle, rest = _battery(emlas, t, drives)
     by_model: dict[str, float] = {}
     for key, hot, hold in (
@@ -52,7 +53,7 @@ def duty_energy(emlas: EmlaSet, state: SampleState, options: DutyOptions) -> Dut
         ("hot_windings_free_rest", True, None),
         ("cold_windings_with_hold", False, options.hold),
     ):
-        variant = _drives(emlas, state, replace(options, hot=hot, hold=hold))
+        variant = duty_drives(emlas, state, replace(options, hot=hot, hold=hold))
         by_model[key] = sum(_battery(emlas, t, variant))
     by_model["hot_windings_with_hold"] = cycle + rest
     exact = battery_energy(t, np.column_stack([d.power for d in drives]), emlas.battery)

@@ -28,8 +28,9 @@ from dataclasses import replace
 import numpy as np
 
 from hiab_sim.emla import battery_energy, operating_point, thermal_check
-from hiab_sim.emla.battery import rest_battery_energy
+from hiab_sim.emla.battery import battery_power, rest_battery_energy
 from hiab_sim.emla.duty_energy import drive_duty
+from hiab_sim.emla.model import OperatingPoint
 from hiab_sim.emla.thermal import Duty
 from hiab_sim.hydraulics import SupplyResult, hydraulic_baseline
 from hiab_sim.hydraulics.battery_boundary import battery_boundary_baselines
@@ -48,7 +49,7 @@ from hiab_sim.study.nlp.interface import SampleState
 from hiab_sim.study.nlp.objectives import SquaredPowerCost
 from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.nlp.thermal_rows import duty_check
-from hiab_sim.study.report.duty_section import duty_energy
+from hiab_sim.study.report.duty_section import duty_drives, duty_energy
 
 #: Drive-loss energies reported per actuator when an option of :mod:`hiab_sim.emla.losses` is on
 #: (electrical = mechanical + copper + rotor friction + screw viscous + inertial + these).
@@ -74,13 +75,35 @@ def costf2(problem: TaskProblem, state: SampleState) -> float:
     return SquaredPowerCost(problem.emlas, problem.dt).value(state)
 
 
-def design_energy(problem: TaskProblem, state: SampleState) -> DesignEnergy:
-    """Battery energy (exact and smooth), costf2, per-actuator energies and thermal state of one design."""
-    t, battery, act = state.joints.time, problem.emlas.battery, state.actuators
-    ops = [
+def _exact_operating_points(problem: TaskProblem, state: SampleState) -> list[OperatingPoint]:
+    act = state.actuators
+    return [
         operating_point(p, act.force[:, i], act.velocity[:, i], act.acceleration[:, i], exact=True)
         for i, p in enumerate(problem.emlas)
     ]
+
+
+def cycle_battery_power(problem: TaskProblem, state: SampleState) -> np.ndarray:
+    """The battery power P_bat(t_k) [W] of one cycle at ``state``'s samples, > 0 discharging.
+
+    Each drive's power (with the study's duty model: at the winding temperature of its fixed point,
+    :func:`~hiab_sim.study.report.duty_section.duty_drives`; else the exact operating point at R_s,ref)
+    through its inverter and the shared DC bus to the battery (:func:`hiab_sim.emla.battery.battery_power`,
+    exact kinks). Its trapezoid integral over the samples is the design's ``duty.cycle_battery_energy_J``
+    (else ``battery_energy_J``): what the playback's overlay accumulates.
+    """
+    options = problem.duty_options
+    if options is not None:
+        power = np.column_stack([d.power for d in duty_drives(problem.emlas, state, options)])
+    else:
+        power = np.column_stack([op.electrical_power for op in _exact_operating_points(problem, state)])
+    return battery_power(power, problem.emlas.battery)[1]
+
+
+def design_energy(problem: TaskProblem, state: SampleState) -> DesignEnergy:
+    """Battery energy (exact and smooth), costf2, per-actuator energies and thermal state of one design."""
+    t, battery, act = state.joints.time, problem.emlas.battery, state.actuators
+    ops = _exact_operating_points(problem, state)
     exact_power = np.column_stack([op.electrical_power for op in ops])
     exact = battery_energy(t, exact_power, battery)
     smooth = battery_energy(t, state.power, battery, smooth=True)
