@@ -111,3 +111,23 @@ def test_ipopt_and_dense_slsqp_reach_the_same_design_of_the_two_task_mix() -> No
         out[method] = (problem.cost(result.z), problem.unpack(result.z)[0].as_array())
     assert out["ipopt"][0] == pytest.approx(out["slsqp"][0], rel=LOCAL_SPREAD)
     np.testing.assert_allclose(out["ipopt"][1], out["slsqp"][1], atol=1e-3)
+
+
+def test_sparse_jacobian_of_a_machine_with_nine_design_variables_is_the_dense_one() -> None:
+    """The excavator (9 design variables, 3 joints): IPOPT's pattern and columns hold every nonzero of the dense rows."""
+    from hiab_sim.study import load_study
+
+    study = StudyProblem(load_study("exact_grading"))
+    assert study.n_xi == 9
+    z0 = study.initial_point(study.study.initial_lengths)
+    rng = np.random.default_rng(3)
+    z = z0.copy()
+    z[: study.n_xi] += rng.uniform(-1e-3, 1e-3, study.n_xi) / XI_SCALE
+    z[study.n_xi :] += rng.normal(0.0, 1e-3, len(z) - study.n_xi)
+    jac = SparseJacobian(study, z0)
+    (t,) = task_rows(study)
+    position = {row: i for i, row in enumerate(study.rows[0])}
+    held = np.array([position[row] for row in t.rows])
+    dense = study.constraints_jacobian(z)[held]
+    assert np.count_nonzero(dense[:, study.n_xi - 3 : study.n_xi]) > 0  # the design variables past the sixth move rows
+    np.testing.assert_array_equal(jac.dense(z), np.vstack([study.equalities_jacobian(z), dense]))

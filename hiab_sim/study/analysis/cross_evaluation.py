@@ -22,7 +22,7 @@ from dataclasses import replace
 from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.results.analysis_sections import CrossEvaluation
 from hiab_sim.results.design_values import DesignValues
-from hiab_sim.study.nlp.interface import N_XI, Array
+from hiab_sim.study.nlp.interface import Array
 from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.report.design_check import design_summary, fine_problem
@@ -64,7 +64,8 @@ def fixed_lengths_optimum(
     settings = problem.study.solver
     fixed = copy.copy(problem)  # the same NLP (and caches) with the Xi bounds collapsed to the design
     fixed.lower, fixed.upper = problem.lower.copy(), problem.upper.copy()
-    fixed.lower[:N_XI] = fixed.upper[:N_XI] = z0[:N_XI]
+    n_xi = problem.n_xi  # the study's design variables (6 on the XS 031, the machine file's count otherwise)
+    fixed.lower[:n_xi] = fixed.upper[:n_xi] = z0[:n_xi]
     outcome = solve_ipopt(fixed, z0, settings.maxiter, settings.ftol)
     return outcome.z, outcome.success, outcome.message
 

@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from scipy import sparse
 
 from hiab_sim.errors import BackendUnavailableError
-from hiab_sim.study.nlp.interface import N_XI, Array, PerSampleBlock
+from hiab_sim.study.nlp.interface import Array, PerSampleBlock
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import TaskProblem
 
@@ -55,9 +55,13 @@ class IpoptOutcome:
 
 
 def task_sparsity(problem: TaskProblem) -> sparse.csr_matrix:
-    """Structural nonzeros of one task's constraint Jacobian (rows, 6 + 3 N) as a 0/1 matrix."""
+    """Structural nonzeros of one task's constraint Jacobian (rows, n_xi + J N) as a 0/1 matrix.
+
+    n_xi design variables (6 on the XS 031, the machine file's count otherwise) and J joints' N
+    coefficients each.
+    """
     support = np.any(problem.B != 0.0, axis=0)  # (K, N): basis functions nonzero at each sample
-    n_c = problem.basis.n
+    n_c, n_xi, n_joints = problem.basis.n, problem.n_xi, problem.n_joints
     rows: list[Array] = []
     for block in problem.layout.blocks:
         s = problem.layout.slices[block.name]
@@ -65,10 +69,10 @@ def task_sparsity(problem: TaskProblem) -> sparse.csr_matrix:
         if isinstance(block, PerSampleBlock):
             per = count // len(block.times)
             # the block's samples are the problem's samples (same grid)
-            cols = np.concatenate([np.ones((len(block.times), N_XI), bool), np.tile(support, (1, 3))], axis=1)
+            cols = np.concatenate([np.ones((len(block.times), n_xi), bool), np.tile(support, (1, n_joints))], axis=1)
             rows.append(np.repeat(cols, per, axis=0))
         else:
-            rows.append(np.ones((count, N_XI + 3 * n_c), bool))
+            rows.append(np.ones((count, n_xi + n_joints * n_c), bool))
     return sparse.csr_matrix(np.vstack(rows).astype(float))
 
 
@@ -123,8 +127,8 @@ def task_z(problem: StudyProblem, z: Array, k: int) -> Array:
 class SparseJacobian:
     """D[e; g]/dz of the rows IPOPT holds (:func:`task_rows`) as the nonzeros of a fixed CSC pattern.
 
-    The pattern is the equalities' nonzeros (constant, 12 rows per task) over each task's held rows
-    of :func:`task_sparsity`. :meth:`values` takes each task's own Jacobian (rows, 6 + 3 N_k) at
+    The pattern is the equalities' nonzeros (constant, 4 J rows per task) over each task's held rows
+    of :func:`task_sparsity`. :meth:`values` takes each task's own Jacobian (rows, n_xi + J N_k) at
     its pattern and puts the pieces into column-major order with one precomputed permutation: no
     dense (m, n) matrix of the mix is formed. The last point's values are kept (IPOPT asks for the
     Jacobian of the equalities and of the inequalities at the same point).
@@ -143,7 +147,8 @@ class SparseJacobian:
             local = task_sparsity(t.problem)[t.rows].tocoo()
             self.local.append((t.rows[local.row], local.col))
             rows.append(local.row + first_row)
-            cols.append(np.where(local.col < N_XI, local.col, local.col - N_XI + t.offset))
+            n_xi = t.problem.n_xi
+            cols.append(np.where(local.col < n_xi, local.col, local.col - n_xi + t.offset))
             first_row += len(t.rows)
         self.shape = (first_row, problem.n)
         source = np.arange(1, sum(len(r) for r in rows) + 1, dtype=float)  # 1-based: a 0 would be dropped
