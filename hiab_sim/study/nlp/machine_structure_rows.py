@@ -47,9 +47,10 @@ def _retracted_partials(model: MachineModel, chain: Any) -> Array:
 class MachineBucklingRows(BucklingRowsBase):
     """1 - n f / P_cr per actuator with screw data and sample, on a machine file (module docstring)."""
 
+    model: MachineModel
+
     def __init__(self, times: Array, model: MachineModel, emlas: EmlaSet, safety_factor: float) -> None:
-        super().__init__(times, safety_factor)
-        self.model = model
+        super().__init__(times, model, safety_factor)
         by_name = {p.name: p for p in emlas}
         names = model.actuator_names
         self.columns = tuple(k for k, name in enumerate(names) if by_name[name].screw is not None)
@@ -123,16 +124,7 @@ class MachineBucklingRows(BucklingRowsBase):
 class MachinePinLoadRows(PinLoadRowsBase):
     """1 - |F_p| / F_max per limited pin and sample (Newton-Euler pin forces of the machine)."""
 
-    def __init__(
-        self,
-        times: Array,
-        model: MachineModel,
-        limits: tuple[tuple[str, float], ...],
-        tcp_force: Array | None,
-        step: float,
-    ) -> None:
-        super().__init__(times, limits, tcp_force, step)
-        self.model = model
+    model: MachineModel
 
     def _magnitudes(self, design: Any, position: Array, velocity: Array, acceleration: Array) -> Array:
         machine = self.model.machine_at(design)
@@ -147,18 +139,7 @@ class MachinePinLoadRows(PinLoadRowsBase):
 class MachineFrequencyRows(FrequencyRowsBase):
     """f_1(q_k, design) / f_min - 1 per sample: the lowest locked-rotor frequency at the sample's pose."""
 
-    def __init__(
-        self,
-        times: Array,
-        model: MachineModel,
-        emlas: EmlaSet,
-        minimum_Hz: float,
-        tcp_force: Array | None,
-        step: float,
-        payload_kg: float = 0.0,
-    ) -> None:
-        super().__init__(times, emlas, minimum_Hz, tcp_force, step, payload_kg)
-        self.model = model
+    model: MachineModel
 
     def _lowest_Hz(self, design: Any, position: Array) -> Array:
         machine = self.model.machine_at(design)

@@ -34,14 +34,7 @@ from hiab_sim.structure.natural_frequency import natural_frequencies
 from hiab_sim.structure.pin_loads import pin_forces, pins
 from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.nlp.differenced_rows import DifferencedRows
-from hiab_sim.study.nlp.interface import (
-    Array,
-    PerSampleBlock,
-    Relaxation,
-    SamplePartials,
-    SampleRows,
-    SampleState,
-)
+from hiab_sim.study.nlp.interface import Array, PerSampleBlock, Relaxation, SamplePartials, SampleRows, SampleState
 
 
 def _per_sample_force(tcp_force: Array | None, samples: int) -> Array | None:
@@ -52,9 +45,10 @@ def _per_sample_force(tcp_force: Array | None, samples: int) -> Array | None:
 class BucklingRowsBase(PerSampleBlock):
     """1 - n f / P_cr per actuator with screw data and sample: the name and relaxation of a crane's and a machine's."""
 
-    def __init__(self, times: Array, safety_factor: float) -> None:
+    def __init__(self, times: Array, model: Any, safety_factor: float) -> None:
         self.name = "structure.buckling"
         self.times = times
+        self.model = model
         self.safety_factor = safety_factor
 
     def relaxation(self, values: Array) -> Relaxation:
@@ -67,10 +61,11 @@ class PinLoadRowsBase(DifferencedRows):
     """1 - |F_p| / F_max per limited pin and sample; a subclass gives the pins' force magnitudes."""
 
     def __init__(
-        self, times: Array, limits: tuple[tuple[str, float], ...], tcp_force: Array | None, step: float
+        self, times: Array, model: Any, limits: tuple[tuple[str, float], ...], tcp_force: Array | None, step: float
     ) -> None:
         self.name = "structure.pin_load"
         self.times = times
+        self.model = model
         self.limits = limits
         self.limit = np.array([value for _, value in limits])
         self.tcp_force = _per_sample_force(tcp_force, len(times))
@@ -98,14 +93,16 @@ class FrequencyRowsBase(DifferencedRows):
     def __init__(
         self,
         times: Array,
+        model: Any,
         emlas: EmlaSet,
         minimum_Hz: float,
         tcp_force: Array | None,
         step: float,
-        payload_kg: float,
+        payload_kg: float = 0.0,
     ) -> None:
         self.name = "structure.natural_frequency"
         self.times = times
+        self.model = model
         self.emlas = emlas
         self.minimum = minimum_Hz
         self.tcp_force = _per_sample_force(tcp_force, len(times))
@@ -142,16 +139,17 @@ class StructureRowKinds:
 class BucklingRows(BucklingRowsBase):
     """1 - n f / P_cr per actuator with screw data and sample (:mod:`hiab_sim.structure.buckling`)."""
 
+    model: Crane
+
     def __init__(self, times: Array, crane: Crane, emlas: EmlaSet, safety_factor: float) -> None:
-        super().__init__(times, safety_factor)
-        self.crane = crane
+        super().__init__(times, crane, safety_factor)
         self.emlas = emlas
         self.sample_rows = tuple(f"{a.name} push <= P_cr / n" for a, _ in buckled_actuators(crane, emlas))
 
     def values(self, state: SampleState) -> Array:
         """1 - u per sample, sample-major (K * r,)."""
         u = buckling_samples(
-            self.crane,
+            self.model,
             self.emlas,
             crane_lengths(state.lengths),
             state.joints.position,
@@ -163,7 +161,7 @@ class BucklingRows(BucklingRowsBase):
     def jacobian(self, state: SampleState, partials: SamplePartials) -> SampleRows:
         """-du/dq9 and -du/dXi (exact P_cr partials, the ID's force partials)."""
         du_dq, du_dxi = utilisation_partials(
-            self.crane,
+            self.model,
             self.emlas,
             crane_lengths(state.lengths),
             state.joints.position,
@@ -178,38 +176,28 @@ class BucklingRows(BucklingRowsBase):
 class PinLoadRows(PinLoadRowsBase):
     """1 - |F_p| / F_max per limited pin and sample (analytic pin forces)."""
 
+    model: Crane
+
     def __init__(
         self, times: Array, crane: Crane, limits: tuple[tuple[str, float], ...], tcp_force: Array | None, step: float
     ) -> None:
-        super().__init__(times, limits, tcp_force, step)
-        self.crane = crane
+        super().__init__(times, crane, limits, tcp_force, step)
         names = [pin.name for pin in pins(crane)]
         self.index = np.array([names.index(name) for name, _ in limits])
 
     def _magnitudes(self, design: Any, position: Array, velocity: Array, acceleration: Array) -> Array:
-        loads = pin_forces(self.crane, crane_lengths(design), position, velocity, acceleration, self.tcp_force)
+        loads = pin_forces(self.model, crane_lengths(design), position, velocity, acceleration, self.tcp_force)
         return loads.magnitude[:, self.index]
 
 
 class NaturalFrequencyRows(FrequencyRowsBase):
     """f_1(q_k, Xi) / f_min - 1 per sample: the lowest locked-rotor frequency at the sample's pose."""
 
-    def __init__(
-        self,
-        times: Array,
-        crane: Crane,
-        emlas: EmlaSet,
-        minimum_Hz: float,
-        tcp_force: Array | None,
-        step: float,
-        payload_kg: float = 0.0,
-    ) -> None:
-        super().__init__(times, emlas, minimum_Hz, tcp_force, step, payload_kg)
-        self.crane = crane
+    model: Crane
 
     def _lowest_Hz(self, design: Any, position: Array) -> Array:
         modes = natural_frequencies(
-            self.crane, self.emlas, crane_lengths(design), position, self.tcp_force, payload_kg=self.payload_kg
+            self.model, self.emlas, crane_lengths(design), position, self.tcp_force, payload_kg=self.payload_kg
         )
         return modes.lowest_Hz
 
