@@ -9,6 +9,7 @@ gradients of central differences and bind when asked to.
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +31,9 @@ from hiab_sim.structure.machine_structure import machine_design_structure, machi
 from hiab_sim.structure.summary import design_structure
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.spec.study_file import load_study
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from machine_result_helper import EXCAVATOR_STUDY, joint_csv
 
 #: The crane file's pin of each machine-file pin of the XS 031 (the same pin, two namings).
 XS031_PINS = {
@@ -126,25 +130,12 @@ def test_machine_frequencies_name_the_actuators_the_emla_file_lacks(
         machine_natural_frequencies(machine, inverse, load_emla_set("xs031"), q)  # lift, tilt, telescope
 
 
-def _csv(path: Path) -> None:
-    t = np.linspace(0.0, 4.0, 41)
-    tau = t / 4.0
-    s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
-    start, end = np.array([0.0, -1.8, -1.0]), np.array([0.5, -1.3, -0.3])
-    lines = ["t,alpha,beta,gamma"] + [
-        ",".join(f"{v:.12g}" for v in (ti, *(start + si * (end - start)))) for ti, si in zip(t, s, strict=True)
-    ]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-
-
+#: The helper's excavator study, coarser, with every structural row.
 STRUCTURE_STUDY = {
+    **EXCAVATOR_STUDY,
     "name": "excavator_structure",
-    "machine": "exact",
-    "emla": "exact",
-    "tasks": [{"name": "move", "weight": 1, "reference": {"kind": "csv", "file": "move.csv"}, "payload": 50.0}],
     "spline": {"control_points": 8, "degree": 5},
     "grid": {"duration": 4.0, "intervals": 6, "fine_factor": 2},
-    "bounds": {"joint_velocity": [0.6, 0.6, 1.0]},
     "structure": {
         "buckling": True,
         "pin_load_limits": {"boom.base_pin": 60000.0},
@@ -154,7 +145,7 @@ STRUCTURE_STUDY = {
 
 
 def test_machine_structure_rows_have_the_gradients_of_central_differences(tmp_path: Path) -> None:
-    _csv(tmp_path / "move.csv")
+    joint_csv(tmp_path / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
     (tmp_path / "study.yaml").write_text(yaml.safe_dump(STRUCTURE_STUDY), encoding="utf-8")
     p = StudyProblem(load_study(tmp_path / "study.yaml"))
     names = p.constraint_names
