@@ -9,12 +9,13 @@ gradients of central differences and bind when asked to.
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
+from differences_helper import central_steps
+from machine_result_helper import EXCAVATOR_STUDY, joint_csv
 
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.loader import load_crane
@@ -31,9 +32,6 @@ from hiab_sim.structure.machine_structure import machine_design_structure, machi
 from hiab_sim.structure.summary import design_structure
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.spec.study_file import load_study
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from machine_result_helper import EXCAVATOR_STUDY, joint_csv
 
 #: The crane file's pin of each machine-file pin of the XS 031 (the same pin, two namings).
 XS031_PINS = {
@@ -158,10 +156,7 @@ def test_machine_structure_rows_have_the_gradients_of_central_differences(tmp_pa
     jac = p.constraints_jacobian(z0)[rows]
     columns = [*range(p.n_xi), *rng.choice(np.arange(p.n_xi, p.n), 5, replace=False)]
     for j in columns:
-        h = 1e-6 * max(1.0, abs(z0[j]))
-        up, down = z0.copy(), z0.copy()
-        up[j] += h
-        down[j] -= h
+        up, down, h = central_steps(z0, j)
         d_rows = (p.constraints(up)[rows] - p.constraints(down)[rows]) / (2 * h)
         scale = max(1.0, float(np.max(np.abs(d_rows))))
         assert float(np.max(np.abs(d_rows - jac[:, j]))) < 2e-4 * scale, f"column {j}"
