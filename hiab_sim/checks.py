@@ -56,3 +56,9 @@ def check_choice(where: str, value: Any, choices: tuple[str, ...]) -> None:
     """Raise :class:`InvalidInputError` unless ``value`` is one of ``choices``."""
     if value not in choices:
         raise InvalidInputError(where, value, f"must be one of {', '.join(choices)}")
+
+
+def check_efficiency(where: str, value: float) -> None:
+    """Raise :class:`InvalidInputError` unless ``value`` is an efficiency: a finite number in (0, 1]."""
+    if not (math.isfinite(value) and 0.0 < value <= 1.0):
+        raise InvalidInputError(where, value, "must be in (0, 1]")

@@ -8,6 +8,8 @@ import numpy as np
 import yaml
 
 from hiab_sim.cli import main
+from hiab_sim.study.run import run_study
+from hiab_sim.study.spec.study_file import load_study
 
 #: A small excavator study: three joints from one pose to another in 4 s (``move.csv``, :func:`joint_csv`), 50 kg held.
 EXCAVATOR_STUDY = {
@@ -36,6 +38,13 @@ def excavator_move(folder: Path) -> None:
     """Write the excavator study's ``move.csv`` and ``study.yaml`` into ``folder``."""
     joint_csv(folder / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
     (folder / "study.yaml").write_text(yaml.safe_dump(EXCAVATOR_STUDY), encoding="utf-8")
+
+
+def solved_study(folder: Path) -> Path:
+    """Optimise ``folder``'s ``study.yaml`` (no figures) into ``folder / "result"`` and return that folder."""
+    out = folder / "result"
+    run_study(load_study(folder / "study.yaml"), out, figures=False, progress=None)
+    return out
 
 
 def excavator_result(folder: Path) -> Path:

@@ -51,7 +51,7 @@ def test_shipped_files_carry_no_issue_numbers_or_internal_paths() -> None:
 
 def test_simulate_closing_lines_read_the_heavier_load_as_its_energy_not_a_failure() -> None:
     """The extra energy of a heavier end mass is named as the load's, with the report's own numbers."""
-    from hiab_sim.cli.simulate import closing_lines
+    from hiab_sim.cli.simulate_summary import closing_lines
 
     nominal = {"energy_difference_percent": -0.06, "tcp_error_mm": {"max": 0.83}, "payload_error": 0.0}
     heavy = {

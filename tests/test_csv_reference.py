@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from hypothesis import given, settings
-from hypothesis import strategies as st
+from references_helper import pick_and_place_tasks
 
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study.motion import trajectory as tr
@@ -159,25 +159,11 @@ def test_telescope_given_once(tmp_path: Path, header: str, telescope: float | No
 
 
 @settings(max_examples=15, deadline=None)
-@given(
-    pick=st.tuples(st.floats(1.2, 2.2), st.floats(-1.6, -0.4)),
-    place=st.tuples(st.floats(2.6, 4.0), st.floats(-1.0, 1.0)),
-    rise=st.floats(0.05, 1.0),
-    telescope=st.tuples(st.floats(0.0, 1.1), st.floats(0.0, 1.1)),
-    move_time=st.floats(5.0, 16.0),
-    dwell=st.tuples(st.floats(0.0, 2.0), st.floats(0.0, 2.0)),
-)
+@given(task=pick_and_place_tasks(rise=1.0, shortest_move=5.0, longest_dwell=2.0))
 def test_csv_of_any_pick_and_place_reproduces_it_within_the_collocation_bands(
-    tmp_path_factory: pytest.TempPathFactory,
-    pick: tuple[float, float],
-    place: tuple[float, float],
-    rise: float,
-    telescope: tuple[float, float],
-    move_time: float,
-    dwell: tuple[float, float],
+    tmp_path_factory: pytest.TempPathFactory, task: PickAndPlace
 ) -> None:
     """A 40 Hz file (1 um resolution) of a pick-and-place, fitted, gives its r, dr, ddr within half the bands."""
-    task = PickAndPlace(pick, place, max(pick[1], place[1]) + rise, telescope, move_time, dwell)
     rows = np.linspace(0.0, task.duration, int(np.ceil(task.duration * 40.0)) + 1)
     path = tmp_path_factory.mktemp("pp") / "pp.csv"
     body = "\n".join(

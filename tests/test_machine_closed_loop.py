@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -21,42 +20,23 @@ import pytest
 from hiab_sim.cli import main
 from hiab_sim.cli.simulate import ENERGY_TOLERANCE, TCP_MAX_MM
 from hiab_sim.env.machine_env import machine_environment, machine_load_mass, run_machine_closed_loop
-from hiab_sim.env.machine_plan import MachinePlan, read_machine_plan
+from hiab_sim.env.machine_plan import MachinePlan
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
-from hiab_sim.study.run import run_study
-from hiab_sim.study.spec.study_file import load_study
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from machine_result_helper import excavator_move
 
 #: Tracking of the plan's own TCP on the planner's model [mm]: only the loops' residual (measured 0.04 mm).
 PLAN_TCP_MAX_MM = 0.5
 
 
-@pytest.fixture(scope="module")
-def result(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    folder = tmp_path_factory.mktemp("excavator_closed_loop")
-    excavator_move(folder)
-    out = folder / "result"
-    run_study(load_study(folder / "study.yaml"), out, figures=False, progress=None)
-    return out
-
-
-@pytest.fixture(scope="module")
-def plan(result: Path) -> MachinePlan:
-    return read_machine_plan(result, "optimal")
-
-
 @pytest.mark.sim
-def test_excavator_closed_loop_tracks_the_plan_and_uses_its_energy(plan: MachinePlan) -> None:
+def test_excavator_closed_loop_tracks_the_plan_and_uses_its_energy(excavator_plan: MachinePlan) -> None:
     """Ideal plant = the planner's model: the energy within the CLI's 2 % and the TCP on the plan's path.
 
     2 % is the closed-loop check of ``hiab-sim simulate`` (and the issue's); on the planner's own
     model the difference is the feedback's work on the loops' residual plus the plan's trapezoid
     quadrature on its 1/12 s grid, measured 0.003 % in total and below 0.2 % on the smallest drive.
     """
-    run, physics = run_machine_closed_loop(plan)
+    run, physics = run_machine_closed_loop(excavator_plan)
     physics.free()
     summary: Any = run.summary()
     assert run.actuator_names == ("boom", "arm", "bucket")
@@ -67,18 +47,18 @@ def test_excavator_closed_loop_tracks_the_plan_and_uses_its_energy(plan: Machine
     assert summary["tcp_error_to_plan_mm"]["max"] < PLAN_TCP_MAX_MM
     assert summary["tcp_error_mm"]["max"] < TCP_MAX_MM
     assert summary["current_limit_fraction"] == 0.0 and summary["voltage_limit_fraction"] == 0.0
-    assert run.time[-1] == pytest.approx(plan.duration, abs=0.01)
+    assert run.time[-1] == pytest.approx(excavator_plan.duration, abs=0.01)
 
 
 @pytest.mark.sim
-def test_load_mass_is_twice_the_kinetic_energy_of_a_unit_slide_rate(plan: MachinePlan) -> None:
+def test_load_mass_is_twice_the_kinetic_energy_of_a_unit_slide_rate(excavator_plan: MachinePlan) -> None:
     """m_L,a from G^T M G against mj_energyVel of the machine moving slide a at 1 m/s, the others held."""
-    env = machine_environment(plan)
-    mass = machine_load_mass(plan, env.task.motion)
+    env = machine_environment(excavator_plan)
+    mass = machine_load_mass(excavator_plan, env.task.motion)
     env.physics.free()
-    dynamics = MujocoMachineDynamics(plan.machine)
-    k = len(plan.time) // 2
-    q = plan.position[k]
+    dynamics = MujocoMachineDynamics(excavator_plan.machine)
+    k = len(excavator_plan.time) // 2
+    q = excavator_plan.position[k]
     n = len(q)
     # the slide rates of unit joint rates, column j: by central differences of the strokes in q
     jx = np.empty((n, n))
@@ -88,7 +68,7 @@ def test_load_mass_is_twice_the_kinetic_energy_of_a_unit_slide_rate(plan: Machin
         rows = np.stack([q + h * np.eye(n)[j], q - h * np.eye(n)[j]])
         stroke = dynamics(rows, zeros, zeros).stroke
         jx[:, j] = (stroke[0] - stroke[1]) / (2 * h)
-    grid = plan.time - plan.time[0]
+    grid = excavator_plan.time - excavator_plan.time[0]
     index = int(np.argmin(np.abs(env.task.motion.time - grid[k])))
     for a in range(n):
         rate = np.linalg.solve(jx, np.eye(n)[a])
@@ -113,18 +93,20 @@ def _open_loop_drift(plan: MachinePlan, with_load: bool) -> float:
 
 
 @pytest.mark.sim
-def test_the_tcp_load_holds_the_start_on_the_planners_model(plan: MachinePlan) -> None:
+def test_the_tcp_load_holds_the_start_on_the_planners_model(excavator_plan: MachinePlan) -> None:
     """Feedforward current and the plan's TCP force hold the start pose in equilibrium; without the force it sags."""
-    held = _open_loop_drift(plan, with_load=True)
-    unloaded = _open_loop_drift(plan, with_load=False)
+    held = _open_loop_drift(excavator_plan, with_load=True)
+    unloaded = _open_loop_drift(excavator_plan, with_load=False)
     assert held < 1e-5  # [m]
     assert unloaded > 100 * held
 
 
 @pytest.mark.sim
-def test_simulate_cli_on_a_machine_result(result: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_simulate_cli_on_a_machine_result(
+    excavator_result: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "sim"
-    code = main(["simulate", str(result), "--no-video", "--no-figures", "--quiet", "--out", str(out)])
+    code = main(["simulate", str(excavator_result), "--no-video", "--no-figures", "--quiet", "--out", str(out)])
     assert code == 0
     report = json.loads((out / "simulation.json").read_text(encoding="utf-8"))
     assert set(report["designs"]) == {"initial", "optimal"}
@@ -138,7 +120,7 @@ def test_simulate_cli_on_a_machine_result(result: Path, tmp_path: Path, capsys: 
         (["--payload-error", "0.2"], "payload-error"),
         ([], "video"),
     ):
-        args = ["simulate", str(result), "--quiet", "--out", str(out), *extra]
+        args = ["simulate", str(excavator_result), "--quiet", "--out", str(out), *extra]
         if word != "video":
             args.append("--no-video")
         assert main(args) == 2

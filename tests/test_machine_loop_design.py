@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -13,32 +12,13 @@ from hiab_sim.cli.simulate_summary import bandwidth_line
 from hiab_sim.control.cascade import DESIGN_RATIO
 from hiab_sim.emla.emla_set import EmlaSet
 from hiab_sim.env.machine_loop_design import machine_loop_design
-from hiab_sim.env.machine_plan import MachinePlan, read_machine_plan
+from hiab_sim.env.machine_plan import MachinePlan
 from hiab_sim.machine.dynamics.paths import make_machine_dynamics
 from hiab_sim.results.read import read_result
 from hiab_sim.structure.machine_modes import machine_natural_frequencies
-from hiab_sim.study.run import run_study
-from hiab_sim.study.spec.study_file import load_study
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from machine_result_helper import excavator_move
 
 #: Every compliance of the drive trains (screw, nut, bearing, pins) times this: k / 4, f_1 about / 2.
 SOFTER = 4.0
-
-
-@pytest.fixture(scope="module")
-def result(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    folder = tmp_path_factory.mktemp("excavator_loop_design")
-    excavator_move(folder)
-    out = folder / "result"
-    run_study(load_study(folder / "study.yaml"), out, figures=False, progress=None)
-    return out
-
-
-@pytest.fixture(scope="module")
-def plan(result: Path) -> MachinePlan:
-    return read_machine_plan(result, "optimal")
 
 
 def _softer(emlas: EmlaSet, factor: float) -> EmlaSet:
@@ -58,14 +38,17 @@ def _softer(emlas: EmlaSet, factor: float) -> EmlaSet:
     return emlas.replaced(**named)
 
 
-def test_the_check_uses_the_machines_lowest_frequency_over_the_motion(result: Path, plan: MachinePlan) -> None:
+def test_the_check_uses_the_machines_lowest_frequency_over_the_motion(
+    excavator_result: Path, excavator_plan: MachinePlan
+) -> None:
     """f_1 of the check = the result's own on-path frequency = the MuJoCo path's modes; designed gains pass."""
+    plan = excavator_plan
     load_mass = np.zeros((len(plan.time), len(plan.actuator_names)))
     design = machine_loop_design(plan, load_mass)
     check = design.check()
     f_1 = check["first_natural_frequency_Hz"]
     assert isinstance(f_1, float)
-    structure = read_result(result).structure
+    structure = read_result(excavator_result).structure
     assert structure is not None and structure.optimal.lowest_frequency_trajectory_Hz is not None
     assert f_1 == pytest.approx(structure.optimal.lowest_frequency_trajectory_Hz, rel=1e-12)
     mujoco = make_machine_dynamics(plan.machine, None, "mujoco")
@@ -79,11 +62,11 @@ def test_the_check_uses_the_machines_lowest_frequency_over_the_motion(result: Pa
     assert "holds" in bandwidth_line("optimal", check)
 
 
-def test_a_softer_drive_train_fails_the_check_of_gains_designed_for_the_stiff_one(plan: MachinePlan) -> None:
+def test_a_softer_drive_train_fails_the_check_of_gains_designed_for_the_stiff_one(excavator_plan: MachinePlan) -> None:
     """A drive stiffness k / 4 halves f_1 (omega^2 = k / m); the stiff train's gains then fail, and one line says so."""
-    load_mass = np.zeros((len(plan.time), len(plan.actuator_names)))
-    stiff = machine_loop_design(plan, load_mass)
-    soft_plan = replace(plan, emlas=_softer(plan.emlas, SOFTER))
+    load_mass = np.zeros((len(excavator_plan.time), len(excavator_plan.actuator_names)))
+    stiff = machine_loop_design(excavator_plan, load_mass)
+    soft_plan = replace(excavator_plan, emlas=_softer(excavator_plan.emlas, SOFTER))
     soft = machine_loop_design(soft_plan, load_mass, gains=stiff.gains)
     f_stiff, f_soft = stiff.first_natural_frequency_Hz, soft.first_natural_frequency_Hz
     assert f_stiff is not None and f_soft is not None

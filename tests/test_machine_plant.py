@@ -32,11 +32,9 @@ from hiab_sim.machine.dynamics.mjcf_build import spec_of_tree
 from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
 from hiab_sim.machine.dynamics.tree import machine_tree
 from hiab_sim.resources import locate
-from hiab_sim.study.run import run_study
-from hiab_sim.study.spec.study_file import load_study
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from machine_result_helper import EXCAVATOR_STUDY, joint_csv
+from machine_result_helper import EXCAVATOR_STUDY, joint_csv, solved_study
 
 REALISTIC = load_plant("realistic")
 #: The issue's bound on the TCP tracking error of the realistic plant [mm].
@@ -56,9 +54,7 @@ def result(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("excavator_plant")
     joint_csv(folder / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.15, -1.65, -0.8], DURATION)
     (folder / "study.yaml").write_text(yaml.safe_dump(SHORT_STUDY), encoding="utf-8")
-    out = folder / "result"
-    run_study(load_study(folder / "study.yaml"), out, figures=False, progress=None)
-    return out
+    return solved_study(folder)
 
 
 @pytest.fixture(scope="module")

@@ -18,7 +18,6 @@ import numpy as np
 import pytest
 from browser_helper import References
 from machine_result_helper import excavator_result
-from test_study_small import small_study, write_study
 
 from hiab_sim.cli import main
 from hiab_sim.machine.kinematics.forward import forward_kinematics
@@ -32,14 +31,6 @@ pytestmark = pytest.mark.e2e
 @pytest.fixture(scope="module")
 def excavator_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return excavator_result(tmp_path_factory.mktemp("excavator"))
-
-
-@pytest.fixture(scope="module")
-def crane_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    folder = tmp_path_factory.mktemp("crane")
-    study = write_study(folder, small_study())
-    assert main(["optimize", str(study), "--out", str(folder / "out"), "--no-video", "--quiet", "--no-figures"]) == 0
-    return folder / "out"
 
 
 def test_report_of_a_machine_result_states_its_variables_pivots_and_structure(excavator_run: Path) -> None:
@@ -62,15 +53,15 @@ def test_report_of_a_machine_result_states_its_variables_pivots_and_structure(ex
 
 
 def test_compare_puts_machine_and_crane_results_in_one_table_by_name(
-    excavator_run: Path, crane_run: Path, tmp_path: Path
+    excavator_run: Path, small_run: Path, tmp_path: Path
 ) -> None:
     out = tmp_path / "cmp"
-    assert main(["compare", str(crane_run), str(excavator_run), "--out", str(out)]) == 0
+    assert main(["compare", str(small_run), str(excavator_run), "--out", str(out)]) == 0
     with (out / "comparison.csv").open() as handle:
         table = list(csv.DictReader(handle))
     assert [r["design"] for r in table] == ["initial", "optimal", "initial", "optimal"]
     excavator = json.loads((excavator_run / "result.json").read_text())
-    crane = json.loads((crane_run / "result.json").read_text())
+    crane = json.loads((small_run / "result.json").read_text())
     for row in table[2:]:
         entry = excavator[row["design"]]
         for name, value in zip(entry["lengths"]["names"], entry["lengths"]["values"], strict=True):

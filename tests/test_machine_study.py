@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from differences_helper import central_steps
 from machine_result_helper import EXCAVATOR_STUDY, joint_csv
 
 from hiab_sim.errors import ConfigError, InvalidInputError
@@ -66,10 +67,7 @@ def test_excavator_gradients_match_central_differences(excavator: StudyProblem) 
     grad, jac = p.cost_gradient(z0), p.constraints_jacobian(z0)
     columns = [*range(p.n_xi), *rng.choice(np.arange(p.n_xi, p.n), 6, replace=False)]
     for j in columns:
-        h = 1e-6 * max(1.0, abs(z0[j]))
-        up, down = z0.copy(), z0.copy()
-        up[j] += h
-        down[j] -= h
+        up, down, h = central_steps(z0, j)
         d_cost = (p.cost(up) - p.cost(down)) / (2 * h)
         d_rows = (p.constraints(up) - p.constraints(down)) / (2 * h)
         assert d_cost == pytest.approx(grad[j], rel=2e-4, abs=1e-6), f"cost column {j}"

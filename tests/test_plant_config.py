@@ -74,25 +74,31 @@ def test_a_rod_side_mass_below_the_stability_bound_is_rejected() -> None:
     train.check_step(5e-4, 1.87e8)  # 23 kg suffices at half the step
 
 
-def test_a_plant_file_that_sets_the_stiffness_is_refused_in_one_line(tmp_path: Path) -> None:
-    """A plant file that sets drive_train.axial_stiffness_N_per_m is refused in one line (the EMLA file owns it)."""
+@pytest.mark.parametrize(
+    ("before", "line", "field", "owner"),
+    [
+        (
+            "  damping_ratio:",
+            "  axial_stiffness_N_per_m: 1.87e8",
+            "drive_train.axial_stiffness_N_per_m",
+            "drive_stiffness",
+        ),
+        ("  dead_time_s:", "  threshold_voltage_V: 1.0", "current_loop.threshold_voltage_V", "drive_losses"),
+    ],
+    ids=["stiffness", "inverter_losses"],
+)
+def test_a_plant_file_that_sets_what_the_emla_file_owns_is_refused_in_one_line(
+    tmp_path: Path, before: str, line: str, field: str, owner: str
+) -> None:
+    """A plant file setting the drive stiffness or an inverter loss is refused in one line: the EMLA file owns it.
+
+    The line names the field and the EMLA file's section (drive_stiffness, drive_losses).
+    """
     text = shipped("plant", "realistic").read_text()
     bad = tmp_path / "old.yaml"
-    bad.write_text(text.replace("  damping_ratio:", "  axial_stiffness_N_per_m: 1.87e8\n  damping_ratio:", 1))
+    bad.write_text(text.replace(before, f"{line}\n{before}", 1))
     with pytest.raises(ConfigError) as error:
         load_plant(str(bad))
     message = str(error.value)
-    assert "drive_train.axial_stiffness_N_per_m" in message and "drive_stiffness" in message
-    assert "\n" not in message
-
-
-def test_a_plant_file_that_sets_inverter_losses_is_refused_in_one_line(tmp_path: Path) -> None:
-    """A plant file with its own inverter loss (current_loop.threshold_voltage_V) is refused: the EMLA file owns it."""
-    text = shipped("plant", "realistic").read_text()
-    bad = tmp_path / "old.yaml"
-    bad.write_text(text.replace("  dead_time_s:", "  threshold_voltage_V: 1.0\n  dead_time_s:", 1))
-    with pytest.raises(ConfigError) as error:
-        load_plant(str(bad))
-    message = str(error.value)
-    assert "current_loop.threshold_voltage_V" in message and "drive_losses" in message
+    assert field in message and owner in message
     assert "\n" not in message

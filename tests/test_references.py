@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import yaml
 from hypothesis import given, settings
-from hypothesis import strategies as st
+from references_helper import pick_and_place_tasks
 
 from hiab_sim.crane import kinematics
 from hiab_sim.errors import ConfigError, InvalidInputError
@@ -80,24 +80,10 @@ def test_closed_form_ik_names_why_a_point_is_unreachable(xy: tuple[float, float]
 
 
 @settings(max_examples=40, deadline=None)
-@given(
-    pick=st.tuples(st.floats(1.2, 2.2), st.floats(-1.6, -0.4)),
-    place=st.tuples(st.floats(2.6, 4.0), st.floats(-1.0, 1.0)),
-    rise=st.floats(0.05, 2.0),
-    telescope=st.tuples(st.floats(0.0, 1.1), st.floats(0.0, 1.1)),
-    move_time=st.floats(3.0, 16.0),
-    dwell=st.tuples(st.floats(0.0, 3.0), st.floats(0.0, 3.0)),
-)
-def test_pick_and_place_is_rest_to_rest_clears_the_height_and_is_c2(
-    pick: tuple[float, float],
-    place: tuple[float, float],
-    rise: float,
-    telescope: tuple[float, float],
-    move_time: float,
-    dwell: tuple[float, float],
-) -> None:
+@given(task=pick_and_place_tasks())
+def test_pick_and_place_is_rest_to_rest_clears_the_height_and_is_c2(task: PickAndPlace) -> None:
     """Ends at pick and place, rest during dwells, apex exactly at the clearance, rates = derivatives of the path."""
-    task = PickAndPlace(pick, place, max(pick[1], place[1]) + rise, telescope, move_time, dwell)
+    pick, place, telescope, move_time, dwell = task.pick, task.place, task.telescope, task.move_time, task.dwell
     t = np.linspace(0.0, task.duration, 4001)
     ref = task.sample(KIN, t)
     np.testing.assert_allclose(ref.position[0], [*pick, telescope[0]], atol=1e-12)

@@ -10,7 +10,6 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-from test_study_small import small_study, write_study
 
 from hiab_sim.cli import main
 from hiab_sim.crane.loader import load_crane
@@ -21,26 +20,17 @@ pytestmark = pytest.mark.e2e
 CRANE = load_crane("xs031")
 
 
-@pytest.fixture(scope="module")
-def solved(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The small study optimised once (no figures, no video)."""
-    folder = tmp_path_factory.mktemp("tools")
-    study = write_study(folder, small_study())
-    assert main(["optimize", str(study), "--out", str(folder / "out"), "--no-video", "--quiet", "--no-figures"]) == 0
-    return folder / "out"
-
-
 def _xi(result: dict, design: str) -> np.ndarray:
     chains = result[design]["lengths"]
     return np.array([chains[c][k] for c in ("lift", "tilt") for k in ("L", "Lc0", "Lc")])
 
 
 @pytest.mark.parametrize("design", ["optimal", "initial"])
-def test_mjcf_from_result_places_the_exact_design(solved: Path, tmp_path: Path, design: str) -> None:
+def test_mjcf_from_result_places_the_exact_design(small_run: Path, tmp_path: Path, design: str) -> None:
     """The exported model's base pivots, rod bodies and rod-end sites are the result's lengths to 1e-15 m."""
     out = tmp_path / f"{design}.xml"
-    assert main(["mjcf", "--from-result", str(solved), "--design", design, "-o", str(out)]) == 0
-    xi = _xi(json.loads((solved / "result.json").read_text()), design)
+    assert main(["mjcf", "--from-result", str(small_run), "--design", design, "-o", str(out)]) == 0
+    xi = _xi(json.loads((small_run / "result.json").read_text()), design)
     model = mujoco.MjModel.from_xml_path(str(out))
     for k, chain in enumerate(CRANE.chains):
         L, Lc0, Lc = xi[3 * k : 3 * k + 3]
@@ -51,27 +41,27 @@ def test_mjcf_from_result_places_the_exact_design(solved: Path, tmp_path: Path, 
         assert model.site(f"{chain.name}_rod_end").pos[0] == Lc
 
 
-def test_mjcf_from_result_rejects_a_missing_folder_and_mixed_options(solved: Path, tmp_path: Path, capsys) -> None:
+def test_mjcf_from_result_rejects_a_missing_folder_and_mixed_options(small_run: Path, tmp_path: Path, capsys) -> None:
     """A missing folder, a folder without result.json and --lengths with --from-result exit 2 with one line."""
     for argv in (
         ["mjcf", "--from-result", str(tmp_path / "nope")],
         ["mjcf", "--from-result", str(tmp_path)],
-        ["mjcf", "--from-result", str(solved), "--lengths", "1,0.1,0.7,1.1,0.1,0.7"],
+        ["mjcf", "--from-result", str(small_run), "--lengths", "1,0.1,0.7,1.1,0.1,0.7"],
     ):
         assert main([*argv, "-o", str(tmp_path / "x.xml")]) == 2
         assert len(capsys.readouterr().err.strip().splitlines()) == 1
     assert not (tmp_path / "x.xml").exists()
 
 
-def test_compare_table_matches_each_result(solved: Path, tmp_path: Path, capsys) -> None:
+def test_compare_table_matches_each_result(small_run: Path, tmp_path: Path, capsys) -> None:
     """Compare writes one CSV row per run and design whose lengths, energies and savings are the results' own."""
     second = tmp_path / "copy"
-    shutil.copytree(solved, second)
+    shutil.copytree(small_run, second)
     data = json.loads((second / "result.json").read_text())
     data["name"] = "copy"
     (second / "result.json").write_text(json.dumps(data))
     out = tmp_path / "cmp"
-    assert main(["compare", str(solved), str(second), "--out", str(out)]) == 0
+    assert main(["compare", str(small_run), str(second), "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "saving [%]" in printed and "copy" in printed
     assert max(len(line) for line in printed.splitlines() if not line.startswith("wrote")) <= 100
@@ -80,7 +70,7 @@ def test_compare_table_matches_each_result(solved: Path, tmp_path: Path, capsys)
     assert [(r["run"], r["design"]) for r in table] == [
         ("small", "initial"), ("small", "optimal"), ("copy", "initial"), ("copy", "optimal")
     ]  # fmt: skip
-    result = json.loads((solved / "result.json").read_text())
+    result = json.loads((small_run / "result.json").read_text())
     for row in table[:2]:
         lengths = [float(row[f"{c} {k} [mm]"]) for c in ("lift", "tilt") for k in ("L", "Lc0", "Lc")]
         np.testing.assert_allclose(lengths, 1e3 * _xi(result, row["design"]), rtol=1e-15)
@@ -92,31 +82,31 @@ def test_compare_table_matches_each_result(solved: Path, tmp_path: Path, capsys)
 
 
 def test_compare_without_out_writes_nothing_and_fits_100_columns(
-    solved: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+    small_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Without --out, compare only prints (no ./comparison/), every line within 100 columns even for long names."""
     second = tmp_path / ("a_rather_long_run_folder_name_" * 4)
-    shutil.copytree(solved, second)
+    shutil.copytree(small_run, second)
     data = json.loads((second / "result.json").read_text())
     data["name"] = second.name
     (second / "result.json").write_text(json.dumps(data))
     work = tmp_path / "work"
     work.mkdir()
     monkeypatch.chdir(work)
-    assert main(["compare", str(solved), str(second)]) == 0
+    assert main(["compare", str(small_run), str(second)]) == 0
     printed = capsys.readouterr().out
     assert max(len(line) for line in printed.splitlines()) <= 100
     assert "..." in printed  # the long name is shortened, not wrapped
     assert list(work.iterdir()) == []
 
 
-def test_compare_rejects_bad_folders_with_one_line(solved: Path, tmp_path: Path, capsys) -> None:
+def test_compare_rejects_bad_folders_with_one_line(small_run: Path, tmp_path: Path, capsys) -> None:
     """A missing folder, a folder without a result and a truncated result exit 2 with one line; nothing is written."""
     broken = tmp_path / "broken"
     broken.mkdir()
     (broken / "result.json").write_text(json.dumps({"crane": "xs031", "optimal": {}}))
     for folder in (tmp_path / "nope", tmp_path / "empty", broken):
         folder.mkdir(exist_ok=True) if folder.name == "empty" else None
-        assert main(["compare", str(solved), str(folder), "--out", str(tmp_path / "cmp")]) == 2
+        assert main(["compare", str(small_run), str(folder), "--out", str(tmp_path / "cmp")]) == 2
         assert len(capsys.readouterr().err.strip().splitlines()) == 1
     assert not (tmp_path / "cmp").exists()

@@ -14,6 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from differences_helper import central_steps
+from machine_result_helper import EXCAVATOR_STUDY, joint_csv
 
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.loader import load_crane
@@ -126,25 +128,12 @@ def test_machine_frequencies_name_the_actuators_the_emla_file_lacks(
         machine_natural_frequencies(machine, inverse, load_emla_set("xs031"), q)  # lift, tilt, telescope
 
 
-def _csv(path: Path) -> None:
-    t = np.linspace(0.0, 4.0, 41)
-    tau = t / 4.0
-    s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
-    start, end = np.array([0.0, -1.8, -1.0]), np.array([0.5, -1.3, -0.3])
-    lines = ["t,alpha,beta,gamma"] + [
-        ",".join(f"{v:.12g}" for v in (ti, *(start + si * (end - start)))) for ti, si in zip(t, s, strict=True)
-    ]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-
-
+#: The helper's excavator study, coarser, with every structural row.
 STRUCTURE_STUDY = {
+    **EXCAVATOR_STUDY,
     "name": "excavator_structure",
-    "machine": "exact",
-    "emla": "exact",
-    "tasks": [{"name": "move", "weight": 1, "reference": {"kind": "csv", "file": "move.csv"}, "payload": 50.0}],
     "spline": {"control_points": 8, "degree": 5},
     "grid": {"duration": 4.0, "intervals": 6, "fine_factor": 2},
-    "bounds": {"joint_velocity": [0.6, 0.6, 1.0]},
     "structure": {
         "buckling": True,
         "pin_load_limits": {"boom.base_pin": 60000.0},
@@ -154,7 +143,7 @@ STRUCTURE_STUDY = {
 
 
 def test_machine_structure_rows_have_the_gradients_of_central_differences(tmp_path: Path) -> None:
-    _csv(tmp_path / "move.csv")
+    joint_csv(tmp_path / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
     (tmp_path / "study.yaml").write_text(yaml.safe_dump(STRUCTURE_STUDY), encoding="utf-8")
     p = StudyProblem(load_study(tmp_path / "study.yaml"))
     names = p.constraint_names
@@ -167,10 +156,7 @@ def test_machine_structure_rows_have_the_gradients_of_central_differences(tmp_pa
     jac = p.constraints_jacobian(z0)[rows]
     columns = [*range(p.n_xi), *rng.choice(np.arange(p.n_xi, p.n), 5, replace=False)]
     for j in columns:
-        h = 1e-6 * max(1.0, abs(z0[j]))
-        up, down = z0.copy(), z0.copy()
-        up[j] += h
-        down[j] -= h
+        up, down, h = central_steps(z0, j)
         d_rows = (p.constraints(up)[rows] - p.constraints(down)[rows]) / (2 * h)
         scale = max(1.0, float(np.max(np.abs(d_rows))))
         assert float(np.max(np.abs(d_rows - jac[:, j]))) < 2e-4 * scale, f"column {j}"

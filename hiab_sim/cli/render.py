@@ -82,7 +82,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Render the video (or the still frame) and print where it was written."""
+    """Render the video (or the still frame, or the frames) and print where it was written."""
     from hiab_sim.render import render_result, render_still  # checks the OpenGL backend on import
 
     if not args.fps > 0:
@@ -90,25 +90,25 @@ def run(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     from hiab_sim.render.machine_playback import is_machine_result
 
-    if is_machine_result(args.result_dir):
-        return _run_machine(args, start)
+    machine = is_machine_result(args.result_dir)
+    if machine and args.mode != "kinematic":
+        raise InvalidInputError("--mode", args.mode, "a machine file's result plays back kinematic only")
     if args.frames:
-        from hiab_sim.render import load_playback, playback_renderer
-        from hiab_sim.render.backend import write_image
-
-        folder = _frames_folder(args)
-        data = load_playback(args.result_dir)
-        with playback_renderer(data, 30.0, args.size, "kinematic", args.layout) as renderer:
-            picks = np.unique(np.linspace(0, len(renderer) - 1, args.count).round().astype(int))
-            paths = [write_image(folder / f"frame_{i:03d}.png", renderer.frame(int(k))) for i, k in enumerate(picks)]
-        print(f"wrote {len(paths)} frames to {folder}")
-        return 0
+        return _machine_frames(args) if machine else _crane_frames(args)
     if args.still:
-        path = render_still(args.result_dir, args.still, at_time=args.at, size=args.size, layout=args.layout)
+        from hiab_sim.render.machine_video import render_machine_still
+
+        still = render_machine_still if machine else render_still
+        path = still(args.result_dir, args.still, at_time=args.at, size=args.size, layout=args.layout)
         print(f"wrote still frame: {path}")
         return 0
     output = Path(args.output) if args.output else None
-    path = render_result(args.result_dir, output, fps=args.fps, size=args.size, mode=args.mode, layout=args.layout)
+    if machine:
+        from hiab_sim.render.machine_video import render_machine_result
+
+        path = render_machine_result(args.result_dir, output, fps=args.fps, size=args.size, layout=args.layout)
+    else:
+        path = render_result(args.result_dir, output, fps=args.fps, size=args.size, mode=args.mode, layout=args.layout)
     print(f"wrote {args.mode} playback: {path} ({time.perf_counter() - start:.1f} s)")
     return 0
 
@@ -122,21 +122,24 @@ def _frames_folder(args: argparse.Namespace) -> Path:
     return folder
 
 
-def _run_machine(args: argparse.Namespace, start: float) -> int:
-    """A machine file's result: frames, a still or the kinematic video."""
-    from hiab_sim.render.machine_video import render_machine_frames, render_machine_result, render_machine_still
+def _crane_frames(args: argparse.Namespace) -> int:
+    """A crane file's result: ``--count`` frames of the kinematic playback."""
+    from hiab_sim.render import load_playback, playback_renderer
+    from hiab_sim.render.backend import write_image
 
-    if args.mode != "kinematic":
-        raise InvalidInputError("--mode", args.mode, "a machine file's result plays back kinematic only")
-    if args.frames:
-        paths = render_machine_frames(args.result_dir, _frames_folder(args), args.count, args.size, args.layout)
-        print(f"wrote {len(paths)} frames to {args.frames}")
-        return 0
-    if args.still:
-        path = render_machine_still(args.result_dir, args.still, at_time=args.at, size=args.size, layout=args.layout)
-        print(f"wrote still frame: {path}")
-        return 0
-    output = Path(args.output) if args.output else None
-    path = render_machine_result(args.result_dir, output, fps=args.fps, size=args.size, layout=args.layout)
-    print(f"wrote kinematic playback: {path} ({time.perf_counter() - start:.1f} s)")
+    folder = _frames_folder(args)
+    data = load_playback(args.result_dir)
+    with playback_renderer(data, 30.0, args.size, "kinematic", args.layout) as renderer:
+        picks = np.unique(np.linspace(0, len(renderer) - 1, args.count).round().astype(int))
+        paths = [write_image(folder / f"frame_{i:03d}.png", renderer.frame(int(k))) for i, k in enumerate(picks)]
+    print(f"wrote {len(paths)} frames to {folder}")
+    return 0
+
+
+def _machine_frames(args: argparse.Namespace) -> int:
+    """A machine file's result: ``--count`` frames evenly spaced over the motion."""
+    from hiab_sim.render.machine_video import render_machine_frames
+
+    paths = render_machine_frames(args.result_dir, _frames_folder(args), args.count, args.size, args.layout)
+    print(f"wrote {len(paths)} frames to {args.frames}")
     return 0

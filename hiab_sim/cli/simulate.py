@@ -34,12 +34,11 @@ drive on the machine's generic MJCF (:mod:`hiab_sim.env.machine_env`); the crane
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 from pathlib import Path
 
-from hiab_sim.cli.simulate_summary import closing_lines
+from hiab_sim.cli.simulate_summary import print_results, write_results
 from hiab_sim.errors import InvalidInputError
 
 #: Closed-loop checks: energy within this fraction of the prediction, TCP error rms and max [mm].
@@ -114,30 +113,13 @@ def run(args: argparse.Namespace) -> int:
         ffmpeg_path()
 
     from hiab_sim.env.plan import read_plan
-    from hiab_sim.env.validation import render_video, simulate_designs, simulation_report, table
+    from hiab_sim.env.validation import render_video, simulate_designs, simulation_report
 
     runs, nominal, physics = simulate_designs(
         args.result_dir, designs, error, quiet=args.quiet, plant=plant, cycles=args.cycles
     )
     report = simulation_report(args.result_dir, runs, nominal)
-    effects = None
-    if plant is not None and plant.enabled:
-        from hiab_sim.env.effects import effect_study
-
-        effects = effect_study(args.result_dir, plant, args.cycles, designs, quiet=args.quiet)
-        report["plant_effects"] = effects
-    from hiab_sim.atomic_io import write_atomic
-
-    write_atomic(out / "simulation.json", json.dumps(report, indent=2) + "\n")
-    written = ["simulation.json"]
-    if not args.no_figures:
-        from hiab_sim.env.figures import write_figures
-
-        written += [p.name for p in write_figures(out, runs, nominal)]
-        if effects is not None:
-            from hiab_sim.env.effects import effect_figure
-
-            written.append(effect_figure(out / "closed_loop_plant_effects.png", effects).name)
+    written, effects = write_results(args, report, runs, nominal, plant, designs, out)
     if not args.no_video:
         plan = read_plan(args.result_dir, runs[0].design)
         video = render_video(
@@ -146,16 +128,6 @@ def run(args: argparse.Namespace) -> int:
         written.append(video.name)
     for item in physics:
         item.free()
-    print(table(report))
-    if effects is not None:
-        from hiab_sim.env.effects import effect_lines, effect_table
-
-        print()
-        print(effect_table(effects))
-        for line in effect_lines(effects):
-            print(line)
-    print()
-    for line in closing_lines(report):
-        print(line)
+    print_results(report, effects)
     print(f"wrote {', '.join(written)} to {out}", file=sys.stderr)
     return 0

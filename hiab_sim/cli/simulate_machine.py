@@ -13,7 +13,6 @@ the plant's ``mismatch`` scales a machine's payload) and the video (drawn with t
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -47,10 +46,10 @@ def refuse_crane_only(args: argparse.Namespace) -> None:
 
 def run_machine(args: argparse.Namespace, designs: tuple[str, ...], plant: Plant | None, out: Path) -> int:
     """Simulate every design of a machine file's result, write ``simulation.json`` (and figures), print the table."""
-    from hiab_sim.cli.simulate_summary import closing_lines
+    from hiab_sim.cli.simulate_summary import print_results, write_results
     from hiab_sim.env.machine_env import run_machine_closed_loop
     from hiab_sim.env.machine_plan import read_machine_plan
-    from hiab_sim.env.validation import simulation_report, table
+    from hiab_sim.env.validation import simulation_report
 
     refuse_crane_only(args)
     plans = [read_machine_plan(args.result_dir, design) for design in designs]  # bad input fails first
@@ -71,35 +70,8 @@ def run_machine(args: argparse.Namespace, designs: tuple[str, ...], plant: Plant
         entry = entries[run.design]
         if entry["bandwidth_check"].get("first_natural_frequency_Hz") is None:
             entry["bandwidth_check"]["note"] = NO_STRUCTURE
-    effects = None
-    if plant is not None and plant.enabled:
-        from hiab_sim.env.effects import effect_study
-
-        effects = effect_study(args.result_dir, plant, args.cycles, designs, quiet=args.quiet)
-        report["plant_effects"] = effects
-    from hiab_sim.atomic_io import write_atomic
-
-    write_atomic(out / "simulation.json", json.dumps(report, indent=2) + "\n")
-    written = ["simulation.json"]
-    if not args.no_figures:
-        from hiab_sim.env.figures import write_figures
-
-        written += [p.name for p in write_figures(out, runs, [])]
-        if effects is not None:
-            from hiab_sim.env.effects import effect_figure
-
-            written.append(effect_figure(out / "closed_loop_plant_effects.png", effects).name)
-    print(table(report))
-    if effects is not None:
-        from hiab_sim.env.effects import effect_lines, effect_table
-
-        print()
-        print(effect_table(effects))
-        for line in effect_lines(effects):
-            print(line)
-    print()
-    for line in closing_lines(report):
-        print(line)
+    written, effects = write_results(args, report, runs, [], plant, designs, out)
+    print_results(report, effects)
     for design, entry in entries.items():
         if entry.get("battery_energy_difference_percent") is not None:
             print(

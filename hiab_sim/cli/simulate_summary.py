@@ -1,9 +1,67 @@
-"""The closing lines ``hiab-sim simulate`` prints for a crane's or a machine's closed loop: the answer per design."""
+"""What ``hiab-sim simulate`` writes and prints for a crane's or a machine's closed loop: files, tables, the answer."""
 
 from __future__ import annotations
 
+import argparse
+import json
 from collections.abc import Mapping
-from typing import Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from hiab_sim.env.plant.config import Plant
+    from hiab_sim.env.rollout import ClosedLoopRun
+
+
+def write_results(
+    args: argparse.Namespace,
+    report: dict[str, object],
+    runs: list[ClosedLoopRun],
+    nominal: list[ClosedLoopRun],
+    plant: Plant | None,
+    designs: tuple[str, ...],
+    out: Path,
+) -> tuple[list[str], dict[str, object] | None]:
+    """Run the effect study (a plant with effects on), write ``simulation.json`` and the figures to ``out``.
+
+    Returns the names of the files written and the effect study (None without one), which ``report`` holds too.
+    """
+    effects: dict[str, object] | None = None
+    if plant is not None and plant.enabled:
+        from hiab_sim.env.effects import effect_study
+
+        effects = effect_study(args.result_dir, plant, args.cycles, designs, quiet=args.quiet)
+        report["plant_effects"] = effects
+    from hiab_sim.atomic_io import write_atomic
+
+    write_atomic(out / "simulation.json", json.dumps(report, indent=2) + "\n")
+    written = ["simulation.json"]
+    if not args.no_figures:
+        from hiab_sim.env.figures import write_figures
+
+        written += [p.name for p in write_figures(out, runs, nominal)]
+        if effects is not None:
+            from hiab_sim.env.effects import effect_figure
+
+            written.append(effect_figure(out / "closed_loop_plant_effects.png", effects).name)
+    return written, effects
+
+
+def print_results(report: dict[str, object], effects: dict[str, object] | None) -> None:
+    """Print the table, the effect study's table and lines (with one) and the closing lines."""
+    from hiab_sim.env.validation import table
+
+    print(table(report))
+    if effects is not None:
+        from hiab_sim.env.effects import effect_lines, effect_table
+
+        print()
+        print(effect_table(effects))
+        for line in effect_lines(effects):
+            print(line)
+    print()
+    for line in closing_lines(report):
+        print(line)
 
 
 def closing_lines(report: dict[str, object]) -> list[str]:

@@ -47,14 +47,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hiab_sim.checks import check_efficiency
 from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
-
-
-def _efficiency(field: str, value: float) -> None:
-    if not (math.isfinite(value) and 0.0 < value <= 1.0):
-        raise InvalidInputError(field, value, "must be in (0, 1]")
 
 
 @dataclass(frozen=True)
@@ -82,9 +78,9 @@ class BatteryParams:
     smoothing_power: float = 1.0
 
     def __post_init__(self) -> None:
-        _efficiency("battery.inverter_efficiency", self.inverter_efficiency)
-        _efficiency("battery.discharge_efficiency", self.discharge_efficiency)
-        _efficiency("battery.charge_efficiency", self.charge_efficiency)
+        check_efficiency("battery.inverter_efficiency", self.inverter_efficiency)
+        check_efficiency("battery.discharge_efficiency", self.discharge_efficiency)
+        check_efficiency("battery.charge_efficiency", self.charge_efficiency)
         if not (math.isfinite(self.smoothing_power) and self.smoothing_power > 0):
             raise InvalidInputError("battery.smoothing_power", self.smoothing_power, "must be finite and > 0", "W")
 

@@ -42,25 +42,18 @@ brake: ``brake_held_power`` = -(1 - s) f_x v_x. Smooth form: s = 1 - exp(-(v_x /
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.checks import check_non_negative, check_positive
-from hiab_sim.errors import InvalidInputError
+from hiab_sim.checks import check_efficiency, check_non_negative, check_positive
 
 Array = NDArray[np.float64]
 
 #: Motor speeds below this fraction of omega_eps are standstill in the exact transmission loss: there the
 #: smooth form's tanh is below 1e-9, so exact and smooth agree; above round-off of a zero speed (~1e-12 rad/s).
 STANDSTILL_FRACTION = 1e-9
-
-
-def _efficiency(field: str, value: float) -> None:
-    if not (math.isfinite(value) and 0.0 < value <= 1.0):
-        raise InvalidInputError(field, value, "must be in (0, 1]")
 
 
 @dataclass(frozen=True)
@@ -93,8 +86,8 @@ class DriveLosses:
     label: str = "drive_losses"
 
     def __post_init__(self) -> None:
-        _efficiency(f"{self.label}.transmission_efficiency_forward", self.transmission_efficiency_forward)
-        _efficiency(f"{self.label}.transmission_efficiency_backdriven", self.transmission_efficiency_backdriven)
+        check_efficiency(f"{self.label}.transmission_efficiency_forward", self.transmission_efficiency_forward)
+        check_efficiency(f"{self.label}.transmission_efficiency_backdriven", self.transmission_efficiency_backdriven)
         check_positive(f"{self.label}.force_smoothing", self.force_smoothing, "N")
         check_non_negative(f"{self.label}.inverter_constant_loss", self.inverter_constant_loss, "W")
         check_non_negative(f"{self.label}.inverter_current_loss", self.inverter_current_loss, "W/A")

@@ -39,6 +39,26 @@ def default_result_dir() -> Path:
     return _DEFAULT_RESULT["dir"]
 
 
+def sub_steps(control_timestep: float, physics_timestep: float) -> int:
+    """Physics steps per agent step; refuses a physics step [s] outside (0, 0.01] or a control step not its multiple."""
+    if not (0.0 < physics_timestep <= 0.01):
+        raise InvalidInputError("physics_timestep", physics_timestep, "must lie in (0, 0.01]", "s")
+    n_sub = round(control_timestep / physics_timestep)
+    if n_sub < 1 or abs(n_sub * physics_timestep - control_timestep) > 1e-9:
+        raise InvalidInputError("control_timestep", control_timestep, "must be a multiple of the physics step", "s")
+    return n_sub
+
+
+def episode(
+    physics: CranePhysics, task: CraneTrackingTask, duration: float, control_timestep: float, n_sub: int
+) -> control.Environment:
+    """The dm_control environment of one plan's ``duration`` [s] in agent steps of ``control_timestep`` [s]."""
+    steps = round(duration / control_timestep)
+    return control.Environment(
+        physics, task, time_limit=(steps - 0.5) * control_timestep, n_sub_steps=n_sub, flat_observation=False
+    )
+
+
 def load(
     result_dir: str | Path | None = None,
     *,
@@ -85,18 +105,11 @@ def make_environment(
     plant: Plant | None = None,
 ) -> control.Environment:
     """Closed-loop environment of a plan (see :func:`load` for the arguments)."""
-    if not (0.0 < physics_timestep <= 0.01):
-        raise InvalidInputError("physics_timestep", physics_timestep, "must lie in (0, 0.01]", "s")
-    n_sub = round(control_timestep / physics_timestep)
-    if n_sub < 1 or abs(n_sub * physics_timestep - control_timestep) > 1e-9:
-        raise InvalidInputError("control_timestep", control_timestep, "must be a multiple of the physics step", "s")
+    n_sub = sub_steps(control_timestep, physics_timestep)
     motion = planned_motion(plan, physics_timestep)
     physics = crane_physics(plan, motion, physics_timestep, payload_error, current_bandwidth_hz, plant)
     task = CraneTrackingTask(plan, motion, physics.drives.drives.current_limit)
-    steps = round(plan.duration / control_timestep)
-    return control.Environment(
-        physics, task, time_limit=(steps - 0.5) * control_timestep, n_sub_steps=n_sub, flat_observation=False
-    )
+    return episode(physics, task, plan.duration, control_timestep, n_sub)
 
 
 __all__ = [

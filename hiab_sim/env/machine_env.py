@@ -51,7 +51,7 @@ from numpy.typing import NDArray
 
 from hiab_sim.control.cascade import CascadeGains
 from hiab_sim.emla.drive_sim import DriveArrays
-from hiab_sim.env import CURRENT_BANDWIDTH_HZ, PHYSICS_TIMESTEP
+from hiab_sim.env import CURRENT_BANDWIDTH_HZ, PHYSICS_TIMESTEP, episode, sub_steps
 from hiab_sim.env.machine_loop_design import machine_loop_design
 from hiab_sim.env.machine_plan import MachinePlan
 from hiab_sim.env.physics import CranePhysics
@@ -189,11 +189,7 @@ def machine_environment(
     plant: Plant | None = None,
 ) -> control.Environment:
     """Closed-loop environment of a machine design's plan on ``plant`` (None: the ideal plant; module docstring)."""
-    if not (0.0 < physics_timestep <= 0.01):
-        raise InvalidInputError("physics_timestep", physics_timestep, "must lie in (0, 0.01]", "s")
-    n_sub = round(control_timestep / physics_timestep)
-    if n_sub < 1 or abs(n_sub * physics_timestep - control_timestep) > 1e-9:
-        raise InvalidInputError("control_timestep", control_timestep, "must be a multiple of the physics step", "s")
+    n_sub = sub_steps(control_timestep, physics_timestep)
     motion, force = machine_motion(plan, physics_timestep)
     active = active_plant(plant)
     machine, arrays, extras = plan.machine, DriveArrays.from_params(plan.emlas), _extras(plan)
@@ -229,10 +225,7 @@ def machine_environment(
     else:
         physics.tcp_load = TcpLoad(physics.model.ptr, force, physics_timestep)
     task = CraneTrackingTask(plan, motion, physics.drives.drives.current_limit)  # type: ignore[arg-type]
-    steps = round(plan.duration / control_timestep)
-    return control.Environment(
-        physics, task, time_limit=(steps - 0.5) * control_timestep, n_sub_steps=n_sub, flat_observation=False
-    )
+    return episode(physics, task, plan.duration, control_timestep, n_sub)
 
 
 def run_machine_closed_loop(

@@ -200,24 +200,32 @@ class CranePhysics(dm_mujoco.Physics):
         model, data = self.model.ptr, self.data.ptr
         h = float(model.opt.timestep)
         ratio = self.drives.drives.ratio
-        losses = self.losses
         with self.check_invalid_state():
             for _ in range(nstep):
                 self._scheduled_resistance(h)
                 v = data.qvel[self.slide_dofs].copy()
-                result = self.drives.step(self.current_reference, ratio * v, h)
-                force, tau_tr = result.rod_force, None
-                if losses.transmission_on:
-                    force, tau_tr = losses.rigid_rod_force(force, ratio * v, data.qacc[self.slide_dofs])
-                data.ctrl[self.actuator_ids] = force
-                if self.tcp_load is not None:
-                    self.tcp_load.apply(model, data, self.holding)
-                mujoco.mj_step(model, data)
-                if tau_tr is not None:
-                    self.transmission_loss += tau_tr * ratio * data.qvel[self.slide_dofs] * h
+                omega = ratio * v
+                result = self.drives.step(self.current_reference, omega, h)
+                self._rigid_step(result.rod_force, omega, h)
                 self._book(result, v, h)
                 self.sensor.push(data.qpos[self.slide_dofs], data.qvel[self.slide_dofs])
             mujoco.mj_kinematics(model, data)  # site positions of the new state, for observations
+
+    def _rigid_step(self, force: Array, omega: Array, h: float) -> None:
+        """One ``mj_step`` with the drives' rod force [N] on rigid drive trains, less the screw's transmission loss.
+
+        ``omega``: the motor speeds [rad/s] the drives stepped at; the loss's energy is booked at the new rates.
+        """
+        model, data, losses = self.model.ptr, self.data.ptr, self.losses
+        tau_tr = None
+        if losses.transmission_on:
+            force, tau_tr = losses.rigid_rod_force(force, omega, data.qacc[self.slide_dofs])
+        data.ctrl[self.actuator_ids] = force
+        if self.tcp_load is not None:
+            self.tcp_load.apply(model, data, self.holding)
+        mujoco.mj_step(model, data)
+        if tau_tr is not None:
+            self.transmission_loss += tau_tr * self.drives.drives.ratio * data.qvel[self.slide_dofs] * h
 
     def _scheduled_resistance(self, h: float) -> None:
         """R_s of the plan's hot windings at this step (none while the plant's own winding model runs)."""
@@ -257,15 +265,7 @@ class CranePhysics(dm_mujoco.Physics):
                 reference = self.current_reference if discrete else self.current_reference - self.current_error.sample()
                 result = self.drives.step(reference, omega, h)
                 if train is None:
-                    force, tau_tr = result.rod_force, None
-                    if losses.transmission_on:
-                        force, tau_tr = losses.rigid_rod_force(force, omega, data.qacc[self.slide_dofs])
-                    data.ctrl[self.actuator_ids] = force
-                    if self.tcp_load is not None:
-                        self.tcp_load.apply(model, data, self.holding)
-                    mujoco.mj_step(model, data)
-                    if tau_tr is not None:
-                        self.transmission_loss += tau_tr * ratio * data.qvel[self.slide_dofs] * h
+                    self._rigid_step(result.rod_force, omega, h)
                 else:
                     force = result.rod_force
                     tau_tr = None

@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hiab_sim.checks import check_efficiency
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.hydraulics.cylinders import HydraulicCylinders
 
@@ -51,11 +52,6 @@ Array = NDArray[np.float64]
 
 #: The two supply variants, in the order :func:`hydraulic_baseline` returns them.
 VARIANTS: tuple[str, ...] = ("constant_pressure", "load_sensing")
-
-
-def _efficiency(field: str, value: float) -> None:
-    if not (math.isfinite(value) and 0.0 < value <= 1.0):
-        raise InvalidInputError(field, value, "must be in (0, 1]")
 
 
 @dataclass(frozen=True)
@@ -84,8 +80,8 @@ class HydraulicSupplyParams:
     def __post_init__(self) -> None:
         if not (math.isfinite(self.load_sensing_margin) and self.load_sensing_margin > 0):
             raise InvalidInputError("hydraulics.load_sensing_margin", self.load_sensing_margin, "must be > 0", "Pa")
-        _efficiency("hydraulics.pump_efficiency", self.pump_efficiency)
-        _efficiency("hydraulics.motor_efficiency", self.motor_efficiency)
+        check_efficiency("hydraulics.pump_efficiency", self.pump_efficiency)
+        check_efficiency("hydraulics.motor_efficiency", self.motor_efficiency)
         if not (math.isfinite(self.standstill_speed) and self.standstill_speed >= 0):
             raise InvalidInputError("hydraulics.standstill_speed", self.standstill_speed, "must be >= 0", "m/s")
         p = self.supply_pressure

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from hiab_sim.checks import check_non_negative, check_positive
+from hiab_sim.checks import check_efficiency, check_non_negative, check_positive
 from hiab_sim.emla.battery import BatteryParams, battery_power, trapezoid_weights
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.hydraulics.baseline import Array
@@ -50,11 +50,6 @@ from hiab_sim.hydraulics.cylinders import HydraulicCylinders
 
 #: The variants at the battery, in the order :func:`battery_boundary_baselines` returns them.
 BOUNDARY_VARIANTS: tuple[str, ...] = ("constant_pressure", "load_sensing", "pump_controlled")
-
-
-def _efficiency(field: str, value: float) -> None:
-    if not (math.isfinite(value) and 0.0 < value <= 1.0):
-        raise InvalidInputError(field, value, "must be in (0, 1]")
 
 
 @dataclass(frozen=True)
@@ -90,9 +85,9 @@ class CircuitParams:
     def __post_init__(self) -> None:
         check_positive("hydraulics.load_sensing_margin", self.load_sensing_margin, "Pa")
         for key in ("pump_efficiency", "motor_efficiency", "inverter_efficiency"):
-            _efficiency(f"hydraulics.{key}", getattr(self, key))
-        _efficiency("hydraulics.eha_pump_efficiency", self.eha_pump_efficiency)
-        _efficiency("hydraulics.eha_motor_efficiency", self.eha_motor_efficiency)
+            check_efficiency(f"hydraulics.{key}", getattr(self, key))
+        check_efficiency("hydraulics.eha_pump_efficiency", self.eha_pump_efficiency)
+        check_efficiency("hydraulics.eha_motor_efficiency", self.eha_motor_efficiency)
         check_non_negative("hydraulics.leakage_conductance", self.leakage_conductance, "m^3/(s Pa)")
         check_non_negative("hydraulics.bleed_flow", self.bleed_flow, "m^3/s")
         check_non_negative("hydraulics.standstill_speed", self.standstill_speed, "m/s")

@@ -35,7 +35,7 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.paths import MachineInverseDynamics
 from hiab_sim.machine.kinematics.tracked import TrackedKinematics
-from hiab_sim.structure.natural_frequency import GEOMETRIC_STEP, Modes, generalized_eigh
+from hiab_sim.structure.natural_frequency import GEOMETRIC_STEP, Modes, differenced_stiffness, generalized_eigh
 
 Array = NDArray[np.float64]
 
@@ -97,17 +97,7 @@ def geometric_stiffness(
     inverse: MachineInverseDynamics, position: ArrayLike, jacobian: Array, tcp_force: ArrayLike | None = None
 ) -> Array:
     """J_x^T df_s/dq of the static actuator forces, symmetrised (T, n, n) [N m per unit joint]."""
-    q = np.atleast_2d(np.asarray(position, dtype=float))
-    T, n = q.shape
-    df = np.zeros((T, jacobian.shape[1], n))
-    for k in range(n):
-        step = np.zeros(n)
-        step[k] = GEOMETRIC_STEP
-        df[:, :, k] = (static_forces(inverse, q + step, tcp_force) - static_forces(inverse, q - step, tcp_force)) / (
-            2.0 * GEOMETRIC_STEP
-        )
-    K = np.einsum("tai,taj->tij", jacobian, df)
-    return 0.5 * (K + np.swapaxes(K, 1, 2))
+    return differenced_stiffness(lambda q: static_forces(inverse, q, tcp_force), position, jacobian)
 
 
 def drive_stiffness(emlas: EmlaSet, names: Sequence[str], stroke: Array) -> Array:

@@ -32,7 +32,7 @@ from hiab_sim.machine.dynamics.tree import PinForces, machine_tree, pin_layout
 from hiab_sim.structure.buckling import DEFAULT_SAFETY_FACTOR, BucklingSamples, check_safety_factor, critical_load
 from hiab_sim.structure.machine_modes import machine_natural_frequencies, machine_working_range_poses
 from hiab_sim.structure.pin_loads import Pin, PinLoads
-from hiab_sim.structure.summary import DesignStructure, buckling_summaries, has_stiffness, largest, pin_summaries
+from hiab_sim.structure.summary import DesignStructure, has_stiffness, largest, summarise
 
 Array = NDArray[np.float64]
 
@@ -168,24 +168,15 @@ def machine_design_structure(
     force = None if tcp_force is None else np.asarray(tcp_force, dtype=float)[..., :2]
     out = inverse(joints.position, joints.velocity, joints.acceleration, tcp_force=force)
     loads = machine_pin_loads(machine, joints.position, out.pins)
-    pins = pin_summaries(loads)
     names = tuple(out.names)
-    b = machine_buckling(machine, emlas, names, np.asarray(out.stroke), np.asarray(out.force), safety_factor)
-    buckling = buckling_summaries(b)
-    trajectory_Hz = grid_Hz = None
+    buckling = machine_buckling(machine, emlas, names, np.asarray(out.stroke), np.asarray(out.force), safety_factor)
+    on_path = grid = None
     if has_stiffness(emlas):
         on_path = machine_natural_frequencies(
             machine, inverse, emlas, joints.position, force, payload_kg, tracked=tracked
-        )
-        trajectory_Hz = float(np.min(on_path.lowest_Hz))
+        ).lowest_Hz
         poses = machine_working_range_poses(machine, WORKING_GRID_PER_JOINT)
-        grid = machine_natural_frequencies(machine, inverse, emlas, poses, largest(force), payload_kg, tracked=tracked)
-        grid_Hz = float(np.min(grid.lowest_Hz))
-    return DesignStructure(
-        pins=pins,
-        most_loaded_pin=loads.most_loaded()[0],
-        buckling=buckling,
-        buckling_safety_factor=safety_factor,
-        lowest_frequency_trajectory_Hz=trajectory_Hz,
-        lowest_frequency_working_range_Hz=grid_Hz,
-    )
+        grid = machine_natural_frequencies(
+            machine, inverse, emlas, poses, largest(force), payload_kg, tracked=tracked
+        ).lowest_Hz
+    return summarise(loads, buckling, safety_factor, on_path, grid)

@@ -36,6 +36,7 @@ the frequencies.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -106,15 +107,21 @@ def geometric_stiffness(
     crane: Crane, lengths: LinkLengths, position: ArrayLike, jx: Array, tcp_force: ArrayLike | None = None
 ) -> Array:
     """J_x^T df/dq of the static actuator forces, symmetrised (T, n, n) (module docstring)."""
+    return differenced_stiffness(lambda q: static_forces(crane, lengths, q, tcp_force), position, jx)
+
+
+def differenced_stiffness(forces: Callable[[Array], Array], position: ArrayLike, jx: Array) -> Array:
+    """J_x^T df/dq, symmetrised (T, n, n): central differences (step :data:`GEOMETRIC_STEP`) of ``forces(q)``.
+
+    ``forces``: the static actuator forces (T, n_a) [N] at joint samples q (T, n); ``jx`` (T, n_a, n).
+    """
     q = np.atleast_2d(np.asarray(position, dtype=float))
     T, n = q.shape
     df = np.zeros((T, jx.shape[1], n))
     for k in range(n):
         step = np.zeros(n)
         step[k] = GEOMETRIC_STEP
-        df[:, :, k] = (
-            static_forces(crane, lengths, q + step, tcp_force) - static_forces(crane, lengths, q - step, tcp_force)
-        ) / (2.0 * GEOMETRIC_STEP)
+        df[:, :, k] = (forces(q + step) - forces(q - step)) / (2.0 * GEOMETRIC_STEP)
     K = np.einsum("tai,taj->tij", jx, df)
     return 0.5 * (K + np.swapaxes(K, 1, 2))
 

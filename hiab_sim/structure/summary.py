@@ -172,23 +172,30 @@ def design_structure(
     in ``tcp_force``).
     """
     loads = analytic_pin_loads(crane, lengths, joints, tcp_force)
-    pins = pin_summaries(loads)
-    buckling = buckling_summaries(buckling_samples(crane, emlas, lengths, joints.position, force, safety_factor))
-    trajectory_Hz = grid_Hz = None
+    buckling = buckling_samples(crane, emlas, lengths, joints.position, force, safety_factor)
+    on_path = grid = None
     if has_stiffness(emlas):
         external = None if tcp_force is None else np.asarray(tcp_force, dtype=float)
-        on_path = natural_frequencies(crane, emlas, lengths, joints.position, external, payload_kg=payload_kg)
-        trajectory_Hz = float(np.min(on_path.lowest_Hz))
+        on_path = natural_frequencies(crane, emlas, lengths, joints.position, external, payload_kg=payload_kg).lowest_Hz
         poses = working_range_poses(crane, WORKING_GRID)
-        grid = natural_frequencies(crane, emlas, lengths, poses, largest(external), payload_kg=payload_kg)
-        grid_Hz = float(np.min(grid.lowest_Hz))
+        grid = natural_frequencies(crane, emlas, lengths, poses, largest(external), payload_kg=payload_kg).lowest_Hz
+    return summarise(loads, buckling, safety_factor, on_path, grid)
+
+
+def summarise(
+    loads: PinLoads, buckling: BucklingSamples, safety_factor: float, on_path_Hz: Array | None, grid_Hz: Array | None
+) -> DesignStructure:
+    """A design's summary from its pin loads, buckling samples and lowest frequencies [Hz] (None: no stiffness data).
+
+    ``on_path_Hz``: f_1 at each sample of the motion; ``grid_Hz``: f_1 at each pose of the working-range grid.
+    """
     return DesignStructure(
-        pins=pins,
+        pins=pin_summaries(loads),
         most_loaded_pin=loads.most_loaded()[0],
-        buckling=buckling,
+        buckling=buckling_summaries(buckling),
         buckling_safety_factor=safety_factor,
-        lowest_frequency_trajectory_Hz=trajectory_Hz,
-        lowest_frequency_working_range_Hz=grid_Hz,
+        lowest_frequency_trajectory_Hz=None if on_path_Hz is None else float(np.min(on_path_Hz)),
+        lowest_frequency_working_range_Hz=None if grid_Hz is None else float(np.min(grid_Hz)),
     )
 
 

@@ -5,7 +5,7 @@ The crane reader handles its keys by hand (no dataclass per section), so each ro
 
 from __future__ import annotations
 
-from hiab_sim.docs_site.field_specs.rows import Key, free, section, section_of
+from hiab_sim.docs_site.field_specs.rows import Key, free, number, section, section_of
 
 
 def crane_keys() -> list[Key]:
@@ -18,31 +18,15 @@ def crane_keys() -> list[Key]:
             unit="m",
             description="Cylinder base pivot {Bc} at the default L, in the parent frame.",
         ),
-        Key(
-            "base_axis_angle",
-            type="number",
-            unit="rad",
-            allowed="finite",
-            description="Direction base pivot -> boom hinge in the parent frame.",
+        number("base_axis_angle", "rad", "Direction base pivot -> boom hinge in the parent frame.", allowed="finite"),
+        number(
+            "joint_offset", "rad", "theta minus the boom's rotation relative to {Bc} (eq. `thetas`).", allowed="finite"
         ),
-        Key(
-            "joint_offset",
-            type="number",
-            unit="rad",
-            allowed="finite",
-            description="theta minus the boom's rotation relative to {Bc} (eq. `thetas`).",
-        ),
-        Key("L", type="number", unit="m", allowed="> 0", description="Base pivot -> boom hinge (seed's L)."),
-        Key(
-            "L1",
-            type="number",
-            unit="m",
-            allowed="> 0",
-            description="Boom hinge -> rod-end pivot (part of the boom, fixed).",
-        ),
-        Key("Lc", type="number", unit="m", allowed="> 0", description="Rod length (seed's Lc)."),
-        Key("Lc0", type="number", unit="m", allowed="> 0", description="Piston offset (seed's Lc0); x0 = Lc0 + Lc."),
-        Key("stroke", type="number", unit="m", allowed="> 0", description="Actuator stroke."),
+        number("L", "m", "Base pivot -> boom hinge (seed's L).", allowed="> 0"),
+        number("L1", "m", "Boom hinge -> rod-end pivot (part of the boom, fixed).", allowed="> 0"),
+        number("Lc", "m", "Rod length (seed's Lc).", allowed="> 0"),
+        number("Lc0", "m", "Piston offset (seed's Lc0); x0 = Lc0 + Lc.", allowed="> 0"),
+        number("stroke", "m", "Actuator stroke.", allowed="> 0"),
         Key(
             "joint_range",
             type="[number, number]",
@@ -56,36 +40,21 @@ def crane_keys() -> list[Key]:
         Key("R", type="3x3 nested list", allowed="a rotation matrix", description="Rotation parent -> frame."),
     ]
     cylinder = [
-        Key("bore", type="number", unit="m", allowed="> 0", description="Piston diameter D."),
-        Key("rod", type="number", unit="m", allowed="0 < rod < bore", description="Rod diameter d."),
-        Key("stroke", type="number", unit="m", allowed="> 0", description="Stroke (reported, not a limit)."),
-        Key(
-            "pin_to_pin_at_zero",
-            type="number",
-            unit="m",
-            default="none",
-            description="Pin-to-pin length at zero stroke (read, not used by the model).",
+        number("bore", "m", "Piston diameter D.", allowed="> 0"),
+        number("rod", "m", "Rod diameter d.", allowed="0 < rod < bore"),
+        number("stroke", "m", "Stroke (reported, not a limit).", allowed="> 0"),
+        number(
+            "pin_to_pin_at_zero", "m", "Pin-to-pin length at zero stroke (read, not used by the model).", default="none"
         ),
         *section_of(
             "counterbalance",
             "Counterbalance valve in the outlet of the load-holding chamber (hydraulic baselines at the battery).",
             [
                 Key("side", type="piston | rod", description="The chamber the valve holds."),
-                Key("pilot_ratio", type="number", allowed="> 0", description="Pilot ratio R."),
-                Key(
-                    "setting_pressure",
-                    type="number",
-                    unit="Pa",
-                    allowed="> 0",
-                    description="Setting p_set: opens when p_out + R p_pilot = p_set.",
-                ),
-                Key(
-                    "check_pressure",
-                    type="number",
-                    unit="Pa",
-                    allowed=">= 0",
-                    default="0",
-                    description="Cracking pressure of the free-flow check.",
+                number("pilot_ratio", "", "Pilot ratio R.", allowed="> 0"),
+                number("setting_pressure", "Pa", "Setting p_set: opens when p_out + R p_pilot = p_set.", allowed="> 0"),
+                number(
+                    "check_pressure", "Pa", "Cracking pressure of the free-flow check.", allowed=">= 0", default="0"
                 ),
             ],
             default="none",
@@ -94,7 +63,7 @@ def crane_keys() -> list[Key]:
     rows = [
         Key("name", type="text", description="Crane name, used in reports."),
         Key("source", type="text", description="Where the data comes from (citation)."),
-        Key("gravity", type="number", unit="m/s^2", description="Gravitational acceleration, along -y of {W}."),
+        number("gravity", "m/s^2", "Gravitational acceleration, along -y of {W}."),
         section("chains", "The two closed chains (cylinder, rod, boom triangle)."),
     ]
     for name in ("lift", "tilt"):
@@ -103,21 +72,9 @@ def crane_keys() -> list[Key]:
         section("telescope", "The telescope: a prismatic joint xt2 along x of the cylinder frame {P22}."),
         Key("telescope.parent", type="text", description="Link the telescope cylinder is fixed to."),
         *section_of("telescope.cylinder_frame", "{P22} in the parent link frame.", pose),
-        Key(
-            "telescope.rod_offset",
-            type="number",
-            unit="m",
-            allowed="finite",
-            description="{B52} at (rod_offset + xt2, 0, 0) in {P22}.",
-        ),
-        Key(
-            "telescope.rod_length",
-            type="number",
-            unit="m",
-            allowed="> 0",
-            description="{B52} -> end-mass frame {P32} along x.",
-        ),
-        Key("telescope.stroke", type="number", unit="m", allowed="> 0", description="Telescope stroke."),
+        number("telescope.rod_offset", "m", "{B52} at (rod_offset + xt2, 0, 0) in {P22}.", allowed="finite"),
+        number("telescope.rod_length", "m", "{B52} -> end-mass frame {P32} along x.", allowed="> 0"),
+        number("telescope.stroke", "m", "Telescope stroke.", allowed="> 0"),
         Key(
             "telescope.joint_range",
             type="[number, number]",
@@ -132,33 +89,15 @@ def crane_keys() -> list[Key]:
     for name in ("lift", "tilt", "telescope"):
         rows += section_of(f"hydraulic_cylinders.{name}", f"The {name} cylinder.", cylinder)
     rows += [
-        Key(
-            "hydraulic_cylinders.supply_pressure",
-            type="number",
-            unit="Pa",
-            allowed="> 0",
-            description="System (relief) pressure p_s.",
-        ),
+        number("hydraulic_cylinders.supply_pressure", "Pa", "System (relief) pressure p_s.", allowed="> 0"),
         *section_of(
             "hydraulic_cylinders.friction",
             "Seal friction of every cylinder.",
             [
-                Key(
-                    "coulomb",
-                    type="number",
-                    unit="N",
-                    default="0",
-                    allowed=">= 0",
-                    description="Coulomb seal friction F_c opposing the rod velocity.",
+                number(
+                    "coulomb", "N", "Coulomb seal friction F_c opposing the rod velocity.", allowed=">= 0", default="0"
                 ),
-                Key(
-                    "viscous",
-                    type="number",
-                    unit="N s/m",
-                    default="0",
-                    allowed=">= 0",
-                    description="Viscous friction b.",
-                ),
+                number("viscous", "N s/m", "Viscous friction b.", allowed=">= 0", default="0"),
             ],
             default="none",
         ),

@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from hiab_sim.docs_site.dataclass_fields import checked_fields
-from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, section, section_of
+from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, number, section, section_of
 
 #: Shown for a vector the loader reads as (x, y) or (x, y, z) (``_vec3``: z defaults to 0).
 POINT = "[x, y] or [x, y, z]"
@@ -45,13 +45,12 @@ def _pose(required_r: bool) -> list[Key]:
             allowed="a rotation matrix (|R R^T - I| <= 1e-6, det > 0); not with `angle`",
             description="Rotation parent -> frame.",
         ),
-        Key(
+        number(
             "angle",
-            type="number",
-            unit="rad",
-            default="0",
+            "rad",
+            "Rotation Rz(angle) about the plane normal instead of `R`.",
             allowed="finite; not with `R`",
-            description="Rotation Rz(angle) about the plane normal instead of `R`.",
+            default="0",
         ),
     ]
 
@@ -63,7 +62,7 @@ def _body(where: str, description: str, default: str = "none") -> list[Key]:
     checked = _checked(RigidBody)
     one = "exactly one of `inertia`, `inertia_zz`"
     keys = [
-        Key("mass", type="number", unit="kg", allowed=checked["mass"], description="Mass."),
+        number("mass", "kg", "Mass.", allowed=checked["mass"]),
         Key(
             "com",
             type=POINT,
@@ -79,13 +78,12 @@ def _body(where: str, description: str, default: str = "none") -> list[Key]:
             allowed="symmetric, eigenvalues > 0, I1 + I2 >= I3",
             description="Inertia about the centre of mass in the frame's axes.",
         ),
-        Key(
+        number(
             "inertia_zz",
-            type="number",
-            unit="kg m^2",
-            default=one,
+            "kg m^2",
+            "Planar inertia Izz only; stored as the thin plate diag(Izz/2, Izz/2, Izz).",
             allowed="> 0",
-            description="Planar inertia Izz only; stored as the thin plate diag(Izz/2, Izz/2, Izz).",
+            default=one,
         ),
     ]
     return section_of(where, description, keys, default)
@@ -218,18 +216,12 @@ def _hydraulic() -> list[Key]:
         section("hydraulic", "The hydraulic cylinders the EMLAs replace (the hydraulic baseline).", "none"),
         free("hydraulic.cylinders", "Cylinder name (an actuator's `hydraulic_cylinder`) -> cylinder.", "mapping"),
         *section_of("hydraulic.cylinders.<cylinder>", "One double-acting single-rod cylinder.", cylinder),
-        Key(
-            "hydraulic.supply_pressure",
-            type="number",
-            unit="Pa",
-            allowed=checked["supply_pressure"],
-            description="System (relief) pressure p_s.",
-        ),
+        number("hydraulic.supply_pressure", "Pa", "System (relief) pressure p_s.", allowed=checked["supply_pressure"]),
         *section_of(
             "hydraulic.friction",
             "Seal friction of every cylinder.",
             [
-                Key(name, type="number", unit=unit, default="0", allowed=checked[f"friction.{name}"], description=text)
+                number(name, unit, text, allowed=checked[f"friction.{name}"], default="0")
                 for name, unit, text in (
                     ("coulomb", "N", "Coulomb seal friction F_c opposing the rod velocity, per cylinder."),
                     ("viscous", "N s/m", "Viscous friction b, per cylinder."),

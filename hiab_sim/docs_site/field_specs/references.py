@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from hiab_sim.docs_site.field_specs.rows import Key, from_class, section, section_of
+from hiab_sim.docs_site.field_specs.rows import Key, from_class, number, section, section_of
 
 
 def reference_keys(where: str) -> list[Key]:
@@ -19,7 +19,7 @@ def reference_keys(where: str) -> list[Key]:
             allowed="one of `spiral`, `pick_and_place`, `csv`",
             description="The kind of reference.",
         ),
-        Key("duration", type="number", unit="s", default="grid.duration", allowed="> 0", description="Duration."),
+        number("duration", "s", "Duration.", allowed="> 0", default="grid.duration"),
         Key(
             "centre_joints",
             type="[number, number]",
@@ -28,18 +28,12 @@ def reference_keys(where: str) -> list[Key]:
             description="Spiral centre as the TCP at (theta1, theta2) with xt2 = telescope_start (or centre_tcp).",
         ),
         Key("centre_tcp", type="[number, number]", unit="m", default="none", description="Spiral centre in {W}."),
-        Key("start_radius", type="number", unit="m", description="Radius at the start."),
-        Key("end_radius", type="number", unit="m", description="Radius at the end."),
-        Key("turns", type="number", description="Turns (counter-clockwise)."),
-        Key("start_angle", type="number", unit="rad", default="0", description="Start angle from +x of {W}."),
-        Key("telescope_start", type="number", unit="m", description="xt2 at both ends (prescribed)."),
-        Key(
-            "telescope_amplitude",
-            type="number",
-            unit="m",
-            default="0",
-            description="xt2 goes out by this much at mid-motion and back.",
-        ),
+        number("start_radius", "m", "Radius at the start."),
+        number("end_radius", "m", "Radius at the end."),
+        number("turns", "", "Turns (counter-clockwise)."),
+        number("start_angle", "rad", "Start angle from +x of {W}.", default="0"),
+        number("telescope_start", "m", "xt2 at both ends (prescribed)."),
+        number("telescope_amplitude", "m", "xt2 goes out by this much at mid-motion and back.", default="0"),
     ]
     pick = [Key("kind", type="text", allowed="`pick_and_place`", description="The kind of reference.")]
     pick += [replace(k, default="[1, 1]" if k.path == "dwell" else k.default) for k in from_class("", PickAndPlace)]
@@ -53,12 +47,11 @@ def reference_keys(where: str) -> list[Key]:
             "by name (joint form: the crane's `theta1, theta2, xt2`); SI units, a header row, `#` comments; "
             "relative to the study file.",
         ),
-        Key(
+        number(
             "telescope",
-            type="number",
-            unit="m (the coordinate's)",
+            "m (the coordinate's)",
+            "The further tracked coordinate (the crane's xt2) when the TCP file has no column for it.",
             default="none",
-            description="The further tracked coordinate (the crane's xt2) when the TCP file has no column for it.",
         ),
         Key(
             "control_points",
@@ -67,14 +60,7 @@ def reference_keys(where: str) -> list[Key]:
             allowed=">= 7",
             description="Control points of the least-squares B-spline fit.",
         ),
-        Key(
-            "fit_tolerance",
-            type="number",
-            unit="m",
-            default="0.005",
-            allowed="> 0",
-            description="Largest distance of the fit from any sample.",
-        ),
+        number("fit_tolerance", "m", "Largest distance of the fit from any sample.", allowed="> 0", default="0.005"),
     ]
     needed = "one of `reference`, `tasks`" if where == "reference" else "required"
     machine = " A machine file's study: only where its third tracked coordinate is a joint (else `csv`)."

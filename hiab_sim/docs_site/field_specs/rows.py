@@ -32,6 +32,11 @@ class Key:
     form: str = ""
 
 
+def number(path: str, unit: str, description: str, *, allowed: str = "", default: str = "", form: str = "") -> Key:
+    """A number in ``unit`` (``""``: none), with the range it must lie in and its default where they are stated."""
+    return Key(path, type="number", unit=unit, default=default, allowed=allowed, description=description, form=form)
+
+
 def section(path: str, description: str, default: str = "required") -> Key:
     """A mapping whose keys are documented by the rows below it."""
     return Key(path, "section", "mapping", default=default, description=description)

@@ -17,9 +17,9 @@ from hiab_sim.study.motion.workspace import tracked_units
 from hiab_sim.study.nlp import blocks as bl
 from hiab_sim.study.nlp.block_registry import register_block
 from hiab_sim.study.nlp.brake_rows import brake_blocks
-from hiab_sim.study.nlp.interface import ConstraintBlock
-from hiab_sim.study.nlp.machine_structure_rows import machine_structure_blocks
-from hiab_sim.study.nlp.structure_rows import structure_blocks
+from hiab_sim.study.nlp.interface import ConstraintBlock, PerSampleBlock
+from hiab_sim.study.nlp.machine_structure_rows import MACHINE_ROWS
+from hiab_sim.study.nlp.structure_rows import CRANE_ROWS, structure_blocks
 from hiab_sim.study.nlp.thermal_rows import thermal_blocks
 
 
@@ -33,6 +33,14 @@ def _tracking(p: Any) -> list[ConstraintBlock]:
         )
         for order in ("position", "velocity", "acceleration")
     ]
+
+
+def _structure(p: Any) -> list[PerSampleBlock]:
+    """The structural rows: a machine file's through its description, a crane file's in closed form."""
+    model, kinds = (p.model, MACHINE_ROWS) if p.study.crane_description is None else (p.crane, CRANE_ROWS)
+    return structure_blocks(
+        p.study.structure, p.times, model, p.emlas, p.tcp_force, p.fd_step, p.task.payload.mass, kinds
+    )
 
 
 # the built-in blocks, in row order (const_b..const_k, thermal limits, holding brakes, buildable design, structure)
@@ -51,13 +59,4 @@ register_block("working_range", lambda p: [bl.WorkingRange(p.model, p.working, p
 register_block("thermal", lambda p: thermal_blocks(p.emlas, p.study.energy.duty, p.task.reference.duration))
 register_block("brake", lambda p: brake_blocks(p.emlas, p.study.energy.duty))
 register_block("buildable", lambda p: buildable_blocks(p.study, p.working, p.tightened))
-register_block(
-    "structure",
-    lambda p: (
-        machine_structure_blocks(
-            p.study.structure, p.times, p.model, p.emlas, p.tcp_force, p.fd_step, p.task.payload.mass
-        )
-        if p.study.crane_description is None  # a machine file's study: its description's rows
-        else structure_blocks(p.study.structure, p.times, p.crane, p.emlas, p.tcp_force, p.fd_step, p.task.payload.mass)
-    ),
-)
+register_block("structure", _structure)

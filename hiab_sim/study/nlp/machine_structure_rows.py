@@ -28,11 +28,9 @@ from hiab_sim.machine.dynamics.paths import make_machine_dynamics
 from hiab_sim.structure.buckling import critical_load
 from hiab_sim.structure.machine_modes import machine_natural_frequencies
 from hiab_sim.structure.machine_structure import machine_pin_loads
-from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.machines.machine_model import MachineModel
-from hiab_sim.study.nlp.differenced_rows import DifferencedRows
-from hiab_sim.study.nlp.interface import Array, PerSampleBlock, Relaxation, SamplePartials, SampleRows, SampleState
-from hiab_sim.study.nlp.structure_rows import buckling_relaxation, frequency_relaxation, pin_load_relaxation
+from hiab_sim.study.nlp.interface import Array, SamplePartials, SampleRows, SampleState
+from hiab_sim.study.nlp.structure_rows import BucklingRowsBase, FrequencyRowsBase, PinLoadRowsBase, StructureRowKinds
 
 
 def _retracted_partials(model: MachineModel, chain: Any) -> Array:
@@ -46,14 +44,13 @@ def _retracted_partials(model: MachineModel, chain: Any) -> Array:
     return out
 
 
-class MachineBucklingRows(PerSampleBlock):
+class MachineBucklingRows(BucklingRowsBase):
     """1 - n f / P_cr per actuator with screw data and sample, on a machine file (module docstring)."""
 
+    model: MachineModel
+
     def __init__(self, times: Array, model: MachineModel, emlas: EmlaSet, safety_factor: float) -> None:
-        self.name = "structure.buckling"
-        self.times = times
-        self.model = model
-        self.safety_factor = safety_factor
+        super().__init__(times, model, safety_factor)
         by_name = {p.name: p for p in emlas}
         names = model.actuator_names
         self.columns = tuple(k for k, name in enumerate(names) if by_name[name].screw is not None)
@@ -107,10 +104,6 @@ class MachineBucklingRows(PerSampleBlock):
         f = np.asarray(state.actuators.force, dtype=float)[:, list(self.columns)]
         return (1.0 - self.safety_factor * f / load).ravel()
 
-    def relaxation(self, values: Array) -> Relaxation:
-        """Per % of the buckling load: (1 - g)(1 - 1 / 1.01), as the crane's rows."""
-        return buckling_relaxation(values)
-
     def jacobian(self, state: SampleState, partials: SamplePartials) -> SampleRows:
         """-du/dq (positions, rates, accelerations) and -du/dXi (exact; module docstring)."""
         s, ds_dq, ds_dxi = self._columns(state)
@@ -128,95 +121,40 @@ class MachineBucklingRows(PerSampleBlock):
         return SampleRows(-factor * (df_dq - ratio * dP_dq), -factor * (df_dxi - ratio * dP_dxi))
 
 
-class MachinePinLoadRows(DifferencedRows):
+class MachinePinLoadRows(PinLoadRowsBase):
     """1 - |F_p| / F_max per limited pin and sample (Newton-Euler pin forces of the machine)."""
 
-    def __init__(
-        self,
-        times: Array,
-        model: MachineModel,
-        limits: tuple[tuple[str, float], ...],
-        tcp_force: Array | None,
-        step: float,
-    ) -> None:
-        self.name = "structure.pin_load"
-        self.times = times
-        self.model = model
-        self.limits = limits
-        self.limit = np.array([value for _, value in limits])
-        self.tcp_force = None if tcp_force is None else np.broadcast_to(np.asarray(tcp_force, float), (len(times), 3))
-        self.step = step
-        self.sample_rows = tuple(f"{name} |F| <= {value:.6g} N" for name, value in limits)
+    model: MachineModel
 
-    def _rows(self, design: Any, position: Array, velocity: Array, acceleration: Array) -> Array:
+    def _magnitudes(self, design: Any, position: Array, velocity: Array, acceleration: Array) -> Array:
         machine = self.model.machine_at(design)
         force = None if self.tcp_force is None else self.tcp_force[:, :2]
         out = make_machine_dynamics(machine, None, "newton_euler")(position, velocity, acceleration, tcp_force=force)
         loads = machine_pin_loads(machine, position, out.pins)
         names = [pin.name for pin in loads.pins]
         index = [names.index(name) for name, _ in self.limits]
-        return 1.0 - loads.magnitude[:, index] / self.limit
-
-    def relaxation(self, values: Array) -> Relaxation:
-        """Per kN of a pin's rating: (1 - g) 1e3 / F_max."""
-        return pin_load_relaxation(values, self.limit)
+        return loads.magnitude[:, index]
 
 
-class MachineFrequencyRows(DifferencedRows):
+class MachineFrequencyRows(FrequencyRowsBase):
     """f_1(q_k, design) / f_min - 1 per sample: the lowest locked-rotor frequency at the sample's pose."""
 
-    uses_rates = False
+    model: MachineModel
 
-    def __init__(
-        self,
-        times: Array,
-        model: MachineModel,
-        emlas: EmlaSet,
-        minimum_Hz: float,
-        tcp_force: Array | None,
-        step: float,
-        payload_kg: float = 0.0,
-    ) -> None:
-        self.name = "structure.natural_frequency"
-        self.times = times
-        self.model = model
-        self.emlas = emlas
-        self.minimum = minimum_Hz
-        self.tcp_force = None if tcp_force is None else np.broadcast_to(np.asarray(tcp_force, float), (len(times), 3))
-        self.step = step
-        self.payload_kg = payload_kg
-        self.sample_rows = (f"lowest frequency >= {minimum_Hz:.6g} Hz",)
-
-    def _rows(self, design: Any, position: Array, velocity: Array, acceleration: Array) -> Array:
+    def _lowest_Hz(self, design: Any, position: Array) -> Array:
         machine = self.model.machine_at(design)
         inverse = make_machine_dynamics(machine, None, "newton_euler")
         force = None if self.tcp_force is None else self.tcp_force[:, :2]
         modes = machine_natural_frequencies(
             machine, inverse, self.emlas, position, force, self.payload_kg, tracked=self.model.extra
         )
-        return (modes.lowest_Hz / self.minimum - 1.0)[:, None]
-
-    def relaxation(self, values: Array) -> Relaxation:
-        """Per Hz of the minimum lowered: (1 + g) / f_min."""
-        return frequency_relaxation(values, self.minimum)
+        return modes.lowest_Hz
 
 
-def machine_structure_blocks(
-    settings: StructureSettings,
-    times: Array,
-    model: MachineModel,
-    emlas: EmlaSet,
-    tcp_force: Array | None,
-    step: float,
-    payload_kg: float = 0.0,
-) -> list[PerSampleBlock]:
-    """The structural blocks a machine file's study asks for (none by default)."""
-    out: list[PerSampleBlock] = []
-    if settings.buckling and any(p.screw is not None for p in emlas):
-        out.append(MachineBucklingRows(times, model, emlas, settings.buckling_safety_factor))
-    if settings.pin_load_limits_N:
-        out.append(MachinePinLoadRows(times, model, settings.pin_load_limits_N, tcp_force, step))
-    if settings.min_natural_frequency_Hz is not None:
-        floor = settings.min_natural_frequency_Hz
-        out.append(MachineFrequencyRows(times, model, emlas, floor, tcp_force, step, payload_kg))
-    return out
+#: A machine file's structural blocks (its description, the Newton-Euler path); :func:`structure_blocks` builds them.
+MACHINE_ROWS = StructureRowKinds(
+    MachineBucklingRows,
+    lambda model, emlas: any(p.screw is not None for p in emlas),
+    MachinePinLoadRows,
+    MachineFrequencyRows,
+)

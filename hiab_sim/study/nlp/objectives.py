@@ -33,7 +33,15 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.nlp.interface import Array, Objective, SamplePartials, SampleState
 
 
-class SquaredPowerCost:
+class EmlaObjective:
+    """An objective of the EMLA set's drives over the sample grid: the set and the sample step Dt [s] it holds."""
+
+    def __init__(self, emlas: EmlaSet, dt: float) -> None:
+        self.emlas = emlas
+        self.dt = dt
+
+
+class SquaredPowerCost(EmlaObjective):
     """f = 1/2 Dt sum_k (sum_i P_i(t_k))^2 (seed eq. ``costf2``) [W^2 s].
 
     Args:
@@ -44,10 +52,6 @@ class SquaredPowerCost:
 
     name = "costf2"
     unit = "W^2 s"
-
-    def __init__(self, emlas: EmlaSet, dt: float) -> None:
-        self.emlas = emlas
-        self.dt = dt
 
     def value(self, state: SampleState) -> float:
         """1/2 Dt sum_k (sum_i P_i)^2 [W^2 s]."""
@@ -60,7 +64,7 @@ class SquaredPowerCost:
         return _chain(self.emlas, state, partials, self.dt * np.repeat(total[:, None], len(self.emlas), axis=1))
 
 
-class BatteryEnergyCost:
+class BatteryEnergyCost(EmlaObjective):
     """E_bat = int P_bat dt over the sample grid (trapezoid), smooth kinks [J] (:mod:`hiab_sim.emla.battery`).
 
     Args:
@@ -71,10 +75,6 @@ class BatteryEnergyCost:
 
     name = "battery_energy"
     unit = "J"
-
-    def __init__(self, emlas: EmlaSet, dt: float) -> None:
-        self.emlas = emlas
-        self.dt = dt
 
     def value(self, state: SampleState) -> float:
         """Smooth battery energy [J] of the cycle, plus the rest's (exact, it only draws) with a duty model."""
