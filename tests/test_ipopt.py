@@ -114,7 +114,7 @@ def test_ipopt_and_dense_slsqp_reach_the_same_design_of_the_two_task_mix() -> No
 
 
 def test_sparse_jacobian_of_a_machine_with_nine_design_variables_is_the_dense_one() -> None:
-    """The excavator (9 design variables, 3 joints): IPOPT's pattern and columns hold every nonzero of the dense rows."""
+    """The excavator (9 design variables, 3 joints): IPOPT's pattern and columns hold every nonzero of the rows."""
     from hiab_sim.study import load_study
 
     study = StudyProblem(load_study("exact_grading"))
