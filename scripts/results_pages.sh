@@ -20,7 +20,7 @@ cd "$(dirname "$0")/.."
 PY="${PYTHON:-.venv/bin/python}"
 RUNS="${RUNS:-runs/results-pages}"
 TARGETS=(xs031_spiral xs031_spiral_energy xs031_spiral_payload xs031_spiral_mounting seed_scale_spiral
-         xs031_codesign xs031_duty_mix exact_digging exact_grading
+         xs031_codesign xs031_duty_mix exact_digging exact_grading exact_duty_mix
          xs031_spiral_energy_map xs031_mounting_space xs031_payload_gear xs031_spiral_pareto_peak_force
          xs031_spiral_model_effects)
 if [ -n "${ONLY:-}" ]; then read -r -a TARGETS <<<"$ONLY"; fi

@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: End-to-end runs of whole studies: the full suite, not the fast tier.
 pytestmark = pytest.mark.e2e
 SHORT_STUDIES = ("xs031_spiral_energy", "xs031_spiral_payload", "xs031_spiral_mounting", "seed_scale_spiral")
-LONG_STUDIES = ("xs031_codesign", "xs031_duty_mix", "exact_digging", "exact_grading")
+LONG_STUDIES = ("xs031_codesign", "xs031_duty_mix", "exact_digging", "exact_grading", "exact_duty_mix")
 
 
 def _check(study: str, out: Path) -> None:

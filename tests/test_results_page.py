@@ -25,7 +25,7 @@ from hiab_sim.docs_site.results_page import BLOCKS, block_names, pages, render_p
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The studies too long for CI to re-run (minutes each): their data are held to the recorded optima.
-LONG_STUDIES = ("xs031_codesign", "xs031_duty_mix", "exact_digging", "exact_grading")
+LONG_STUDIES = ("xs031_codesign", "xs031_duty_mix", "exact_digging", "exact_grading", "exact_duty_mix")
 DATA = load_data()
 
 

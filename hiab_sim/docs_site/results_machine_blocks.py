@@ -2,7 +2,7 @@
 
 Each block is a function of :class:`~hiab_sim.docs_site.results_data.RunData` returning Markdown: the
 duty mix's ``tasks`` and ``cross_evaluation``, the default run's ``simulation.json`` (``hiab-sim
-simulate --payload-error 0.2``) and the eXact excavator's two studies on its machine file.
+simulate --payload-error 0.2``), the eXact excavator's two studies on its machine file and their mix.
 """
 
 from __future__ import annotations
@@ -16,11 +16,18 @@ from hiab_sim.docs_site.results_format import before_after, kilo, lengths, perce
 
 MIX, DEFAULT = "xs031_duty_mix", "xs031_spiral"
 EXCAVATOR = ("exact_digging", "exact_grading")
+#: The excavator's mix of its two tasks (optimize/exact_duty_mix.yaml).
+EXCAVATOR_MIX = "exact_duty_mix"
 
 
 def mix_run(runs: RunData) -> str:
     """How the duty mix's optimum was reached and re-checked."""
-    r = runs.result(MIX)
+    return _run_line(runs, MIX)
+
+
+def _run_line(runs: RunData, study: str) -> str:
+    """How a mix study's optimum was reached and re-checked."""
+    r = runs.result(study)
     tasks = r("tasks")
     worst = max(t["recheck"]["max_violation_scaled"] for t in tasks)
     tcp = max(t["recheck"]["tracking_error"]["position_m"] for t in tasks)
@@ -108,7 +115,12 @@ def _cell(value: float | None, digits: int = 1) -> str:
 
 def mix_cross(runs: RunData) -> str:
     """Each task's optimum and the mix's, evaluated on every task and on the mix: net energy [J]."""
-    c = runs.result(MIX)("cross_evaluation")
+    return _cross_table(runs, MIX)
+
+
+def _cross_table(runs: RunData, study: str) -> str:
+    """A mix study's cross-evaluation: each design (rows) on each task and on the mix, net energy [J]."""
+    c = runs.result(study)("cross_evaluation")
     rows = []
     for d, design in enumerate(c["designs"]):
         lost, lost_pct = c["mix_energy_lost_J"][d], c["mix_energy_lost_percent"][d]
@@ -240,6 +252,70 @@ def excavator_energy(runs: RunData) -> str:
     return "\n".join(lines)
 
 
+def excavator_mix_run(runs: RunData) -> str:
+    """How the excavator mix's optimum was reached and re-checked."""
+    return _run_line(runs, EXCAVATOR_MIX)
+
+
+def excavator_mix_tasks(runs: RunData) -> str:
+    """Per task: battery energy per duty period built → optimal; the mix's over the weighted hour."""
+    r = runs.result(EXCAVATOR_MIX)
+    rows: list[tuple[object, ...]] = []
+    for t in r("tasks"):
+        i, o = t["energy"]["initial"], t["energy"]["optimal"]
+        load = f", {t['payload_kg']:.0f} kg" if t["payload_kg"] else ""
+        rows.append(
+            (
+                f"{t['name']}{load} ({t['weight']:g} per hour, {t['duration_s']:g} s)",
+                before_after(i["battery_energy_J"] / 1e3, o["battery_energy_J"] / 1e3, "kJ", 3),
+                before_after(
+                    t["initial"]["net_electrical_energy_J"] / 1e3,
+                    t["optimal"]["net_electrical_energy_J"] / 1e3,
+                    "kJ",
+                    3,
+                ),
+            )
+        )
+    rows.append(
+        (
+            "mix, the weighted hour",
+            before_after(
+                r("energy.initial.battery_energy_J") / 1e6, r("energy.optimal.battery_energy_J") / 1e6, "MJ", 3
+            ),
+            before_after(
+                r("initial.net_electrical_energy_J") / 1e6, r("optimal.net_electrical_energy_J") / 1e6, "MJ", 3
+            ),
+        )
+    )
+    header = ("task (weight, cycle)", "battery energy per duty period, built → optimal", "net electrical, cycle only")
+    rms = ", ".join(f"{m} {v:.2f} N m" for m, v in r("energy.hourly_rms_torque_Nm").items())
+    return (
+        table(header, rows)
+        + f"\n\nThe weights fill {r('energy.hourly_work_s'):.0f} s of the hour with work; the optimum's motors run at "
+        f"hourly RMS torques of {rms}."
+    )
+
+
+def excavator_mix_designs(runs: RunData) -> str:
+    """Every decision variable [m]: the machine file, each task's study optimum (when recorded) and the mix's."""
+    r = runs.result(EXCAVATOR_MIX)
+    first = r("initial.lengths")
+    columns = [
+        (f"`{s}` optimum", runs.result(s)("optimal.lengths")["values"]) for s in EXCAVATOR if runs.has(s, "result")
+    ]
+    columns.append((f"`{EXCAVATOR_MIX}` optimum", r("optimal.lengths")["values"]))
+    rows = [
+        (f"`{name}`", f"{first['values'][i]:.3f}", *(f"{values[i]:.3f}" for _, values in columns))
+        for i, name in enumerate(first["names"])
+    ]
+    return table(("variable [m]", "machine file", *(label for label, _ in columns)), rows)
+
+
+def excavator_mix_cross(runs: RunData) -> str:
+    """The excavator mix's cross-evaluation (each task's optimum alone and the mix's on every task)."""
+    return _cross_table(runs, EXCAVATOR_MIX)
+
+
 BLOCKS: dict[str, Callable[[RunData], str]] = {
     "duty-mix-run": mix_run,
     "duty-mix-tasks": mix_tasks,
@@ -252,4 +328,8 @@ BLOCKS: dict[str, Callable[[RunData], str]] = {
     "excavator-studies": excavator_studies,
     "excavator-designs": excavator_designs,
     "excavator-energy": excavator_energy,
+    "excavator-mix-run": excavator_mix_run,
+    "excavator-mix-tasks": excavator_mix_tasks,
+    "excavator-mix-designs": excavator_mix_designs,
+    "excavator-mix-cross": excavator_mix_cross,
 }

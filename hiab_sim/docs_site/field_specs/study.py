@@ -67,6 +67,7 @@ def _mounting_keys() -> list[Key]:
 
 def study_keys() -> list[Key]:
     """The study file (:func:`hiab_sim.study.spec.study_file.study_from_dict`)."""
+    from hiab_sim.emla.hold import HOLD_MODES
     from hiab_sim.machine.loader import PRESETS as MACHINE_PRESETS
     from hiab_sim.study.nlp.objectives import OBJECTIVES
     from hiab_sim.study.spec.build import BuildSettings
@@ -242,12 +243,22 @@ def study_keys() -> list[Key]:
             allowed="one of " + ", ".join(f"`{n}`" for n in OBJECTIVES),
             description="What the optimiser minimises: the seed's eq. `costf2` or the battery energy.",
         ),
-        section("duty", "Rest between cycles: thermal rows and report (give exactly one key).", "none"),
+        section(
+            "duty",
+            "Rest between cycles: thermal rows and report (exactly one of rest_time, cycles_per_hour, rest_ratio).",
+            "none",
+        ),
         *from_class(
             "duty",
             DutySettings,
             rest_time={"unit": "s", "description": "Rest after each cycle."},
             cycles_per_hour={"unit": "1/h", "description": "Cycles per hour (rest = 3600/n - T)."},
+            rest_ratio={"description": "Rest as a share of each task's cycle time T (rest = r T)."},
+            hold={
+                "allowed": "one of " + ", ".join(f"`{m}`" for m in (*HOLD_MODES, "none")),
+                "default": "`brake` if every EMLA has brake data",
+                "description": "What carries the machine during the rest.",
+            },
         ),
         section("transmission", "Catalogue of (gear ratio, screw lead) options per actuator: co-design.", "none"),
     ]

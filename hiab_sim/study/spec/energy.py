@@ -4,13 +4,16 @@ Three optional top-level keys of a study file, each validated here into a frozen
 
 * ``objective: <name>`` (default ``costf2``, the seed's eq. ``costf2``; ``battery_energy``): a name
   registered in :data:`hiab_sim.study.nlp.objectives.OBJECTIVES`, the one objective registry.
-* ``duty: {cycles_per_hour: n}`` or ``duty: {rest_time: T_rest}`` [s]: the cycle (the study's
-  trajectory, duration T) repeats with a rest of T_rest at zero torque, or n times an hour
-  (T_rest = 3600/n - T). With a duty and an EMLA set that has thermal data, the NLP holds the
-  motors' thermal limits (:mod:`hiab_sim.study.nlp.thermal_rows`). ``hold: brake | motor`` says
-  what carries the machine during the rest (:mod:`hiab_sim.emla.hold`); with a duty, the energy
-  and the thermal rows use R_s at the winding temperature of EMLAs with ``winding_resistance``
-  data (:mod:`hiab_sim.emla.duty_energy`).
+* ``duty: {cycles_per_hour: n}``, ``duty: {rest_time: T_rest}`` [s] or ``duty: {rest_ratio: r}``:
+  the cycle (the study's trajectory, duration T) repeats with a rest of T_rest at zero torque, n
+  times an hour (T_rest = 3600/n - T) or with a rest of T_rest = r T. Each task of a mix gets its
+  duty from its own duration T, so ``rest_ratio`` gives every task the same share of rest (r = 0.2:
+  a 50-minute working hour, 60/50 - 1) where one ``rest_time`` cannot. With a duty and an EMLA set
+  that has thermal data, the NLP holds the motors' thermal limits
+  (:mod:`hiab_sim.study.nlp.thermal_rows`). ``hold: brake | motor`` says what carries the machine
+  during the rest (:mod:`hiab_sim.emla.hold`); with a duty, the energy and the thermal rows use R_s
+  at the winding temperature of EMLAs with ``winding_resistance`` data
+  (:mod:`hiab_sim.emla.duty_energy`).
 * ``transmission: {lift: [{gear_ratio: G, screw_lead: rho}, ...], tilt: [...], ...}``: a catalogue
   of discrete (G, rho) options per actuator; actuators not listed keep the EMLA file's. The
   co-design (:mod:`hiab_sim.study.analysis.codesign`) optimises the mounting for every combination.
@@ -31,10 +34,18 @@ from hiab_sim.emla.thermal import Duty
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.yaml_fields import mapping, number
 
+#: The keys of ``duty:`` that set the rest; a duty gives exactly one.
+DUTY_REST_KEYS = ("rest_time", "cycles_per_hour", "rest_ratio")
+_ONE_OF = "rest_time [s], cycles_per_hour [1/h] or rest_ratio [-]"
+
 
 @dataclass(frozen=True)
 class DutySettings:
-    """Rest between cycles: exactly one of ``rest_time`` [s] >= 0 or ``cycles_per_hour`` [1/h] > 0.
+    """Rest between cycles: exactly one of ``rest_time`` [s] >= 0, ``cycles_per_hour`` [1/h] > 0 or ``rest_ratio`` >= 0.
+
+    ``rest_ratio`` r is the rest as a share of the cycle: T_rest = r T for a cycle of T [s], so every
+    task of a mix rests in proportion to its own duration (r = 0.2: the cycle is 5/6 of its period,
+    a 50-minute working hour).
 
     ``hold`` says what carries the machine during the rest (:mod:`hiab_sim.emla.hold`): ``brake``
     (the EMLAs' holding brakes), ``motor`` (the motors hold the last pose) or ``none`` (the
@@ -46,25 +57,28 @@ class DutySettings:
     rest_time: float | None = None
     cycles_per_hour: float | None = None
     hold: str | None = None
+    rest_ratio: float | None = None
 
     def __post_init__(self) -> None:
         if self.hold is not None:
             check_choice("duty.hold", self.hold, (*HOLD_MODES, "none"))
-        if (self.rest_time is None) == (self.cycles_per_hour is None):
-            raise InvalidInputError(
-                "duty",
-                "{}" if self.rest_time is None else "both",
-                "give exactly one of rest_time [s] or cycles_per_hour",
-            )
+        given = [k for k in DUTY_REST_KEYS if getattr(self, k) is not None]
+        if len(given) != 1:
+            shown = " and ".join(given) if given else "{}"
+            raise InvalidInputError("duty", shown, f"give exactly one of {_ONE_OF}")
         if self.rest_time is not None:
             check_range("duty.rest_time", self.rest_time, 0.0, unit="s")
         if self.cycles_per_hour is not None:
             check_range("duty.cycles_per_hour", self.cycles_per_hour, 0.0, unit="1/h", low_open=True)
+        if self.rest_ratio is not None:
+            check_range("duty.rest_ratio", self.rest_ratio, 0.0)
 
     def duty(self, cycle_time: float) -> Duty:
         """The :class:`~hiab_sim.emla.thermal.Duty` of a cycle of ``cycle_time`` [s]."""
         if self.cycles_per_hour is not None:
             return Duty.from_cycles_per_hour(cycle_time, self.cycles_per_hour)
+        if self.rest_ratio is not None:
+            return Duty(cycle_time, self.rest_ratio * cycle_time)
         assert self.rest_time is not None
         return Duty(cycle_time, self.rest_time)
 
@@ -81,7 +95,12 @@ class DutySettings:
     def describe(self, cycle_time: float, emlas: EmlaSet | None = None) -> str:
         """E.g. ``60 cycles/hour (6.25 s cycle + 53.75 s rest), hold: brake``."""
         d = self.duty(cycle_time)
-        head = f"{self.cycles_per_hour:g} cycles/hour" if self.cycles_per_hour is not None else "rest between cycles"
+        if self.cycles_per_hour is not None:
+            head = f"{self.cycles_per_hour:g} cycles/hour"
+        elif self.rest_ratio is not None:
+            head = f"rest {self.rest_ratio:g} x the cycle time"
+        else:
+            head = "rest between cycles"
         text = f"{head} ({d.cycle_time:g} s cycle + {d.rest_time:g} s rest)"
         if emlas is not None:
             mode = self.hold_mode(emlas)
@@ -152,13 +171,13 @@ def energy_settings(top: Any) -> EnergySettings:
     objective = top.get("objective", "costf2")  # EnergySettings checks it against the objective registry
     duty = None
     if top.get("duty") is not None:
-        d = dict(mapping(top["duty"], "duty", {"rest_time", "cycles_per_hour", "hold"}, set()))
+        d = dict(mapping(top["duty"], "duty", {*DUTY_REST_KEYS, "hold"}, set()))
         hold = d.pop("hold", None)
         if hold is not None and not isinstance(hold, str):
             raise InvalidInputError("duty.hold", hold, f"must be one of {', '.join((*HOLD_MODES, 'none'))}")
         duty = DutySettings(**{k: number(v, f"duty.{k}") for k, v in d.items()}, hold=hold)
     elif "duty" in top:
-        raise InvalidInputError("duty", None, "give exactly one of rest_time [s] or cycles_per_hour")
+        raise InvalidInputError("duty", None, f"give exactly one of {_ONE_OF}")
     transmission = None
     if "transmission" in top:
         transmission = _catalogue(top["transmission"])
