@@ -51,6 +51,8 @@ def test_summary_numbers_are_the_results_own(run: tuple[Path, str]) -> None:
     assert f"{r.energy.initial.battery_energy_J / 1e3:.3f} kJ before" in text
     assert f"{r.energy.optimal.battery_energy_J / 1e3:.3f} kJ after" in text
     assert "at the battery" in text
+    period = "per duty period (cycle and rest)" if r.energy.optimal.duty is not None else "per cycle"
+    assert f"Energy {period} at the battery" in text  # the period the battery figure covers, named
     assert str(folder) in text and r.buildable.mjcf_command in text
 
 

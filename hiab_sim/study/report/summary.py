@@ -112,6 +112,15 @@ def _design_lines(built: DesignValues, initial: DesignValues, tolerance_mm: floa
 
 
 def _energy_line(r: Result) -> str:
+    """The energy before/after, named with its boundary and the period it covers.
+
+    With the study's duty model the battery energy covers a duty period (the cycle and the rest that
+    follows it); a study of several tasks reports the tasks' weighted sum (the study's weights, e.g.
+    cycles per hour: then J per hour).
+    """
+    reports = [t.energy for t in r.tasks] if r.tasks else [r.energy]
+    with_duty = any(e is not None and e.optimal.duty is not None for e in reports)
+    period = "duty period (cycle and rest)" if r.energy is not None and with_duty else "cycle"
     if r.energy is not None:
         e = r.energy
         before, after = e.initial.battery_energy_J, e.optimal.battery_energy_J
@@ -119,7 +128,8 @@ def _energy_line(r: Result) -> str:
     else:
         before, after = r.initial.net_electrical_energy_J, r.optimal.net_electrical_energy_J
         where = NET_BOUNDARY
-    return f"Energy per cycle {where}: {before_after(before, after)}."
+    head = f"Energy, the tasks' weighted sum of each task's energy per {period}" if r.tasks else f"Energy per {period}"
+    return f"{head} {where}: {before_after(before, after)}."
 
 
 def before_after(before: float, after: float, names: tuple[str, str] = ("before", "after")) -> str:
