@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
+
+import pytest
 
 from hiab_sim.env.effects import compact_effect_table, effect_markdown, write_effect_markdown
 
@@ -96,3 +99,21 @@ def test_effects_md_holds_the_compact_and_the_full_table(tmp_path: Path) -> None
     assert text.startswith("# Plant effects: realistic plant, 1 cycle(s) per run")
     assert compact_effect_table(report) in text
     assert text.count("| all | ") == 2  # initial and optimal rows of the full table
+
+
+@pytest.mark.e2e
+def test_the_replanned_battery_energy_is_one_cycles_as_the_closed_loops() -> None:
+    """With the study's duty the re-plan's battery energy is its cycle's, not the cycle's and the rest's.
+
+    The closed loop and the nominal prediction leave the rest between cycles out; the re-planned optimum's
+    number must too, or knowing the load would seem to cost the rest's standby (3.5 kJ on the default study).
+    """
+    from hiab_sim.env import default_result_dir
+    from hiab_sim.env.effects import replanned_summary
+
+    folder = default_result_dir()
+    duty = json.loads((folder / "result.json").read_text(encoding="utf-8"))["energy"]["optimal"]["duty"]
+    summary = replanned_summary(folder)
+    assert summary["predicted_battery_J"] == duty["cycle_battery_energy_J"]
+    assert duty["rest_battery_energy_J"] > 0.0
+    assert summary["predicted_battery_J"] < duty["battery_energy_J"] - 0.5 * duty["rest_battery_energy_J"]

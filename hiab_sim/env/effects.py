@@ -120,16 +120,23 @@ def true_study(study: Study, plant: Plant) -> Study:
     return replace(study, crane_description=true_crane(study.crane, plant.mismatch))
 
 
-def replanned_summary(result: dict[str, Any]) -> dict[str, object]:
-    """``predicted_J``, ``lengths`` (and ``predicted_battery_J`` with a battery) of a re-planned ``result.json``."""
+def replanned_summary(result_dir: str | Path) -> dict[str, object]:
+    """``predicted_J``, ``lengths`` (and ``predicted_battery_J`` with a battery) of a re-planned result folder.
+
+    ``predicted_battery_J`` is the re-planned optimum's battery energy of one cycle, the boundary of the
+    closed loop's and of the nominal prediction (``predicted_cycle_battery_energy`` of
+    :mod:`hiab_sim.env.closed_loop_battery`: with the study's duty model the cycle's share, the rest
+    between cycles left out).
+    """
+    result = json.loads((Path(result_dir) / "result.json").read_text(encoding="utf-8"))
     optimal = result["optimal"]
     replanned: dict[str, object] = {
         "predicted_J": float(optimal["net_electrical_energy_J"]),
         "lengths": optimal.get("lengths"),
     }
-    energy = result.get("energy")
-    if isinstance(energy, dict) and "optimal" in energy:
-        replanned["predicted_battery_J"] = float(energy["optimal"]["battery_energy_J"])
+    battery = predicted_cycle_battery_energy(result_dir)
+    if "optimal" in battery:
+        replanned["predicted_battery_J"] = float(battery["optimal"])
     return replanned
 
 
@@ -154,7 +161,7 @@ def replanned_prediction(result_dir: str | Path, plant: Plant) -> dict[str, obje
         out = run_study(
             true_study(study, plant), Path(folder) / "replan", progress=None, figures=False, force=True, cross=False
         )
-        return replanned_summary(json.loads((out.folder / "result.json").read_text(encoding="utf-8")))
+        return replanned_summary(out.folder)
 
 
 def attach_replanned(report: dict[str, Any], replanned: dict[str, object]) -> None:
