@@ -22,7 +22,7 @@ def write_results(
     designs: tuple[str, ...],
     out: Path,
 ) -> tuple[list[str], dict[str, object] | None]:
-    """Run the effect study (a plant with effects on), write ``simulation.json``, ``effects.md`` and the figures to ``out``.
+    """Run the effect study (a plant with effects on); write ``simulation.json``, ``effects.md``, the figures.
 
     Returns the names of the files written and the effect study (None without one), which ``report`` holds too.
     """
