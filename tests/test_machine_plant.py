@@ -218,6 +218,10 @@ def test_simulate_runs_the_effect_study_on_a_machine_result(
     assert split["replanned_optimum_predicted_J"] > 0.0
     printed = capsys.readouterr().out
     assert "| mismatch | optimal |" in printed and "re-planned for the true masses" in printed
+    compact = (out / "effects.md").read_text(encoding="utf-8").split("\n\n")[1].splitlines()
+    assert compact[0] == "| effect | ideal | mismatch |" and len(compact) == 5
+    tcp = effects["variants"]["mismatch"]["optimal"]["tcp_error_mm"]["max"]
+    assert compact[3].endswith(f"/ {tcp:.2f} |")
 
 
 def test_the_xs031_machine_file_gets_the_crane_files_friction(crane: Crane) -> None:

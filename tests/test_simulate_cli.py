@@ -164,6 +164,10 @@ def test_simulate_on_the_realistic_plant_reports_every_effect(small_result: Path
     # No worse than the nominal optimum at the true masses, within the small study's solver and ID tolerances.
     assert split["replanned_optimum_predicted_J"] <= split["predicted_at_true_masses_J"] * (1 + 1e-3)
     assert (out / "closed_loop_plant_effects.png").is_file()
+    compact = (out / "effects.md").read_text(encoding="utf-8").split("\n\n")[1].splitlines()
+    assert compact[0] == "| effect | " + " | ".join(effects["variants"]) + " |"
+    tcp = effects["variants"]["all"]["optimal"]["tcp_error_mm"]["max"]
+    assert compact[3].endswith(f"/ {tcp:.2f} |")
 
 
 def test_a_bad_plant_exits_2_naming_it(small_result: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

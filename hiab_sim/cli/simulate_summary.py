@@ -22,7 +22,7 @@ def write_results(
     designs: tuple[str, ...],
     out: Path,
 ) -> tuple[list[str], dict[str, object] | None]:
-    """Run the effect study (a plant with effects on), write ``simulation.json`` and the figures to ``out``.
+    """Run the effect study (a plant with effects on); write ``simulation.json``, ``effects.md``, the figures.
 
     Returns the names of the files written and the effect study (None without one), which ``report`` holds too.
     """
@@ -36,6 +36,10 @@ def write_results(
 
     write_atomic(out / "simulation.json", json.dumps(report, indent=2) + "\n")
     written = ["simulation.json"]
+    if effects is not None:
+        from hiab_sim.env.effects import write_effect_markdown
+
+        written.append(write_effect_markdown(out / "effects.md", effects).name)
     if not args.no_figures:
         from hiab_sim.env.figures import write_figures
 

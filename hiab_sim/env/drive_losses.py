@@ -37,19 +37,57 @@ E_dc = E_m + s P_coil h + E_inv - (1 - s) E_m.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.emla.config import EmlaParams
 from hiab_sim.emla.drive_sim import DriveStep
-from hiab_sim.emla.losses import brake_release, inverter_loss, transmission_loss_torque
+from hiab_sim.emla.losses import DriveLosses, brake_release, inverter_loss, transmission_loss_torque
 
 Array = NDArray[np.float64]
 
 #: Newton steps of the transmission's inversion: the loss torque is piecewise almost linear in f_sm
 #: (smooth |f_sm| within f_eps = 10 N), so two steps from the exact form's solution reach round-off.
 NEWTON_STEPS = 3
+
+
+@dataclass(frozen=True)
+class _StackedLosses:
+    """The drives' loss parameters as arrays, read by the planner's loss functions in one call for all drives.
+
+    :func:`~hiab_sim.emla.losses.transmission_loss_torque` and :func:`~hiab_sim.emla.losses.inverter_loss`
+    are elementwise in their parameters, so one call on (n,) arrays (columns (n, 1) for the inverter's
+    per-sample currents) gives each drive what its own call gives, to the bit.
+    """
+
+    transmission_efficiency_forward: Array
+    transmission_efficiency_backdriven: Array
+    force_smoothing: Array
+    inverter_constant_loss: Array
+    inverter_current_loss: Array
+    inverter_resistance: Array
+    current_smoothing: Array
+
+    @classmethod
+    def of(cls, losses: tuple[DriveLosses, ...], shape: tuple[int, ...]) -> DriveLosses:
+        """The stacked parameters of ``losses``, each field reshaped to ``shape``."""
+
+        def stack(field: str) -> Array:
+            return np.array([getattr(loss, field) for loss in losses], dtype=float).reshape(shape)
+
+        fields = (
+            "transmission_efficiency_forward",
+            "transmission_efficiency_backdriven",
+            "force_smoothing",
+            "inverter_constant_loss",
+            "inverter_current_loss",
+            "inverter_resistance",
+            "current_smoothing",
+        )
+        return cast(DriveLosses, cls(*(stack(field) for field in fields)))
 
 
 class DriveLossModel:
@@ -68,24 +106,30 @@ class DriveLossModel:
         self.rotor_mass = np.array([p.motor.rotor_inertia * p.transmission_ratio**2 for p in self.params])
         self.omega_eps = np.array([p.motor.friction_smoothing_speed for p in self.params])
         self.transmission_on = any(loss.transmission_on for loss in self.losses)
+        n = len(self.params)
+        self._transmission = np.array([loss.transmission_on for loss in self.losses])
+        self._inverter = np.array([loss.inverter_on for loss in self.losses])
+        self._stacked = _StackedLosses.of(self.losses, (n,))
+        self._columns = _StackedLosses.of(self.losses, (n, 1))
+        self._coil_power = np.array([loss.brake_coil_power for loss in self.losses])
+        self._braked = [j for j, loss in enumerate(self.losses) if loss.brake_on]
 
     def loss_torque(self, screw_force: Array, motor_speed: Array) -> tuple[Array, Array]:
-        """(tau_tr [N m], d tau_tr / d f_sm [m]) per drive at the screw forces [N] and motor speeds [rad/s]."""
-        tau = np.zeros(len(self.params))
-        slope = np.zeros(len(self.params))
-        for j, loss in enumerate(self.losses):
-            if not loss.transmission_on:
-                continue
-            t, d_f, _ = transmission_loss_torque(
-                loss,
-                np.asarray(screw_force[j], dtype=float),
-                np.asarray(motor_speed[j], dtype=float),
-                float(self.ratio[j]),
-                float(self.omega_eps[j]),
-                exact=False,
-            )
-            tau[j], slope[j] = float(t), float(d_f)
-        return tau, slope
+        """(tau_tr [N m], d tau_tr / d f_sm [m]) per drive at the screw forces [N] and motor speeds [rad/s].
+
+        One call of the planner's function on all drives (:class:`_StackedLosses`); 0 where a drive's
+        transmission is lossless.
+        """
+        t, d_f, _ = transmission_loss_torque(
+            self._stacked,
+            np.asarray(screw_force, dtype=float),
+            np.asarray(motor_speed, dtype=float),
+            self.ratio,  # type: ignore[arg-type]
+            self.omega_eps,  # type: ignore[arg-type]
+            exact=False,
+        )
+        on = self._transmission
+        return np.where(on, t, 0.0), np.where(on, d_f, 0.0)
 
     def screw_force(self, available: Array, motor_speed: Array) -> tuple[Array, Array]:
         """(f_sm [N], tau_tr [N m]) solving f_sm + k tau_tr(f_sm, omega_m) = y for y = ``available`` [N]."""
@@ -112,19 +156,24 @@ class DriveLossModel:
     def dc_energy(self, step: DriveStep, rod_velocity: Array, h: float) -> tuple[Array, Array, Array, Array]:
         """(E_dc, E_inv, E_coil, E_brake_carried) [J] per drive over the step (module docstring)."""
         n = len(self.params)
-        dc, inverter, coil, carried = (np.zeros(n) for _ in range(4))
+        release = np.ones(n)
+        for j in self._braked:  # the brake's release factor s(v_x); 1 where no brake is modelled
+            loss = self.losses[j]
+            release[j] = float(brake_release(loss, np.asarray(float(rod_velocity[j])), exact=False)[0])
+        motor = np.asarray(step.electrical_energy, dtype=float)
+        coil = release * self._coil_power * h
         magnitudes = step.current_samples
         weights = step.sample_weights
-        for j, loss in enumerate(self.losses):
-            s = float(brake_release(loss, np.asarray(float(rod_velocity[j])), exact=False)[0])
-            motor = float(step.electrical_energy[j])
-            coil[j] = s * loss.brake_coil_power * h
-            if loss.inverter_on:
-                if magnitudes is None or weights is None:
+        inverter = np.zeros(n)
+        if magnitudes is None or weights is None:
+            for j, loss in enumerate(self.losses):
+                if loss.inverter_on:
                     amplitude = np.array([np.hypot(float(step.i_d[j]), float(step.i_q[j]))])
-                    inverter[j] = h * float(inverter_loss(loss, s * amplitude, exact=False)[0][0])
-                else:
-                    inverter[j] = float(weights @ inverter_loss(loss, s * magnitudes[j], exact=False)[0])
-            carried[j] = (1.0 - s) * motor
-            dc[j] = s * motor + coil[j] + inverter[j]
+                    inverter[j] = h * float(inverter_loss(loss, release[j] * amplitude, exact=False)[0][0])
+        elif self._inverter.any():
+            power = inverter_loss(self._columns, release[:, None] * magnitudes, exact=False)[0]
+            for row in np.flatnonzero(self._inverter).tolist():
+                inverter[row] = float(weights @ power[row])
+        carried = (1.0 - release) * motor
+        dc = release * motor + coil + inverter
         return dc, inverter, coil, carried

@@ -120,16 +120,23 @@ def true_study(study: Study, plant: Plant) -> Study:
     return replace(study, crane_description=true_crane(study.crane, plant.mismatch))
 
 
-def replanned_summary(result: dict[str, Any]) -> dict[str, object]:
-    """``predicted_J``, ``lengths`` (and ``predicted_battery_J`` with a battery) of a re-planned ``result.json``."""
+def replanned_summary(result_dir: str | Path) -> dict[str, object]:
+    """``predicted_J``, ``lengths`` (and ``predicted_battery_J`` with a battery) of a re-planned result folder.
+
+    ``predicted_battery_J`` is the re-planned optimum's battery energy of one cycle, the boundary of the
+    closed loop's and of the nominal prediction (``predicted_cycle_battery_energy`` of
+    :mod:`hiab_sim.env.closed_loop_battery`: with the study's duty model the cycle's share, the rest
+    between cycles left out).
+    """
+    result = json.loads((Path(result_dir) / "result.json").read_text(encoding="utf-8"))
     optimal = result["optimal"]
     replanned: dict[str, object] = {
         "predicted_J": float(optimal["net_electrical_energy_J"]),
         "lengths": optimal.get("lengths"),
     }
-    energy = result.get("energy")
-    if isinstance(energy, dict) and "optimal" in energy:
-        replanned["predicted_battery_J"] = float(energy["optimal"]["battery_energy_J"])
+    battery = predicted_cycle_battery_energy(result_dir)
+    if "optimal" in battery:
+        replanned["predicted_battery_J"] = float(battery["optimal"])
     return replanned
 
 
@@ -154,7 +161,7 @@ def replanned_prediction(result_dir: str | Path, plant: Plant) -> dict[str, obje
         out = run_study(
             true_study(study, plant), Path(folder) / "replan", progress=None, figures=False, force=True, cross=False
         )
-        return replanned_summary(json.loads((out.folder / "result.json").read_text(encoding="utf-8")))
+        return replanned_summary(out.folder)
 
 
 def attach_replanned(report: dict[str, Any], replanned: dict[str, object]) -> None:
@@ -335,6 +342,78 @@ def effect_table(report: dict[str, object]) -> str:
                 line += f" {row['battery_energy_J']:.1f} | {versus} | {at_battery} |"
             lines.append(line)
     return "\n".join(lines)
+
+
+def compact_effect_table(report: dict[str, object]) -> str:
+    """Five-line markdown table of the effect study: one column per variant, both designs in each cell.
+
+    Rows: the closed loop's battery energy against the prediction [%] (the DC-bus energy where the result
+    has no battery), the TCP's largest error [mm], and whether the optimal design draws less than the
+    initial one in closed loop (at the battery, or at the DC bus).
+    """
+    table = report["variants"]
+    assert isinstance(table, dict)
+    battery = "battery_energy" in report
+    designs = [d for d in ("initial", "optimal") if all(d in entry for entry in table.values())]
+    names = list(table)
+    key, where = (
+        ("battery_energy_difference_percent", "battery energy")
+        if battery
+        else ("dc_bus_energy_difference_percent", "DC-bus energy")
+    )
+    cheaper_key = "optimal_below_initial_battery" if battery else "optimal_below_initial"
+
+    def cells(value: Any) -> str:
+        return " | ".join(value(table[name]) for name in names)
+
+    def percent(entry: dict[str, Any]) -> str:
+        values = [entry[d][key] for d in designs]
+        if any(v is None for v in values):
+            return "n/a"
+        return " / ".join(f"{v:+.2f}" for v in values) + " %"
+
+    def tcp(entry: dict[str, Any]) -> str:
+        return " / ".join(f"{entry[d]['tcp_error_mm']['max']:.2f}" for d in designs)
+
+    def cheaper(entry: dict[str, Any]) -> str:
+        flag = entry.get(cheaper_key)
+        return "n/a" if flag is None else ("yes" if flag else "**no**")
+
+    label = " / ".join(designs)
+    lines = [
+        f"| effect | {' | '.join(names)} |",
+        "|---|" + "---:|" * len(names),
+        f"| closed-loop {where} vs predicted ({label}) | {cells(percent)} |",
+        f"| TCP max error ({label}) [mm] | {cells(tcp)} |",
+    ]
+    if designs == ["initial", "optimal"]:
+        at = "at the battery" if battery else "at the DC bus"
+        lines.append(f"| optimum stays cheaper ({at}) | {cells(cheaper)} |")
+    return "\n".join(lines)
+
+
+def effect_markdown(report: dict[str, object]) -> str:
+    """``effects.md``: the compact table (:func:`compact_effect_table`), the full table, the lines in words."""
+    cycles = report.get("cycles", 1)
+    parts = [
+        f"# Plant effects: {report['plant']} plant, {cycles} cycle(s) per run (energies of the last)",
+        "",
+        compact_effect_table(report),
+        "",
+        effect_table(report),
+        "",
+        *(f"* {line}" for line in effect_lines(report)),
+        "",
+    ]
+    return "\n".join(parts)
+
+
+def write_effect_markdown(path: Path, report: dict[str, object]) -> Path:
+    """Write :func:`effect_markdown` to ``path`` (``effects.md`` in the run folder); return the path."""
+    from hiab_sim.atomic_io import write_atomic
+
+    write_atomic(path, effect_markdown(report))
+    return path
 
 
 def effect_lines(report: dict[str, object]) -> list[str]:

@@ -13,7 +13,8 @@ passes (nothing here knows a machine's names):
   ``rod_side_mass_kg``, no damping) and makes the slides' motors the springs (:func:`spring_actuators`);
 * :func:`plant_parts`: the drives (the continuous loop, or the discrete one of
   :mod:`hiab_sim.env.plant.current_loop`), the EMLA file's drive losses, the two-mass trains, the
-  winding temperature, the friction meter and the plan's hot-winding resistance, which
+  winding temperature, the friction meter and the plan's hot-winding resistance (not computed
+  while the plant's own winding temperature sets R_s), which
   :meth:`hiab_sim.env.physics.CranePhysics.attach_parts` puts on the Physics.
 """
 
@@ -147,5 +148,6 @@ def plant_parts(
         drive_train=train,
         thermal=thermal,
         friction=FrictionMeter(model, *friction) if friction[0] else None,
-        resistance_schedule=hot_resistance(plan, motion, arrays.resistance),
+        # the plan's hot windings, unless the plant's own winding temperature sets R_s
+        resistance_schedule=None if thermal is not None else hot_resistance(plan, motion, arrays.resistance),
     )

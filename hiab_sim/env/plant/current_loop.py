@@ -37,34 +37,47 @@ from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
 
+#: A 2x2 matrix, row-major.
+Quad = tuple[float, float, float, float]
+
 #: Current scale [A] of the smooth sign of the dead-time error (model choice, see the module docstring).
 DEAD_TIME_CURRENT_A = 1.0
 
 
-def _exp_maps(a11: float, a12: float, a21: float, a22: float, t: float) -> tuple[tuple[float, ...], ...]:
+def _exp_maps(
+    a11: float, a12: float, a21: float, a22: float, t: float
+) -> tuple[tuple[float, float, float, float], tuple[float, float, float, float], tuple[float, float, float, float]]:
     """E = exp(A t), F = A^-1 (E - I), G = A^-1 (F - t I) of a 2x2 A with det(A) != 0, row-major."""
+    (e, f, g), _ = _exp_maps_full_half(a11, a12, a21, a22, t)
+    return e, f, g
+
+
+def _exp_maps_full_half(
+    a11: float, a12: float, a21: float, a22: float, t: float
+) -> tuple[tuple[Quad, Quad, Quad], tuple[Quad, Quad]]:
+    """((E, F, G) at t, (E, F) at t / 2) of :func:`_exp_maps`, sharing the eigenvalues and A^-1.
+
+    One evaluation per drive and physics step: the speed, and so A, is held over the step.
+    """
     m = 0.5 * (a11 + a22)
     det = a11 * a22 - a12 * a21
     q = cmath.sqrt(m * m - det)
-    if abs(q * t) < 1e-8:
-        ch, sh = 1.0, t
-    else:
-        ch, sh = cmath.cosh(q * t).real, (cmath.sinh(q * t) / q).real
-    g = math.exp(m * t)
-    e = (g * (ch + sh * (a11 - m)), g * sh * a12, g * sh * a21, g * (ch + sh * (a22 - m)))
-    inv = (a22 / det, -a12 / det, -a21 / det, a11 / det)
-
-    def times_inv(x: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
-        return (
-            inv[0] * x[0] + inv[1] * x[2],
-            inv[0] * x[1] + inv[1] * x[3],
-            inv[2] * x[0] + inv[3] * x[2],
-            inv[2] * x[1] + inv[3] * x[3],
-        )
-
-    f = times_inv((e[0] - 1.0, e[1], e[2], e[3] - 1.0))
-    gg = times_inv((f[0] - t, f[1], f[2], f[3] - t))
-    return e, f, gg
+    i0, i1, i2, i3 = a22 / det, -a12 / det, -a21 / det, a11 / det
+    maps = []
+    for span in (t, 0.5 * t):
+        if abs(q * span) < 1e-8:
+            ch, sh = 1.0, span
+        else:
+            ch, sh = cmath.cosh(q * span).real, (cmath.sinh(q * span) / q).real
+        g = math.exp(m * span)
+        e0, e1, e2, e3 = g * (ch + sh * (a11 - m)), g * sh * a12, g * sh * a21, g * (ch + sh * (a22 - m))
+        x0, x1, x2, x3 = e0 - 1.0, e1, e2, e3 - 1.0
+        f0, f1, f2, f3 = i0 * x0 + i1 * x2, i0 * x1 + i1 * x3, i2 * x0 + i3 * x2, i2 * x1 + i3 * x3
+        maps.append(((e0, e1, e2, e3), (f0, f1, f2, f3)))
+    (e, f), half = maps
+    x0, x1, x2, x3 = f[0] - t, f[1], f[2], f[3] - t
+    gg = (i0 * x0 + i1 * x2, i0 * x1 + i1 * x3, i2 * x0 + i3 * x2, i2 * x1 + i3 * x3)
+    return (e, f, gg), half
 
 
 class DiscreteCurrentLoop(DriveSimulator):
@@ -100,6 +113,7 @@ class DiscreteCurrentLoop(DriveSimulator):
         weights[1::2] += 4.0 * self.period / 6.0
         weights[2::2] += self.period / 6.0
         self.sample_weights = weights
+        self._cached: tuple[tuple[Array, ...], tuple[list[float], ...]] | None = None
 
     def reset(self, i_d: ArrayLike, i_q: ArrayLike) -> None:
         """Set the currents; integrators and the pending voltage at the steady state at rest."""
@@ -110,7 +124,11 @@ class DiscreteCurrentLoop(DriveSimulator):
         self.pending_q = self.x_q.copy()
 
     def step(self, reference_q: ArrayLike, omega_m: ArrayLike, h: float) -> DriveStep:
-        """Advance every drive by h [s] (``self.periods`` PWM periods) at held motor speeds [rad/s]."""
+        """Advance every drive by h [s] (``self.periods`` PWM periods) at held motor speeds [rad/s].
+
+        Scalar Python per drive and period (a few drives, eight periods: numpy's per-call cost on
+        arrays of three would exceed the arithmetic); the constants are read once per parameter set.
+        """
         d = self.drives
         omega = np.asarray(omega_m, dtype=float)
         requested = np.asarray(reference_q, dtype=float)
@@ -119,40 +137,45 @@ class DiscreteCurrentLoop(DriveSimulator):
         errors = self.sensor.sample(self.periods)
         noise_d = self.sensor.sample(self.periods) - self.sensor.offset if self.sensor.enabled else errors
         n = len(d.names)
-        out = {key: np.zeros(n) for key in ("id", "iq", "vd", "vq", "energy", "copper", "torque")}
-        samples = np.zeros((n, 2 * self.periods + 1))
+        ld_all, lq_all, p_all, flux_all, ki_all, vmax2_all = self._constants(d)
+        r_all = d.resistance.tolist()
+        omega_all, ref_all = omega.tolist(), ref_q.tolist()
+        noise_q_all, noise_d_all = errors.T.tolist(), noise_d.T.tolist()
+        state_id, state_iq = self.i_d.tolist(), self.i_q.tolist()
+        state_xd, state_xq = self.x_d.tolist(), self.x_q.tolist()
+        state_pd, state_pq = self.pending_d.tolist(), self.pending_q.tolist()
+        out_id, out_iq, out_vd, out_vq, out_energy, out_copper, out_torque = ([0.0] * n for _ in range(7))
+        samples = np.empty((n, 2 * self.periods + 1))
         saturated = np.zeros(n, dtype=bool)
-        loop = self.loop
+        periods = range(self.periods)
         T = self.period
         wc = self.bandwidth
-        v_dead = loop.dead_time_voltage_V
+        v_dead = self.loop.dead_time_voltage_V
         eps2 = DEAD_TIME_CURRENT_A**2
         for j in range(n):
-            r, ld, lq, p, flux = (
-                float(d.resistance[j]),
-                float(d.Ld[j]),
-                float(d.Lq[j]),
-                float(d.pole_pairs[j]),
-                float(d.flux[j]),
-            )
-            w_e = p * float(omega[j])
+            r, ld, lq, p, flux = r_all[j], ld_all[j], lq_all[j], p_all[j], flux_all[j]
+            w_e = p * omega_all[j]
             a11, a12, a21, a22 = -r / ld, w_e * lq / ld, -w_e * ld / lq, -r / lq
-            e1, f1, g1 = _exp_maps(a11, a12, a21, a22, T)
-            e2, f2, _ = _exp_maps(a11, a12, a21, a22, 0.5 * T)
+            (e1, f1, g1), (e2, f2) = _exp_maps_full_half(a11, a12, a21, a22, T)
+            e10, e11, e12, e13 = e1
+            f10, f11, f12, f13 = f1
+            g10, g11, g12, g13 = g1
+            e20, e21, e22, e23 = e2
+            f20, f21, f22, f23 = f2
             kp_d, kp_q = ld * wc, lq * wc
-            ki = float(self.nominal_resistance[j]) * wc * T
-            vmax2 = float(d.voltage_limit[j]) ** 2
-            i_d, i_q = float(self.i_d[j]), float(self.i_q[j])
-            x_d, x_q = float(self.x_d[j]), float(self.x_q[j])
-            pend_d, pend_q = float(self.pending_d[j]), float(self.pending_q[j])
-            ref = float(ref_q[j])
+            ki = ki_all[j]
+            vmax2 = vmax2_all[j]
+            i_d, i_q = state_id[j], state_iq[j]
+            x_d, x_q = state_xd[j], state_xq[j]
+            pend_d, pend_q = state_pd[j], state_pq[j]
+            ref = ref_all[j]
+            noise_q, noise_dj = noise_q_all[j], noise_d_all[j]
             energy = copper = torque = 0.0
-            row = samples[j]
-            row[0] = math.hypot(i_d, i_q)
+            row = [math.hypot(i_d, i_q)]
             sat = False
             va_d = va_q = 0.0
-            for k in range(self.periods):
-                m_d, m_q = i_d + float(noise_d[k, j]), i_q + float(errors[k, j])
+            for k in periods:
+                m_d, m_q = i_d + noise_dj[k], i_q + noise_q[k]
                 err_d, err_q = -m_d, ref - m_q
                 nx_d, nx_q = x_d + ki * err_d, x_q + ki * err_q
                 v_d = kp_d * err_d + nx_d - w_e * lq * m_q
@@ -169,39 +192,58 @@ class DiscreteCurrentLoop(DriveSimulator):
                 va_d, va_q = pend_d - blur * i_d, pend_q - blur * i_q
                 pend_d, pend_q = v_d, v_q
                 u_d, u_q = va_d / ld, (va_q - w_e * flux) / lq
-                end_d = e1[0] * i_d + e1[1] * i_q + f1[0] * u_d + f1[1] * u_q
-                end_q = e1[2] * i_d + e1[3] * i_q + f1[2] * u_d + f1[3] * u_q
-                mid_d = e2[0] * i_d + e2[1] * i_q + f2[0] * u_d + f2[1] * u_q
-                mid_q = e2[2] * i_d + e2[3] * i_q + f2[2] * u_d + f2[3] * u_q
-                int_d = f1[0] * i_d + f1[1] * i_q + g1[0] * u_d + g1[1] * u_q
-                int_q = f1[2] * i_d + f1[3] * i_q + g1[2] * u_d + g1[3] * u_q
+                end_d = e10 * i_d + e11 * i_q + f10 * u_d + f11 * u_q
+                end_q = e12 * i_d + e13 * i_q + f12 * u_d + f13 * u_q
+                mid_d = e20 * i_d + e21 * i_q + f20 * u_d + f21 * u_q
+                mid_q = e22 * i_d + e23 * i_q + f22 * u_d + f23 * u_q
+                int_d = f10 * i_d + f11 * i_q + g10 * u_d + g11 * u_q
+                int_q = f12 * i_d + f13 * i_q + g12 * u_d + g13 * u_q
                 energy += 1.5 * (va_d * int_d + va_q * int_q)
                 s0, sm, s1 = i_d * i_d + i_q * i_q, mid_d * mid_d + mid_q * mid_q, end_d * end_d + end_q * end_q
                 squares = T * (s0 + 4.0 * sm + s1) / 6.0
                 copper += 1.5 * r * squares
                 products = T * (i_d * i_q + 4.0 * mid_d * mid_q + end_d * end_q) / 6.0
                 torque += 1.5 * p * (flux * int_q + (ld - lq) * products)
-                row[2 * k + 1], row[2 * k + 2] = math.sqrt(sm), math.sqrt(s1)
+                row.append(math.sqrt(sm))
+                row.append(math.sqrt(s1))
                 i_d, i_q = end_d, end_q
-            self.x_d[j], self.x_q[j] = x_d, x_q
-            self.pending_d[j], self.pending_q[j] = pend_d, pend_q
-            out["id"][j], out["iq"][j], out["vd"][j], out["vq"][j] = i_d, i_q, va_d, va_q
-            out["energy"][j], out["copper"][j], out["torque"][j] = energy, copper, torque / h
+            state_xd[j], state_xq[j] = x_d, x_q
+            state_pd[j], state_pq[j] = pend_d, pend_q
+            out_id[j], out_iq[j], out_vd[j], out_vq[j] = i_d, i_q, va_d, va_q
+            out_energy[j], out_copper[j], out_torque[j] = energy, copper, torque / h
+            samples[j] = row
             saturated[j] = sat
-        self.i_d, self.i_q = out["id"], out["iq"]
+        self.x_d, self.x_q = np.array(state_xd), np.array(state_xq)
+        self.pending_d, self.pending_q = np.array(state_pd), np.array(state_pq)
+        i_d_end, i_q_end, torque_mean = np.array(out_id), np.array(out_iq), np.array(out_torque)
+        self.i_d, self.i_q = i_d_end, i_q_end
         friction = d.coulomb * np.tanh(omega / d.smoothing)
         return DriveStep(
-            i_d=out["id"],
-            i_q=out["iq"],
-            v_d=out["vd"],
-            v_q=out["vq"],
-            electrical_energy=out["energy"],
-            copper_energy=out["copper"],
-            torque=out["torque"],
+            i_d=i_d_end,
+            i_q=i_q_end,
+            v_d=np.array(out_vd),
+            v_q=np.array(out_vq),
+            electrical_energy=np.array(out_energy),
+            copper_energy=np.array(out_copper),
+            torque=torque_mean,
             friction_torque=friction,
-            rod_force=d.ratio * (out["torque"] - friction),
+            rod_force=d.ratio * (torque_mean - friction),
             current_limited=np.abs(requested) >= limit,
             voltage_limited=saturated,
             current_samples=samples,
             sample_weights=self.sample_weights,
         )
+
+    def _constants(self, d: DriveArrays) -> tuple[list[float], ...]:
+        """(L_d, L_q, p, Phi_PM, K_i T_s, V_max^2) per drive as floats, read again only when they change.
+
+        R_s is not among them: the winding temperature hands over a new one every step.
+        """
+        key = (d.Ld, d.Lq, d.pole_pairs, d.flux, d.voltage_limit)
+        cached = self._cached
+        if cached is None or any(a is not b for a, b in zip(cached[0], key, strict=True)):
+            ki = (self.nominal_resistance * self.bandwidth * self.period).tolist()
+            vmax2 = [v**2 for v in d.voltage_limit.tolist()]
+            values = (d.Ld.tolist(), d.Lq.tolist(), d.pole_pairs.tolist(), d.flux.tolist(), ki, vmax2)
+            cached = self._cached = (key, values)
+        return cached[1]

@@ -92,6 +92,11 @@ class TwoMassDriveTrain:
         self.viscous = np.asarray(viscous, dtype=float)
         self.position = np.zeros_like(self.mass)
         self.velocity = np.zeros_like(self.mass)
+        # the constants as floats for the per-step scalar loops
+        self._stiffness = self.stiffness.tolist()
+        self._damping = self.damping.tolist()
+        self._mass = self.mass.tolist()
+        self._viscous = np.broadcast_to(self.viscous, self.mass.shape).tolist()
 
     def reset(self, rod_position: Array, rod_velocity: Array, force: Array) -> None:
         """Put the motor side where the spring carries ``force`` [N] at rest relative to the rod."""
@@ -106,20 +111,56 @@ class TwoMassDriveTrain:
         return np.where(d > self.half_play, d - self.half_play, np.where(d < -self.half_play, d + self.half_play, 0.0))
 
     def spring_force(self, rod_position: Array, rod_velocity: Array) -> Array:
-        """f_s [N] on the rod, positive extending (module docstring)."""
-        e = self.contact_deflection(rod_position)
-        force = self.stiffness * e + np.where(e != 0.0, self.damping * (self.velocity - rod_velocity), 0.0)
-        return np.where(e > 0.0, np.maximum(force, 0.0), np.where(e < 0.0, np.minimum(force, 0.0), 0.0))
+        """f_s [N] on the rod, positive extending (module docstring).
+
+        Per drive in scalar Python, as :meth:`rod_actuator` and :meth:`step`: called every physics step
+        on a few drives, where numpy's per-call cost would exceed the arithmetic.
+        """
+        b = self.half_play
+        forces = []
+        for x_m, v_m, x, v, k_s, c_s in zip(
+            self.position.tolist(),
+            self.velocity.tolist(),
+            np.asarray(rod_position, dtype=float).tolist(),
+            np.asarray(rod_velocity, dtype=float).tolist(),
+            self._stiffness,
+            self._damping,
+            strict=True,
+        ):
+            d = x_m - x
+            if d > b:
+                force = k_s * (d - b) + c_s * (v_m - v)
+                forces.append(force if force > 0.0 else 0.0)
+            elif d < -b:
+                force = k_s * (d + b) + c_s * (v_m - v)
+                forces.append(force if force < 0.0 else 0.0)
+            else:
+                forces.append(0.0)
+        return np.array(forces)
 
     def rod_actuator(self, rod_position: Array, h: float) -> tuple[Array, Array, Array]:
         """(ctrl [N], k_c [N/m], c_c [N s/m]) of the rod's actuator f = ctrl - k_c x - c_c v (module docstring)."""
-        d = self.position - rod_position
-        above, below = d > self.half_play, d < -self.half_play
-        contact = above | below
-        anchor = self.position - np.where(above, self.half_play, np.where(below, -self.half_play, 0.0))
-        k_c = np.where(contact, self.stiffness, 0.0)
-        c_c = np.where(contact, self.damping, 0.0)
-        return k_c * anchor + c_c * self.velocity, k_c, c_c
+        ctrl, k_c, c_c = self._rod_actuator(np.asarray(rod_position, dtype=float).tolist())
+        return np.array(ctrl), np.array(k_c), np.array(c_c)
+
+    def _rod_actuator(self, rod_position: list[float]) -> tuple[list[float], list[float], list[float]]:
+        """:meth:`rod_actuator` on lists of floats."""
+        b = self.half_play
+        ctrl, k_c, c_c = [], [], []
+        for x_m, v_m, x, k_s, c_s in zip(
+            self.position.tolist(), self.velocity.tolist(), rod_position, self._stiffness, self._damping, strict=True
+        ):
+            d = x_m - x
+            if d > b:
+                k, c, anchor = k_s, c_s, x_m - b
+            elif d < -b:
+                k, c, anchor = k_s, c_s, x_m + b
+            else:
+                k, c, anchor = 0.0, 0.0, x_m
+            ctrl.append(k * anchor + c * v_m)
+            k_c.append(k)
+            c_c.append(c)
+        return ctrl, k_c, c_c
 
     def spring_energy(self, rod_position: Array) -> Array:
         """1/2 k_s e^2 [J] per drive."""
@@ -138,15 +179,40 @@ class TwoMassDriveTrain:
             spring's damping c_s (v_m - v')^2 h and the numerical k_s h^2 v'^2 (module docstring).
 
         """
-        contact = rod_force != 0.0
-        slip = self.velocity - rod_velocity
-        spring = np.where(contact, h * self.damping * slip * slip, 0.0)
-        # Screw friction implicit (-b_f v_m at the new rate): its work over the step is -b_f v_m^2 h exactly.
-        self.velocity = (self.velocity + h * (drive_force - rod_force) / self.mass) / (
-            1.0 + h * self.viscous / self.mass
+        return np.array(
+            self._step(
+                np.asarray(drive_force, dtype=float).tolist(),
+                np.asarray(rod_force, dtype=float).tolist(),
+                np.asarray(rod_velocity, dtype=float).tolist(),
+                h,
+            )
         )
-        self.position = self.position + h * self.velocity
-        dissipated: Array = h * self.viscous * self.velocity**2 + spring
+
+    def _step(
+        self, drive_force: list[float], rod_force: list[float], rod_velocity: list[float], h: float
+    ) -> list[float]:
+        """:meth:`step` on lists of floats."""
+        positions, velocities, dissipated = [], [], []
+        for x_m, v_m, f_d, f_r, v, m, c_s, b_f in zip(
+            self.position.tolist(),
+            self.velocity.tolist(),
+            drive_force,
+            rod_force,
+            rod_velocity,
+            self._mass,
+            self._damping,
+            self._viscous,
+            strict=True,
+        ):
+            slip = v_m - v
+            spring = h * c_s * slip * slip if f_r != 0.0 else 0.0
+            # Screw friction implicit (-b_f v_m at the new rate): its work over the step is -b_f v_m^2 h exactly.
+            v_m = (v_m + h * (f_d - f_r) / m) / (1.0 + h * b_f / m)
+            positions.append(x_m + h * v_m)
+            velocities.append(v_m)
+            dissipated.append(h * b_f * (v_m * v_m) + spring)
+        self.position = np.array(positions)
+        self.velocity = np.array(velocities)
         return dissipated
 
 
@@ -164,12 +230,14 @@ def coupled_step(
     ``actuators`` are the slides' affine actuators (gain 1, bias (0, -k_c, -c_c)), ``dofs`` the slides'
     degrees of freedom; see the module docstring.
     """
-    x = data.qpos[dofs].copy()
-    ctrl, k_c, c_c = train.rod_actuator(x, h)
+    x = data.qpos[dofs].tolist()
+    ctrl, k_c, c_c = train._rod_actuator(x)
     data.ctrl[actuators] = ctrl
-    model.actuator_biasprm[actuators, 1] = -k_c
-    model.actuator_biasprm[actuators, 2] = -c_c
+    bias = model.actuator_biasprm
+    bias[actuators, 1] = [-k for k in k_c]
+    bias[actuators, 2] = [-c for c in c_c]
     mujoco.mj_step(model, data)
-    v_new = data.qvel[dofs]
-    force = ctrl - k_c * x - c_c * v_new  # what the rod received over the step
-    return train.step(drive_force, force, v_new, h)
+    v_new = data.qvel[dofs].tolist()
+    # what the rod received over the step
+    force = [u - k * x_j - c * v for u, k, x_j, c, v in zip(ctrl, k_c, x, c_c, v_new, strict=True)]
+    return np.array(train._step(np.asarray(drive_force, dtype=float).tolist(), force, v_new, h))

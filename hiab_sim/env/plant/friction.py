@@ -137,18 +137,26 @@ class FrictionMeter:
         for row, t in enumerate(ids):
             for w in range(model.tendon_adr[t], model.tendon_adr[t] + model.tendon_num[t]):
                 self.tendon_rows[row, model.jnt_dofadr[model.wrap_objid[w]]] = model.wrap_prm[w]
+        self._velocity = np.zeros(0)  # J qvel over the constraint rows, reused while nefc stays
 
     def power(self, model: mujoco.MjModel, data: mujoco.MjData) -> float:
-        """Dissipated power [W] (>= 0) at the state in ``data``, with its last solver's friction forces."""
-        friction = (data.efc_type == mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF) | (
-            data.efc_type == mujoco.mjtConstraint.mjCNSTR_FRICTION_TENDON
-        )
+        """Dissipated power [W] (>= 0) at the state in ``data``, with its last solver's friction forces.
+
+        MuJoCo orders the constraint rows equality, friction (dof, then tendon), limits, contacts, so
+        the friction rows are ``ne .. ne + nf - 1``; J v is formed in a buffer kept between steps.
+        """
         coulomb = 0.0
-        if friction.any():
-            velocity = np.zeros(data.nefc)
+        nf = data.nf
+        if nf:
+            nefc = data.nefc
+            if self._velocity.size != nefc:
+                self._velocity = np.zeros(nefc)
+            velocity = self._velocity
             mujoco.mj_mulJacVec(model, data, velocity, data.qvel)
-            coulomb = float(-(data.efc_force[friction] @ velocity[friction]))
-        viscous = float(self.joint_damping @ data.qvel[self.dofs] ** 2)
+            rows = slice(data.ne, data.ne + nf)
+            coulomb = float(-(data.efc_force[rows] @ velocity[rows]))
+        qvel = data.qvel
+        viscous = float(self.joint_damping @ qvel[self.dofs] ** 2)
         if self.tendon_damping.size:
-            viscous += float(self.tendon_damping @ (self.tendon_rows @ data.qvel) ** 2)
+            viscous += float(self.tendon_damping @ (self.tendon_rows @ qvel) ** 2)
         return coulomb + viscous

@@ -37,6 +37,7 @@ class WindingTemperature:
         self.tau = np.array([p.thermal.time_constant for p in emlas if p.thermal is not None])
         self.ambient = np.array([p.thermal.ambient_temperature for p in emlas if p.thermal is not None])
         self.temperature = np.full(len(emlas), thermal.initial_temperature_C)
+        self._decay_step, self._decay = float("nan"), np.ones(len(emlas))
 
     def resistance(self) -> Array:
         """R_s(T) per drive [ohm]."""
@@ -47,7 +48,9 @@ class WindingTemperature:
 
     def advance(self, copper_energy: Array, h: float) -> None:
         """Advance by h [s] with the copper loss E_cu [J] of the step."""
-        decay = np.exp(-h / self.tau)
+        if h != self._decay_step:  # exp(-h / tau_th), the same for every step of length h
+            self._decay_step, self._decay = h, np.exp(-h / self.tau)
+        decay = self._decay
         power = np.asarray(copper_energy, dtype=float) / h if h > 0 else 0.0
         self.temperature = self.ambient + (self.temperature - self.ambient) * decay + self.r_th * power * (1.0 - decay)
 
