@@ -117,3 +117,12 @@ def test_the_replanned_battery_energy_is_one_cycles_as_the_closed_loops() -> Non
     assert summary["predicted_battery_J"] == duty["cycle_battery_energy_J"]
     assert duty["rest_battery_energy_J"] > 0.0
     assert summary["predicted_battery_J"] < duty["battery_energy_J"] - 0.5 * duty["rest_battery_energy_J"]
+
+
+def test_every_plant_effect_has_words_for_the_figure() -> None:
+    """The effect figure labels each variant in words: every effect of the plant file, the ideal plant and all."""
+    from hiab_sim.env.effects import EFFECT_WORDS
+    from hiab_sim.env.plant.config import EFFECTS
+
+    assert {*EFFECTS, "ideal", "all"} <= set(EFFECT_WORDS)
+    assert all("_" not in words for words in EFFECT_WORDS.values())

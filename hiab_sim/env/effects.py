@@ -452,21 +452,45 @@ def effect_lines(report: dict[str, object]) -> list[str]:
     return lines
 
 
+#: Each variant of the effect study in words (the figure's tick labels; the plant file's keys in the tables).
+EFFECT_WORDS = {
+    "ideal": "ideal plant",
+    "drive_train": "drive-train\ncompliance, backlash",
+    "joint_friction": "hinge and pin\nfriction",
+    "sensors": "sensor noise,\nresolution, delay",
+    "current_loop": "discrete current\nloop, dead time",
+    "thermal": "windings heating\nover cycles",
+    "mismatch": "mass and friction\nerrors",
+    "all": "all effects",
+}
+
+
 def effect_figure(path: Path, report: dict[str, object]) -> Path:
-    """Bar chart: DC-bus energy difference to the prediction per variant and design [%]."""
+    """Bar chart: the closed loop's energy against the prediction per variant and design [%].
+
+    At the battery where the run has a battery model (one boundary with the planner's answer), else at
+    the DC bus; the variants in words (:data:`EFFECT_WORDS`).
+    """
     table = report["variants"]
     assert isinstance(table, dict)
     names = list(table)
-    fig = new_figure((8.0, 3.6))
+    battery = "battery_energy" in report
+    key = "battery_energy_difference_percent" if battery else "dc_bus_energy_difference_percent"
+    where = "battery energy (at the battery)" if battery else "DC-bus energy (drives' input)"
+    fig = new_figure((9.0, 3.9))
     ax = fig.add_subplot()
     x = np.arange(len(names))
     for offset, design in ((-0.2, "initial"), (0.2, "optimal")):
-        values = [table[n][design]["dc_bus_energy_difference_percent"] if design in table[n] else np.nan for n in names]
-        ax.bar(x + offset, values, width=0.4, color=COLOURS.get(design, COLOURS["reference"]), label=design)
-    ax.set_xticks(x, names, rotation=20)
+        values = [
+            np.nan if design not in table[n] or table[n][design].get(key) is None else table[n][design][key]
+            for n in names
+        ]
+        ax.bar(x + offset, values, width=0.4, color=COLOURS.get(design, COLOURS["reference"]), label=f"{design} design")
+    ax.set_xticks(x, [EFFECT_WORDS.get(n, n.replace("_", " ")) for n in names], fontsize=8)
     ax.axhline(0.0, color="k", linewidth=0.8)
     ax.set(
-        ylabel="closed loop vs predicted [%]", title=f"Closed-loop DC-bus energy per plant effect ({report['plant']})"
+        ylabel="closed loop vs predicted [%]",
+        title=f"Closed-loop {where} against the plan's prediction, per plant effect ({report['plant']} plant)",
     )
     ax.grid(alpha=0.3, axis="y")
     ax.legend(fontsize=8)
