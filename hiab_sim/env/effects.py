@@ -54,6 +54,7 @@ from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
 from hiab_sim.machine.dynamics.tree import MachineActuatorSamples
 from hiab_sim.study.spec.study import Study
 from hiab_sim.style import COLOURS
+from hiab_sim.terminal import progress_wanted
 
 
 def variants(plant: Plant) -> list[Plant]:
@@ -220,7 +221,8 @@ def effect_study(
     battery = predicted_cycle_battery_energy(result_dir)
     table: dict[str, dict[str, object]] = {}
     runs = [(variant, design) for variant in variants(plant) for design in designs]
-    for variant, design in tqdm(runs, desc="plant effects", disable=quiet, file=sys.stderr, leave=False):
+    hidden = quiet or not progress_wanted()  # redirected to a file, a bar would dump its updates into the log
+    for variant, design in tqdm(runs, desc="plant effects", disable=hidden, file=sys.stderr, leave=False):
         run, physics = run_plan(plans[design], variant, cycles)
         physics.free()
         entry = _entry(run.summary())

@@ -28,6 +28,7 @@ from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.plan import read_plan
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.rollout import ClosedLoopRun, run_closed_loop
+from hiab_sim.terminal import progress_wanted
 
 Array = NDArray[np.float64]
 
@@ -58,7 +59,7 @@ def simulate_designs(
         for error in conditions:
             label = design if error == 0.0 else f"{design} end mass +{100 * error:g} %"
             with tqdm(
-                total=1, desc=label, unit="step", disable=quiet or not sys.stderr.isatty(), file=sys.stderr, leave=False
+                total=1, desc=label, unit="step", disable=quiet or not progress_wanted(), file=sys.stderr, leave=False
             ) as bar:
 
                 def progress(done: int, total: int, bar: tqdm = bar) -> None:
@@ -245,7 +246,7 @@ def render_video(
                 range(frames),
                 desc="video",
                 unit="frame",
-                disable=quiet or not sys.stderr.isatty(),
+                disable=quiet or not progress_wanted(),
                 file=sys.stderr,
                 leave=False,
             ):
