@@ -117,6 +117,18 @@ class Source:
         return Source(str(path), path, shipped=False)
 
 
+def recorded_path(source: Source) -> str:
+    """The path a result records for ``source``: a user's file made absolute, a shipped one as it is.
+
+    Absolute, so that a result folder can be read from any working directory (a relative path was
+    resolved against wherever the reader ran); a shipped file's own path lies inside the package.
+    """
+    if source.shipped:
+        return str(source.file)
+    path = Path(str(source.file))
+    return str(path.resolve()) if path.is_file() else str(path)
+
+
 def _folder_of(file: Traversable) -> Traversable:
     """The folder of a shipped file (package data lies on disk for editable and wheel installs)."""
     parent = getattr(file, "parent", None)

@@ -10,7 +10,7 @@ from hiab_sim.emla.config import load_emla_set
 from hiab_sim.errors import ConfigError
 from hiab_sim.machine.loader import PRESETS as MACHINE_PRESETS
 from hiab_sim.machine.loader import load_machine
-from hiab_sim.resources import Source, locate
+from hiab_sim.resources import Source, locate, recorded_path
 from hiab_sim.structure.machine_structure import machine_pin_names
 from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.machines.machine_model import MachineModel
@@ -86,7 +86,7 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
         initial = model.design(values)
     return Study(
         name=name,
-        path=str(file.file),
+        path=recorded_path(file),
         crane_source=source,
         crane_description=None,
         emla_source=emla_source,

@@ -28,7 +28,7 @@ from hiab_sim.crane.loader import load_crane
 from hiab_sim.crane.mounting import MountingSpace
 from hiab_sim.emla.config import load_emla_set
 from hiab_sim.errors import ConfigError
-from hiab_sim.resources import DEFAULT_STUDY, Source, locate
+from hiab_sim.resources import DEFAULT_STUDY, Source, locate, recorded_path
 from hiab_sim.structure.pin_loads import pins
 from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.machines.crane_model import CraneModel
@@ -110,7 +110,7 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
     moved = "initial_lengths" not in top and initial != crane.default_lengths
     return Study(
         name=name,
-        path=str(file.file),
+        path=recorded_path(file),
         crane_source=crane_source,
         crane_description=crane,
         emla_source=emla_source,
