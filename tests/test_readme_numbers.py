@@ -33,3 +33,28 @@ def test_the_model_effect_row_is_the_recorded_re_optimised_runs() -> None:
         assert match.group(1) == f"{row['battery_energy_J'] / 1e3:.2f}", key
         assert match.group(2) == f"{row['battery_energy_saved_percent']:.1f}", key
     assert by_key["hold_motor"]["status"] == "infeasible"
+
+
+#: The recorded effect studies of the README's plant table: (row label, ``plant_effects.json`` of the run).
+PLANT_RUNS = (
+    ("XS 031 spiral", ROOT / "tests" / "data" / "plant_effects_xs031_spiral.json"),
+    ("eXact digging", ROOT / "tests" / "data" / "plant_effects_exact_digging.json"),
+)
+
+
+def test_the_plant_effect_rows_are_the_recorded_runs_compact_tables() -> None:
+    """Each README row of the plant table is the command's compact table of the recorded run, cell for cell."""
+    from hiab_sim.env.effects import compact_effect_table
+
+    header = _row("closed loop vs plan")
+    for label, path in PLANT_RUNS:
+        report = json.loads(path.read_text())
+        lines = compact_effect_table(report).splitlines()
+        names = [c.strip() for c in lines[0].strip().strip("|").split("|")][1:]
+        assert names == header, label
+        by_first = {c[0]: c[1:] for c in ([x.strip() for x in line.strip().strip("|").split("|")] for line in lines[2:])}
+        energy = next(v for k, v in by_first.items() if k.startswith("closed-loop battery energy"))
+        tcp = next(v for k, v in by_first.items() if k.startswith("TCP max error"))
+        assert _row(f"{label}: battery energy") == energy, label
+        assert _row(f"{label}: TCP max error") == tcp, label
+        assert all(cell == "yes" for cell in by_first["optimum stays cheaper (at the battery)"]), label

@@ -278,7 +278,8 @@ class Result:
     """What ``hiab-sim optimize`` writes to ``result.json``.
 
     ``crane`` is the preset name, or ``crane.yaml`` (a copy in the result folder) when the study
-    gave a file, then named in ``crane_source``; ``study`` is the study's path.
+    gave a file, then named in ``crane_source``; ``study`` is the study file's absolute path (a
+    shipped study's file in the package).
     """
 
     crane: str
