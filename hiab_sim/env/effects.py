@@ -478,7 +478,7 @@ def effect_figure(path: Path, report: dict[str, object]) -> Path:
     names = list(table)
     battery = "battery_energy" in report
     key = "battery_energy_difference_percent" if battery else "dc_bus_energy_difference_percent"
-    where = "battery energy (at the battery)" if battery else "DC-bus energy (drives' input)"
+    where = "battery energy" if battery else "DC-bus energy (drives' input)"
     fig = new_figure((9.0, 3.9))
     ax = fig.add_subplot()
     x = np.arange(len(names))
