@@ -42,6 +42,11 @@ PLANT_RUNS = (
 )
 
 
+def _cells(line: str) -> list[str]:
+    """The stripped cells of one markdown table line."""
+    return [c.strip() for c in line.strip().strip("|").split("|")]
+
+
 def test_the_plant_effect_rows_are_the_recorded_runs_compact_tables() -> None:
     """Each README row of the plant table is the command's compact table of the recorded run, cell for cell."""
     from hiab_sim.env.effects import compact_effect_table
@@ -50,9 +55,9 @@ def test_the_plant_effect_rows_are_the_recorded_runs_compact_tables() -> None:
     for label, path in PLANT_RUNS:
         report = json.loads(path.read_text())
         lines = compact_effect_table(report).splitlines()
-        names = [c.strip() for c in lines[0].strip().strip("|").split("|")][1:]
+        names = _cells(lines[0])[1:]
         assert names == header, label
-        by_first = {c[0]: c[1:] for c in ([x.strip() for x in line.strip().strip("|").split("|")] for line in lines[2:])}
+        by_first = {cells[0]: cells[1:] for cells in map(_cells, lines[2:])}
         energy = next(v for k, v in by_first.items() if k.startswith("closed-loop battery energy"))
         tcp = next(v for k, v in by_first.items() if k.startswith("TCP max error"))
         assert _row(f"{label}: battery energy") == energy, label
