@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from hiab_sim.env.effects import compact_effect_table, effect_markdown, write_effect_markdown
+from hiab_sim.env.effect_report import compact_effect_table, effect_markdown, write_effect_markdown
 
 
 def _row(dc_percent: float, tcp_max_mm: float, battery_percent: float | None = None) -> dict[str, object]:
@@ -121,7 +121,7 @@ def test_the_replanned_battery_energy_is_one_cycles_as_the_closed_loops() -> Non
 
 def test_every_plant_effect_has_words_for_the_figure() -> None:
     """The effect figure labels each variant in words: every effect of the plant file, the ideal plant and all."""
-    from hiab_sim.env.effects import EFFECT_WORDS
+    from hiab_sim.env.effect_report import EFFECT_WORDS
     from hiab_sim.env.plant.config import EFFECTS
 
     assert {*EFFECTS, "ideal", "all"} <= set(EFFECT_WORDS)

@@ -49,7 +49,7 @@ def _cells(line: str) -> list[str]:
 
 def test_the_plant_effect_rows_are_the_recorded_runs_compact_tables() -> None:
     """Each README row of the plant table is the command's compact table of the recorded run, cell for cell."""
-    from hiab_sim.env.effects import compact_effect_table
+    from hiab_sim.env.effect_report import compact_effect_table
 
     header = _row("closed loop vs plan")
     for label, path in PLANT_RUNS:

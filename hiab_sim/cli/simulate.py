@@ -23,7 +23,7 @@ The table printed at the end is the one of docs/results/closed-loop.md.
 ideal, the planner's own model) and, when the plant has effects on, adds ``plant_effects`` to
 ``simulation.json`` (:mod:`hiab_sim.env.effects`: each effect alone and all together, both designs),
 prints its table, writes ``effects.md`` (a five-line table, one column per variant, and the full one:
-:func:`hiab_sim.env.effects.effect_markdown`) and ``closed_loop_plant_effects.png``. ``--cycles N`` runs
+:func:`hiab_sim.env.effect_report.effect_markdown`) and ``closed_loop_plant_effects.png``. ``--cycles N`` runs
 N cycles with the winding temperature carried over; the energies are the last cycle's.
 
 A machine file's result (:mod:`hiab_sim.machine`, e.g. the excavator) runs through

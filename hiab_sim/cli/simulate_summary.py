@@ -37,7 +37,7 @@ def write_results(
     write_atomic(out / "simulation.json", json.dumps(report, indent=2) + "\n")
     written = ["simulation.json"]
     if effects is not None:
-        from hiab_sim.env.effects import write_effect_markdown
+        from hiab_sim.env.effect_report import write_effect_markdown
 
         written.append(write_effect_markdown(out / "effects.md", effects).name)
     if not args.no_figures:
@@ -45,7 +45,7 @@ def write_results(
 
         written += [p.name for p in write_figures(out, runs, nominal)]
         if effects is not None:
-            from hiab_sim.env.effects import effect_figure
+            from hiab_sim.env.effect_report import effect_figure
 
             written.append(effect_figure(out / "closed_loop_plant_effects.png", effects).name)
     return written, effects
@@ -57,7 +57,7 @@ def print_results(report: dict[str, object], effects: dict[str, object] | None) 
 
     print(table(report))
     if effects is not None:
-        from hiab_sim.env.effects import effect_lines, effect_table
+        from hiab_sim.env.effect_report import effect_lines, effect_table
 
         print()
         print(effect_table(effects))
