@@ -145,21 +145,21 @@ def other_path(path: str) -> str:
     return "analytic" if path == "mujoco" else "mujoco"
 
 
-def trajectory_arrays(fine: TaskProblem, checks: dict[str, DesignCheck], prefix: str = "") -> dict[str, Array]:
-    """``trajectory.npz``'s arrays of one task on its fine grid (SI units; keys prefixed by ``prefix``)."""
-    arrays: dict[str, Array] = {f"{prefix}time": fine.times, f"{prefix}reference_tcp": fine.reference.tcp()}
-    arrays[f"{prefix}payload_mass"] = fine.task.payload.mass_at(fine.times)  # the video draws it while held
+def trajectory_arrays(fine: TaskProblem, checks: dict[str, DesignCheck]) -> dict[str, Array]:
+    """``trajectory.npz``'s arrays of one task on its fine grid (SI units; a mix prefixes each task's keys)."""
+    arrays: dict[str, Array] = {"time": fine.times, "reference_tcp": fine.reference.tcp()}
+    arrays["payload_mass"] = fine.task.payload.mass_at(fine.times)  # the video draws it while held
     for name in ("initial", "optimal"):
         ev = checks[name].evaluation
-        arrays[f"{prefix}{name}_position"] = ev.joints.position
-        arrays[f"{prefix}{name}_velocity"] = ev.joints.velocity
-        arrays[f"{prefix}{name}_acceleration"] = ev.joints.acceleration
-        arrays[f"{prefix}{name}_tcp"] = fine.kin.position(ev.joints.position)
-        arrays[f"{prefix}{name}_actuator_force"] = ev.actuators.force
-        arrays[f"{prefix}{name}_actuator_velocity"] = ev.actuators.velocity
-        arrays[f"{prefix}{name}_actuator_stroke"] = ev.actuators.stroke
-        arrays[f"{prefix}{name}_electrical_power"] = ev.power
-        arrays[f"{prefix}{name}_battery_power"] = cycle_battery_power(fine, ev)
+        arrays[f"{name}_position"] = ev.joints.position
+        arrays[f"{name}_velocity"] = ev.joints.velocity
+        arrays[f"{name}_acceleration"] = ev.joints.acceleration
+        arrays[f"{name}_tcp"] = fine.kin.position(ev.joints.position)
+        arrays[f"{name}_actuator_force"] = ev.actuators.force
+        arrays[f"{name}_actuator_velocity"] = ev.actuators.velocity
+        arrays[f"{name}_actuator_stroke"] = ev.actuators.stroke
+        arrays[f"{name}_electrical_power"] = ev.power
+        arrays[f"{name}_battery_power"] = cycle_battery_power(fine, ev)
     return arrays
 
 

@@ -130,11 +130,12 @@ def build_result(
             )
         )
         decompositions.append(energy_decomposition(p, fine, z0, z1))
+        task_arrays = trajectory_arrays(fine, checks)  # once per task: the battery trace solves the duty again
         if k == 0:
             first_checks = checks
-            arrays.update(trajectory_arrays(fine, checks))
+            arrays.update(task_arrays)
         if problem.n_tasks > 1:
-            arrays.update(trajectory_arrays(fine, checks, f"task{k}_"))
+            arrays.update({f"task{k}_{key}": value for key, value in task_arrays.items()})
     initial = weighted_summary([t.initial for t in task_results], w, names)
     optimal = weighted_summary([t.optimal for t in task_results], w, names)
     e0, e1 = initial.net_electrical_energy_J, optimal.net_electrical_energy_J
