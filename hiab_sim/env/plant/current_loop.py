@@ -44,18 +44,12 @@ Quad = tuple[float, float, float, float]
 DEAD_TIME_CURRENT_A = 1.0
 
 
-def _exp_maps(
-    a11: float, a12: float, a21: float, a22: float, t: float
-) -> tuple[tuple[float, float, float, float], tuple[float, float, float, float], tuple[float, float, float, float]]:
-    """E = exp(A t), F = A^-1 (E - I), G = A^-1 (F - t I) of a 2x2 A with det(A) != 0, row-major."""
-    (e, f, g), _ = _exp_maps_full_half(a11, a12, a21, a22, t)
-    return e, f, g
-
-
 def _exp_maps_full_half(
     a11: float, a12: float, a21: float, a22: float, t: float
 ) -> tuple[tuple[Quad, Quad, Quad], tuple[Quad, Quad]]:
-    """((E, F, G) at t, (E, F) at t / 2) of :func:`_exp_maps`, sharing the eigenvalues and A^-1.
+    """((E, F, G) at t, (E, F) at t / 2) of a 2x2 A with det(A) != 0, row-major, sharing the eigenvalues and A^-1.
+
+    E = exp(A t), F = A^-1 (E - I), G = A^-1 (F - t I).
 
     One evaluation per drive and physics step: the speed, and so A, is held over the step.
     """
