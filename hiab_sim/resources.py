@@ -56,7 +56,7 @@ _NAMED: dict[str, dict[str, str]] = {
         "paper": "emla_paper.yaml",
         "exact": "emla_exact.yaml",
     },
-    "plant": {"realistic": "plant_realistic.yaml"},
+    "plant": {"realistic": "plant_realistic.yaml", "realistic_exact": "plant_realistic_exact.yaml"},
     "machine": {"xs031": "xs031_machine.yaml", "exact": "exact_excavator.yaml"},
     "soil": {"loose_sand": "soil_loose_sand.yaml", "medium_clay": "soil_medium_clay.yaml"},
 }

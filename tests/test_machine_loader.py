@@ -117,6 +117,8 @@ BAD_FILES: list[tuple[str, Callable[[dict[str, Any]], None], type[HiabSimError],
         InvalidInputError,
         "links.arm.joint_frame.R",
     ),
+    ("realistic plant that does not exist", _set("realistic_plant", "no_such_plant"), ConfigError, "realistic_plant"),
+    ("realistic plant not a name", _set("realistic_plant", {"file": "x"}), ConfigError, "realistic_plant"),
 ]
 
 

@@ -49,10 +49,13 @@ def run_machine(args: argparse.Namespace, designs: tuple[str, ...], plant: Plant
     from hiab_sim.cli.simulate_summary import print_results, write_results
     from hiab_sim.env.machine_env import run_machine_closed_loop
     from hiab_sim.env.machine_plan import read_machine_plan
+    from hiab_sim.env.plant.load import machine_plant
     from hiab_sim.env.validation import simulation_report
 
     refuse_crane_only(args)
     plans = [read_machine_plan(args.result_dir, design) for design in designs]  # bad input fails first
+    if plant is not None:  # --plant realistic: the machine's own realistic plant where its file names one
+        plant = machine_plant(args.plant, plans[0].machine.realistic_plant)
     out.mkdir(parents=True, exist_ok=True)
     runs = []
     for plan in plans:

@@ -183,6 +183,9 @@ class Machine:
         hydraulic: The hydraulic baseline, or None.
         workspace: ((x_min, x_max), (y_min, y_max)) the TCP must stay in over the working
             ranges [m] (a cell, a floor), or None.
+        realistic_plant: The plant ``hiab-sim simulate --plant realistic`` runs for this machine (a
+            shipped plant name or an absolute path, :func:`hiab_sim.env.plant.load_plant`), or None:
+            the shipped ``realistic`` (the XS 031's estimates).
 
     """
 
@@ -195,6 +198,7 @@ class Machine:
     tcp: Pose
     hydraulic: HydraulicSystem | None = field(default=None, repr=False)
     workspace: tuple[tuple[float, float], tuple[float, float]] | None = None
+    realistic_plant: str | None = None
 
     def __post_init__(self) -> None:
         check_positive("gravity", self.gravity, "m/s^2")

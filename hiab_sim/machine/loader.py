@@ -32,7 +32,7 @@ from hiab_sim.yaml_fields import SafeLoader, integer, mapping, number, parse_yam
 PRESETS: tuple[str, ...] = tuple(shipped_names("machine"))
 
 _TOP = {"name", "source", "gravity", "links", "chains", "tcp"}
-_TOP_OPTIONAL = {"hydraulic", "workspace", "notes"}
+_TOP_OPTIONAL = {"hydraulic", "workspace", "notes", "realistic_plant"}
 _LINK = {"parent", "joint", "kind", "joint_frame", "joint_range", "bodies"}
 _CHAIN = {"kind", "joint", "pivots", "actuator", "linkage", "variables"}
 _ACTUATOR = {"stroke", "piston_offset", "rod_length", "emla", "hydraulic_cylinder", "cylinder_body", "rod_body"}
@@ -79,11 +79,16 @@ def load_machine(source: str | Path | Source = "xs031", *, check_assembly: bool 
 
     """
     found = locate(source, "machine")
-    return machine_from_dict(read_machine_yaml(found), origin=found.label, check_assembly=check_assembly)
+    return machine_from_dict(read_machine_yaml(found), origin=found.label, check_assembly=check_assembly, located=found)
 
 
-def machine_from_dict(data: Any, origin: str = "machine", *, check_assembly: bool = True) -> Machine:
-    """Build and validate a :class:`Machine` from a parsed YAML mapping."""
+def machine_from_dict(
+    data: Any, origin: str = "machine", *, check_assembly: bool = True, located: Source | None = None
+) -> Machine:
+    """Build and validate a :class:`Machine` from a parsed YAML mapping.
+
+    ``located``: the file it was read from, against which a relative ``realistic_plant`` path resolves.
+    """
     top = mapping(data, origin, _TOP | _TOP_OPTIONAL, _TOP)
     if "notes" in top and not isinstance(top["notes"], Mapping | list | str):
         raise ConfigError("notes: expected text, a list or a mapping")
@@ -102,6 +107,7 @@ def machine_from_dict(data: Any, origin: str = "machine", *, check_assembly: boo
         tcp=_pose(tcp, "tcp"),
         hydraulic=_hydraulic(top["hydraulic"]) if "hydraulic" in top else None,
         workspace=_workspace(top["workspace"]) if "workspace" in top else None,
+        realistic_plant=_plant(top["realistic_plant"], located) if "realistic_plant" in top else None,
     )
     for variable, value in zip(machine.decision_variables, machine.design_values(), strict=True):
         check_range(f"chains.{variable.chain}.variables.{variable.name}", value, variable.low, variable.high, "m")
@@ -110,6 +116,15 @@ def machine_from_dict(data: Any, origin: str = "machine", *, check_assembly: boo
         if failures:
             raise failures[0].error()
     return machine
+
+
+def _plant(node: Any, located: Source | None) -> str:
+    """``realistic_plant``: a shipped plant name as it is, a file as its absolute path (it must exist)."""
+    try:
+        found = locate(text(node, "realistic_plant"), "plant", located)
+    except ConfigError as error:
+        raise ConfigError(f"realistic_plant: {error}") from None
+    return found.label if found.shipped else str(Path(str(found.file)).resolve())
 
 
 def _parents_first(links: tuple[Link, ...]) -> tuple[Link, ...]:

@@ -83,6 +83,18 @@ def _read_section(cls: type, node: Any, where: str, provenance: list[tuple[str, 
     return cls(**values)
 
 
+def machine_plant(source: str | Path, realistic: str | None) -> Plant:
+    """``--plant`` on a machine file's result: ``realistic`` means the machine's own realistic plant.
+
+    ``realistic``: the machine file's ``realistic_plant`` (:attr:`hiab_sim.machine.description.Machine.realistic_plant`:
+    a shipped plant name or an absolute path) or None, when ``realistic`` is the shipped one (the XS 031's
+    estimates). ``ideal`` and a plant file are read as :func:`load_plant` reads them.
+    """
+    if str(source) == "realistic" and realistic is not None:
+        return load_plant(realistic)
+    return load_plant(source)
+
+
 def load_plant(source: str | Path | Source) -> Plant:
     """Load a plant: a shipped preset name (``realistic``), ``ideal`` (realistic, every effect off) or a YAML path."""
     if isinstance(source, str) and source == "ideal":
