@@ -49,6 +49,14 @@ def test_the_rest_between_cycles_is_the_digging_studys_duty() -> None:
     assert own.thermal.rest_between_cycles_s == load_study("exact_digging").energy.duty.rest_time
 
 
+def test_machine_show_names_the_realistic_plant() -> None:
+    """``machine show`` says which plant ``simulate --plant realistic`` reads for the machine."""
+    from hiab_sim.cli.machine import describe
+
+    assert describe(load_machine("exact"))[-1] == "realistic plant (simulate --plant realistic): realistic_exact"
+    assert describe(load_machine("xs031"))[-1].endswith("realistic (the shipped plant; the file names none)")
+
+
 def test_the_xs031_machine_file_keeps_the_shipped_realistic_plant() -> None:
     """A machine file that names no realistic plant gets the shipped one (the XS 031's estimates)."""
     assert load_machine("xs031").realistic_plant is None

@@ -259,5 +259,14 @@ def machine_keys() -> list[Key]:
             ],
             "none",
         ),
+        Key(
+            "realistic_plant",
+            type="text",
+            default="none (the shipped realistic plant)",
+            description=(
+                "The plant `hiab-sim simulate --plant realistic` runs on this machine's results: a shipped plant "
+                "name or a plant file, read next to the machine file (docs/plant.md)."
+            ),
+        ),
         Key("notes", type="text, list or mapping", default="none", description="Free provenance notes, not read."),
     ]
