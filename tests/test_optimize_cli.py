@@ -248,13 +248,16 @@ def test_failed_start_is_listed_not_grouped_as_an_optimum(
     assert main(["optimize", str(path), "--out", str(out), "--starts", "2", *FLAGS, "--verbose"]) == 0
     raw = json.loads((out / "result.json").read_text())["multistart"]
     assert set(raw["failed_starts"][0]) == {"start", "initial_xi", "message"}
-    assert set(raw["distinct_optima"][0]) == {"xi", "cost_W2s", "starts", "net_electrical_energy_J"}
+    assert set(raw["distinct_optima"][0]) == {"xi", "cost_W2s", "starts", "net_electrical_energy_J", "objective_value"}
+    assert (raw["objective"], raw["objective_unit"]) == ("costf2", "W^2 s")
     assert raw["starts"][1]["optimal_lengths"] is None and raw["starts"][1]["cost_W2s"] is None
     ms = read_result(out).multistart
     assert [f.start for f in ms.failed_starts] == [1]
     assert "Iteration limit" in ms.failed_starts[0].message
     assert ms.converged_starts == 1
     assert [d.starts for d in ms.distinct_optima] == [(0,)]
+    # the optimum's objective is the result's own: costf2 on the fine grid at start 0's design
+    assert ms.distinct_optima[0].objective_value == pytest.approx(read_result(out).optimal.cost_W2s, rel=1e-12)
     row = ms.starts[1]
     assert row.success is False and row.optimal_lengths is None and row.cost_W2s is None
     printed = capsys.readouterr().out

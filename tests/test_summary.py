@@ -56,6 +56,40 @@ def test_summary_numbers_are_the_results_own(run: tuple[Path, str]) -> None:
     assert str(folder) in text and r.buildable.mjcf_command in text
 
 
+def test_distinct_optima_are_ranked_by_the_objective_in_the_summary(run: tuple[Path, str]) -> None:
+    """Two distinct optima: the line gives their objective's spread and where the reported (start 0's) one lies."""
+    import dataclasses
+
+    from hiab_sim.results.multistart import DistinctOptimum
+    from hiab_sim.study.report.summary import summary_lines
+
+    folder, _ = run
+    r = read_result(folder)
+    row = r.multistart.starts[0]
+    optima = (
+        DistinctOptimum(xi=(0.1,), cost_W2s=1.0, starts=(0,), objective_value=1003.0),
+        DistinctOptimum(xi=(0.2,), cost_W2s=1.0, starts=(1, 2), objective_value=1000.0),
+    )
+    ms = dataclasses.replace(
+        r.multistart,
+        starts=(row, dataclasses.replace(row, start=1), dataclasses.replace(row, start=2)),
+        converged_starts=3,
+        same_optimum=False,
+        distinct_optima=optima,
+        objective="battery_energy",
+        objective_unit="J",
+    )
+    text = "\n".join(summary_lines(dataclasses.replace(r, multistart=ms), folder))
+    assert (
+        "Starts: 3 of 3 converged, to 2 distinct local optima (their battery_energy within 0.3 % of the lowest; "
+        "the result is start 0's, 0.3 % above the lowest)." in text
+    )
+    lowest = dataclasses.replace(ms, distinct_optima=(optima[1], optima[0]))
+    assert "the result is start 0's, the lowest)." in "\n".join(
+        summary_lines(dataclasses.replace(r, multistart=lowest), folder)
+    )
+
+
 def test_verbose_prints_the_iterations_before_the_summary(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """--verbose adds the per-iteration lines (stderr) and the full report; the summary still comes last."""
     study = write_study(tmp_path, small_study())

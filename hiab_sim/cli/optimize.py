@@ -126,7 +126,10 @@ def summary_lines(r: Result) -> list[str]:
             for d in ms.distinct_optima:
                 xi = " ".join(f"{v:.4f}" for v in d.xi)
                 energy = "n/a" if d.net_electrical_energy_J is None else f"{d.net_electrical_energy_J / 1e3:.3f}"
-                lines.append(f"  Xi [{xi}] m  net energy {energy} kJ  starts {list(d.starts)}")
+                value = (
+                    "" if d.objective_value is None else f"  {ms.objective} {d.objective_value:.9g} {ms.objective_unit}"
+                )
+                lines.append(f"  Xi [{xi}] m  net energy {energy} kJ{value}  starts {list(d.starts)}")
         for f in ms.failed_starts:
             lines.append(f"  start {f.start} failed (not an optimum): {f.message}")
     return lines

@@ -23,12 +23,17 @@ class StartRow:
 
 @dataclass(frozen=True)
 class DistinctOptimum:
-    """Converged starts whose Xi agree within the tolerance; energy written with more than one start."""
+    """Converged starts whose Xi agree within the tolerance; energy and objective written with more than one start.
+
+    ``objective_value``: the study's objective at the group's first start, exact (unsmoothed) and weighted over
+    the tasks' fine grids [:attr:`MultiStart.objective_unit`], the number the optima are ranked by.
+    """
 
     xi: tuple[float, ...]  # [m], the design's decision variables (the crane's lift L, Lc0, Lc, tilt L, Lc0, Lc)
     cost_W2s: float | None
     starts: tuple[int, ...]
     net_electrical_energy_J: float | None = optional()
+    objective_value: float | None = optional()
 
 
 @dataclass(frozen=True)
@@ -50,3 +55,5 @@ class MultiStart:
     same_optimum: bool
     distinct_optima: tuple[DistinctOptimum, ...]
     failed_starts: tuple[FailedStart, ...]
+    objective: str | None = optional()  # the study's objective's name, with its unit below
+    objective_unit: str | None = optional()

@@ -40,7 +40,7 @@ from hiab_sim.results.schema import (
 )
 from hiab_sim.results.trajectory_file import write_trajectory
 from hiab_sim.structure.summary import mix_structure
-from hiab_sim.study.nlp.objectives import costf2
+from hiab_sim.study.nlp.objectives import costf2, exact_value
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.report.design_check import (
     DesignCheck,
@@ -149,6 +149,14 @@ def build_result(
             )
         )
 
+    def study_objective(z: Array) -> float:
+        return float(
+            sum(
+                wk * exact_value(f.objective, f.evaluate(problem.task_z(z, k)))
+                for k, (wk, f) in enumerate(zip(w, fines, strict=True))
+            )
+        )
+
     study = problem.study
     first = problem.problems[0]
     energy = (
@@ -175,7 +183,9 @@ def build_result(
         ),
         solver=solver_summary(problem, main, wall_time),
         recheck=weighted_recheck([t.recheck for t in task_results], w, names),
-        multistart=multistart_summary(problem, results, multistart_tolerance, energy=study_energy),
+        multistart=multistart_summary(
+            problem, results, multistart_tolerance, energy=study_energy, objective=study_objective
+        ),
         settings=Settings(
             spline_control_points=sum(p.basis.n for p in problem.problems),
             spline_degree=first.basis.k,
@@ -226,12 +236,14 @@ def multistart_summary(
     results: list[SolveResult],
     tolerance: float,
     energy: Callable[[Array], float] | None = None,
+    objective: Callable[[Array], float] | None = None,
 ) -> MultiStart:
     """Whether every converged start reached the same Xi within ``tolerance`` [m]; else the distinct optima.
 
     A start whose solver failed is no optimum: it is left out of ``distinct_optima`` and listed
     under ``failed_starts`` with its message (its row has no optimal lengths or cost). ``energy``
-    gives a design's net energy [J] (the weighted sum over the tasks' fine grids; None: not given).
+    gives a design's net energy [J] (the weighted sum over the tasks' fine grids; None: not given),
+    ``objective`` the study's objective there [its unit], exact where it smooths for the solver.
     """
     rows: list[StartRow] = []
     failed: list[FailedStart] = []
@@ -262,6 +274,7 @@ def multistart_summary(
             cost_W2s=cost,
             starts=tuple(starts),
             net_electrical_energy_J=None if energy is None or len(results) < 2 else energy(by_start[starts[0]].z),
+            objective_value=None if objective is None or len(results) < 2 else objective(by_start[starts[0]].z),
         )
         for xi, cost, starts in groups
     )
@@ -272,4 +285,6 @@ def multistart_summary(
         same_optimum=len(distinct) == 1,
         distinct_optima=distinct,
         failed_starts=tuple(failed),
+        objective=None if objective is None else problem.study.energy.objective,
+        objective_unit=None if objective is None else problem.objective.unit,
     )

@@ -167,6 +167,12 @@ def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[st
     if len(ms.starts) > 1:
         failed = f", {len(ms.failed_starts)} failed" if ms.failed_starts else ""
         agree = "the same optimum" if ms.same_optimum else f"{len(ms.distinct_optima)} distinct local optima"
+        values = [d.objective_value for d in ms.distinct_optima if d.objective_value is not None]
+        if not ms.same_optimum and len(values) == len(ms.distinct_optima) and min(values) > 0:
+            spread = 100.0 * (max(values) - min(values)) / min(values)
+            reported = 100.0 * (values[0] - min(values)) / min(values)  # the result is start 0's optimum
+            where = "the lowest" if reported == 0.0 else f"{reported:.2g} % above the lowest"
+            agree += f" (their {ms.objective} within {spread:.2g} % of the lowest; the result is start 0's, {where})"
         lines.append(f"Starts: {ms.converged_starts} of {len(ms.starts)} converged, to {agree}{failed}.")
     violation = r.recheck.max_violation_scaled
     lines.append(
