@@ -224,6 +224,17 @@ def test_simulate_runs_the_effect_study_on_a_machine_result(
     assert compact[3].endswith(f"/ {tcp:.2f} |")
 
 
+def test_a_bad_plant_on_a_machine_result_exits_2_and_writes_nothing(
+    result: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--plant`` is read where the machine's own realistic plant is known: a bad one is one line, no folder."""
+    out = tmp_path / "sim"
+    assert main(["simulate", str(result), "--plant", "windy", "--no-video", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "windy" in err and "\n" not in err and "Traceback" not in err
+    assert not out.exists()
+
+
 def test_the_xs031_machine_file_gets_the_crane_files_friction(crane: Crane) -> None:
     """The XS 031 as a machine file and as the crane file: the same hinges, pins and loop-pin tendons, valued alike."""
     from hiab_sim.machine.loader import load_machine

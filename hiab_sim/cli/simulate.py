@@ -92,19 +92,19 @@ def run(args: argparse.Namespace) -> int:
         raise InvalidInputError("--payload-error", error, "must lie in [0, 2] (relative end-mass error)")
     if args.cycles < 1:
         raise InvalidInputError("--cycles", args.cycles, "must be an integer >= 1")
-    from hiab_sim.env.plant import load_plant
-
-    plant = load_plant(args.plant) if args.plant is not None else None
     designs = ("initial", "optimal") if args.design == "both" else (args.design,)
     out = Path(args.out) if args.out else Path(args.result_dir)
     if out.exists() and not out.is_dir():
         raise InvalidInputError("--out", str(out), "must be a folder")
     from hiab_sim.env.machine_plan import is_machine_result
 
-    if is_machine_result(args.result_dir):
+    if is_machine_result(args.result_dir):  # its plant: the machine file's realistic one, read there
         from hiab_sim.cli.simulate_machine import run_machine
 
-        return run_machine(args, designs, plant, out)
+        return run_machine(args, designs, out)
+    from hiab_sim.env.plant import load_plant
+
+    plant = load_plant(args.plant) if args.plant is not None else None
     for design in designs:
         read_plan(args.result_dir, design)  # bad input fails before any simulation
     out.mkdir(parents=True, exist_ok=True)

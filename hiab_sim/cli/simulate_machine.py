@@ -16,7 +16,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from hiab_sim.env.plant.config import Plant
 from hiab_sim.errors import InvalidInputError
 
 #: What the report says of the energy boundary and the TCP error of a machine's closed loop.
@@ -44,8 +43,12 @@ def refuse_crane_only(args: argparse.Namespace) -> None:
         )
 
 
-def run_machine(args: argparse.Namespace, designs: tuple[str, ...], plant: Plant | None, out: Path) -> int:
-    """Simulate every design of a machine file's result, write ``simulation.json`` (and figures), print the table."""
+def run_machine(args: argparse.Namespace, designs: tuple[str, ...], out: Path) -> int:
+    """Simulate every design of a machine file's result, write ``simulation.json`` (and figures), print the table.
+
+    ``--plant realistic`` is the machine file's own realistic plant where it names one
+    (:func:`hiab_sim.env.plant.load.machine_plant`).
+    """
     from hiab_sim.cli.simulate_summary import print_results, write_results
     from hiab_sim.env.machine_env import run_machine_closed_loop
     from hiab_sim.env.machine_plan import read_machine_plan
@@ -54,8 +57,7 @@ def run_machine(args: argparse.Namespace, designs: tuple[str, ...], plant: Plant
 
     refuse_crane_only(args)
     plans = [read_machine_plan(args.result_dir, design) for design in designs]  # bad input fails first
-    if plant is not None:  # --plant realistic: the machine's own realistic plant where its file names one
-        plant = machine_plant(args.plant, plans[0].machine.realistic_plant)
+    plant = None if args.plant is None else machine_plant(args.plant, plans[0].machine.realistic_plant)
     out.mkdir(parents=True, exist_ok=True)
     runs = []
     for plan in plans:
