@@ -263,3 +263,14 @@ def test_failed_start_is_listed_not_grouped_as_an_optimum(
     printed = capsys.readouterr().out
     assert "all 1 converged starts" in printed and "start 1 failed (not an optimum)" in printed
     assert "Starts: 1 of 2 converged" in printed and "1 failed." in printed  # the summary says it too
+
+
+def test_study_whose_drives_lack_stiffness_data_writes_every_figure_but_the_frequencies(tmp_path: Path) -> None:
+    """seed_scale_spiral's EMLA file has no screw or drive-stiffness data: no frequencies, and the run still ends."""
+    root = Path(__file__).resolve().parents[1]
+    out = tmp_path / "seed"
+    assert main(["optimize", str(root / "optimize" / "seed_scale_spiral.yaml"), "--out", str(out), *FLAGS[:2]]) == 0
+    r = read_result(out)
+    assert r.structure is not None and r.structure.optimal.lowest_frequency_working_range_Hz is None
+    assert (out / "structure_initial_vs_optimal.png").is_file()
+    assert not (out / "structure_natural_frequency.png").exists()

@@ -329,7 +329,9 @@ def write_figures(
     if result.sensitivity is not None:
         paths["sensitivity"] = out / "sensitivity.png"
         sensitivity_figure(result.sensitivity, paths["sensitivity"])
-    if crane is not None and result.structure is not None:
+    structure = result.structure
+    # the frequencies need every drive's screw and stiffness data: drawn where the result has them
+    if crane is not None and structure is not None and structure.optimal.lowest_frequency_working_range_Hz is not None:
         from hiab_sim.structure.report import natural_frequency_figure
 
         paths["frequency"] = natural_frequency_figure(
