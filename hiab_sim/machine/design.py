@@ -75,11 +75,18 @@ def with_design(machine: MachineT, values: Any, *, check_bounds: bool = True) ->
         raise InvalidInputError("design", f"{values.size} values", f"need {len(variables)}: {machine.variable_keys}")
     for v, value in zip(variables, values, strict=True):
         check_range(v.key, float(value), v.low if check_bounds else None, v.high if check_bounds else None, "m")
-    chains = []
-    for chain in machine.chains:
-        mine = [(v, float(x)) for v, x in zip(variables, values, strict=True) if v.chain == chain.name]
-        chains.append(_chain_with(machine, chain, mine) if mine else chain)
-    return replace(machine, chains=tuple(chains))  # type: ignore[type-var]
+    return replace(machine, chains=tuple(designed_chain(machine, chain, values) for chain in machine.chains))  # type: ignore[type-var]
+
+
+def designed_chain(machine: Designable, chain: Chain, values: np.ndarray) -> Chain:
+    """One chain of ``machine`` with its decision variables taken from ``values`` (all of them, in order).
+
+    The chain :func:`with_design` builds, without building the machine around it: for geometry that
+    reads one chain and the links (which no decision variable moves), e.g. the stroke rows. Values
+    are not checked here.
+    """
+    mine = [(v, float(x)) for v, x in zip(machine.decision_variables, values, strict=True) if v.chain == chain.name]
+    return _chain_with(machine, chain, mine) if mine else chain
 
 
 def _chain_with(machine: Designable, chain: Chain, assigned: list[tuple[DecisionVariable, float]]) -> Chain:

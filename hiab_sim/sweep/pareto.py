@@ -36,7 +36,6 @@ from scipy.optimize import minimize
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla.drive import drive_state
 from hiab_sim.errors import InvalidInputError, SolverError
-from hiab_sim.study.nlp.id_partials import id_joint_partials
 from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import C_SCALE, XI_SCALE, TaskProblem
@@ -78,7 +77,7 @@ def task_samples(p: TaskProblem, zk: Array, name: str, jacobian: bool = False) -
         s = np.array([np.sqrt(np.mean(np.sum(tau**2, axis=1)))])
     if not jacobian:
         return s, None
-    id_q = id_joint_partials(model, samples, p.fd_step, p.tcp_force)  # (K, 3 A outputs (f, v, a), 3 n)
+    id_q = p.joint_partials(design, samples)  # (K, 3 A outputs (f, v, a), 3 n)
     id_xi = p.model.design_partials(design, samples, p.xi_path, p.fd_step, p.tcp_force)  # (K, 3 A, n_xi)
     if name == "peak_force":  # q9 index = order * n + joint; B (3 orders, K, N)
         dc = np.einsum("kaoj,okm->kajm", id_q[:, :A].reshape(K, A, 3, n), p.B) * C_SCALE

@@ -156,6 +156,9 @@ class TaskProblem(ScaledProblem):
         self.tcp_force = task.id_force(self.kin, model.gravity, self.times)
         self.fd_step = study.solver.fd_step
         self.xi_path = "analytic" if study.solver.xi_derivatives == "analytic" else self.id_path
+        # unset: the analytic path on a machine file, the optimisation's own on a crane file (SolverSettings)
+        joint = study.solver.joint_derivatives or ("path" if getattr(model, "crane", None) is not None else "analytic")
+        self.q_path = "analytic" if joint == "analytic" else self.id_path
         # initial fit: inverse kinematics on the fine grid, least-squares spline at rest at both ends
         fine_ref = task.reference.sample(self.kin, self.fine_times())
         ik = model.inverse_kinematics(fine_ref, ik_start(task.reference, model, fine_ref))
@@ -191,7 +194,7 @@ class TaskProblem(ScaledProblem):
         self.constraint_names = self.layout.names
         #: added to the solver's rows gives the nominal scaled margins (each block owns its clearance)
         self.clearance = self.layout.clearance
-        self._id_cache: dict[bytes, InverseDynamics] = {}
+        self._id_cache: dict[tuple[bytes, str], InverseDynamics] = {}
         self._eval_cache: dict[bytes, Evaluation] = {}
         self._grad_cache: dict[bytes, tuple[Array, Array]] = {}
         self.n_evaluations = 0
@@ -241,13 +244,21 @@ class TaskProblem(ScaledProblem):
 
     # -- evaluation --------------------------------------------------------------------------
 
-    def _id(self, lengths: Design) -> InverseDynamics:
-        key = lengths.as_array().tobytes()
+    def _id(self, lengths: Design, path: str | None = None) -> InverseDynamics:
+        """The inverse dynamics of a design on ``path`` (default: the optimisation's), cached by value."""
+        key = (lengths.as_array().tobytes(), path or self.id_path)
         if key not in self._id_cache:
             if len(self._id_cache) > 32:
                 self._id_cache.clear()
-            self._id_cache[key] = self.model.inverse_dynamics(lengths, self.id_path)
+            self._id_cache[key] = self.model.inverse_dynamics(lengths, key[1])
         return self._id_cache[key]
+
+    def joint_partials(self, lengths: Design, samples: JointSamples) -> Array:
+        """dY/d(q, dq, ddq) per sample of a design's inverse dynamics on ``solver.joint_derivatives``' path.
+
+        (K, 3 m, 3 n), :func:`~hiab_sim.study.nlp.id_partials.id_joint_partials` (central differences).
+        """
+        return id_joint_partials(self._id(lengths, self.q_path), samples, self.fd_step, self.tcp_force)
 
     def joints(self, c: Array) -> tr.JointTrajectory:
         """Joint samples on this problem's grid for coefficients c (n, N)."""
@@ -366,7 +377,7 @@ class TaskProblem(ScaledProblem):
         ev = self.evaluate(z)
         samples = JointSamples(ev.joints.position, ev.joints.velocity, ev.joints.acceleration)
         partials = SamplePartials(
-            lambda: id_joint_partials(self._id(ev.lengths), samples, self.fd_step, self.tcp_force),
+            lambda: self.joint_partials(ev.lengths, samples),
             lambda: self.model.design_partials(ev.lengths, samples, self.xi_path, self.fd_step, self.tcp_force),
         )
         jac = self.layout.jacobian(ev, partials, self._to_z)
