@@ -229,7 +229,12 @@ def study_keys() -> list[Key]:
             "each joint's working range in the machine file); `reference`: only the reference's.",
         ),
     ]
-    rows += [section("solver", "Solver settings.", "defaults"), *from_class("solver", SolverSettings)]
+    rows += [
+        section("solver", "Solver settings.", "defaults"),
+        *from_class(
+            "solver", SolverSettings, joint_derivatives={"default": "analytic on a machine file, path on a crane file"}
+        ),
+    ]
     rows += [
         section("build", "Manufacturing tolerance and stroke margin.", "defaults"),
         *from_class("build", BuildSettings),
