@@ -81,6 +81,7 @@ def _only_mismatch(**errors: Any) -> Plant:
     return dataclasses.replace(REALISTIC, mismatch=dataclasses.replace(REALISTIC.mismatch, **zero)).only("mismatch")
 
 
+@pytest.mark.sim
 def test_ideal_plant_reproduces_the_machines_closed_loop_exactly(plan: MachinePlan, today: ClosedLoopRun) -> None:
     """Every effect off gives the machine's closed loop without a plant, sample for sample."""
     ideal = _run(plan, REALISTIC.ideal())
@@ -90,6 +91,7 @@ def test_ideal_plant_reproduces_the_machines_closed_loop_exactly(plan: MachinePl
     assert ideal.gains == today.gains
 
 
+@pytest.mark.sim
 @pytest.mark.parametrize("effect", EFFECTS)
 def test_each_effect_alone_completes_the_cycle_and_tracks(plan: MachinePlan, today: ClosedLoopRun, effect: str) -> None:
     """With one effect on, the excavator's cycle completes within 10 mm of the reference at -2 % to +80 % energy."""
@@ -160,6 +162,7 @@ def _drift(plan: MachinePlan, plant: Plant, current: np.ndarray) -> float:
     return drift
 
 
+@pytest.mark.sim
 def test_a_heavier_payload_is_held_by_the_current_of_its_inverse_dynamics(plan: MachinePlan) -> None:
     """The simulated payload (1 + e) P: the planned feedforward sags, the one of (1 + e) P in the MuJoCo ID holds.
 
