@@ -78,18 +78,21 @@ def with_design(machine: MachineT, values: Any, *, check_bounds: bool = True) ->
     return replace(machine, chains=tuple(designed_chain(machine, chain, values) for chain in machine.chains))  # type: ignore[type-var]
 
 
-def designed_chain(machine: Designable, chain: Chain, values: np.ndarray) -> Chain:
+def designed_chain(machine: Designable, chain: Chain, values: np.ndarray, *, bodies: bool = True) -> Chain:
     """One chain of ``machine`` with its decision variables taken from ``values`` (all of them, in order).
 
     The chain :func:`with_design` builds, without building the machine around it: for geometry that
     reads one chain and the links (which no decision variable moves), e.g. the stroke rows. Values
-    are not checked here.
+    are not checked here. ``bodies=False`` keeps the actuator's bodies as they are (no slender
+    scaling): the chain's geometry is the same, its masses and inertias are not the design's.
     """
     mine = [(v, float(x)) for v, x in zip(machine.decision_variables, values, strict=True) if v.chain == chain.name]
-    return _chain_with(machine, chain, mine) if mine else chain
+    return _chain_with(machine, chain, mine, bodies) if mine else chain
 
 
-def _chain_with(machine: Designable, chain: Chain, assigned: list[tuple[DecisionVariable, float]]) -> Chain:
+def _chain_with(
+    machine: Designable, chain: Chain, assigned: list[tuple[DecisionVariable, float]], bodies: bool = True
+) -> Chain:
     act = chain.actuator
     piston, rod = act.piston_offset, act.rod_length
     pivots = {p.role: p for p in chain.pivots}
@@ -114,7 +117,7 @@ def _chain_with(machine: Designable, chain: Chain, assigned: list[tuple[Decision
             rod = value - piston
     new = replace(act, piston_offset=piston, rod_length=rod)
     x0_old, x0_new = act.retracted_length, new.retracted_length
-    if act.body_scaling == "slender" and x0_old is not None and x0_new is not None:
+    if bodies and act.body_scaling == "slender" and x0_old is not None and x0_new is not None:
         if act.cylinder_body is not None:
             new = replace(new, cylinder_body=act.cylinder_body.scaled_slender(x0_new / x0_old))
         if act.rod_body is not None and rod is not None and act.rod_length is not None:

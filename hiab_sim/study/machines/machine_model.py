@@ -295,7 +295,8 @@ class MachineModel:
 
         Their geometry reads only the chain and the links, which no decision variable moves, so the
         stroke rows use them with this model's machine and build no machine per design (the NLP holds
-        the bounds). Cached by the key: the chain's name and the values of its own variables.
+        the bounds), nor the actuator bodies' design masses (geometry only). Cached by the key: the
+        chain's name and the values of its own variables.
         """
         values = np.asarray(design.as_array(), dtype=float)
         cache, columns = self.__dict__["_chain_cache"], self.__dict__["_chain_columns"]
@@ -305,7 +306,7 @@ class MachineModel:
             if key not in cache:
                 if len(cache) > 256:
                     cache.clear()
-                cache[key] = designed_chain(self.machine, chain, values)
+                cache[key] = designed_chain(self.machine, chain, values, bodies=False)  # geometry only
             out.append((key, cache[key]))
         return out
 

@@ -252,18 +252,19 @@ class BlockLayout:
         self,
         state: SampleState,
         partials: SamplePartials,
-        to_z: Callable[[ConstraintBlock, BlockJacobian, int], Array],
+        to_z: Callable[[ConstraintBlock, BlockJacobian, Array], None],
+        n: int,
     ) -> Array:
-        """Jacobian (m, n): each block's partials mapped to z by ``to_z(block, jacobian, rows)``.
+        """Jacobian (m, n): each block's partials written into its rows by ``to_z(block, jacobian, rows)``.
 
         ``to_z`` belongs to the problem, which alone knows the layout of z (for several tasks it
-        picks the block's task's spline matrices and columns).
+        picks the block's task's spline matrices and columns); ``rows`` is the block's (rows, n) view
+        of the Jacobian, zeros on entry.
         """
-        parts = []
+        out = np.zeros((len(self.names), n))
         for block in self.blocks:
-            rows = self.slices[block.name]
-            parts.append(to_z(block, block.jacobian(state, partials), rows.stop - rows.start))
-        return np.concatenate(parts, axis=0)
+            to_z(block, block.jacobian(state, partials), out[self.slices[block.name]])
+        return out
 
     def split(self, rows: Array) -> dict[str, Array]:
         """A row vector (margins, multipliers) cut into blocks by name."""

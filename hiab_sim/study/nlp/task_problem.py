@@ -43,6 +43,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from hiab_sim.dynamics.interface import InverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
@@ -149,6 +150,10 @@ class TaskProblem(ScaledProblem):
         points = task.spline_points(study.spline.control_points, study.grid.duration, study.spline.degree)
         self.basis = tr.SplineBasis(points, study.spline.degree, duration)
         self.B = np.stack(self.basis.matrices(self.times))  # (3 orders, K, N)
+        #: the band of B: the W basis functions from ``band_start[k]`` on hold every nonzero at sample k
+        self.band_start, self.band = _band(self.B)
+        self.band_rows = np.arange(len(self.times))[:, None]
+        self.band_columns = self.band_start[:, None] + np.arange(self.band.shape[2])
         model = study.model
         self.n_joints = len(model.joint_names)
         self.kin = model.kinematics
@@ -349,15 +354,22 @@ class TaskProblem(ScaledProblem):
         out[order] = jac
         return out
 
-    def _to_z(self, block: ConstraintBlock, jac: BlockJacobian, rows: int) -> Array:
-        """A block's partials w.r.t. q9 and Xi [per m] as rows of D g / dz (m, n), through the spline matrices."""
+    def _to_z(self, block: ConstraintBlock, jac: BlockJacobian, out: Array) -> None:
+        """A block's partials w.r.t. q9 and Xi [per m] into its rows ``out`` (rows, n) of D g / dz (zeros on entry).
+
+        Through the spline matrices: a per-sample row sees only the W coefficients per joint whose basis
+        functions are nonzero at its sample (:func:`_band`), the same products as the full matrices.
+        """
         K, nj = len(self.times), self.n_joints
-        out = np.zeros((rows, self.n))
+        rows = out.shape[0]
         if isinstance(jac, SampleRows):
             r = jac.dq.shape[1]
-            # q9 index = order * n_joints + joint
-            dc = np.einsum("kmoj,okn->kmjn", jac.dq.reshape(K, r, 3, nj), self.B) * C_SCALE
-            out[:, self.n_xi :] = dc.reshape(rows, self.n_c)
+            # q9 index = order * n_joints + joint; dc[k, m, j, n] = sum_o dq[k, m, o, j] B[o, k, n] on the band
+            band = np.einsum("kmoj,okb->kbmj", jac.dq.reshape(K, r, 3, nj), self.band) * C_SCALE
+            dc = out[:, self.n_xi :].reshape(K, r, nj, self.basis.n)  # a view: rows k r + m, columns j N + n
+            if not np.may_share_memory(dc, out):
+                raise AssertionError("the Jacobian's coefficient columns must reshape without a copy")
+            dc[self.band_rows, :, :, self.band_columns] = band
             if jac.dxi is not None:
                 out[:, : self.n_xi] = (jac.dxi * XI_SCALE).reshape(rows, self.n_xi)
         else:
@@ -366,7 +378,6 @@ class TaskProblem(ScaledProblem):
                 out[:, self.n_xi :] = dc.reshape(rows, self.n_c)
             if jac.dxi is not None:
                 out[:, : self.n_xi] = jac.dxi * XI_SCALE
-        return out
 
     def _gradients(self, z: Array) -> tuple[Array, Array]:
         z = np.array(z, dtype=float)
@@ -380,7 +391,7 @@ class TaskProblem(ScaledProblem):
             lambda: self.joint_partials(ev.lengths, samples),
             lambda: self.model.design_partials(ev.lengths, samples, self.xi_path, self.fd_step, self.tcp_force),
         )
-        jac = self.layout.jacobian(ev, partials, self._to_z)
+        jac = self.layout.jacobian(ev, partials, self._to_z, self.n)
         dcost_q, dcost_xi = self.objective.gradient(ev, partials)
         K = len(self.times)
         grad_c = np.einsum("koj,okn->jn", dcost_q.reshape(K, 3, self.n_joints), self.B).ravel() * C_SCALE
@@ -389,3 +400,18 @@ class TaskProblem(ScaledProblem):
             self._grad_cache.clear()
         self._grad_cache[key] = (grad, jac)
         return grad, jac
+
+
+def _band(B: Array) -> tuple[NDArray[np.intp], Array]:
+    """The band of spline matrices B (3, K, N): window starts s_k (K,) and B on the windows (3, K, W).
+
+    Per sample k the W columns from s_k on hold every nonzero of B[:, k] (W: the widest support,
+    degree + 1 for a B-spline).
+    """
+    nonzero = np.any(B != 0.0, axis=0)  # (K, N)
+    first = np.argmax(nonzero, axis=1)
+    last = B.shape[2] - 1 - np.argmax(nonzero[:, ::-1], axis=1)
+    width = int(np.max(last - first)) + 1
+    start = np.minimum(first, B.shape[2] - width).astype(np.intp)
+    columns = start[:, None] + np.arange(width)
+    return start, np.take_along_axis(B, np.broadcast_to(columns, (3, *columns.shape)), axis=2)
