@@ -1,8 +1,9 @@
-"""A machine file's result folder made by ``hiab-sim optimize`` on a small excavator study (about 10 s)."""
+"""A small excavator study optimised by ``hiab-sim optimize`` (about 10 s), and the open-loop hold of a plan's start."""
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import yaml
@@ -10,6 +11,9 @@ import yaml
 from hiab_sim.cli import main
 from hiab_sim.study.run import run_study
 from hiab_sim.study.spec.study_file import load_study
+
+if TYPE_CHECKING:
+    from dm_control.rl import control
 
 #: A small excavator study: three joints from one pose to another in 4 s (``move.csv``, :func:`joint_csv`), 50 kg held.
 EXCAVATOR_STUDY = {
@@ -66,3 +70,20 @@ def excavator_result(folder: Path) -> Path:
     if status != 0:
         raise AssertionError(f"hiab-sim optimize exited {status}")
     return run
+
+
+def held_stroke_drift(env: control.Environment, current: np.ndarray) -> float:
+    """Largest stroke change [m] over 200 physics steps (0.2 s) holding the start at ``current`` [A], no feedback.
+
+    ``env``: a machine file's closed-loop environment (:func:`hiab_sim.env.machine_env.machine_environment`),
+    reset here; its physics is freed afterwards.
+    """
+    physics = env.physics
+    env.reset()
+    start = physics.stroke().copy()
+    physics.holding = True
+    physics.current_reference = current.copy()
+    physics.step(200)
+    drift = float(np.max(np.abs(physics.stroke() - start)))
+    physics.free()
+    return drift

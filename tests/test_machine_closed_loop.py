@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from machine_result_helper import held_stroke_drift
 
 from hiab_sim.cli import main
 from hiab_sim.cli.simulate import ENERGY_TOLERANCE, TCP_MAX_MM
@@ -79,17 +80,9 @@ def test_load_mass_is_twice_the_kinetic_energy_of_a_unit_slide_rate(excavator_pl
 def _open_loop_drift(plan: MachinePlan, with_load: bool) -> float:
     """Largest stroke change [m] over 0.2 s at the first sample's feedforward current, no feedback."""
     env = machine_environment(plan)
-    physics = env.physics
     if not with_load:
-        physics.tcp_load = None
-    env.reset()
-    start = physics.stroke().copy()
-    physics.holding = True
-    physics.current_reference = env.task.motion.current[0].copy()
-    physics.step(200)
-    drift = float(np.max(np.abs(physics.stroke() - start)))
-    physics.free()
-    return drift
+        env.physics.tcp_load = None
+    return held_stroke_drift(env, env.task.motion.current[0])
 
 
 @pytest.mark.sim

@@ -34,7 +34,7 @@ from hiab_sim.machine.dynamics.tree import machine_tree
 from hiab_sim.resources import locate
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from machine_result_helper import EXCAVATOR_STUDY, joint_csv, solved_study
+from machine_result_helper import EXCAVATOR_STUDY, held_stroke_drift, joint_csv, solved_study
 
 REALISTIC = load_plant("realistic")
 #: The issue's bound on the TCP tracking error of the realistic plant [mm].
@@ -150,16 +150,7 @@ def test_true_machine_scales_every_moving_part_by_the_link_error(plan: MachinePl
 
 def _drift(plan: MachinePlan, plant: Plant, current: np.ndarray) -> float:
     """Largest stroke change [m] over 0.2 s holding the start at ``current`` [A], no feedback."""
-    env = machine_environment(plan, plant=plant)
-    physics = env.physics
-    env.reset()
-    start = physics.stroke().copy()
-    physics.holding = True
-    physics.current_reference = current.copy()
-    physics.step(200)
-    drift = float(np.max(np.abs(physics.stroke() - start)))
-    physics.free()
-    return drift
+    return held_stroke_drift(machine_environment(plan, plant=plant), current)
 
 
 @pytest.mark.sim

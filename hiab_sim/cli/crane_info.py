@@ -6,6 +6,7 @@ import argparse
 
 import numpy as np
 
+from hiab_sim.cli.options import add_crane_option
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.loader import load_crane
 
@@ -21,7 +22,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "working range the study uses; the telescope; every body with its mass."
         ),
     )
-    parser.add_argument("--crane", default="xs031", help="preset name or YAML file (default: xs031)")
+    add_crane_option(parser)
     parser.set_defaults(run=run)
 
 

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from hiab_sim.atomic_io import write_atomic
+from hiab_sim.cli.options import add_crane_option, add_machine_option
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.errors import ConfigError, HiabSimError, InvalidInputError
@@ -50,12 +51,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "Opens in 'python -m mujoco.viewer --mjcf=FILE'."
         ),
     )
-    parser.add_argument("--crane", default="xs031", help="preset name or YAML file (default: xs031)")
-    parser.add_argument(
-        "--machine",
-        metavar="NAME|FILE",
-        help="a machine file (shipped: xs031, exact) instead of a crane file: its generic MJCF",
-    )
+    add_crane_option(parser)
+    add_machine_option(parser, "a machine file (shipped: xs031, exact) instead of a crane file: its generic MJCF")
     parser.add_argument(
         "--lengths",
         metavar="L,Lc0,Lc,L,Lc0,Lc",

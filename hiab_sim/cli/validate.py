@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Protocol
 
+from hiab_sim.cli.options import DEFAULT_CRANE, add_crane_option, add_machine_option
 from hiab_sim.errors import InvalidInputError
 
 #: ``--samples`` presets: samples per case.
@@ -49,7 +50,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "energy balance. Exit status 1 when any error exceeds its tolerance."
         ),
     )
-    parser.add_argument("--crane", default="xs031", help="crane preset or YAML file (default: xs031)")
+    add_crane_option(parser, f"crane preset or YAML file (default: {DEFAULT_CRANE})")
     parser.add_argument(
         "--cases", type=Path, default=None, metavar="FILE.yaml", help="case file (default: validate/cases.yaml)"
     )
@@ -60,10 +61,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         metavar="N|small|full",
         help="samples per case (default 'full': as in the case file; 'small' = 24)",
     )
-    parser.add_argument(
-        "--machine",
-        metavar="NAME|FILE",
-        help="validate a machine file's paths (Newton-Euler vs MuJoCo) instead of the crane's (shipped: xs031, exact)",
+    add_machine_option(
+        parser,
+        "validate a machine file's paths (Newton-Euler vs MuJoCo) instead of the crane's (shipped: xs031, exact)",
     )
     parser.add_argument(
         "--tcp-force",

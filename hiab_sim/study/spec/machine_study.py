@@ -10,18 +10,18 @@ from hiab_sim.emla.config import load_emla_set
 from hiab_sim.errors import ConfigError
 from hiab_sim.machine.loader import PRESETS as MACHINE_PRESETS
 from hiab_sim.machine.loader import load_machine
-from hiab_sim.resources import Source, locate, recorded_path
+from hiab_sim.resources import Source, locate
 from hiab_sim.structure.machine_structure import machine_pin_names
 from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.machines.machine_model import MachineModel
 from hiab_sim.study.spec.settings import (
-    GridSettings,
     bounds_from_mapping,
     shared_sections,
+    work_sections,
 )
 from hiab_sim.study.spec.study import Study
-from hiab_sim.study.spec.tasks import column_names, study_tasks
-from hiab_sim.yaml_fields import mapping, number, section
+from hiab_sim.study.spec.tasks import column_names
+from hiab_sim.yaml_fields import mapping, number
 
 
 def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
@@ -64,9 +64,8 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
             f"{machine_file.label}: chains.{k.replace('.', '.variables.')}.bounds" for k in model.design_names
         ),
     )
-    grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
-    name = str(top.get("name", Path(str(file.file)).stem))
-    tasks = study_tasks(top, folder, grid.duration, name, column_names(model))
+    work = work_sections(top, file, column_names(model))
+    tasks = work["tasks"]
     # the spiral and pick-and-place kinds prescribe the third tracked coordinate as a crane's telescope:
     # a machine of three joints whose third tracked coordinate is a joint may use them
     prescribed = len(model.tracked_names) == 3 and model.tracked_names[2] in model.joint_names
@@ -85,15 +84,12 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
             values[model.design_names.index(key)] = number(value, f"initial_lengths.{key}")
         initial = model.design(values)
     return Study(
-        name=name,
-        path=recorded_path(file),
+        **work,
         crane_source=source,
         crane_description=None,
         emla_source=emla_source,
         emlas=emlas,
         initial_lengths=initial,
-        grid=grid,
-        tasks=tasks,
         bounds=bounds,
         **shared_sections(top),
         crane_file=machine_file,

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -16,8 +17,11 @@ import numpy as np
 from hiab_sim.checks import check_choice, check_range
 from hiab_sim.crane.description import CHAIN_NAMES
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.resources import Source, recorded_path
+from hiab_sim.study.references.csv_file import ColumnNames
 from hiab_sim.study.spec.build import BuildSettings
 from hiab_sim.study.spec.energy import energy_settings
+from hiab_sim.study.spec.tasks import study_tasks
 from hiab_sim.yaml_fields import mapping, number, section, vector
 
 ID_PATHS = ("mujoco", "analytic")
@@ -233,3 +237,16 @@ def shared_sections(top: Mapping[str, Any]) -> dict[str, Any]:
         "build": BuildSettings.from_mapping(top.get("build")),
         "energy": energy_settings(top),
     }
+
+
+def work_sections(top: Mapping[str, Any], file: Source, names: ColumnNames) -> dict[str, Any]:
+    """The study's name, recorded path, grid and tasks, read alike from a crane file's and a machine file's study.
+
+    The name defaults to the study file's stem; the tasks' CSV paths resolve in its folder and a spiral's
+    duration defaults to ``grid.duration`` [s]. ``names``: the machine's CSV column names
+    (:func:`hiab_sim.study.spec.tasks.column_names`).
+    """
+    grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
+    name = str(top.get("name", Path(str(file.file)).stem))
+    tasks = study_tasks(top, Path(str(file.file)).parent, grid.duration, name, names)
+    return {"name": name, "path": recorded_path(file), "grid": grid, "tasks": tasks}

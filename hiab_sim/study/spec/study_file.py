@@ -28,7 +28,7 @@ from hiab_sim.crane.loader import load_crane
 from hiab_sim.crane.mounting import MountingSpace
 from hiab_sim.emla.config import load_emla_set
 from hiab_sim.errors import ConfigError
-from hiab_sim.resources import DEFAULT_STUDY, Source, locate, recorded_path
+from hiab_sim.resources import DEFAULT_STUDY, Source, locate
 from hiab_sim.structure.pin_loads import pins
 from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.machines.crane_model import CraneModel
@@ -43,10 +43,11 @@ from hiab_sim.study.spec.settings import (
     Tracking,
     bounds_from_mapping,
     shared_sections,
+    work_sections,
 )
 from hiab_sim.study.spec.study import Study
-from hiab_sim.study.spec.tasks import column_names, study_tasks
-from hiab_sim.yaml_fields import mapping, positive, read_yaml, section
+from hiab_sim.study.spec.tasks import column_names
+from hiab_sim.yaml_fields import mapping, positive, read_yaml
 
 _TOP = {
     "name",
@@ -103,21 +104,16 @@ def study_from_dict(data: Any, file: str | Path | Source = "<study>") -> Study:
     emla_source = "default" if top.get("emla") is None else str(top["emla"])
     emlas = load_emla_set(locate(emla_source, "emla", relative_to=file)).renamed(CraneModel(crane).actuator_names)
     bounds = bounds_from_mapping(top["bounds"])
-    grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
-    name = str(top.get("name", Path(str(file.file)).stem))
-    tasks = study_tasks(top, Path(str(file.file)).parent, grid.duration, name, column_names(CraneModel(crane)))
+    work = work_sections(top, file, column_names(CraneModel(crane)))
     initial = _lengths(top.get("initial_lengths"), crane, bounds)
     moved = "initial_lengths" not in top and initial != crane.default_lengths
     return Study(
-        name=name,
-        path=recorded_path(file),
+        **work,
         crane_source=crane_source,
         crane_description=crane,
         emla_source=emla_source,
         emlas=emlas,
         initial_lengths=initial,
-        grid=grid,
-        tasks=tasks,
         bounds=bounds,
         **shared_sections(top),
         mounting=None if top.get("mounting") is None else MountingSpace.from_mapping(top["mounting"]),
