@@ -57,6 +57,31 @@ def test_constraint_jacobian_matches_finite_differences(problem: TaskProblem) ->
         np.testing.assert_allclose(jac[:, i], fd, atol=2e-5 * np.max(np.abs(jac[:, i])) + 1e-7, err_msg=f"column {i}")
 
 
+def test_per_sample_rows_on_the_spline_band_equal_the_full_spline_product() -> None:
+    """A per-sample block's rows chained through B on its band are the product with the full (3, K, N) matrices.
+
+    The full product sum_o dq[k, m, o, j] B[o, k, n] over every column n, zeros outside each
+    sample's support included, is the plain reading of the chain rule; the problem multiplies only
+    the W columns per sample where B is nonzero and writes them into the Jacobian's rows in place.
+    """
+    from hiab_sim.study.nlp.interface import SampleRows
+    from hiab_sim.study.nlp.task_problem import C_SCALE, XI_SCALE
+
+    p = TaskProblem(STUDY, id_path="analytic")
+    K, nj, r = len(p.times), p.n_joints, 4
+    rng = np.random.default_rng(7)
+    jac = SampleRows(dq=rng.normal(size=(K, r, 3 * nj)), dxi=rng.normal(size=(K, r, p.n_xi)))
+    out = np.zeros((K * r, p.n))
+    p._to_z(None, jac, out)  # type: ignore[arg-type]  (the block is not read for sample rows)
+    full = np.zeros((K, r, nj, p.basis.n))
+    for o in range(3):
+        for j in range(nj):
+            full[:, :, j, :] += jac.dq[:, :, o * nj + j, None] * p.B[o][:, None, :]
+    np.testing.assert_allclose(out[:, p.n_xi :], full.reshape(K * r, p.n_c) * C_SCALE, rtol=1e-14, atol=1e-14)
+    np.testing.assert_array_equal(out[:, : p.n_xi], jac.dxi.reshape(K * r, p.n_xi) * XI_SCALE)
+    assert p.band.shape[2] == STUDY.spline.degree + 1  # the band of a B-spline: degree + 1 functions per sample
+
+
 def test_equality_jacobian_is_exact(problem: TaskProblem) -> None:
     """The rest-to-rest equalities are linear in c; their jacobian reproduces them."""
     z = _point(problem)

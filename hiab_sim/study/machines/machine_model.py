@@ -117,6 +117,7 @@ class MachineModel:
         object.__setattr__(self, "_chain_columns", columns)
         object.__setattr__(self, "_chain_cache", {})
         object.__setattr__(self, "_partials_cache", {})
+        object.__setattr__(self, "_variable_maps", {})
 
     @property
     def name(self) -> str:
@@ -339,19 +340,33 @@ class MachineModel:
             ds_dq, dx_dv = cache[at]
             r = 3 * c
             dq[:, r, j], dq[:, r + 1, j], dq[:, r + 2, j] = ds_dq, -ds_dq, -ds_dq
-            retracted = any(v.kind == "retracted_length" for v in chain.variables)
-            for k, v in enumerate(chain.variables):
-                col = keys.index(v.key)
-                dx = dx_dv[:, k]
-                if v.kind == "piston_offset" and retracted:
-                    dx = np.zeros(K)  # x0 is the variable: moving the piston changes only the rod
-                rod = {"rod_length": 1.0, "retracted_length": 1.0}.get(v.kind, 0.0)
-                if v.kind == "piston_offset" and retracted:
-                    rod = -1.0  # rod = x0 - Lc0
-                dxi[:, r, col] = dx
-                dxi[:, r + 1, col] = rod - dx
-                dxi[:, r + 2, col] = -dx
+            columns, moves, rod = self._stroke_variable_map(chain, keys)
+            dx = dx_dv * moves  # (K, v)
+            dxi[:, r, columns] = dx
+            dxi[:, r + 1, columns] = rod - dx
+            dxi[:, r + 2, columns] = -dx
         return dq, dxi
+
+    def _stroke_variable_map(self, chain: Any, keys: tuple[str, ...]) -> tuple[list[int], Array, Array]:
+        """Per variable of a stroke chain: its column in Xi, whether it moves the stroke (1 or 0), d(rod)/dv.
+
+        With the retracted length x0 a variable, the piston offset Lc0 moves only the rod (rod = x0 - Lc0).
+        Cached by the chain's name (a designed chain has the variables of the machine's).
+        """
+        maps = self.__dict__["_variable_maps"]
+        if chain.name in maps:
+            return maps[chain.name]
+        retracted = any(v.kind == "retracted_length" for v in chain.variables)
+        columns = [keys.index(v.key) for v in chain.variables]
+        moves = np.array([0.0 if v.kind == "piston_offset" and retracted else 1.0 for v in chain.variables])
+        rod = np.array(
+            [
+                -1.0 if v.kind == "piston_offset" and retracted else float(v.kind in ("rod_length", "retracted_length"))
+                for v in chain.variables
+            ]
+        )
+        maps[chain.name] = (columns, moves, rod)
+        return columns, moves, rod
 
     def _stroke_chain_list(self, machine: Machine) -> list[Any]:
         return [c for c in machine.chains if c.kind != "direct"]

@@ -152,8 +152,7 @@ class TaskProblem(ScaledProblem):
         self.B = np.stack(self.basis.matrices(self.times))  # (3 orders, K, N)
         #: the band of B: the W basis functions from ``band_start[k]`` on hold every nonzero at sample k
         self.band_start, self.band = _band(self.B)
-        self.band_rows = np.arange(len(self.times))[:, None]
-        self.band_columns = self.band_start[:, None] + np.arange(self.band.shape[2])
+        self._band_indices: dict[int, NDArray[np.intp]] = {}
         model = study.model
         self.n_joints = len(model.joint_names)
         self.kin = model.kinematics
@@ -366,10 +365,10 @@ class TaskProblem(ScaledProblem):
             r = jac.dq.shape[1]
             # q9 index = order * n_joints + joint; dc[k, m, j, n] = sum_o dq[k, m, o, j] B[o, k, n] on the band
             band = np.einsum("kmoj,okb->kbmj", jac.dq.reshape(K, r, 3, nj), self.band) * C_SCALE
-            dc = out[:, self.n_xi :].reshape(K, r, nj, self.basis.n)  # a view: rows k r + m, columns j N + n
-            if not np.may_share_memory(dc, out):
-                raise AssertionError("the Jacobian's coefficient columns must reshape without a copy")
-            dc[self.band_rows, :, :, self.band_columns] = band
+            flat = out.reshape(-1)  # the block's rows are contiguous rows of the Jacobian
+            if not np.may_share_memory(flat, out):
+                raise AssertionError("a block's Jacobian rows must be contiguous")
+            flat[self._band_index(r)] = band.reshape(-1)
             if jac.dxi is not None:
                 out[:, : self.n_xi] = (jac.dxi * XI_SCALE).reshape(rows, self.n_xi)
         else:
@@ -378,6 +377,18 @@ class TaskProblem(ScaledProblem):
                 out[:, self.n_xi :] = dc.reshape(rows, self.n_c)
             if jac.dxi is not None:
                 out[:, : self.n_xi] = jac.dxi * XI_SCALE
+
+    def _band_index(self, r: int) -> NDArray[np.intp]:
+        """Flat indices into a block's (K r, n) rows of its band entries, in (k, b, m, j) order (cached per r).
+
+        Row k r + m, column n_xi + j N + s_k + b: the coefficient b of the band of sample k for joint j.
+        """
+        if r not in self._band_indices:
+            K, W, N = len(self.times), self.band.shape[2], self.basis.n
+            k, b, m, j = np.ix_(np.arange(K), np.arange(W), np.arange(r), np.arange(self.n_joints))
+            column = self.n_xi + j * N + self.band_start[k] + b
+            self._band_indices[r] = ((k * r + m) * self.n + column).reshape(-1).astype(np.intp)
+        return self._band_indices[r]
 
     def _gradients(self, z: Array) -> tuple[Array, Array]:
         z = np.array(z, dtype=float)

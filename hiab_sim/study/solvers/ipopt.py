@@ -23,7 +23,6 @@ and MUMPS).
 
 from __future__ import annotations
 
-import functools
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -32,8 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 from scipy import sparse
-from threadpoolctl import OpenBLASController, threadpool_limits
-from threadpoolctl import register as register_threadpool
+from threadpoolctl import threadpool_limits
 
 from hiab_sim.errors import BackendUnavailableError
 from hiab_sim.study.nlp.interface import Array, PerSampleBlock
@@ -198,18 +196,7 @@ def _casadi() -> Any:
         raise BackendUnavailableError(
             "IPOPT (solver.method: ipopt, duty-mix cross-evaluation) needs CasADi: pip install 'hiab-sim[ipopt]'"
         ) from None
-    _register_casadi_openblas()
     return casadi
-
-
-@functools.cache
-def _register_casadi_openblas() -> None:
-    """Let threadpoolctl find the OpenBLAS that CasADi's wheels ship under their own name (once)."""
-
-    class CasadiOpenBLAS(OpenBLASController):
-        filename_prefixes = ("libcasadi-tp-openblas",)
-
-    register_threadpool(CasadiOpenBLAS)
 
 
 def _callback_class(ca: Any) -> Any:
@@ -371,12 +358,13 @@ def solve_ipopt(
     ubx = np.where(np.isfinite(problem.upper), problem.upper, np.inf)
     lbg = np.zeros(m)
     ubg = jac.upper(z0)
-    # One thread for every BLAS and OpenMP pool loaded by now (numpy's and scipy's OpenBLAS, CasADi's
-    # own OpenBLAS under MUMPS, loaded with the plugin above): the NLP's matrices are small, and on a
-    # shared 2-core machine pooled threads spin against each other (digging study: 117 s with two
-    # threads beside a test run, 9 s with one). It also makes IPOPT's iterates independent of the
-    # machine's core count (CasADi's thread count changed them: 168 or 180 iterations).
-    with threadpool_limits(limits=1):
+    # One thread for numpy's and scipy's BLAS inside the solve (threadpoolctl finds their OpenBLAS by
+    # name): the NLP's evaluations work on small matrices, and on a shared 2-core machine pooled
+    # threads spin against each other (digging study: 117 s with two threads beside a test run, 9 s
+    # with one; the same iterates). CasADi's own OpenBLAS under MUMPS keeps its threads: IPOPT's
+    # iterates depend on them (168 or 131 iterations on the digging study), and the shipped duty
+    # mix reaches its recorded optimum with the default (with one thread it stops at max_iter).
+    with threadpool_limits(limits=1, user_api="blas"):
         out = solver(x0=z0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
     stats = solver.stats()
     z = np.asarray(out["x"]).ravel()
