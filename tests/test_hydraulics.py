@@ -13,8 +13,8 @@ from hiab_sim.crane.loader import load_crane
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.hydraulics import (
     Cylinder,
-    HydraulicCylinders,
     HydraulicSupplyParams,
+    HydraulicSystem,
     cylinder_flows,
     hydraulic_baseline,
     hydraulic_cylinders_from_mapping,
@@ -22,7 +22,7 @@ from hiab_sim.hydraulics import (
 
 XS031 = load_crane().hydraulic_cylinders
 assert XS031 is not None
-FRICTIONLESS = HydraulicCylinders(XS031.lift, XS031.tilt, XS031.telescope, supply_pressure=19.0e6)
+FRICTIONLESS = HydraulicSystem(XS031.cylinders, supply_pressure=19.0e6)
 IDEAL = HydraulicSupplyParams(pump_efficiency=1.0, motor_efficiency=1.0)
 
 
@@ -64,7 +64,7 @@ def test_lowering_a_load_fills_the_rod_side_and_throttles_the_piston_side() -> N
     f = np.array([[30.0e3, -10.0e3, 0.0]])
     v = np.array([[-0.1, 0.1, 0.0]])
     flows = cylinder_flows(f, v, FRICTIONLESS, IDEAL)
-    assert flows.inlet_flow[0, 0] == pytest.approx(0.1 * XS031.lift.annulus_area, rel=1e-15)
+    assert flows.inlet_flow[0, 0] == pytest.approx(0.1 * XS031.cylinder("lift").annulus_area, rel=1e-15)
     assert flows.load_pressure[0, :2] == pytest.approx([0.0, 0.0], abs=0.0)
     assert flows.meter_out_loss[0, :2] == pytest.approx([3000.0, 1000.0], rel=1e-15)
 
@@ -75,7 +75,7 @@ def test_cylinders_at_standstill_draw_no_flow_and_do_not_set_the_load_sensing_pr
     f = np.tile([90.0e3, 10.0e3, 0.0], (2, 1))
     v = np.tile([1e-4, 0.05, 0.0], (2, 1))
     _, ls = hydraulic_baseline(t, f, v, FRICTIONLESS, IDEAL)
-    assert ls.pump_pressure == pytest.approx(np.full(2, 10.0e3 / XS031.tilt.piston_area + 2.0e6), rel=1e-14)
+    assert ls.pump_pressure == pytest.approx(np.full(2, 10.0e3 / XS031.cylinder("tilt").piston_area + 2.0e6), rel=1e-14)
     assert ls.input_energy_per_actuator[0] == 0.0
 
 
@@ -111,11 +111,13 @@ def test_load_sensing_never_uses_more_than_constant_pressure_below_the_supply_pr
 
 def test_crane_file_carries_the_cylinders_it_was_built_with() -> None:
     """The XS 031 preset gives the 80/45 mm lift and tilt and 50/30 mm telescope cylinders at 190 bar."""
-    assert (XS031.lift.bore, XS031.lift.rod, XS031.telescope.bore, XS031.telescope.rod) == (0.08, 0.045, 0.05, 0.03)
+    lift, tilt, telescope = XS031.cylinders  # in the crane's actuator order
+    assert (lift.name, tilt.name, telescope.name) == ("lift", "tilt", "telescope")
+    assert (lift.bore, lift.rod, telescope.bore, telescope.rod) == (0.08, 0.045, 0.05, 0.03)
     assert XS031.supply_pressure == 19.0e6
     # The EMLA preset's hydraulic comparison forces: 95.5 kN push and 65.3 kN pull at 190 bar.
-    assert XS031.lift.piston_area * XS031.supply_pressure == pytest.approx(95.5e3, rel=1e-3)
-    assert XS031.lift.annulus_area * XS031.supply_pressure == pytest.approx(65.3e3, rel=1e-3)
+    assert lift.piston_area * XS031.supply_pressure == pytest.approx(95.5e3, rel=1e-3)
+    assert lift.annulus_area * XS031.supply_pressure == pytest.approx(65.3e3, rel=1e-3)
 
 
 @pytest.mark.parametrize(
@@ -126,7 +128,10 @@ def test_crane_file_carries_the_cylinders_it_was_built_with() -> None:
         ("hydraulics.pump_efficiency", lambda: HydraulicSupplyParams(pump_efficiency=0.0)),
         ("hydraulics.motor_efficiency", lambda: HydraulicSupplyParams(motor_efficiency=1.5)),
         ("hydraulics.load_sensing_margin", lambda: HydraulicSupplyParams(load_sensing_margin=-1.0)),
-        ("hydraulic_cylinders.supply_pressure", lambda: HydraulicCylinders(*FRICTIONLESS, supply_pressure=0.0)),
+        ("hydraulic_cylinders.supply_pressure", lambda: HydraulicSystem(XS031.cylinders, 0.0, label="hydraulic_cylinders")),
+        ("hydraulic.supply_pressure", lambda: HydraulicSystem(XS031.cylinders, supply_pressure=0.0)),
+        ("hydraulic.cylinders.boom.rod", lambda: Cylinder("boom", 0.08, 0.09, 0.5, label="hydraulic.cylinders.boom")),
+        ("hydraulic.cylinders", lambda: HydraulicSystem((*XS031.cylinders, XS031.cylinders[0]), 19.0e6)),
     ],
 )
 def test_bad_hydraulic_parameters_name_the_field(field: str, build: object) -> None:
@@ -144,7 +149,7 @@ def test_unknown_key_in_the_cylinder_section_is_a_config_error() -> None:
         "supply_pressure": 19.0e6,
     }
     with pytest.raises(ConfigError, match="telescope"):
-        hydraulic_cylinders_from_mapping(data)
+        hydraulic_cylinders_from_mapping(data, ("lift", "tilt", "telescope"))
 
 
 def test_comparison_figure_shows_the_energies_it_was_given() -> None:

@@ -11,13 +11,15 @@ import pytest
 from hiab_sim.emla.battery import BatteryParams
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.hydraulics.battery_boundary import BOUNDARY_VARIANTS, CircuitParams, battery_boundary_baselines
-from hiab_sim.hydraulics.cylinders import CounterbalanceValve, Cylinder, HydraulicCylinders
+from hiab_sim.hydraulics.cylinders import CounterbalanceValve, Cylinder, HydraulicSystem
 
 CBV = CounterbalanceValve("piston", 3.0, 24.7e6, 0.17e6)
-CYLINDERS = HydraulicCylinders(
-    lift=Cylinder("lift", 0.08, 0.045, 0.59, counterbalance=CBV),
-    tilt=Cylinder("tilt", 0.08, 0.045, 0.59, counterbalance=CBV),
-    telescope=Cylinder("telescope", 0.05, 0.03, 1.1),
+CYLINDERS = HydraulicSystem(
+    (
+        Cylinder("lift", 0.08, 0.045, 0.59, counterbalance=CBV),
+        Cylinder("tilt", 0.08, 0.045, 0.59, counterbalance=CBV),
+        Cylinder("telescope", 0.05, 0.03, 1.1),
+    ),
     supply_pressure=19e6,
     coulomb_friction=4000.0,
     viscous_friction=3000.0,
@@ -69,7 +71,8 @@ def test_pump_controlled_cylinders_recover_what_the_load_returns_through_the_sha
     assert eha.terms["useful_work"] == pytest.approx(ls.terms["useful_work"], rel=0.05)
     no_leak = battery_boundary_baselines(t, f, v, CYLINDERS, BATTERY, CircuitParams(leakage_conductance=0.0))[1]
     assert no_leak.battery_energy < ls.battery_energy and ls.terms["leakage"] > 0
-    plain = replace(CYLINDERS, lift=replace(CYLINDERS.lift, counterbalance=None))
+    lift, *rest = CYLINDERS.cylinders
+    plain = replace(CYLINDERS, cylinders=(replace(lift, counterbalance=None), *rest))
     assert battery_boundary_baselines(t, f, v, plain, BATTERY)[1].battery_energy < ls.battery_energy
 
 

@@ -44,7 +44,6 @@ CRANE_MODEL = {
     "model/mjcf.py": "builds the crane file's MJCF: bodies, joints and sites named after the crane",
     "env/physics.py": "the crane file's closed-loop physics: adds the payload to the crane MJCF's telescope rod",
     "env/plant/mismatch.py": "the end-mass mismatch acts on the crane file's end_mass body (another session's area)",
-    "hydraulics/cylinders.py": "the crane file's hydraulic_cylinders section, keyed by its actuators",
     "study/figures/design.py": "draws a crane file's design from the crane's closed-form frames",
     "study/machines/crane_model.py": "the crane file as the study's machine: its fixed names and variables",
     "docs_site/field_specs/crane.py": "documents the crane file's fields, which are named after its chains",

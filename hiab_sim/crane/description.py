@@ -27,7 +27,7 @@ import numpy as np
 
 from hiab_sim.checks import check_range
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.hydraulics.cylinders import HydraulicCylinders
+from hiab_sim.hydraulics.cylinders import HydraulicSystem
 from hiab_sim.machine.parts import check_interval, check_rotation, homogeneous, mat3, vec3
 
 Vector3 = tuple[float, float, float]
@@ -218,7 +218,7 @@ class Crane:
     telescope: Telescope
     tcp: Pose  # TCP frame {D22} in the end-mass frame {P32}
     bodies: tuple[RigidBody, ...] = field(repr=False)
-    hydraulic_cylinders: HydraulicCylinders | None = None  # the cylinders the EMLAs replace, if given
+    hydraulic_cylinders: HydraulicSystem | None = None  # the cylinders the EMLAs replace, if given
 
     def __post_init__(self) -> None:
         check_range("gravity", self.gravity, 0.0, unit="m/s^2", low_open=True)

@@ -27,6 +27,7 @@ from hiab_sim.crane.description import (
     vec3,
 )
 from hiab_sim.crane.mechanism import check_lengths
+from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.hydraulics.cylinders import hydraulic_cylinders_from_mapping
 from hiab_sim.resources import Source, locate
@@ -101,7 +102,9 @@ def crane_from_dict(data: Any, origin: str = "crane") -> Crane:
         tcp=tcp,
         bodies=bodies,
         hydraulic_cylinders=(
-            hydraulic_cylinders_from_mapping(top["hydraulic_cylinders"]) if "hydraulic_cylinders" in top else None
+            hydraulic_cylinders_from_mapping(top["hydraulic_cylinders"], ACTUATOR_NAMES)
+            if "hydraulic_cylinders" in top
+            else None
         ),
     )
     check_lengths(crane, crane.default_lengths)

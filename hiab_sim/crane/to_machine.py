@@ -21,8 +21,8 @@ from __future__ import annotations
 import numpy as np
 
 from hiab_sim.crane.description import ClosedChain, Crane
-from hiab_sim.hydraulics.cylinders import HydraulicCylinders
-from hiab_sim.machine.chains import Actuator, Chain, DecisionVariable, HydraulicSystem, Pivot
+from hiab_sim.hydraulics.cylinders import HydraulicSystem
+from hiab_sim.machine.chains import Actuator, Chain, DecisionVariable, Pivot
 from hiab_sim.machine.description import Link, Machine
 from hiab_sim.machine.parts import Pose, RigidBody, mat3, rot_z, vec3
 
@@ -82,11 +82,12 @@ def _triangle(crane: Crane, chain: ClosedChain, joint: str, bounds: tuple[tuple[
     )
 
 
-def _hydraulic(cylinders: HydraulicCylinders | None) -> HydraulicSystem | None:
+def _hydraulic(cylinders: HydraulicSystem | None) -> HydraulicSystem | None:
+    """The crane file's cylinders as a machine file's ``hydraulic`` section (its error messages' prefix)."""
     if cylinders is None:
         return None
     return HydraulicSystem(
-        cylinders=tuple(cylinders),
+        cylinders=cylinders.cylinders,
         supply_pressure=cylinders.supply_pressure,
         coulomb_friction=cylinders.coulomb_friction,
         viscous_friction=cylinders.viscous_friction,

@@ -46,7 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.checks import check_efficiency
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.hydraulics.cylinders import HydraulicCylinders
+from hiab_sim.hydraulics.cylinders import HydraulicSystem
 
 Array = NDArray[np.float64]
 
@@ -161,12 +161,12 @@ class SupplyResult:
 
 
 def cylinder_flows(
-    force: ArrayLike, velocity: ArrayLike, cylinders: HydraulicCylinders, params: HydraulicSupplyParams
+    force: ArrayLike, velocity: ArrayLike, cylinders: HydraulicSystem, params: HydraulicSupplyParams
 ) -> CylinderFlows:
     """Return the meter-in flows, load pressures and valve/friction losses of each cylinder.
 
     Args:
-        force: Rod force f_x [N], shape (K, n) with columns in :data:`CYLINDER_NAMES` order.
+        force: Rod force f_x [N], shape (K, n) with columns in :attr:`HydraulicSystem.cylinders` order.
         velocity: Rod velocity v_x [m/s], shape (K, n).
         cylinders: Geometry, supply pressure and friction.
         params: Supply parameters (``standstill_speed``).
@@ -202,7 +202,7 @@ def hydraulic_baseline(
     time: ArrayLike,
     force: ArrayLike,
     velocity: ArrayLike,
-    cylinders: HydraulicCylinders,
+    cylinders: HydraulicSystem,
     params: HydraulicSupplyParams | None = None,
 ) -> tuple[SupplyResult, SupplyResult]:
     """Return the (constant-pressure, load-sensing) baselines for rod forces and velocities on a time grid.

@@ -46,7 +46,7 @@ from hiab_sim.checks import check_efficiency, check_non_negative, check_positive
 from hiab_sim.emla.battery import BatteryParams, battery_power, trapezoid_weights
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.hydraulics.baseline import Array
-from hiab_sim.hydraulics.cylinders import HydraulicCylinders
+from hiab_sim.hydraulics.cylinders import HydraulicSystem
 
 #: The variants at the battery, in the order :func:`battery_boundary_baselines` returns them.
 BOUNDARY_VARIANTS: tuple[str, ...] = ("constant_pressure", "load_sensing", "pump_controlled")
@@ -122,7 +122,7 @@ class BoundaryResult:
         return self.battery_energy - math.fsum(self.terms.values())
 
 
-def _chambers(force: Array, velocity: Array, cylinders: HydraulicCylinders, standstill: float) -> dict[str, Array]:
+def _chambers(force: Array, velocity: Array, cylinders: HydraulicSystem, standstill: float) -> dict[str, Array]:
     """Per-sample chamber pressures, flows and valve losses of each cylinder (module docstring), (K, n) each."""
     cyl = tuple(cylinders)
     moving = np.abs(velocity) >= standstill
@@ -251,7 +251,7 @@ def battery_boundary_baselines(
     time: ArrayLike,
     force: ArrayLike,
     velocity: ArrayLike,
-    cylinders: HydraulicCylinders,
+    cylinders: HydraulicSystem,
     battery: BatteryParams,
     circuit: CircuitParams | None = None,
 ) -> tuple[BoundaryResult, BoundaryResult, BoundaryResult]:

@@ -5,14 +5,12 @@ Conventions in :mod:`hiab_sim.machine.description`. Lengths in m.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
 
 from hiab_sim.checks import check_choice, check_non_negative, check_positive
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.hydraulics.cylinders import Cylinder
 from hiab_sim.machine.parts import RigidBody, Vector3, check_interval, check_vector
 
 CHAIN_KINDS = ("triangle", "linkage", "direct")
@@ -185,34 +183,3 @@ class Chain:
             if p.role == role:
                 return p
         raise InvalidInputError(f"chains.{self.name}.pivots", role, f"no pivot {role}")
-
-
-@dataclass(frozen=True)
-class HydraulicSystem:
-    """The hydraulic cylinders the EMLAs replace (the baseline), supply pressure [Pa], friction."""
-
-    cylinders: tuple[Cylinder, ...]
-    supply_pressure: float
-    coulomb_friction: float = 0.0  # N per cylinder
-    viscous_friction: float = 0.0  # N s/m per cylinder
-
-    def __post_init__(self) -> None:
-        check_positive("hydraulic.supply_pressure", self.supply_pressure, "Pa")
-        check_non_negative("hydraulic.friction.coulomb", self.coulomb_friction, "N")
-        check_non_negative("hydraulic.friction.viscous", self.viscous_friction, "N s/m")
-        names = [c.name for c in self.cylinders]
-        if len(set(names)) != len(names):
-            raise InvalidInputError("hydraulic.cylinders", str(names), "names must be unique")
-
-    def __iter__(self) -> Iterator[Cylinder]:
-        """The cylinders in order (the hydraulic baseline's actuator order)."""
-        return iter(self.cylinders)
-
-    def cylinder(self, name: str) -> Cylinder:
-        """The cylinder of this name."""
-        for c in self.cylinders:
-            if c.name == name:
-                return c
-        raise InvalidInputError(
-            "hydraulic.cylinders", name, f"no such cylinder; have {[c.name for c in self.cylinders]}"
-        )

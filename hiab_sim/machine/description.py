@@ -58,6 +58,7 @@ import numpy as np
 
 from hiab_sim.checks import check_choice, check_positive
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.hydraulics.cylinders import HydraulicSystem
 from hiab_sim.machine.chains import (
     CHAIN_KINDS,
     PIVOT_ROLES,
@@ -65,7 +66,6 @@ from hiab_sim.machine.chains import (
     Actuator,
     Chain,
     DecisionVariable,
-    HydraulicSystem,
     Linkage,
     Pivot,
 )

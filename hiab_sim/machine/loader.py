@@ -20,8 +20,8 @@ import yaml
 
 from hiab_sim.checks import check_range
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.hydraulics.cylinders import Cylinder
-from hiab_sim.machine.chains import Actuator, Chain, DecisionVariable, HydraulicSystem, Linkage, Pivot
+from hiab_sim.hydraulics.cylinders import HydraulicSystem, cylinder_from_mapping
+from hiab_sim.machine.chains import Actuator, Chain, DecisionVariable, Linkage, Pivot
 from hiab_sim.machine.description import Link, Machine
 from hiab_sim.machine.kinematics.assembly import check_machine
 from hiab_sim.machine.parts import IDENTITY, Matrix3, Pose, RigidBody, Vector3, rot_z
@@ -295,12 +295,9 @@ def _chain(name: str, node: Any) -> Chain:
 def _hydraulic(node: Any) -> HydraulicSystem:
     top = mapping(node, "hydraulic", {"cylinders", "supply_pressure", "friction"}, {"cylinders", "supply_pressure"})
     cylinders_node = mapping(top["cylinders"], "hydraulic.cylinders", None)
-    cylinders = []
-    for name, c in cylinders_node.items():
-        cw = f"hydraulic.cylinders.{name}"
-        cn = mapping(c, cw, {"bore", "rod", "stroke"})
-        bore, rod, stroke = (number(cn[k], f"{cw}.{k}") for k in ("bore", "rod", "stroke"))
-        cylinders.append(Cylinder(str(name), bore, rod, stroke))
+    cylinders = [
+        cylinder_from_mapping(c, f"hydraulic.cylinders.{name}", str(name)) for name, c in cylinders_node.items()
+    ]
     friction = mapping(top.get("friction", {}), "hydraulic.friction", {"coulomb", "viscous"}, set())
     return HydraulicSystem(
         cylinders=tuple(cylinders),

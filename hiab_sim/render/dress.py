@@ -170,7 +170,7 @@ def machine_dress(model: mujoco.MjModel, crane: Crane, tcp_site: str = "tcp") ->
         if material < 0:
             continue
         chain = next((c for c in chain_names if body in (f"{c}_cylinder", f"{c}_rod")), "")
-        data = getattr(cylinders, chain, None) if cylinders is not None and chain else None
+        data = cylinders.find(chain) if cylinders is not None and chain else None
         if material == found.get("hiab_red"):
             side = COLUMN_SECTION_M if int(model.geom_bodyid[g]) == base else BOOM_SECTION_M
             kind[g], section[g] = "structure", (side, side)

@@ -205,12 +205,11 @@ def _chains() -> list[Key]:
 
 
 def _hydraulic() -> list[Key]:
-    """``hydraulic``: the baseline cylinders (:class:`~hiab_sim.machine.chains.HydraulicSystem`)."""
-    from hiab_sim.hydraulics.cylinders import Cylinder
-    from hiab_sim.machine.chains import HydraulicSystem
+    """``hydraulic``: the baseline cylinders (:class:`~hiab_sim.hydraulics.cylinders.HydraulicSystem`)."""
+    from hiab_sim.hydraulics.cylinders import Cylinder, HydraulicSystem
 
-    checked = _checked(HydraulicSystem, "hydraulic.")
-    cylinder = from_class("", Cylinder, skip=("name", "pin_to_pin_at_zero", "counterbalance"))
+    checked = _checked(HydraulicSystem)
+    cylinder = from_class("", Cylinder, skip=("name", "pin_to_pin_at_zero", "counterbalance", "label"))
     cylinder = [replace(k, allowed="0 < rod < bore") if k.path == "rod" else k for k in cylinder]
     return [
         section("hydraulic", "The hydraulic cylinders the EMLAs replace (the hydraulic baseline).", "none"),

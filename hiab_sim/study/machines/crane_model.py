@@ -20,7 +20,7 @@ from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.names import ACTUATOR_NAMES, JOINT_NAMES
 from hiab_sim.dynamics.interface import InverseDynamics, make_inverse_dynamics
-from hiab_sim.hydraulics.cylinders import HydraulicCylinders
+from hiab_sim.hydraulics.cylinders import HydraulicSystem
 from hiab_sim.study.machines.crane_reach import REASONS, planar_ik
 from hiab_sim.study.machines.protocol import Array, PointReach
 from hiab_sim.study.motion import trajectory as tr
@@ -55,7 +55,7 @@ class CraneModel:
         return self.crane.gravity
 
     @property
-    def hydraulic_cylinders(self) -> HydraulicCylinders | None:
+    def hydraulic_cylinders(self) -> HydraulicSystem | None:
         """The cylinders the EMLAs replace (the crane file's ``hydraulic_cylinders``), or None."""
         return self.crane.hydraulic_cylinders
 

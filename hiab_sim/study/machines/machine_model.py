@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.machine.chains import HydraulicSystem
+from hiab_sim.hydraulics.cylinders import HydraulicSystem
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.design import MachineDesign, designed_chain
 from hiab_sim.machine.dynamics.newton_euler import batched_inverse_dynamics
