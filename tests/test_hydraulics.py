@@ -128,7 +128,7 @@ def test_crane_file_carries_the_cylinders_it_was_built_with() -> None:
         ("hydraulics.pump_efficiency", lambda: HydraulicSupplyParams(pump_efficiency=0.0)),
         ("hydraulics.motor_efficiency", lambda: HydraulicSupplyParams(motor_efficiency=1.5)),
         ("hydraulics.load_sensing_margin", lambda: HydraulicSupplyParams(load_sensing_margin=-1.0)),
-        ("hydraulic_cylinders.supply_pressure", lambda: HydraulicSystem(XS031.cylinders, 0.0, label="hydraulic_cylinders")),
+        ("hydraulic_cylinders.supply_pressure", lambda: HydraulicSystem(XS031.cylinders, 0.0, 0.0, 0.0, XS031.label)),
         ("hydraulic.supply_pressure", lambda: HydraulicSystem(XS031.cylinders, supply_pressure=0.0)),
         ("hydraulic.cylinders.boom.rod", lambda: Cylinder("boom", 0.08, 0.09, 0.5, label="hydraulic.cylinders.boom")),
         ("hydraulic.cylinders", lambda: HydraulicSystem((*XS031.cylinders, XS031.cylinders[0]), 19.0e6)),
