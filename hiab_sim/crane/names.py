@@ -12,3 +12,7 @@ from __future__ import annotations
 JOINT_NAMES: tuple[str, ...] = ("theta1", "theta2", "xt2")
 #: Actuators, in the column order of actuator samples and of an EMLA set.
 ACTUATOR_NAMES: tuple[str, ...] = ("lift", "tilt", "telescope")
+#: The link that carries the TCP and the load (the telescope's rod, frame {B52}).
+TOOL_LINK = "telescope_rod"
+#: The body of the crane file that is the load at the tip (``bodies.end_mass``, frame {P32}).
+LOAD_BODY = "end_mass"

@@ -136,7 +136,7 @@ class MujocoInverseDynamics:
         self._x0 = np.array([getattr(self.lengths, c).x0 for c in _CHAINS])
         self._tcp = m.site("tcp").id
         mujoco.mj_kinematics(m, self.data)
-        axes = self.data.xaxis[[m.joint(n).id for n in ("theta1", "theta2", "lift_q1", "tilt_q1")]]
+        axes = self.data.xaxis[[m.joint(n).id for n in _DEPENDENT]]  # the booms' and cylinders' hinges
         self._axis = axes[0].copy()  # common hinge axis n in the world
         if np.max(np.abs(axes - self._axis)) > 1e-12:
             raise AssertionError("hinge axes of a planar crane must be parallel")

@@ -37,7 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import CubicSpline
 
-from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.crane.description import CHAIN_NAMES, Crane, LinkLengths
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import InvalidInputError
@@ -135,7 +135,7 @@ def replay(
         tcp = model.site("tcp").id
     actuator = [model.actuator(name).id for name in ACTUATORS]
     joint = [model.joint(name).qposadr[0] for name in JOINTS]
-    sites = [(model.site(f"{c}_rod_end").id, model.site(f"{c}_boom_pivot").id) for c in ("lift", "tilt")]
+    sites = [(model.site(f"{c}_rod_end").id, model.site(f"{c}_boom_pivot").id) for c in CHAIN_NAMES]
 
     n_steps = int(np.ceil((t[-1] - t[0]) / dt - 1e-9))
     midpoints = t[0] + (np.arange(n_steps) + 0.5) * dt

@@ -36,6 +36,7 @@ import numpy as np
 from dm_control import mujoco as dm_mujoco
 from numpy.typing import NDArray
 
+from hiab_sim.crane.names import LOAD_BODY, TOOL_LINK
 from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator, DriveStep
 from hiab_sim.env.drive_losses import DriveLossModel
 from hiab_sim.env.plan import DesignPlan
@@ -350,9 +351,9 @@ def _add_view(spec: mujoco.MjSpec, motion: PlannedMotion) -> None:
 
 def _add_payload(spec: mujoco.MjSpec, plan: DesignPlan, payload_error: float) -> None:
     """Extra end mass (payload_error x end mass) and the study's payload x (1 + payload_error) at the TCP."""
-    rod = spec.body("telescope_rod")
+    rod = spec.body(TOOL_LINK)
     if payload_error != 0.0:
-        end = next(body for body in plan.crane.bodies if body.name == "end_mass")
+        end = next(body for body in plan.crane.bodies if body.name == LOAD_BODY)
         extra = rod.add_body(name="end_mass_error", pos=list(end.com))
         inertia = np.asarray(end.inertia) * payload_error
         extra.explicitinertial = True

@@ -22,15 +22,13 @@ from dataclasses import replace
 import numpy as np
 
 from hiab_sim.crane.description import Crane, RigidBody, mat3, vec3
+from hiab_sim.crane.names import LOAD_BODY
 from hiab_sim.emla.drive_sim import DriveArrays
 from hiab_sim.env.plant.config import Mismatch
 from hiab_sim.errors import ConfigError
 from hiab_sim.machine import parts
 from hiab_sim.machine.description import Machine
 from hiab_sim.model.drives import SlideDrives
-
-#: Name of the load's body in a crane description.
-END_MASS = "end_mass"
 
 
 def _scaled(body: RigidBody, factor: float, shift: np.ndarray) -> RigidBody:
@@ -46,11 +44,11 @@ def true_crane(crane: Crane, mismatch: Mismatch) -> Crane:
     """The crane with the mismatch's mass and centre-of-mass errors (module docstring)."""
     if not mismatch.enabled:
         return crane
-    if not any(body.name == END_MASS for body in crane.bodies):
-        raise ConfigError(f"crane '{crane.name}' has no body '{END_MASS}' for the end-mass mismatch")
+    if not any(body.name == LOAD_BODY for body in crane.bodies):
+        raise ConfigError(f"crane '{crane.name}' has no body '{LOAD_BODY}' for the end-mass mismatch")
     bodies = []
     for body in crane.bodies:
-        if body.name == END_MASS:
+        if body.name == LOAD_BODY:
             bodies.append(_scaled(body, 1.0 + mismatch.end_mass_error, np.asarray(mismatch.end_mass_com_offset_m)))
         else:
             shift = np.array([mismatch.link_com_shift_m, 0.0, 0.0])

@@ -39,10 +39,18 @@ class CraneModel:
     joint_names = JOINT_NAMES
     joint_units = ("rad", "rad", "m")
     actuator_names = ACTUATOR_NAMES
-    tracked_names = ("x_tcp", "y_tcp", "xt2")
-    design_names = tuple(f"{c}.{k}" for c in ("lift", "tilt") for k in ("L", "Lc0", "Lc"))
-    stroke_chains = ("lift", "tilt")
+    tracked_names = ("x_tcp", "y_tcp", JOINT_NAMES[2])  # the TCP in the plane and the telescope's extension
     stroke_joints = (0, 1)
+
+    @property
+    def design_names(self) -> tuple[str, ...]:
+        """Xi: the seed's [L, Lc0, Lc] of each triangle chain, ``<chain>.<L|Lc0|Lc>`` in chain order."""
+        return tuple(f"{c.name}.{k}" for c in self.crane.chains for k in ("L", "Lc0", "Lc"))
+
+    @property
+    def stroke_chains(self) -> tuple[str, ...]:
+        """The triangle chains (their strokes follow their joints 0 and 1)."""
+        return tuple(c.name for c in self.crane.chains)
 
     @property
     def name(self) -> str:
