@@ -9,45 +9,26 @@ Run: ``.venv/bin/python benchmarks/bench_render.py [--frames N]``.
 from __future__ import annotations
 
 import argparse
-import json
 import os
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-from hiab_sim.crane.description import LinkLengths
-from hiab_sim.crane.kinematics import tcp_position
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.render import load_playback, playback_renderer
 from hiab_sim.render.frames import LAYOUTS, Layout
 
+# The benchmark renders the render tests' fabricated result (tests/ is a folder of modules, not a package).
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from playback_result_helper import write_playback_result
+
 
 def write_demo_result(folder: Path, duration: float = 4.0, samples: int = 401) -> Path:
     """A result folder: a joint-space loop around (0.6, -1.3, 0.4), two designs."""
-    crane = load_crane("xs031")
-    initial = crane.default_lengths
-    optimal = LinkLengths.from_array(initial.as_array() * np.array([1.03, 1.2, 1.0, 1.0, 1.0, 1.0]))
-    t = np.linspace(0.0, duration, samples)
-    w = 2.0 * np.pi / duration
-    amp, freq, phase = np.array([0.25, 0.3, 0.3]), np.array([1.0, 1.0, 2.0]), np.array([0.0, 1.0, 0.0])
-    arg = w * freq * t[:, None] + phase
-    p = np.array([0.6, -1.3, 0.4]) + amp * np.sin(arg)
-    v = amp * w * freq * np.cos(arg)
-    a = -amp * (w * freq) ** 2 * np.sin(arg)
-
-    def lengths(xi: LinkLengths) -> dict[str, dict[str, float]]:
-        return {n: {"L": c.L, "Lc0": c.Lc0, "Lc": c.Lc} for n, c in zip(("lift", "tilt"), xi, strict=True)}
-
-    result = {"crane": "xs031", "study": "bench", "initial": {"lengths": lengths(initial)}}
-    result["optimal"] = {"lengths": lengths(optimal)}
-    (folder / "result.json").write_text(json.dumps(result))
-    arrays = {"time": t, "reference_tcp": tcp_position(crane, p[:, 0], p[:, 1], p[:, 2])}
-    for d in ("initial", "optimal"):
-        arrays |= {f"{d}_position": p, f"{d}_velocity": v, f"{d}_acceleration": a}
-    np.savez(folder / "trajectory.npz", **arrays)
-    return folder
+    return write_playback_result(folder, load_crane("xs031"), duration, samples, "bench")
 
 
 def frames_per_second(folder: Path, layout: Layout, shadows: bool, frames: int, repeats: int = 3) -> float:

@@ -7,7 +7,6 @@ trajectory inside the working ranges and two feasible link-length sets.
 
 from __future__ import annotations
 
-import json
 import shutil
 import subprocess
 import sys
@@ -15,12 +14,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from playback_result_helper import write_playback_result
 
 from hiab_sim import _gl
 from hiab_sim.cli import main
-from hiab_sim.crane.description import Crane, LinkLengths
-from hiab_sim.crane.kinematics import tcp_position
-from hiab_sim.crane.mechanism import check_lengths
+from hiab_sim.crane.description import Crane
 from hiab_sim.model.mjcf import source_to_world
 from hiab_sim.render import backend as render_backend
 from hiab_sim.render import (
@@ -39,37 +37,9 @@ SIZE = (320, 240)
 FRAMES = int(DURATION * FPS) + 1
 
 
-def _motion(time: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(theta1, theta2, xt2) around (0.6, -1.3, 0.4) with exact rates and accelerations."""
-    w = 2.0 * np.pi / DURATION
-    amp = np.array([0.25, 0.3, 0.3])
-    freq = np.array([1.0, 1.0, 2.0])
-    phase = np.array([0.0, 1.0, 0.0])
-    arg = w * freq * time[:, None] + phase
-    centre = np.array([0.6, -1.3, 0.4])
-    return centre + amp * np.sin(arg), amp * w * freq * np.cos(arg), -amp * (w * freq) ** 2 * np.sin(arg)
-
-
 def write_result(folder: Path, crane: Crane, samples: int = 201) -> Path:
     """A result folder as ``hiab-sim optimize`` writes it."""
-    folder.mkdir(parents=True, exist_ok=True)
-    initial = crane.default_lengths
-    optimal = LinkLengths.from_array(initial.as_array() * np.array([1.03, 1.2, 1.0, 1.0, 1.0, 1.0]))
-    check_lengths(crane, optimal)
-    time = np.linspace(0.0, DURATION, samples)
-    p, v, a = _motion(time)
-
-    def lengths(xi: LinkLengths) -> dict[str, dict[str, float]]:
-        return {name: {"L": c.L, "Lc0": c.Lc0, "Lc": c.Lc} for name, c in zip(("lift", "tilt"), xi, strict=True)}
-
-    result = {"crane": "xs031", "study": "test", "initial": {"lengths": lengths(initial)}}
-    result["optimal"] = {"lengths": lengths(optimal)}
-    (folder / "result.json").write_text(json.dumps(result))
-    arrays = {"time": time, "reference_tcp": tcp_position(crane, p[:, 0], p[:, 1], p[:, 2])}
-    for design in ("initial", "optimal"):
-        arrays |= {f"{design}_position": p, f"{design}_velocity": v, f"{design}_acceleration": a}
-    np.savez(folder / "trajectory.npz", **arrays)
-    return folder
+    return write_playback_result(folder, crane, DURATION, samples, "test")
 
 
 @pytest.fixture(scope="module")

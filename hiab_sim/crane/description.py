@@ -28,6 +28,7 @@ import numpy as np
 from hiab_sim.checks import check_range
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.hydraulics.cylinders import HydraulicSystem
+from hiab_sim.machine import parts
 from hiab_sim.machine.parts import check_interval, check_rotation, homogeneous, mat3, vec3
 
 Vector3 = tuple[float, float, float]
@@ -47,9 +48,8 @@ LINK_NAMES = (
 
 
 def rot_z(angle: float) -> np.ndarray:
-    """Rotation matrix Rz(angle) about the z axis, angle in [rad]."""
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    """Rotation matrix Rz(angle) about the z axis, angle [rad], as an array (:func:`hiab_sim.machine.parts.rot_z`)."""
+    return np.array(parts.rot_z(angle))
 
 
 @dataclass(frozen=True)

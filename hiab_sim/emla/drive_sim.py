@@ -247,10 +247,10 @@ class DriveSimulator:
             i_dm = np.where(saturated, 0.5 * (i_d0 + i_d1), i_dm)  # the sub-stepped path: the chord's middle
             i_qm = np.where(saturated, 0.5 * (i_q0 + i_q1), i_qm)
 
-        self.i_d, self.i_q = i_d1, i_q1
         samples = np.stack([np.hypot(i_d0, i_q0), np.hypot(i_dm, i_qm), np.hypot(i_d1, i_q1)], axis=1)
-        friction = d.coulomb * np.tanh(omega / d.smoothing)
-        return DriveStep(
+        return self._end_step(
+            omega,
+            requested,
             i_d=i_d1,
             i_q=i_q1,
             v_d=v_d,
@@ -258,12 +258,50 @@ class DriveSimulator:
             electrical_energy=energy,
             copper_energy=copper,
             torque=torque,
-            friction_torque=friction,
-            rod_force=d.ratio * (torque - friction),
-            current_limited=np.abs(requested) >= limit,
             voltage_limited=saturated,
             current_samples=samples,
             sample_weights=np.array([h / 6.0, 4.0 * h / 6.0, h / 6.0]),  # Simpson's rule
+        )
+
+    def _end_step(
+        self,
+        omega_m: Array,
+        requested: Array,
+        *,
+        i_d: Array,
+        i_q: Array,
+        v_d: Array,
+        v_q: Array,
+        electrical_energy: Array,
+        copper_energy: Array,
+        torque: Array,
+        voltage_limited: NDArray[np.bool_],
+        current_samples: Array,
+        sample_weights: Array,
+    ) -> DriveStep:
+        """Keep a step's end currents i_d, i_q [A] as the state and return the step (:class:`DriveStep`).
+
+        The mechanical side is the same for every current loop: the rotor's Coulomb friction at the
+        held motor speeds ``omega_m`` [rad/s], the rod force k (torque - friction) [N], and whether the
+        requested q-currents ``requested`` [A] were clipped to the current limit.
+        """
+        self.i_d, self.i_q = i_d, i_q
+        d = self.drives
+        friction = d.friction_torque(omega_m)
+        return DriveStep(
+            i_d=i_d,
+            i_q=i_q,
+            v_d=v_d,
+            v_q=v_q,
+            electrical_energy=electrical_energy,
+            copper_energy=copper_energy,
+            torque=torque,
+            friction_torque=friction,
+            rod_force=d.ratio * (torque - friction),
+            current_limited=np.abs(requested) >= d.current_limit,
+            voltage_limited=voltage_limited,
+            current_samples=current_samples,
+            sample_weights=sample_weights,
         )
 
     def limited_command(

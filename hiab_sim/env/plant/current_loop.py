@@ -209,20 +209,16 @@ class DiscreteCurrentLoop(DriveSimulator):
             saturated[j] = sat
         self.x_d, self.x_q = np.array(state_xd), np.array(state_xq)
         self.pending_d, self.pending_q = np.array(state_pd), np.array(state_pq)
-        i_d_end, i_q_end, torque_mean = np.array(out_id), np.array(out_iq), np.array(out_torque)
-        self.i_d, self.i_q = i_d_end, i_q_end
-        friction = d.coulomb * np.tanh(omega / d.smoothing)
-        return DriveStep(
-            i_d=i_d_end,
-            i_q=i_q_end,
+        return self._end_step(
+            omega,
+            requested,
+            i_d=np.array(out_id),
+            i_q=np.array(out_iq),
             v_d=np.array(out_vd),
             v_q=np.array(out_vq),
             electrical_energy=np.array(out_energy),
             copper_energy=np.array(out_copper),
-            torque=torque_mean,
-            friction_torque=friction,
-            rod_force=d.ratio * (torque_mean - friction),
-            current_limited=np.abs(requested) >= limit,
+            torque=np.array(out_torque),
             voltage_limited=saturated,
             current_samples=samples,
             sample_weights=self.sample_weights,

@@ -5,7 +5,6 @@ Conventions and units in :mod:`hiab_sim.machine.mjcf_import.importer`.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -15,6 +14,7 @@ from numpy.typing import NDArray
 
 from hiab_sim.machine.mjcf_import.graph import Mechanism, connect_points, name_of
 from hiab_sim.machine.mjcf_import.pose import plane_axes
+from hiab_sim.machine.parts import rot_z
 
 Array = NDArray[np.float64]
 
@@ -70,7 +70,7 @@ class Frames:
     def bodies(self, group: int, origin: Array, angle: float, prefix: str = "") -> dict[str, Note]:
         """Each massive MJCF body of a group in the frame (origin, Rz(angle)) of machine coordinates."""
         model, d = self.mech.model, self.data
-        rot = _rz(angle)
+        rot = np.array(rot_z(angle))
         out: dict[str, Note] = {}
         for b in self.mech.bodies(group):
             if model.body_mass[b] <= 0.0:
@@ -91,11 +91,6 @@ class Frames:
             value = {"mass": float(model.body_mass[b]), "com": _list(com), "inertia": [_list(r) for r in inertia]}
             out[prefix + bname] = Note(value, origin_text)
         return out
-
-
-def _rz(angle: float) -> Array:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def _list(v: Array) -> list[float]:

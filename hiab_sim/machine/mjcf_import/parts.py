@@ -6,7 +6,6 @@ Conventions and units in :mod:`hiab_sim.machine.mjcf_import.importer`; every ent
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import mujoco
@@ -15,19 +14,15 @@ import numpy as np
 from hiab_sim.machine.mjcf_import.chains import Role, in_plane_angle
 from hiab_sim.machine.mjcf_import.frames import Frames, Imported, Note
 from hiab_sim.machine.mjcf_import.graph import UnsupportedMJCFError, actuator_on, name_of
+from hiab_sim.machine.parts import rot_z
 
 #: Name of the root link: the world body and everything welded or locked to it.
 ROOT = "ground"
 Frame = tuple[np.ndarray, float]  # origin (3,) in machine coordinates [m], angle about z [rad]
 
 
-def _rz(angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
 def _local(frame: Frame, p: np.ndarray) -> list[float]:
-    return [float(v) for v in _rz(frame[1]).T @ (np.asarray(p) - frame[0])]
+    return [float(v) for v in np.array(rot_z(frame[1])).T @ (np.asarray(p) - frame[0])]
 
 
 def group_name(imported: Imported, g: int) -> str:
@@ -295,7 +290,7 @@ def tcp_entry(imported: Imported, frames: Frames, link_frames: dict[int, Frame],
     xmat = data.xmat[body].reshape(3, 3)
     imported.tcp = (body, xmat.T @ (np.asarray(p) - data.xpos[body]))
     frame = link_frames[group]
-    rotation = _rz(frame[1]).T @ frames.axes.T @ np.asarray(rot).reshape(3, 3)
+    rotation = np.array(rot_z(frame[1])).T @ frames.axes.T @ np.asarray(rot).reshape(3, 3)
     return {
         "link": Note(group_name(imported, group), f"{what}: the link it is on"),
         "r": Note(_local(frame, frames.point(p)), f"{what} position in the link frame"),
