@@ -41,13 +41,7 @@ CRANE_MODEL = {
     "dynamics/analytic_planar.py": "the crane file's planar closed-form dynamics on its named bodies",
     "model/mjcf.py": "builds the crane file's MJCF: bodies, joints and sites named after the crane",
     "study/figures/design.py": "draws a crane file's design from the crane's closed-form frames",
-    "docs_site/field_specs/crane.py": "documents the crane file's fields, which are named after its chains",
-    "docs_site/field_specs/study.py": "documents a crane study's per-chain fields (bounds, initial_lengths)",
-    "docs_site/results_data.py": "records the shipped XS 031 runs' fields for the results pages, by chain",
-    "docs_site/results_design_blocks.py": "renders the shipped XS 031 runs' design tables, by chain",
-    "docs_site/results_energy_blocks.py": "renders the shipped XS 031 runs' energy and thermal tables, by actuator",
-    "docs_site/results_format.py": "formats the shipped XS 031 runs' chain lengths for the results pages",
-    "docs_site/results_machine_blocks.py": "renders the XS 031 rows beside the excavator's on its results page",
+    "docs_site/field_specs/crane.py": "documents the crane file's top-level telescope section, a key the loader reads",
 }
 #: (module, literal) pairs where the word has another meaning than the machine's name.
 OTHER_MEANING = {

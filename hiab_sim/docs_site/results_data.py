@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from hiab_sim.atomic_io import write_atomic
+from hiab_sim.crane.description import CHAIN_NAMES
 from hiab_sim.results.read import read_result
 from hiab_sim.results.schema import parse_json
 
@@ -199,7 +200,7 @@ SWEEP_FIELDS: tuple[str, ...] = (
             "opt_battery_energy_J",
             "start_net_energy_J",
             "opt_net_energy_J",
-            *(f"opt_{c}_{k}_m" for c in ("lift", "tilt") for k in ("L", "Lc0", "Lc")),
+            *(f"opt_{c}_{k}_m" for c in CHAIN_NAMES for k in ("L", "Lc0", "Lc")),
         )
     ),
 )

@@ -12,7 +12,16 @@ from collections.abc import Callable
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.docs_site.markdown import table
 from hiab_sim.docs_site.results_data import RunData
-from hiab_sim.docs_site.results_format import CHAINS, before_after, kilo, lengths, percent_change
+from hiab_sim.docs_site.results_format import (
+    CHAINS,
+    LIFT,
+    before_after,
+    chain_lengths,
+    kilo,
+    length_headers,
+    lengths,
+    percent_change,
+)
 from hiab_sim.study.report.buildable_section import mjcf_command
 
 DEFAULT = "xs031_spiral"
@@ -69,14 +78,15 @@ def default_answer(runs: RunData) -> str:
     code = runs.result("xs031_codesign")
     i, o, b = r("initial.lengths"), r("optimal.lengths"), r("buildable.lengths")
     x0 = {c: (i[c]["Lc0"] + i[c]["Lc"], o[c]["Lc0"] + o[c]["Lc"]) for c in CHAINS}
-    lift = r("energy.optimal.thermal")["lift"]
+    lift = r("energy.optimal.thermal")[LIFT]
     battery0 = r("energy.initial.battery_energy_J")
     return (
-        f"**The answer for the XS 031** (default study): lift L {i['lift']['L']:.3f} → {o['lift']['L']:.3f} m, tilt L "
-        f"{i['tilt']['L']:.3f} → {o['tilt']['L']:.3f} m, retracted actuators x0 = Lc0 + Lc "
+        "**The answer for the XS 031** (default study): "
+        + ", ".join(f"{c} L {i[c]['L']:.3f} → {o[c]['L']:.3f} m" for c in CHAINS)
+        + ", retracted actuators x0 = Lc0 + Lc "
         + ", ".join(f"{x0[c][0]:.2f} → {x0[c][1]:.2f} m ({c})" for c in CHAINS)
         + f". Rounded to the {1e3 * r('buildable.tolerance_m'):.0f} mm manufacturing tolerance, the design to build "
-        f"is lift L / Lc0 / Lc = {lengths(b, 'lift')} m, tilt {lengths(b, 'tilt')} m. Net electrical energy on the "
+        f"is {chain_lengths(b, legend=True)}. Net electrical energy on the "
         f"spiral: {kilo(r('initial.net_electrical_energy_J'))} → {kilo(r('optimal.net_electrical_energy_J'))} kJ "
         f"({percent_change(r('initial.net_electrical_energy_J'), r('optimal.net_electrical_energy_J'), 1)}), "
         f"{r('improvement.decomposition.from_lengths_J'):.0f} J of the saving from the lengths alone. "
@@ -85,7 +95,7 @@ def default_answer(runs: RunData) -> str:
         f"({percent_change(battery0, r('energy.optimal.battery_energy_J'), 1)}; "
         f"{percent_change(battery0, energy('energy.optimal.battery_energy_J'), 1)} to "
         f"{kilo(energy('energy.optimal.battery_energy_J'))} kJ when the battery energy itself is the objective); "
-        f"the lift motor runs at {lift['rms_torque_Nm']:.1f} of {lift['continuous_torque_Nm']:.0f} N m RMS, winding "
+        f"the {LIFT} motor runs at {lift['rms_torque_Nm']:.1f} of {lift['continuous_torque_Nm']:.0f} N m RMS, winding "
         f"{lift['peak_winding_temperature_C']:.0f} of {lift['max_winding_temperature_C']:.0f} °C. Choosing the gear "
         f"ratios with the mounting (`xs031_codesign`) saves {code('codesign.codesign_saving_percent'):.1f} % of the "
         f"battery energy against {code('codesign.mounting_only_saving_percent'):.1f} % for the mounting alone."
@@ -97,8 +107,8 @@ def default_answer_mix(runs: RunData) -> str:
     mix, spiral = runs.result("xs031_duty_mix"), runs.result(DEFAULT)("optimal.lengths")
     o = mix("optimal.lengths")
     return (
-        f"Designed for the duty mix (`xs031_duty_mix`), the optimum is lift {lengths(o, 'lift')} m, tilt "
-        f"{lengths(o, 'tilt')} m (the spiral's: lift {lengths(spiral, 'lift')} m, tilt {lengths(spiral, 'tilt')} m), "
+        f"Designed for the duty mix (`xs031_duty_mix`), the optimum is {chain_lengths(o)} "
+        f"(the spiral's: {chain_lengths(spiral)}), "
         f"{percent_change(mix('initial.net_electrical_energy_J'), mix('optimal.net_electrical_energy_J'))} net "
         "energy on the mix."
     )
@@ -114,8 +124,7 @@ def default_designs(runs: RunData) -> str:
         rows.append(
             (
                 label,
-                lengths(r(f"{design}.lengths"), "lift", 4),
-                lengths(r(f"{design}.lengths"), "tilt", 4),
+                *(lengths(r(f"{design}.lengths"), c, 4) for c in CHAINS),
                 f"{net:.1f} J" + ("" if design == "initial" else f" ({percent_change(net0, net)})"),
                 f"{r(f'{design}.drawn_energy_summed_drives_J'):.1f} J",
                 f"{r(f'{design}.energy_breakdown_J.copper'):.1f} J",
@@ -124,8 +133,7 @@ def default_designs(runs: RunData) -> str:
     rows.append(
         (
             f"rounded to {1e3 * r('buildable.tolerance_m'):.0f} mm (buildable)",
-            lengths(r("buildable.lengths"), "lift"),
-            lengths(r("buildable.lengths"), "tilt"),
+            *(lengths(r("buildable.lengths"), c) for c in CHAINS),
             f"{r('buildable.net_electrical_energy_J'):.1f} J",
             "",
             "",
@@ -133,8 +141,7 @@ def default_designs(runs: RunData) -> str:
     )
     header = (
         "design",
-        "lift L / Lc0 / Lc [m]",
-        "tilt L / Lc0 / Lc [m]",
+        *length_headers(),
         "net energy",
         "drawn, summed drives",
         "copper",
@@ -176,11 +183,10 @@ def other_studies(runs: RunData) -> str:
                     r("initial.net_electrical_energy_J") / 1e3, r("optimal.net_electrical_energy_J") / 1e3, "kJ", 2
                 ),
                 f"{r('improvement.decomposition.from_lengths_J'):.1f} J",
-                lengths(r("optimal.lengths"), "lift", 4),
-                lengths(r("optimal.lengths"), "tilt", 4),
+                *(lengths(r("optimal.lengths"), c, 4) for c in CHAINS),
             )
         )
-    header = ("study", "iterations", "net energy", "from the lengths alone", "lift L / Lc0 / Lc [m]", "tilt [m]")
+    header = ("study", "iterations", "net energy", "from the lengths alone", *length_headers(legend_once=True))
     return table(header, rows)
 
 
@@ -193,7 +199,7 @@ def buildable_designs(runs: RunData) -> str:
         rows.append(
             (
                 f"`{study}`",
-                f"{lengths(b, 'lift')}, {lengths(b, 'tilt')}",
+                ", ".join(lengths(b, c) for c in CHAINS),
                 f"{1e6 * r('buildable.tolerance_check.margin'):+.1f} µm",
                 f"{r('buildable.recheck.margin'):.1e}",
                 f"{r('buildable.net_electrical_energy_J'):.1f} J "
@@ -202,7 +208,7 @@ def buildable_designs(runs: RunData) -> str:
         )
     header = (
         "study",
-        "rounded design (lift, tilt L / Lc0 / Lc) [m]",
+        f"rounded design ({', '.join(CHAINS)} L / Lc0 / Lc) [m]",
         "±1 mm worst margin",
         "fine-grid re-check",
         "net energy",
@@ -241,8 +247,7 @@ def mounting(runs: RunData) -> str:
         default("initial.net_electrical_energy_J"), default("optimal.net_electrical_energy_J")
     )
     return (
-        f"`xs031_spiral_mounting` (recorded): the optimum rounds to lift {lengths(b, 'lift')} m, tilt "
-        f"{lengths(b, 'tilt')} m; net energy "
+        f"`xs031_spiral_mounting` (recorded): the optimum rounds to {chain_lengths(b)}; net energy "
         f"{before_after(r('initial.net_electrical_energy_J'), r('optimal.net_electrical_energy_J'))}, "
         f"against {default_change} for the default study; duty: {r('energy.duty')}."
     )

@@ -11,7 +11,7 @@ from typing import Any
 
 from hiab_sim.docs_site.markdown import table
 from hiab_sim.docs_site.results_data import RunData
-from hiab_sim.docs_site.results_format import kilo, lengths, percent_change
+from hiab_sim.docs_site.results_format import CHAINS, LIFT, chain_lengths, kilo, length_headers, lengths, percent_change
 
 DEFAULT, ENERGY, CODESIGN, PAYLOAD = "xs031_spiral", "xs031_spiral_energy", "xs031_codesign", "xs031_spiral_payload"
 #: The default study re-optimised per EMLA model level (:mod:`hiab_sim.study.analysis.model_effects`).
@@ -25,8 +25,7 @@ def objectives(runs: RunData) -> str:
     rows: list[tuple[object, ...]] = [
         (
             "start (built XS 031)",
-            lengths(start("initial.lengths"), "lift", 4),
-            lengths(start("initial.lengths"), "tilt", 4),
+            *(lengths(start("initial.lengths"), c, 4) for c in CHAINS),
             f"{battery0:.1f} J",
             f"{start('energy.initial.costf2_W2s'):.4g}",
         )
@@ -37,13 +36,12 @@ def objectives(runs: RunData) -> str:
         rows.append(
             (
                 f"`{study}` ({r('energy.objective')})",
-                lengths(r("optimal.lengths"), "lift", 4),
-                lengths(r("optimal.lengths"), "tilt", 4),
+                *(lengths(r("optimal.lengths"), c, 4) for c in CHAINS),
                 f"{battery:.1f} J ({percent_change(battery0, battery)})",
                 f"{r('energy.optimal.costf2_W2s'):.4g}",
             )
         )
-    header = ("design", "lift L / Lc0 / Lc [m]", "tilt L / Lc0 / Lc [m]", "battery energy", "costf2 [W² s]")
+    header = ("design", *length_headers(), "battery energy", "costf2 [W² s]")
     return table(header, rows)
 
 
@@ -90,9 +88,10 @@ def thermal(runs: RunData) -> str:
     return table(header, rows)
 
 
-def _gears(row: dict[str, Any]) -> tuple[str, str]:
+def _gears(row: dict[str, Any]) -> list[str]:
+    """A co-design row's gear ratio of each chain's actuator, in the crane's chain order."""
     t = row["transmission"]
-    return f"{t['lift']['gear_ratio']:g}", f"{t['tilt']['gear_ratio']:g}"
+    return [f"{t[c]['gear_ratio']:g}" for c in CHAINS]
 
 
 def codesign(runs: RunData) -> str:
@@ -101,24 +100,24 @@ def codesign(runs: RunData) -> str:
     best, reference = r("codesign.best"), r("codesign.reference")
     rows = []
     for i, row in enumerate(r("codesign.rows")):
-        lift, tilt = _gears(row)
+        *gears, last = _gears(row)
         note = " (EMLA file: mounting alone)" if i == reference else (" (best)" if i == best else "")
         optimum = row.get("battery_energy_J")
         rows.append(
             (
-                lift,
-                tilt + note,
+                *gears,
+                last + note,
                 f"{row['initial_battery_energy_J']:.1f} J" if row.get("initial_battery_energy_J") else row["status"],
                 row["status"] if optimum is None else f"{optimum:.1f} J",
             )
         )
     b = r("codesign.rows")[best]
-    text = table(("lift G", "tilt G", "battery energy at the start", "at the mounting optimum"), rows)
+    text = table((*(f"{c} G" for c in CHAINS), "battery energy at the start", "at the mounting optimum"), rows)
     return (
         f"{text}\n\nThe co-design saves **{r('codesign.codesign_saving_percent'):.1f} %** of the battery energy "
         f"against **{r('codesign.mounting_only_saving_percent'):.1f} %** for the mounting alone "
-        f"({r('codesign.extra_saving_J'):.0f} J more per duty period); the best combination's mounting: lift "
-        f"{lengths(b['lengths'], 'lift')} m, tilt {lengths(b['lengths'], 'tilt')} m."
+        f"({r('codesign.extra_saving_J'):.0f} J more per duty period); the best combination's mounting: "
+        f"{chain_lengths(b['lengths'])}."
     )
 
 
@@ -216,7 +215,7 @@ def model_effects(runs: RunData) -> str:
                 r["label"],
                 f"{battery / 1e3:.3f} kJ",
                 change,
-                f"{r['peak_winding_temperature_C']['lift']:.1f} °C",
+                f"{r['peak_winding_temperature_C'][LIFT]:.1f} °C",
                 f"{r['battery_energy_saved_percent']:.2f} %",
             )
         )
@@ -224,7 +223,7 @@ def model_effects(runs: RunData) -> str:
         "model",
         "battery energy per duty period at the optimum",
         "change",
-        "lift winding (peak)",
+        f"{LIFT} winding (peak)",
         "optimum's saving vs the built crane",
     )
     return table(header, rows)

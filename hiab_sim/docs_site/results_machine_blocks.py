@@ -12,7 +12,7 @@ from typing import Any
 
 from hiab_sim.docs_site.markdown import table
 from hiab_sim.docs_site.results_data import RunData
-from hiab_sim.docs_site.results_format import before_after, kilo, lengths, percent_change
+from hiab_sim.docs_site.results_format import CHAINS, LIFT, before_after, kilo, length_headers, lengths, percent_change
 
 MIX, DEFAULT = "xs031_duty_mix", "xs031_spiral"
 EXCAVATOR = ("exact_digging", "exact_grading")
@@ -55,7 +55,7 @@ def mix_tasks(runs: RunData) -> str:
                 f"{t['name']}{load} ({t['weight']:g})",
                 before_after(i["net_electrical_energy_J"], o["net_electrical_energy_J"], digits=0),
                 f"{i['drawn_energy_summed_drives_J']:.0f} → {o['drawn_energy_summed_drives_J']:.0f} J",
-                f"{kilo(o['actuators']['lift']['peak_force_N'], 1)} kN",
+                f"{kilo(o['actuators'][LIFT]['peak_force_N'], 1)} kN",
             )
         )
     rows.append(
@@ -67,7 +67,7 @@ def mix_tasks(runs: RunData) -> str:
             "",
         )
     )
-    header = ("task (weight)", "net energy initial → optimal", "drawn, summed drives", "lift peak force, optimum")
+    header = ("task (weight)", "net energy initial → optimal", "drawn, summed drives", f"{LIFT} peak force, optimum")
     return table(header, rows)
 
 
@@ -88,14 +88,10 @@ def mix_hour(runs: RunData) -> str:
 def mix_designs(runs: RunData) -> str:
     """The spiral's optimum beside the duty mix's."""
     rows = [
-        (
-            label,
-            lengths(runs.result(study)("optimal.lengths"), "lift", 4),
-            lengths(runs.result(study)("optimal.lengths"), "tilt", 4),
-        )
+        (label, *(lengths(runs.result(study)("optimal.lengths"), c, 4) for c in CHAINS))
         for label, study in (("spiral alone (the default study)", DEFAULT), ("duty mix", MIX))
     ]
-    return table(("design", "lift L / Lc0 / Lc [m]", "tilt L / Lc0 / Lc [m]"), rows)
+    return table(("design", *length_headers()), rows)
 
 
 def mix_starts(runs: RunData) -> str:

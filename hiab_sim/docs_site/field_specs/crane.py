@@ -5,6 +5,8 @@ The crane reader handles its keys by hand (no dataclass per section), so each ro
 
 from __future__ import annotations
 
+from hiab_sim.crane.description import CHAIN_NAMES
+from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.docs_site.field_specs.rows import Key, free, number, section, section_of
 
 
@@ -66,7 +68,7 @@ def crane_keys() -> list[Key]:
         number("gravity", "m/s^2", "Gravitational acceleration, along -y of {W}."),
         section("chains", "The two closed chains (cylinder, rod, boom triangle)."),
     ]
-    for name in ("lift", "tilt"):
+    for name in CHAIN_NAMES:
         rows += section_of(f"chains.{name}", f"The {name} chain.", chain)
     rows += [
         section("telescope", "The telescope: a prismatic joint xt2 along x of the cylinder frame {P22}."),
@@ -86,7 +88,7 @@ def crane_keys() -> list[Key]:
         free("bodies", "Rigid bodies by name, each `{frame, mass, com, inertia}` in its source frame."),
         section("hydraulic_cylinders", "The cylinders the EMLAs replace (hydraulic baseline).", default="none"),
     ]
-    for name in ("lift", "tilt", "telescope"):
+    for name in ACTUATOR_NAMES:
         rows += section_of(f"hydraulic_cylinders.{name}", f"The {name} cylinder.", cylinder)
     rows += [
         number("hydraulic_cylinders.supply_pressure", "Pa", "System (relief) pressure p_s.", allowed="> 0"),

@@ -6,6 +6,8 @@ Two forms: a crane file's study (``crane:``) and a machine file's (``machine:``,
 
 from __future__ import annotations
 
+from hiab_sim.crane.description import CHAIN_NAMES
+from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.docs_site.dataclass_fields import field_rows
 from hiab_sim.docs_site.field_specs.references import payload_keys, reference_keys, soil_keys
 from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, in_form, names, section, section_of
@@ -116,7 +118,7 @@ def study_keys() -> list[Key]:
         Key(k, type="number", unit="m", allowed="> 0, within the bounds", description=d)
         for k, d in (("L", "Base pivot -> boom hinge."), ("Lc0", "Piston offset."), ("Lc", "Rod length."))
     ]
-    for chain in ("lift", "tilt"):
+    for chain in CHAIN_NAMES:
         rows += section_of(f"initial_lengths.{chain}", f"The {chain} chain's start.", start)
     rows = [*rows[:5], *in_form("crane", rows[5:])]  # the crane's initial lengths; the machine's below
     rows.append(
@@ -176,7 +178,7 @@ def study_keys() -> list[Key]:
             "crane",
             [
                 k
-                for chain in ("lift", "tilt")
+                for chain in CHAIN_NAMES
                 for k in section_of(f"bounds.{chain}", f"Bounds of the {chain} chain's Xi (const_g).", chain_bounds)
             ],
         ),
@@ -267,7 +269,7 @@ def study_keys() -> list[Key]:
         ),
         section("transmission", "Catalogue of (gear ratio, screw lead) options per actuator: co-design.", "none"),
     ]
-    for name in ("lift", "tilt", "telescope"):
+    for name in ACTUATOR_NAMES:
         rows += [
             Key(f"transmission.{name}", type="list", default="the EMLA file's", description=f"Options for {name}."),
             section(f"transmission.{name}[]", "One option."),
