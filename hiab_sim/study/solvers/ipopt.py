@@ -31,12 +31,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 from scipy import sparse
-from threadpoolctl import threadpool_limits
 
 from hiab_sim.errors import BackendUnavailableError
 from hiab_sim.study.nlp.interface import Array, PerSampleBlock
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import TaskProblem
+from hiab_sim.study.solvers.threads import single_blas_thread
 
 #: IPOPT return states counted as converged.
 SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
@@ -358,13 +358,11 @@ def solve_ipopt(
     ubx = np.where(np.isfinite(problem.upper), problem.upper, np.inf)
     lbg = np.zeros(m)
     ubg = jac.upper(z0)
-    # One thread for numpy's and scipy's BLAS inside the solve (threadpoolctl finds their OpenBLAS by
-    # name): the NLP's evaluations work on small matrices, and on a shared 2-core machine pooled
-    # threads spin against each other (digging study: 117 s with two threads beside a test run, 9 s
-    # with one; the same iterates). CasADi's own OpenBLAS under MUMPS keeps its threads: IPOPT's
-    # iterates depend on them (168 or 131 iterations on the digging study), and the shipped duty
-    # mix reaches its recorded optimum with the default (with one thread it stops at max_iter).
-    with threadpool_limits(limits=1, user_api="blas"):
+    # numpy's and scipy's BLAS on one thread (:mod:`hiab_sim.study.solvers.threads`); CasADi's own
+    # OpenBLAS under MUMPS keeps its threads: IPOPT's iterates depend on them (168 or 131 iterations
+    # on the digging study), and the shipped XS 031 duty mix reaches its recorded optimum with the
+    # default (with one thread it stops at its iteration limit)
+    with single_blas_thread():
         out = solver(x0=z0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
     stats = solver.stats()
     z = np.asarray(out["x"]).ravel()

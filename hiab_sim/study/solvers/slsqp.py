@@ -31,6 +31,7 @@ from hiab_sim.machine.design import MachineDesign
 from hiab_sim.results.design_values import DesignValues
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.solvers.ipopt import solve_ipopt
+from hiab_sim.study.solvers.threads import single_blas_thread
 
 Array = NDArray[np.float64]
 #: Largest violation [scaled units] of a nominal constraint (:meth:`TaskProblem.margins`) a start
@@ -318,16 +319,17 @@ def solve(
         if problem.study.solver.method == "ipopt":
             res = _ipopt(problem, z_begin, limit, record)
         else:
-            res = minimize(
-                problem.cost,
-                z_begin,
-                jac=problem.cost_gradient if use_gradients else None,
-                method="SLSQP",
-                bounds=bounds,
-                constraints=[eq, ineq],
-                callback=record,
-                options={"maxiter": limit, "ftol": problem.study.solver.ftol},
-            )
+            with single_blas_thread():  # small matrices: pooled BLAS threads only contend (solvers.threads)
+                res = minimize(
+                    problem.cost,
+                    z_begin,
+                    jac=problem.cost_gradient if use_gradients else None,
+                    method="SLSQP",
+                    bounds=bounds,
+                    constraints=[eq, ineq],
+                    callback=record,
+                    options={"maxiter": limit, "ftol": problem.study.solver.ftol},
+                )
     except InvalidInputError as error:
         result.message = f"a trial point left the model's domain: {error}"
         if out is not None:
