@@ -6,9 +6,9 @@ a few hundred rows. With a pool of one thread per core, OpenBLAS's threads spin-
 on a 2-core machine shared with anything else (a test run's two workers, a sweep) they spin against
 the other processes and every call waits for a time slice. Measured on the digging study
 (``exact_digging``, 12 SLSQP iterations, the 2-core machine with a test run beside it): 48-56 s with
-the default pool, 8.5-8.9 s with one thread; IPOPT on the same study 101.5 s and 18.7 s beside two
-busy processes, 18.2 s and 9.0 s idle. One thread also makes the iterates independent of the
-machine's core count (the pool's size changes BLAS's summation order in the last bits).
+the default pool, 8.5-8.9 s with one thread (``benchmarks/bench_solver_threads.py`` measures both in
+one process). One thread also makes the iterates independent of the machine's core count (the
+pool's size changes BLAS's summation order in the last bits).
 
 CasADi's own OpenBLAS under IPOPT's MUMPS is not limited: threadpoolctl does not find it under its
 name, and IPOPT's iterates on the shipped XS 031 duty mix depend on it (docs/results/excavator.md).
