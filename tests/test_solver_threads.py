@@ -19,9 +19,9 @@ from hiab_sim.study.solvers.slsqp import solve
 from hiab_sim.study.spec.study_file import study_from_dict
 
 
-def _blas_threads() -> list[int]:
-    """The thread count of every BLAS library numpy and scipy loaded."""
-    return [int(info["num_threads"]) for info in threadpool_info() if info["user_api"] == "blas"]
+def _blas_threads() -> dict[str, int]:
+    """The thread count of every loaded BLAS library (numpy's, scipy's, CasADi's once loaded), by its file."""
+    return {info["filepath"]: int(info["num_threads"]) for info in threadpool_info() if info["user_api"] == "blas"}
 
 
 def _problem() -> tuple[StudyProblem, Any]:
@@ -32,24 +32,26 @@ def _problem() -> tuple[StudyProblem, Any]:
 def test_slsqp_iterates_with_one_blas_thread_and_restores_the_pool() -> None:
     """Every SLSQP iterate is recorded with one BLAS thread; afterwards the pool is what it was."""
     before = _blas_threads()
-    seen: list[list[int]] = []
+    seen: list[dict[str, int]] = []
     problem, initial = _problem()
     result = solve(problem, initial, progress=None, on_iterate=lambda _: seen.append(_blas_threads()))
     assert result.success and len(seen) > 2
-    assert all(counts and set(counts) == {1} for counts in seen[1:])  # seen[0]: the start, recorded before
+    assert all(counts and set(counts.values()) == {1} for counts in seen[1:])  # seen[0]: the start, before
     assert _blas_threads() == before
 
 
 def test_ipopt_iterates_with_one_blas_thread_and_restores_the_pool() -> None:
-    """Every IPOPT iterate (its iteration callback) sees one numpy/scipy BLAS thread; the pool is restored."""
+    """Every IPOPT iterate sees one thread in every BLAS, CasADi's under MUMPS included; the pools are restored."""
     pytest.importorskip("casadi")
     from hiab_sim.study.solvers.ipopt import solve_ipopt
 
-    before = _blas_threads()
     problem, initial = _problem()
-    seen: list[list[int]] = []
+    seen: list[dict[str, int]] = []
     z0 = problem.initial_point(initial)
+    solve_ipopt(problem, np.asarray(z0), 1, 1e-7)  # loads CasADi and its OpenBLAS
+    before = _blas_threads()
+    assert any("casadi" in path for path in before), before  # threadpoolctl finds CasADi's OpenBLAS
     outcome = solve_ipopt(problem, np.asarray(z0), 3, 1e-7, on_iterate=lambda _: seen.append(_blas_threads()))
     assert outcome.iterations >= 1 and seen
-    assert all(counts and set(counts) == {1} for counts in seen)
+    assert all(counts == dict.fromkeys(before, 1) for counts in seen)
     assert _blas_threads() == before

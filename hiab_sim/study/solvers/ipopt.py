@@ -36,7 +36,7 @@ from hiab_sim.errors import BackendUnavailableError
 from hiab_sim.study.nlp.interface import Array, PerSampleBlock
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import TaskProblem
-from hiab_sim.study.solvers.threads import single_blas_thread
+from hiab_sim.study.solvers.threads import register_casadi_blas, single_blas_thread
 
 #: IPOPT return states counted as converged.
 SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
@@ -196,6 +196,7 @@ def _casadi() -> Any:
         raise BackendUnavailableError(
             "IPOPT (solver.method: ipopt, duty-mix cross-evaluation) needs CasADi: pip install 'hiab-sim[ipopt]'"
         ) from None
+    register_casadi_blas()
     return casadi
 
 
@@ -358,10 +359,8 @@ def solve_ipopt(
     ubx = np.where(np.isfinite(problem.upper), problem.upper, np.inf)
     lbg = np.zeros(m)
     ubg = jac.upper(z0)
-    # numpy's and scipy's BLAS on one thread (:mod:`hiab_sim.study.solvers.threads`); CasADi's own
-    # OpenBLAS under MUMPS keeps its threads: IPOPT's iterates depend on them (168 or 131 iterations
-    # on the digging study), and the shipped XS 031 duty mix reaches its recorded optimum with the
-    # default (with one thread it stops at its iteration limit)
+    # every BLAS on one thread, CasADi's own OpenBLAS under MUMPS included (loaded with the plugin
+    # above): IPOPT's iterates then do not depend on the core count (:mod:`hiab_sim.study.solvers.threads`)
     with single_blas_thread():
         out = solver(x0=z0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
     stats = solver.stats()

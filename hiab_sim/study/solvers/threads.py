@@ -10,17 +10,32 @@ the default pool, 8.5-8.9 s with one thread (``benchmarks/bench_solver_threads.p
 one process). One thread also makes the iterates independent of the machine's core count (the
 pool's size changes BLAS's summation order in the last bits).
 
-CasADi's own OpenBLAS under IPOPT's MUMPS is not limited: threadpoolctl does not find it under its
-name, and IPOPT's iterates on the shipped XS 031 duty mix depend on it (docs/results/excavator.md).
+CasADi's wheels ship their own OpenBLAS (under MUMPS, IPOPT's linear solver) under a name threadpoolctl
+does not know; :func:`register_casadi_blas` (called when the IPOPT backend loads CasADi) lets it limit
+that one too, so IPOPT's iterates no longer depend on the core count either (with its default pool the
+digging study took 168 iterations here and 131 with one thread; the XS 031 duty mix 124 and 181).
 """
 
 from __future__ import annotations
 
+import functools
 from contextlib import AbstractContextManager
 
-from threadpoolctl import threadpool_limits
+from threadpoolctl import OpenBLASController, register, threadpool_limits
 
 
 def single_blas_thread() -> AbstractContextManager[object]:
-    """Limit numpy's and scipy's BLAS to one thread inside a ``with`` block (restored after it)."""
+    """Limit every loaded BLAS (numpy's, scipy's, CasADi's once registered) to one thread inside a ``with`` block."""
     return threadpool_limits(limits=1, user_api="blas")
+
+
+class _CasadiOpenBLAS(OpenBLASController):
+    """CasADi's bundled OpenBLAS (``libcasadi-tp-openblas``): the OpenBLAS API under CasADi's file name."""
+
+    filename_prefixes = ("libcasadi-tp-openblas",)
+
+
+@functools.cache
+def register_casadi_blas() -> None:
+    """Let threadpoolctl find and limit CasADi's OpenBLAS (once per process)."""
+    register(_CasadiOpenBLAS)
