@@ -8,7 +8,7 @@ are the crane's actuator names); :func:`cylinder_from_mapping` reads one cylinde
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -185,6 +185,14 @@ def hydraulic_cylinders_from_mapping(
     top = mapping(data, where, required | {"friction"}, required)
     optional = frozenset({"pin_to_pin_at_zero", "counterbalance"})
     cylinders = tuple(cylinder_from_mapping(top[name], f"{where}.{name}", name, optional) for name in names)
+    return system_from_mapping(top, where, cylinders)
+
+
+def system_from_mapping(top: Mapping[str, Any], where: str, cylinders: tuple[Cylinder, ...]) -> HydraulicSystem:
+    """The :class:`HydraulicSystem` of a section at ``where`` (its keys checked by the caller) and its cylinders.
+
+    Reads ``supply_pressure`` [Pa] and the optional ``friction: {coulomb [N], viscous [N s/m]}`` (0 when absent).
+    """
     friction = mapping(top.get("friction", {}), f"{where}.friction", {"coulomb", "viscous"}, set())
     return HydraulicSystem(
         cylinders,

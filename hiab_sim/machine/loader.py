@@ -20,7 +20,7 @@ import yaml
 
 from hiab_sim.checks import check_range
 from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.hydraulics.cylinders import HydraulicSystem, cylinder_from_mapping
+from hiab_sim.hydraulics.cylinders import HydraulicSystem, cylinder_from_mapping, system_from_mapping
 from hiab_sim.machine.chains import Actuator, Chain, DecisionVariable, Linkage, Pivot
 from hiab_sim.machine.description import Link, Machine
 from hiab_sim.machine.kinematics.assembly import check_machine
@@ -295,16 +295,10 @@ def _chain(name: str, node: Any) -> Chain:
 def _hydraulic(node: Any) -> HydraulicSystem:
     top = mapping(node, "hydraulic", {"cylinders", "supply_pressure", "friction"}, {"cylinders", "supply_pressure"})
     cylinders_node = mapping(top["cylinders"], "hydraulic.cylinders", None)
-    cylinders = [
+    cylinders = tuple(
         cylinder_from_mapping(c, f"hydraulic.cylinders.{name}", str(name)) for name, c in cylinders_node.items()
-    ]
-    friction = mapping(top.get("friction", {}), "hydraulic.friction", {"coulomb", "viscous"}, set())
-    return HydraulicSystem(
-        cylinders=tuple(cylinders),
-        supply_pressure=number(top["supply_pressure"], "hydraulic.supply_pressure"),
-        coulomb_friction=number(friction.get("coulomb", 0.0), "hydraulic.friction.coulomb"),
-        viscous_friction=number(friction.get("viscous", 0.0), "hydraulic.friction.viscous"),
     )
+    return system_from_mapping(top, "hydraulic", cylinders)
 
 
 def _workspace(node: Any) -> tuple[tuple[float, float], tuple[float, float]]:
