@@ -79,7 +79,7 @@ def test_per_sample_rows_on_the_spline_band_equal_the_full_spline_product() -> N
             full[:, :, j, :] += jac.dq[:, :, o * nj + j, None] * p.B[o][:, None, :]
     np.testing.assert_allclose(out[:, p.n_xi :], full.reshape(K * r, p.n_c) * C_SCALE, rtol=1e-14, atol=1e-14)
     np.testing.assert_array_equal(out[:, : p.n_xi], jac.dxi.reshape(K * r, p.n_xi) * XI_SCALE)
-    assert p.band.shape[2] == STUDY.spline.degree + 1  # the band of a B-spline: degree + 1 functions per sample
+    assert p.chain.band.shape[2] == STUDY.spline.degree + 1  # the band of a B-spline: degree + 1 functions per sample
 
 
 def test_equality_jacobian_is_exact(problem: TaskProblem) -> None:

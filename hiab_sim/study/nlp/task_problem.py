@@ -43,7 +43,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from hiab_sim.dynamics.interface import InverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
@@ -55,6 +54,7 @@ from hiab_sim.emla.duty_energy import drive_duty
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.machines.protocol import Design
 from hiab_sim.study.motion import trajectory as tr
+from hiab_sim.study.motion.spline_chain import SplineChain
 from hiab_sim.study.nlp import blocks as bl
 from hiab_sim.study.nlp import builtin_blocks  # noqa: F401  (registers the built-in blocks, in row order)
 from hiab_sim.study.nlp.block_registry import build_blocks
@@ -150,9 +150,6 @@ class TaskProblem(ScaledProblem):
         points = task.spline_points(study.spline.control_points, study.grid.duration, study.spline.degree)
         self.basis = tr.SplineBasis(points, study.spline.degree, duration)
         self.B = np.stack(self.basis.matrices(self.times))  # (3 orders, K, N)
-        #: the band of B: the W basis functions from ``band_start[k]`` on hold every nonzero at sample k
-        self.band_start, self.band = _band(self.B)
-        self._band_indices: dict[int, NDArray[np.intp]] = {}
         model = study.model
         self.n_joints = len(model.joint_names)
         self.kin = model.kinematics
@@ -187,6 +184,8 @@ class TaskProblem(ScaledProblem):
         self.n_xi = len(model.design_names)
         self.n_c = self.n_joints * self.basis.n
         self.n = self.n_xi + self.n_c
+        #: per-sample rows chained to the coefficients on each sample's band of B
+        self.chain = SplineChain(self.B, self.n_xi, self.n_joints)
         xi_low, xi_up = study.bounds.xi_low, study.bounds.xi_up
         self.lower = np.concatenate([np.asarray(xi_low) / XI_SCALE, np.full(self.n_c, -np.inf)])
         self.upper = np.concatenate([np.asarray(xi_up) / XI_SCALE, np.full(self.n_c, np.inf)])
@@ -356,19 +355,13 @@ class TaskProblem(ScaledProblem):
     def _to_z(self, block: ConstraintBlock, jac: BlockJacobian, out: Array) -> None:
         """A block's partials w.r.t. q9 and Xi [per m] into its rows ``out`` (rows, n) of D g / dz (zeros on entry).
 
-        Through the spline matrices: a per-sample row sees only the W coefficients per joint whose basis
-        functions are nonzero at its sample (:func:`_band`), the same products as the full matrices.
+        Through the spline matrices: a per-sample row sees only the coefficients per joint whose basis
+        functions are nonzero at its sample (:class:`~hiab_sim.study.motion.spline_chain.SplineChain`).
         """
         K, nj = len(self.times), self.n_joints
         rows = out.shape[0]
         if isinstance(jac, SampleRows):
-            r = jac.dq.shape[1]
-            # q9 index = order * n_joints + joint; dc[k, m, j, n] = sum_o dq[k, m, o, j] B[o, k, n] on the band
-            band = np.einsum("kmoj,okb->kbmj", jac.dq.reshape(K, r, 3, nj), self.band) * C_SCALE
-            flat = out.reshape(-1)  # the block's rows are contiguous rows of the Jacobian
-            if not np.may_share_memory(flat, out):
-                raise AssertionError("a block's Jacobian rows must be contiguous")
-            flat[self._band_index(r)] = band.reshape(-1)
+            self.chain.write_sample_rows(jac.dq, out, C_SCALE)  # the block's rows: contiguous rows of D g / dz
             if jac.dxi is not None:
                 out[:, : self.n_xi] = (jac.dxi * XI_SCALE).reshape(rows, self.n_xi)
         else:
@@ -377,18 +370,6 @@ class TaskProblem(ScaledProblem):
                 out[:, self.n_xi :] = dc.reshape(rows, self.n_c)
             if jac.dxi is not None:
                 out[:, : self.n_xi] = jac.dxi * XI_SCALE
-
-    def _band_index(self, r: int) -> NDArray[np.intp]:
-        """Flat indices into a block's (K r, n) rows of its band entries, in (k, b, m, j) order (cached per r).
-
-        Row k r + m, column n_xi + j N + s_k + b: the coefficient b of the band of sample k for joint j.
-        """
-        if r not in self._band_indices:
-            K, W, N = len(self.times), self.band.shape[2], self.basis.n
-            k, b, m, j = np.ix_(np.arange(K), np.arange(W), np.arange(r), np.arange(self.n_joints))
-            column = self.n_xi + j * N + self.band_start[k] + b
-            self._band_indices[r] = ((k * r + m) * self.n + column).reshape(-1).astype(np.intp)
-        return self._band_indices[r]
 
     def _gradients(self, z: Array) -> tuple[Array, Array]:
         z = np.array(z, dtype=float)
@@ -411,18 +392,3 @@ class TaskProblem(ScaledProblem):
             self._grad_cache.clear()
         self._grad_cache[key] = (grad, jac)
         return grad, jac
-
-
-def _band(B: Array) -> tuple[NDArray[np.intp], Array]:
-    """The band of spline matrices B (3, K, N): window starts s_k (K,) and B on the windows (3, K, W).
-
-    Per sample k the W columns from s_k on hold every nonzero of B[:, k] (W: the widest support,
-    degree + 1 for a B-spline).
-    """
-    nonzero = np.any(B != 0.0, axis=0)  # (K, N)
-    first = np.argmax(nonzero, axis=1)
-    last = B.shape[2] - 1 - np.argmax(nonzero[:, ::-1], axis=1)
-    width = int(np.max(last - first)) + 1
-    start = np.minimum(first, B.shape[2] - width).astype(np.intp)
-    columns = start[:, None] + np.arange(width)
-    return start, np.take_along_axis(B, np.broadcast_to(columns, (3, *columns.shape)), axis=2)
