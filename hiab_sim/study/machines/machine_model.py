@@ -32,13 +32,13 @@ from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.hydraulics.cylinders import HydraulicSystem
 from hiab_sim.machine.description import Machine
-from hiab_sim.machine.design import MachineDesign, designed_chain
+from hiab_sim.machine.design import MachineDesign
 from hiab_sim.machine.dynamics.newton_euler import batched_inverse_dynamics
 from hiab_sim.machine.dynamics.paths import make_machine_dynamics
 from hiab_sim.machine.kinematics.closure import joint_to_stroke, stroke_to_joint
-from hiab_sim.machine.kinematics.design_partials import stroke_design_partials
 from hiab_sim.machine.kinematics.tracked import TrackedKinematics
 from hiab_sim.machine.kinematics.tracked import inverse_kinematics as tracked_ik
+from hiab_sim.study.machines.machine_strokes import StrokeRows
 from hiab_sim.study.machines.protocol import PointReach
 from hiab_sim.study.motion import trajectory as tr
 
@@ -108,16 +108,7 @@ class MachineModel:
     def __post_init__(self) -> None:
         object.__setattr__(self, "kinematics", TrackedKinematics(self.machine, self.extra))
         object.__setattr__(self, "_dynamics_machine", unbounded(self.machine))
-        # stroke chains at designs, by the values of their own variables (a finite difference in one
-        # chain's variable leaves the others' chains as they were: they are built once)
-        columns = {
-            c.name: [k for k, v in enumerate(self.machine.decision_variables) if v.chain == c.name]
-            for c in self.machine.chains
-        }
-        object.__setattr__(self, "_chain_columns", columns)
-        object.__setattr__(self, "_chain_cache", {})
-        object.__setattr__(self, "_partials_cache", {})
-        object.__setattr__(self, "_variable_maps", {})
+        object.__setattr__(self, "_strokes", StrokeRows(self.machine, self.stroke_joints))
 
     @property
     def name(self) -> str:
@@ -291,82 +282,16 @@ class MachineModel:
             out[:, :, i] = (values[0] - values[1]) / (2.0 * h)
         return out
 
-    def _stroke_chains_at(self, design: Any) -> list[tuple[tuple[str, bytes], Any]]:
-        """(key, chain) of every stroke chain with ``design``'s values: :func:`~hiab_sim.machine.design.designed_chain`.
-
-        Their geometry reads only the chain and the links, which no decision variable moves, so the
-        stroke rows use them with this model's machine and build no machine per design (the NLP holds
-        the bounds), nor the actuator bodies' design masses (geometry only). Cached by the key: the
-        chain's name and the values of its own variables.
-        """
-        values = np.asarray(design.as_array(), dtype=float)
-        cache, columns = self.__dict__["_chain_cache"], self.__dict__["_chain_columns"]
-        out = []
-        for chain in self._stroke_chain_list(self.machine):
-            key = (chain.name, values[columns[chain.name]].tobytes())
-            if key not in cache:
-                if len(cache) > 256:
-                    cache.clear()
-                cache[key] = designed_chain(self.machine, chain, values, bodies=False)  # geometry only
-            out.append((key, cache[key]))
-        return out
-
     def stroke_margins(self, design: Any, q: Array) -> Array:
-        """x, Lc - x, stroke - x per stroke chain [m], (K, 3 m)."""
-        machine = self.machine
-        cols = []
-        for (_, chain), j in zip(self._stroke_chains_at(design), self.stroke_joints, strict=True):
-            x = joint_to_stroke(machine, chain, q[:, j])
-            act = chain.actuator
-            cols += [x, float(act.rod_length) - x, act.stroke - x]
-        return np.column_stack(cols)
+        """x, Lc - x, stroke - x per stroke chain [m], (K, 3 m).
+
+        Built by :class:`~hiab_sim.study.machines.machine_strokes.StrokeRows` (chains and partials cached).
+        """
+        return self.__dict__["_strokes"].margins(design, q)
 
     def stroke_margin_partials(self, design: Any, q: Array) -> tuple[Array, Array]:
         """Exact partials of :meth:`stroke_margins` w.r.t. q (K, 3 m, n) and Xi (K, 3 m, n_xi)."""
-        K, n = q.shape[0], len(self.joint_names)
-        chains = self._stroke_chains_at(design)
-        dq = np.zeros((K, 3 * len(chains), n))
-        dxi = np.zeros((K, 3 * len(chains), len(self.design_names)))
-        keys = self.design_names
-        cache = self.__dict__["_partials_cache"]
-        for c, ((key, chain), j) in enumerate(zip(chains, self.stroke_joints, strict=True)):
-            # cached by chain and samples: the robust rows' finite differences in one chain's variable
-            # ask again for every other chain's partials at the same joint values
-            at = (key, q[:, j].tobytes())
-            if at not in cache:
-                if len(cache) > 256:
-                    cache.clear()
-                cache[at] = stroke_design_partials(self.machine, chain, q[:, j])
-            ds_dq, dx_dv = cache[at]
-            r = 3 * c
-            dq[:, r, j], dq[:, r + 1, j], dq[:, r + 2, j] = ds_dq, -ds_dq, -ds_dq
-            columns, moves, rod = self._stroke_variable_map(chain, keys)
-            dx = dx_dv * moves  # (K, v)
-            dxi[:, r, columns] = dx
-            dxi[:, r + 1, columns] = rod - dx
-            dxi[:, r + 2, columns] = -dx
-        return dq, dxi
-
-    def _stroke_variable_map(self, chain: Any, keys: tuple[str, ...]) -> tuple[list[int], Array, Array]:
-        """Per variable of a stroke chain: its column in Xi, whether it moves the stroke (1 or 0), d(rod)/dv.
-
-        With the retracted length x0 a variable, the piston offset Lc0 moves only the rod (rod = x0 - Lc0).
-        Cached by the chain's name (a designed chain has the variables of the machine's).
-        """
-        maps = self.__dict__["_variable_maps"]
-        if chain.name in maps:
-            return maps[chain.name]
-        retracted = any(v.kind == "retracted_length" for v in chain.variables)
-        columns = [keys.index(v.key) for v in chain.variables]
-        moves = np.array([0.0 if v.kind == "piston_offset" and retracted else 1.0 for v in chain.variables])
-        rod = np.array(
-            [
-                -1.0 if v.kind == "piston_offset" and retracted else float(v.kind in ("rod_length", "retracted_length"))
-                for v in chain.variables
-            ]
-        )
-        maps[chain.name] = (columns, moves, rod)
-        return columns, moves, rod
+        return self.__dict__["_strokes"].partials(design, q)
 
     def _stroke_chain_list(self, machine: Machine) -> list[Any]:
         return [c for c in machine.chains if c.kind != "direct"]
