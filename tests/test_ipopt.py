@@ -7,7 +7,7 @@ import pytest
 from test_mix import LOCAL_SPREAD, two_tasks
 
 from hiab_sim.dynamics.samples import JointSamples
-from hiab_sim.errors import InvalidInputError
+from hiab_sim.errors import HiabSimError, InvalidInputError
 from hiab_sim.study.nlp.id_partials import id_length_partials
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import XI_SCALE
@@ -68,6 +68,10 @@ def test_sparse_jacobian_holds_the_dense_jacobians_rows_and_each_pair_once(mix: 
         held += [start + position[row] for row in t.rows]
         start += len(kept)
     held_rows = np.array(held)
+    # the values' buffer is overwritten point after point: a first point's values must not leak into the next
+    np.testing.assert_array_equal(
+        jac.dense(z0), np.vstack([mix.equalities_jacobian(z0), mix.constraints_jacobian(z0)[held_rows]])
+    )
     np.testing.assert_array_equal(jac.dense(z), np.vstack([mix.equalities_jacobian(z), dense[held_rows]]))
     np.testing.assert_array_equal(jac.rows(z), np.concatenate([mix.equalities(z), g[held_rows]]))
     pairs = sum(len(range_pairs(p)[0]) for p in mix.problems)
@@ -131,3 +135,30 @@ def test_sparse_jacobian_of_a_machine_with_nine_design_variables_is_the_dense_on
     dense = study.constraints_jacobian(z)[held]
     assert np.count_nonzero(dense[:, study.n_xi - 3 : study.n_xi]) > 0  # the design variables past the sixth move rows
     np.testing.assert_array_equal(jac.dense(z), np.vstack([study.equalities_jacobian(z), dense]))
+
+
+def test_the_studys_lbfgs_history_is_the_one_ipopt_keeps(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``solver.lbfgs_history`` reaches IPOPT's ``limited_memory_max_history``; IPOPT's own default 6 otherwise."""
+    casadi = pytest.importorskip("casadi")
+    seen: list[dict] = []
+
+    class StopError(Exception):
+        pass
+
+    def nlpsol(name: str, plugin: str, nlp: dict, options: dict) -> None:
+        seen.append(options)
+        raise StopError
+
+    monkeypatch.setattr(casadi, "nlpsol", nlpsol)
+    for solver, expected in (({"method": "ipopt"}, 6), ({"method": "ipopt", "lbfgs_history": 37}, 37)):
+        problem = StudyProblem(study_from_dict(two_tasks(**solver), "two.yaml"))
+        with pytest.raises(StopError):
+            solve(problem, problem.study.initial_lengths, progress=None)
+        assert seen[-1]["ipopt.limited_memory_max_history"] == expected
+
+
+@pytest.mark.parametrize("value", [0, 2.5, "many", 501])
+def test_a_bad_lbfgs_history_names_the_field(value: object) -> None:
+    """0, a fraction, a word or more than 500 pairs: one line naming ``solver.lbfgs_history`` and the value."""
+    with pytest.raises(HiabSimError, match=rf"solver\.lbfgs_history.*{value}"):
+        study_from_dict(two_tasks(method="ipopt", lbfgs_history=value), "two.yaml")

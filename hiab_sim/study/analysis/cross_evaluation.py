@@ -66,7 +66,7 @@ def fixed_lengths_optimum(
     fixed.lower, fixed.upper = problem.lower.copy(), problem.upper.copy()
     n_xi = problem.n_xi  # the study's design variables (6 on the XS 031, the machine file's count otherwise)
     fixed.lower[:n_xi] = fixed.upper[:n_xi] = z0[:n_xi]
-    outcome = solve_ipopt(fixed, z0, settings.maxiter, settings.ftol)
+    outcome = solve_ipopt(fixed, z0, settings.maxiter, settings.ftol, history=settings.lbfgs_history)
     return outcome.z, outcome.success, outcome.message
 
 

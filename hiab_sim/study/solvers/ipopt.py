@@ -23,6 +23,7 @@ and MUMPS).
 
 from __future__ import annotations
 
+import itertools
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -130,9 +131,10 @@ class SparseJacobian:
 
     The pattern is the equalities' nonzeros (constant, 4 J rows per task) over each task's held rows
     of :func:`task_sparsity`. :meth:`values` takes each task's own Jacobian (rows, n_xi + J N_k) at
-    its pattern and puts the pieces into column-major order with one precomputed permutation: no
-    dense (m, n) matrix of the mix is formed. The last point's values are kept (IPOPT asks for the
-    Jacobian of the equalities and of the inequalities at the same point).
+    its pattern (precomputed flat indices) straight into its column-major positions: no dense (m, n)
+    matrix of the mix is formed. The last point's values are kept in one buffer, overwritten at the
+    next point (IPOPT asks for the Jacobian of the equalities and of the inequalities at the same
+    point and copies it).
     """
 
     def __init__(self, problem: StudyProblem, z0: Array) -> None:
@@ -156,9 +158,19 @@ class SparseJacobian:
         pattern = sparse.csc_matrix((source, (np.concatenate(rows), np.concatenate(cols))), shape=self.shape)
         pattern.sort_indices()
         self.indptr, self.indices = pattern.indptr, pattern.indices
-        self.order = pattern.data.astype(np.intp) - 1  # CSC position -> index into the pieces' concatenation
+        order = pattern.data.astype(np.intp) - 1  # CSC position -> index into the pieces' concatenation
+        # each piece's CSC positions, and each task's entries as flat indices into its (rows, columns) Jacobian
+        position = np.empty_like(order)
+        position[order] = np.arange(len(order))
+        ends = np.cumsum([len(self.eq_values)] + [len(r) for r, _ in self.local])
+        self._task_positions = [position[a:b] for a, b in itertools.pairwise(ends)]
+        self._task_flat = [
+            r * (t.problem.n_xi + t.problem.n_joints * t.problem.basis.n) + c
+            for t, (r, c) in zip(self.tasks, self.local, strict=True)
+        ]
         self._z: Array | None = None
-        self._values = np.empty(0)
+        self._values = np.zeros(len(order))
+        self._values[position[: ends[0]]] = self.eq_values  # constant
 
     def rows(self, z: Array) -> Array:
         """[e; g] at z: the equalities, then each task's held rows."""
@@ -177,10 +189,9 @@ class SparseJacobian:
     def values(self, z: Array) -> Array:
         """The Jacobian's values at z in the pattern's column-major order."""
         if self._z is None or not np.array_equal(z, self._z):
-            pieces = [self.eq_values]
-            for k, (t, (r, c)) in enumerate(zip(self.tasks, self.local, strict=True)):
-                pieces.append(t.problem.constraints_jacobian(task_z(self.problem, z, k))[r, c])
-            self._values = np.concatenate(pieces)[self.order]
+            for k, (t, flat) in enumerate(zip(self.tasks, self._task_flat, strict=True)):
+                jacobian = t.problem.constraints_jacobian(task_z(self.problem, z, k))
+                self._values[self._task_positions[k]] = jacobian.reshape(-1).take(flat)
             self._z = np.array(z, dtype=float)
         return self._values
 
@@ -275,6 +286,7 @@ def solve_ipopt(
     on_iterate: Callable[[Array], None] | None = None,
     objective: tuple[Callable[[Array], float], Callable[[Array], Array]] | None = None,
     constraint_tolerance: float = 1e-8,
+    history: int = 6,
 ) -> IpoptOutcome:
     """Minimise the problem's scaled cost from z0 with IPOPT (L-BFGS Hessian, sparse Jacobians).
 
@@ -288,6 +300,7 @@ def solve_ipopt(
         objective: (value, gradient) of another objective over the problem's rows and bounds
             (the feasibility phase's distance to a point); default the problem's scaled cost.
         constraint_tolerance: Largest scaled row violation IPOPT may end with (its ``constr_viol_tol``).
+        history: Pairs the L-BFGS Hessian keeps (``solver.lbfgs_history``; IPOPT's default 6).
 
     """
     cost, cost_gradient = (problem.cost, problem.cost_gradient) if objective is None else objective
@@ -338,6 +351,7 @@ def solve_ipopt(
         # than 2 x history extra back-solves per iteration (Sherman-Morrison): ~25 % less wall time
         # on the duty mix at the same iterates' quality (benchmarks/bench_duty_mix.py)
         "ipopt.limited_memory_aug_solver": "extended",
+        "ipopt.limited_memory_max_history": int(history),
         "ipopt.max_iter": int(maxiter),
         "ipopt.tol": 1e-8,
         "ipopt.constr_viol_tol": constraint_tolerance,

@@ -366,7 +366,9 @@ def _ipopt(problem: StudyProblem, z: Array, limit: int, record: Callable[[Array]
             record(x)
         seen.append(1)
 
-    outcome = solve_ipopt(problem, z, limit, problem.study.solver.ftol, on_iterate)
+    outcome = solve_ipopt(
+        problem, z, limit, problem.study.solver.ftol, on_iterate, history=problem.study.solver.lbfgs_history
+    )
     status = 0 if outcome.success else 1
     return OptimizeResult(x=outcome.z, success=outcome.success, status=status, message=outcome.message)
 
