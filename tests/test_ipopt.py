@@ -162,3 +162,17 @@ def test_a_bad_lbfgs_history_names_the_field(value: object) -> None:
     """0, a fraction, a word or more than 500 pairs: one line naming ``solver.lbfgs_history`` and the value."""
     with pytest.raises(HiabSimError, match=rf"solver\.lbfgs_history.*{value}"):
         study_from_dict(two_tasks(method="ipopt", lbfgs_history=value), "two.yaml")
+
+
+def test_a_jacobian_written_point_after_point_into_one_buffer_is_the_fresh_one(mix: StudyProblem) -> None:
+    """With ``jacobian_buffer`` set, each point's Jacobian overwrites the last in place and equals a new one."""
+    points = _points(mix, 3)
+    fresh = [[p.constraints_jacobian(task_z(mix, z, k)).copy() for k, p in enumerate(mix.problems)] for z in points]
+    again = StudyProblem(mix.study)  # no cached gradients
+    for p in again.problems:
+        p.jacobian_buffer = np.zeros((len(p.constraint_names), p.n))
+    for z, expected in zip([*points, points[0]], [*fresh, fresh[0]], strict=True):
+        for k, p in enumerate(again.problems):
+            got = p.constraints_jacobian(task_z(again, z, k))
+            assert got is p.jacobian_buffer
+            np.testing.assert_array_equal(got, expected[k])

@@ -254,14 +254,17 @@ class BlockLayout:
         partials: SamplePartials,
         to_z: Callable[[ConstraintBlock, BlockJacobian, Array], None],
         n: int,
+        out: Array | None = None,
     ) -> Array:
         """Jacobian (m, n): each block's partials written into its rows by ``to_z(block, jacobian, rows)``.
 
         ``to_z`` belongs to the problem, which alone knows the layout of z (for several tasks it
         picks the block's task's spline matrices and columns); ``rows`` is the block's (rows, n) view
-        of the Jacobian, zeros on entry.
+        of the Jacobian, zeros on entry into a new one. ``out``: a (m, n) array to write into instead
+        (zeros on its first use; a block writes the same entries at every point, so what no block
+        writes stays zero): no 20 MB allocation per point where the solver gathers the values at once.
         """
-        out = np.zeros((len(self.names), n))
+        out = np.zeros((len(self.names), n)) if out is None else out
         for block in self.blocks:
             to_z(block, block.jacobian(state, partials), out[self.slices[block.name]])
         return out

@@ -200,6 +200,7 @@ class TaskProblem(ScaledProblem):
         self._id_cache: dict[tuple[bytes, str], InverseDynamics] = {}
         self._eval_cache: dict[bytes, Evaluation] = {}
         self._grad_cache: dict[bytes, tuple[Array, Array]] = {}
+        self.jacobian_buffer: Array | None = None  # set: each point's Jacobian overwrites it (solvers.ipopt)
         self.n_evaluations = 0
         self.n_gradients = 0
         self.cost_scale = 1.0
@@ -383,7 +384,9 @@ class TaskProblem(ScaledProblem):
             lambda: self.joint_partials(ev.lengths, samples),
             lambda: self.model.design_partials(ev.lengths, samples, self.xi_path, self.fd_step, self.tcp_force),
         )
-        jac = self.layout.jacobian(ev, partials, self._to_z, self.n)
+        if self.jacobian_buffer is not None:  # it holds one point's Jacobian: the one written next
+            self._grad_cache.clear()
+        jac = self.layout.jacobian(ev, partials, self._to_z, self.n, self.jacobian_buffer)
         dcost_q, dcost_xi = self.objective.gradient(ev, partials)
         K = len(self.times)
         grad_c = np.einsum("koj,okn->jn", dcost_q.reshape(K, 3, self.n_joints), self.B).ravel() * C_SCALE

@@ -375,8 +375,16 @@ def solve_ipopt(
     ubg = jac.upper(z0)
     # every BLAS on one thread, CasADi's own OpenBLAS under MUMPS included (loaded with the plugin
     # above): IPOPT's iterates then do not depend on the core count (:mod:`hiab_sim.study.solvers.threads`)
-    with single_blas_thread():
-        out = solver(x0=z0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+    # each task's Jacobian written into one buffer, point after point: IPOPT gathers its nonzeros at once
+    # (SparseJacobian.values) and no (m, n) array is allocated per point; the problems own theirs again after
+    for t in jac.tasks:
+        t.problem.jacobian_buffer = np.zeros((len(t.problem.constraint_names), t.problem.n))
+    try:
+        with single_blas_thread():
+            out = solver(x0=z0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+    finally:  # (the last point's cached Jacobian stays the buffer, which nothing writes again)
+        for t in jac.tasks:
+            t.problem.jacobian_buffer = None
     stats = solver.stats()
     z = np.asarray(out["x"]).ravel()
     return IpoptOutcome(
