@@ -60,9 +60,9 @@ def test_codesign_study_converges_and_saves_more_than_mounting_alone(tmp_path: P
 def test_excavator_digging_from_three_starts_reports_its_optima_ranked_by_battery_energy(tmp_path: Path) -> None:
     """exact_digging from 3 starts: all converge; the optima are listed with their battery objective.
 
-    Measured (2 December 2026): two distinct optima at the 1e-4 m tolerance that differ only in the
-    bucket's base pin (by 0.03 mm in x and 0.14-0.17 mm in y; boom and arm alike to round-off) and in
-    the objective by 0.015 % (about 4 J of 26.6 kJ), the objective's flat direction, not two designs.
+    Measured (7 December 2026, IPOPT with 80 L-BFGS pairs): one optimum at the 1e-4 m tolerance, the
+    bucket's base pin within 0.035 mm (its flat direction), the costs alike to 4e-11. On SLSQP the starts
+    had stopped 0.17 mm and 0.015 % apart (two listed optima): the test holds every optimum within 0.1 %.
     """
     r = run_study("exact_digging", tmp_path, starts=3, progress=None, figures=False).result
     _converged_from_three_starts(r)
