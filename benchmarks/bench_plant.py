@@ -97,21 +97,15 @@ CLASS_PARTS = [
     (physics_module, "replace", "winding temperature, R_s hand-over"),
 ]
 
-#: Parts patched on the Physics's own objects once the environment is built: (attribute path, method, part).
+#: Parts patched on the Physics's own objects once the environment is built: (attribute path, methods, part).
 INSTANCE_PARTS = [
-    ("drives", "step", "current loops"),
-    ("losses", "dc_energy", "drive losses (inverter, brake, screw)"),
-    ("losses", "loss_torque", "drive losses (inverter, brake, screw)"),
-    ("losses", "rigid_rod_force", "drive losses (inverter, brake, screw)"),
-    ("drive_train", "spring_force", "drive train (Python side)"),
-    ("drive_train", "rod_actuator", "drive train (Python side)"),
-    ("drive_train", "step", "drive train (Python side)"),
-    ("friction", "power", "friction meter"),
-    ("thermal", "advance", "winding temperature, R_s hand-over"),
-    ("thermal", "resistance", "winding temperature, R_s hand-over"),
-    ("sensor", "push", "sensors (encoder, delay, current errors)"),
-    ("sensor", "measured", "sensors (encoder, delay, current errors)"),
-    ("current_error", "sample", "sensors (encoder, delay, current errors)"),
+    ("drives", ("step",), "current loops"),
+    ("losses", ("dc_energy", "loss_torque", "rigid_rod_force"), "drive losses (inverter, brake, screw)"),
+    ("drive_train", ("spring_force", "rod_actuator", "step"), "drive train (Python side)"),
+    ("friction", ("power",), "friction meter"),
+    ("thermal", ("advance", "resistance"), "winding temperature, R_s hand-over"),
+    ("sensor", ("push", "measured"), "sensors (encoder, delay, current errors)"),
+    ("current_error", ("sample",), "sensors (encoder, delay, current errors)"),
 ]
 
 
@@ -123,10 +117,11 @@ def instrumented_run(plan: Any, plant: Any) -> tuple[PartTimer, Any]:
     def build_and_instrument(*args: Any, **kwargs: Any) -> Any:
         env = build(*args, **kwargs)
         physics = env.physics
-        for holder, method, part in INSTANCE_PARTS:
+        for holder, methods, part in INSTANCE_PARTS:
             owner = getattr(physics, holder, None)
-            if owner is not None and hasattr(owner, method):
-                setattr(owner, method, timer.wrap(part, getattr(owner, method)))
+            for method in methods:
+                if owner is not None and hasattr(owner, method):
+                    setattr(owner, method, timer.wrap(part, getattr(owner, method)))
         return env
 
     with patched(PHASES, timer), patched(CLASS_PARTS, timer):

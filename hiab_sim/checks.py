@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Mapping
 from typing import Any
 
 from hiab_sim.errors import InvalidInputError
@@ -50,6 +52,33 @@ def check_positive(where: str, value: Any, unit: str = "") -> None:
 def check_non_negative(where: str, value: Any, unit: str = "") -> None:
     """Raise :class:`InvalidInputError` unless ``value`` is a finite number >= 0."""
     check_range(where, value, 0.0, unit=unit)
+
+
+def check_fields(
+    obj: Any,
+    positive: Mapping[str, str] | None = None,
+    non_negative: Mapping[str, str] | None = None,
+    *,
+    where: str | None = None,
+) -> None:
+    """Check fields of the dataclass ``obj``: each ``positive`` one > 0, each ``non_negative`` one >= 0.
+
+    The tables map a field's name to its unit; the fields are checked in the dataclass's order with
+    :func:`check_positive` / :func:`check_non_negative`, an error naming ``<where>.<field>`` (``where``
+    defaults to ``obj.label``).
+    """
+    prefix = obj.label if where is None else where
+    positive, non_negative = positive or {}, non_negative or {}
+    fields = dataclasses.fields(obj)
+    unknown = (positive.keys() | non_negative.keys()) - {field.name for field in fields}
+    if unknown:
+        raise TypeError(f"{type(obj).__name__} has no field {', '.join(sorted(unknown))}")
+    for field in fields:
+        name = field.name
+        if name in positive:
+            check_positive(f"{prefix}.{name}", getattr(obj, name), positive[name])
+        elif name in non_negative:
+            check_non_negative(f"{prefix}.{name}", getattr(obj, name), non_negative[name])
 
 
 def check_choice(where: str, value: Any, choices: tuple[str, ...]) -> None:

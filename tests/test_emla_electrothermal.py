@@ -6,22 +6,17 @@ import math
 
 import numpy as np
 import pytest
+from thermal_helper import motor_thermal
 
 from hiab_sim.emla.electrothermal import (
     FIXED_POINT_TOLERANCE_K,
     WindingResistance,
     coupled_winding_temperature,
 )
-from hiab_sim.emla.thermal import Duty, ThermalParams, periodic_winding_temperature
+from hiab_sim.emla.thermal import Duty, periodic_winding_temperature
 from hiab_sim.errors import InvalidInputError
 
-THERMAL = ThermalParams(
-    continuous_torque=14.0,
-    thermal_resistance=0.4,
-    time_constant=20.0,
-    ambient_temperature=40.0,
-    max_winding_temperature=140.0,
-)
+THERMAL = motor_thermal(thermal_resistance=0.4, time_constant=20.0)
 COPPER = WindingResistance(reference_temperature=20.0, temperature_coefficient=0.00393, insulation_limit=155.0)
 R_REF, K_T = 0.268, 0.7355  # ohm, N m/A
 

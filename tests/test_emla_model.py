@@ -23,6 +23,8 @@ from hiab_sim.emla.pmsm import dq_voltages, electromagnetic_torque
 from hiab_sim.errors import InvalidInputError
 
 EMLAS = load_emla_set("paper")
+#: An EMLA with samples of its load: (params, f_x [N], v_x [m/s], a_x [m/s^2]).
+Loaded = tuple[EmlaParams, np.ndarray, np.ndarray, np.ndarray]
 
 
 @st.composite
@@ -49,8 +51,13 @@ def emla_params(draw: st.DrawFn) -> EmlaParams:
     )
 
 
-def samples(draw: st.DrawFn, params: EmlaParams, n: int = 16) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Draw n (f_x, v_x, a_x) samples, some at crawl speeds inside the friction smoothing band."""
+@st.composite
+def loaded_emlas(draw: st.DrawFn, n: int = 16) -> Loaded:
+    """An EMLA of :func:`emla_params` and n drawn (f_x [N], v_x [m/s], a_x [m/s^2]) samples of its load.
+
+    Some samples are at crawl speeds inside the friction smoothing band, one at standstill.
+    """
+    params = draw(emla_params())
     seed = draw(st.integers(0, 2**32 - 1))
     rng = np.random.default_rng(seed)
     f_scale = 1.3 * peak_force(params)
@@ -60,16 +67,14 @@ def samples(draw: st.DrawFn, params: EmlaParams, n: int = 16) -> tuple[np.ndarra
     v[: n // 4] *= 3e-3  # crawl speeds, where the regularised friction bends
     v[n // 4] = 0.0
     a = rng.uniform(-3.0, 3.0, n)
-    return f, v, a
+    return params, f, v, a
 
 
 @settings(max_examples=150, deadline=None)
-@given(data=st.data(), params=emla_params())
-def test_electrical_power_equals_mechanical_power_plus_losses_to_machine_precision(
-    data: st.DataObject, params: EmlaParams
-) -> None:
+@given(loaded=loaded_emlas())
+def test_electrical_power_equals_mechanical_power_plus_losses_to_machine_precision(loaded: Loaded) -> None:
     """P_elec (electrical side) = f v + copper + rotor friction + screw viscous + inertial power."""
-    f, v, a = samples(data.draw, params)
+    params, f, v, a = loaded
     op = operating_point(params, f, v, a)
     terms = [
         op.mechanical_power,
@@ -102,12 +107,10 @@ def test_dq_power_splits_into_copper_loss_and_air_gap_power_for_any_d_current(
 
 
 @settings(max_examples=150, deadline=None)
-@given(data=st.data(), params=emla_params())
-def test_efficiency_never_exceeds_one_unless_kinetic_energy_is_released(
-    data: st.DataObject, params: EmlaParams
-) -> None:
+@given(loaded=loaded_emlas())
+def test_efficiency_never_exceeds_one_unless_kinetic_energy_is_released(loaded: Loaded) -> None:
     """Efficiency is <= 1 in all four quadrants, in and out of the envelope, wherever a_x v_x >= 0."""
-    f, v, a = samples(data.draw, params)
+    params, f, v, a = loaded
     a = np.abs(a) * np.sign(v)  # a v >= 0: steady or accelerating
     op = operating_point(params, f, v, a)
     defined = ~np.isnan(op.efficiency)
@@ -234,10 +237,10 @@ def test_electrical_power_equals_the_operating_point_power_elementwise() -> None
 
 
 @settings(max_examples=60, deadline=None)
-@given(data=st.data(), params=emla_params())
-def test_electrical_power_partials_match_central_finite_differences(data: st.DataObject, params: EmlaParams) -> None:
+@given(loaded=loaded_emlas())
+def test_electrical_power_partials_match_central_finite_differences(loaded: Loaded) -> None:
     """Analytic dP/df, dP/dv, dP/da agree with central differences to 1e-6 relative (+ FD roundoff)."""
-    f, v, a = samples(data.draw, params)
+    params, f, v, a = loaded
     analytic = electrical_power_partials(params, f, v, a)
     eps_v = params.motor.friction_smoothing_speed / params.transmission_ratio
     steps = (1e-3 * peak_force(params), 1e-4 * eps_v, 1e-3)

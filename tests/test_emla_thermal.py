@@ -2,16 +2,17 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
+from thermal_helper import motor_thermal
 
 from hiab_sim.emla.thermal import (
     Duty,
-    ThermalParams,
     copper_loss,
     periodic_winding_temperature,
     rms_torque,
@@ -19,13 +20,7 @@ from hiab_sim.emla.thermal import (
 )
 from hiab_sim.errors import InvalidInputError
 
-FAST = ThermalParams(
-    continuous_torque=14.0,
-    thermal_resistance=0.5,
-    time_constant=4.0,
-    ambient_temperature=40.0,
-    max_winding_temperature=140.0,
-)
+FAST = motor_thermal(thermal_resistance=0.5, time_constant=4.0)
 
 
 def _loss(t: np.ndarray) -> np.ndarray:
@@ -135,11 +130,9 @@ def test_temperature_gradients_match_finite_differences() -> None:
 )
 def test_bad_thermal_parameters_name_the_field(field: str, changes: dict[str, float]) -> None:
     """Negative R_th, zero time constant, NaN torque, T_max <= T_amb are rejected by name."""
-    values = dict(continuous_torque=14.0, thermal_resistance=0.5, time_constant=1800.0, ambient_temperature=40.0,
-                  max_winding_temperature=140.0, label="lift.thermal")  # fmt: skip
-    values.update(changes)
+    valid = motor_thermal(thermal_resistance=0.5, time_constant=1800.0, label="lift.thermal")
     with pytest.raises(InvalidInputError, match=re.escape(field)):
-        ThermalParams(**values)  # type: ignore[arg-type]
+        dataclasses.replace(valid, **changes)
 
 
 def test_a_duty_with_no_time_is_rejected() -> None:

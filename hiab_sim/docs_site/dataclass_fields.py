@@ -2,9 +2,10 @@
 
 The description is the field's entry under ``Attributes:`` in the class docstring (Google style), the
 unit the first ``[...]`` in it; the allowed range is read from the ``check_range`` / ``check_positive`` /
-``check_non_negative`` / ``check_choice`` calls of ``__post_init__`` that test ``self.<field>``
-(:func:`checked_ranges`), or from the field name each check reports (:func:`checked_fields`, for a
-dataclass that checks the keys of its parts), so the reference states exactly what the code enforces.
+``check_non_negative`` / ``check_choice`` calls of ``__post_init__`` that test ``self.<field>`` and the
+tables of its ``check_fields`` calls (:func:`checked_ranges`), or from the field name each check reports
+(:func:`checked_fields`, for a dataclass that checks the keys of its parts), so the reference states exactly
+what the code enforces.
 """
 
 from __future__ import annotations
@@ -105,9 +106,30 @@ def _checks(cls: type) -> list[tuple[ast.Call, str, str]]:
     return out
 
 
+#: The tables of :func:`hiab_sim.checks.check_fields` and the range each one's fields must lie in.
+FIELD_TABLES = {"positive": "> 0", "non_negative": ">= 0"}
+
+
+def _table_ranges(cls: type) -> dict[str, str]:
+    """``field -> allowed range`` from the ``positive`` / ``non_negative`` tables of ``check_fields`` calls."""
+    method = cls.__dict__.get("__post_init__")
+    if method is None:
+        return {}
+    out: dict[str, str] = {}
+    for call in ast.walk(ast.parse(textwrap.dedent(inspect.getsource(method)))):
+        if not (isinstance(call, ast.Call) and isinstance(call.func, ast.Name) and call.func.id == "check_fields"):
+            continue
+        for keyword in call.keywords:
+            if keyword.arg in FIELD_TABLES and isinstance(keyword.value, ast.Dict):
+                for key in keyword.value.keys:
+                    if isinstance(key, ast.Constant) and isinstance(key.value, str):
+                        out[key.value] = FIELD_TABLES[keyword.arg]
+    return out
+
+
 def checked_ranges(cls: type) -> dict[str, str]:
     """``field -> allowed range`` from the range checks of ``cls.__post_init__`` on ``self.<field>``."""
-    out: dict[str, str] = {}
+    out = _table_ranges(cls)
     for call, check, allowed in _checks(cls):
         if check in ("check_vector", "check_interval"):
             continue  # reported by checked_fields under the name they check

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from hiab_sim.checks import check_non_negative, check_positive
+from hiab_sim.checks import check_fields
 
 
 @dataclass(frozen=True)
@@ -27,7 +27,8 @@ class HoldingBrake:
     label: str = "holding_brake"
 
     def __post_init__(self) -> None:
-        check_positive(f"{self.label}.holding_torque", self.holding_torque, "N m")
-        check_non_negative(f"{self.label}.coil_power", self.coil_power, "W")
-        check_non_negative(f"{self.label}.release_time", self.release_time, "s")
-        check_non_negative(f"{self.label}.engage_time", self.engage_time, "s")
+        check_fields(
+            self,
+            positive={"holding_torque": "N m"},
+            non_negative={"coil_power": "W", "release_time": "s", "engage_time": "s"},
+        )

@@ -23,7 +23,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hiab_sim.checks import check_positive, check_range
+from hiab_sim.checks import check_fields, check_range
 from hiab_sim.errors import InvalidInputError
 
 
@@ -72,9 +72,15 @@ class DriveStiffness:
     label: str = "drive_stiffness"
 
     def __post_init__(self) -> None:
-        check_positive(f"{self.label}.support_length", self.support_length, "m")
-        for key in ("nut_stiffness", "bearing_stiffness", "pin_stiffness"):
-            check_positive(f"{self.label}.{key}", getattr(self, key), "N/m")
+        check_fields(
+            self,
+            positive={
+                "support_length": "m",
+                "nut_stiffness": "N/m",
+                "bearing_stiffness": "N/m",
+                "pin_stiffness": "N/m",
+            },
+        )
         check_range(f"{self.label}.pin_count", self.pin_count, 0.0, 8.0)
         if not float(self.pin_count).is_integer():
             raise InvalidInputError(f"{self.label}.pin_count", self.pin_count, "must be a whole number of pins")

@@ -47,7 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from hiab_sim.checks import check_efficiency, check_non_negative, check_positive
+from hiab_sim.checks import check_efficiency, check_fields
 
 Array = NDArray[np.float64]
 
@@ -88,13 +88,17 @@ class DriveLosses:
     def __post_init__(self) -> None:
         check_efficiency(f"{self.label}.transmission_efficiency_forward", self.transmission_efficiency_forward)
         check_efficiency(f"{self.label}.transmission_efficiency_backdriven", self.transmission_efficiency_backdriven)
-        check_positive(f"{self.label}.force_smoothing", self.force_smoothing, "N")
-        check_non_negative(f"{self.label}.inverter_constant_loss", self.inverter_constant_loss, "W")
-        check_non_negative(f"{self.label}.inverter_current_loss", self.inverter_current_loss, "W/A")
-        check_non_negative(f"{self.label}.inverter_resistance", self.inverter_resistance, "ohm")
-        check_positive(f"{self.label}.current_smoothing", self.current_smoothing, "A")
-        check_non_negative(f"{self.label}.brake_speed", self.brake_speed, "m/s")
-        check_non_negative(f"{self.label}.brake_coil_power", self.brake_coil_power, "W")
+        check_fields(
+            self,
+            positive={"force_smoothing": "N", "current_smoothing": "A"},
+            non_negative={
+                "inverter_constant_loss": "W",
+                "inverter_current_loss": "W/A",
+                "inverter_resistance": "ohm",
+                "brake_speed": "m/s",
+                "brake_coil_power": "W",
+            },
+        )
 
     @property
     def transmission_on(self) -> bool:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from hiab_sim.checks import check_non_negative, check_positive, check_range
+from hiab_sim.checks import check_fields, check_positive, check_range
 from hiab_sim.emla.brake import HoldingBrake
 from hiab_sim.emla.drive_stiffness import DriveStiffness
 from hiab_sim.emla.electrothermal import WindingResistance
@@ -54,15 +54,14 @@ class PmsmParams:
         pp = self.pole_pairs
         if isinstance(pp, bool) or not isinstance(pp, int) or pp <= 0:
             raise InvalidInputError(f"{self.label}.pole_pairs", pp, "must be a positive integer")
-        check_positive(f"{self.label}.flux_linkage", self.flux_linkage, "Wb")
-        check_non_negative(f"{self.label}.stator_resistance", self.stator_resistance, "ohm")
-        check_positive(f"{self.label}.Ld", self.Ld, "H")
-        check_positive(f"{self.label}.Lq", self.Lq, "H")
-        check_positive(f"{self.label}.rated_speed_rpm", self.rated_speed_rpm, "rev/min")
-        check_positive(f"{self.label}.rated_torque", self.rated_torque, "N m")
-        check_positive(f"{self.label}.peak_torque", self.peak_torque, "N m")
-        check_non_negative(f"{self.label}.rotor_inertia", self.rotor_inertia, "kg m^2")
-        check_non_negative(f"{self.label}.rotor_coulomb_friction", self.rotor_coulomb_friction, "N m")
+        check_fields(
+            self, positive={"flux_linkage": "Wb", "Ld": "H", "Lq": "H"}, non_negative={"stator_resistance": "ohm"}
+        )
+        check_fields(
+            self,
+            positive={"rated_speed_rpm": "rev/min", "rated_torque": "N m", "peak_torque": "N m"},
+            non_negative={"rotor_inertia": "kg m^2", "rotor_coulomb_friction": "N m"},
+        )
         if self.rotor_coulomb_friction >= self.peak_torque:
             raise InvalidInputError(
                 f"{self.label}.rotor_coulomb_friction",
@@ -70,8 +69,7 @@ class PmsmParams:
                 f"must be < peak_torque = {self.peak_torque:g} N m",
                 "N m",
             )
-        check_positive(f"{self.label}.max_line_voltage_rms", self.max_line_voltage_rms, "V")
-        check_positive(f"{self.label}.friction_smoothing_speed", self.friction_smoothing_speed, "rad/s")
+        check_fields(self, positive={"max_line_voltage_rms": "V", "friction_smoothing_speed": "rad/s"})
 
     @property
     def rated_speed(self) -> float:
@@ -110,9 +108,7 @@ class ScrewColumn:
     label: str = "screw"
 
     def __post_init__(self) -> None:
-        check_positive(f"{self.label}.root_diameter", self.root_diameter, "m")
-        check_positive(f"{self.label}.elastic_modulus", self.elastic_modulus, "Pa")
-        check_positive(f"{self.label}.yield_strength", self.yield_strength, "Pa")
+        check_fields(self, positive={"root_diameter": "m", "elastic_modulus": "Pa", "yield_strength": "Pa"})
         if not (math.isfinite(self.yield_strength) and self.yield_strength < self.elastic_modulus):
             raise InvalidInputError(
                 f"{self.label}.yield_strength", self.yield_strength, "must be < elastic_modulus", "Pa"
@@ -166,9 +162,12 @@ class EmlaParams:
     def __post_init__(self) -> None:
         if not (math.isfinite(self.gear_ratio) and self.gear_ratio > 1.0):
             raise InvalidInputError(f"{self.name}.gear_ratio", self.gear_ratio, "must be finite and > 1 (a reduction)")
-        check_positive(f"{self.name}.screw_lead", self.screw_lead, "m")
-        check_non_negative(f"{self.name}.screw_moving_mass", self.screw_moving_mass, "kg")
-        check_non_negative(f"{self.name}.viscous_friction", self.viscous_friction, "N s/m")
+        check_fields(
+            self,
+            positive={"screw_lead": "m"},
+            non_negative={"screw_moving_mass": "kg", "viscous_friction": "N s/m"},
+            where=self.name,
+        )
         for key in ("hydraulic_push_force", "hydraulic_pull_force"):
             value = getattr(self, key)
             if value is not None:

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hiab_sim.checks import check_positive
+from hiab_sim.checks import check_fields, check_positive
 from hiab_sim.errors import InvalidInputError
 
 Array = NDArray[np.float64]
@@ -62,9 +62,7 @@ class ThermalParams:
     label: str = "thermal"
 
     def __post_init__(self) -> None:
-        check_positive(f"{self.label}.continuous_torque", self.continuous_torque, "N m")
-        check_positive(f"{self.label}.thermal_resistance", self.thermal_resistance, "K/W")
-        check_positive(f"{self.label}.time_constant", self.time_constant, "s")
+        check_fields(self, positive={"continuous_torque": "N m", "thermal_resistance": "K/W", "time_constant": "s"})
         if not math.isfinite(self.ambient_temperature):
             raise InvalidInputError(f"{self.label}.ambient_temperature", self.ambient_temperature, "must be finite")
         t_max = self.max_winding_temperature
