@@ -265,8 +265,18 @@ def render_still(
     size: tuple[int, int] = (640, 480),
     layout: Layout = DEFAULT_LAYOUT,
 ) -> Path:
-    """Render one frame (.png) of the kinematic playback at ``at_time`` [s] (default: the end)."""
+    """Render one frame (.png) of the kinematic playback at ``at_time`` [s] (default: the end).
+
+    A machine file's result is drawn at ``at_time`` itself (:func:`hiab_sim.render.machine_video.machine_still`);
+    a crane file's at the nearest frame of the 30 fps playback.
+    """
+    from hiab_sim.render.machine_playback import is_machine_result
+
     check_gl_backend()
+    if is_machine_result(result_dir):
+        from hiab_sim.render.machine_video import machine_still  # it builds on this module
+
+        return machine_still(result_dir, output, at_time, size, layout)
     data = load_playback(result_dir)
     _check_size(size, even=False)
     output = check_output_path(Path(output), (".png",), "image")
