@@ -258,25 +258,13 @@ def render_result(
         return write_video(renderer, output, size, fps, progress)
 
 
-def render_still(
-    result_dir: str | Path,
-    output: str | Path,
-    at_time: float | None = None,
-    size: tuple[int, int] = (640, 480),
-    layout: Layout = DEFAULT_LAYOUT,
+def crane_still(
+    result_dir: str | Path, output: str | Path, at_time: float | None, size: tuple[int, int], layout: Layout
 ) -> Path:
-    """Render one frame (.png) of the kinematic playback at ``at_time`` [s] (default: the end).
+    """One frame (.png) of a crane file's result at the 30 fps frame nearest ``at_time`` [s] (None: the last).
 
-    A machine file's result is drawn at ``at_time`` itself (:func:`hiab_sim.render.machine_video.machine_still`);
-    a crane file's at the nearest frame of the 30 fps playback.
+    Reached through :func:`hiab_sim.render.still.render_still`, which checks the OpenGL backend first.
     """
-    from hiab_sim.render.machine_playback import is_machine_result
-
-    check_gl_backend()
-    if is_machine_result(result_dir):
-        from hiab_sim.render.machine_video import machine_still  # it builds on this module
-
-        return machine_still(result_dir, output, at_time, size, layout)
     data = load_playback(result_dir)
     _check_size(size, even=False)
     output = check_output_path(Path(output), (".png",), "image")
