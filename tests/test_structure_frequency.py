@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from hiab_sim.crane.description import Crane
 from hiab_sim.emla.config import EmlaSet, load_emla_set
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.structure.free_vibration import free_vibration_frequency, spectrum_peak_Hz
+from hiab_sim.structure.free_vibration import FreeVibration, free_vibration_frequency, spectrum_peak_Hz
 from hiab_sim.structure.natural_frequency import (
     axial_stiffness,
     bandwidth_margin,
@@ -64,7 +64,7 @@ def test_drive_stiffness_falls_with_stroke_and_stays_below_each_part(a: float, b
 def test_lowest_frequency_matches_a_free_vibration_in_mujoco(crane: Crane, emlas: EmlaSet, pose: tuple) -> None:
     """The FFT peak of the spring-mounted MuJoCo model's free vibration is within 1 % of the eigenvalue's frequency."""
     modes = natural_frequencies(crane, emlas, crane.default_lengths, np.array([pose]))
-    simulated = free_vibration_frequency(crane, emlas, crane.default_lengths, pose, mode=0)
+    simulated = free_vibration_frequency(crane, emlas, crane.default_lengths, pose, FreeVibration(mode=0))
     assert simulated == pytest.approx(float(modes.lowest_Hz[0]), rel=0.01)
 
 
@@ -75,7 +75,9 @@ def test_payload_held_at_the_tcp_matches_a_free_vibration_with_a_point_mass(cran
     weight = np.array([0.0, -300.0 * crane.gravity, 0.0])
     loaded = natural_frequencies(crane, emlas, crane.default_lengths, np.array([pose]), weight, payload_kg=300.0)
     empty = natural_frequencies(crane, emlas, crane.default_lengths, np.array([pose]))
-    simulated = free_vibration_frequency(crane, emlas, crane.default_lengths, pose, mode=0, payload_kg=300.0)
+    simulated = free_vibration_frequency(
+        crane, emlas, crane.default_lengths, pose, FreeVibration(mode=0), payload_kg=300.0
+    )
     assert simulated == pytest.approx(float(loaded.lowest_Hz[0]), rel=0.01)
     assert loaded.lowest_Hz[0] < 0.9 * empty.lowest_Hz[0]  # the payload matters
 
@@ -85,7 +87,7 @@ def test_second_frequency_matches_a_free_vibration_in_mujoco(crane: Crane, emlas
     """The second mode too: the FFT of its free vibration within 1 % of its eigenvalue."""
     pose = (0.0, -2.0, 0.0)
     modes = natural_frequencies(crane, emlas, crane.default_lengths, np.array([pose]))
-    simulated = free_vibration_frequency(crane, emlas, crane.default_lengths, pose, mode=1)
+    simulated = free_vibration_frequency(crane, emlas, crane.default_lengths, pose, FreeVibration(mode=1))
     assert simulated == pytest.approx(float(modes.frequency_Hz[0, 1]), rel=0.01)
 
 

@@ -26,6 +26,7 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.paths import make_machine_dynamics
 from hiab_sim.machine.loader import load_machine
+from hiab_sim.structure.free_vibration import FreeVibration
 from hiab_sim.structure.machine_free_vibration import machine_free_vibration_frequency
 from hiab_sim.structure.machine_modes import actuator_jacobian, machine_natural_frequencies, mass_matrix
 from hiab_sim.structure.machine_structure import machine_design_structure, machine_pin_loads, machine_pin_names
@@ -114,7 +115,9 @@ def test_excavator_frequency_matches_a_free_vibration_of_the_spring_mounted_mujo
     machine, emlas = excavator
     pose = np.array([0.3, -1.6, -0.8])
     for mode in (0, 1):
-        simulated, eigen = machine_free_vibration_frequency(machine, emlas, pose, mode=mode, periods=20.0)
+        simulated, eigen = machine_free_vibration_frequency(
+            machine, emlas, pose, FreeVibration(mode=mode, periods=20.0)
+        )
         assert simulated == pytest.approx(eigen, rel=0.01), f"mode {mode}"
 
 

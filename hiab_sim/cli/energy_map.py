@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from hiab_sim.cli.options import add_out_option
+
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register the subcommand."""
@@ -35,7 +37,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--grid", type=int, default=50, metavar="N", help="grid points per axis (default 50)")
     parser.add_argument("--result", metavar="DIR", help="result folder of hiab-sim optimize: map around its optimum")
-    parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<study name>/energy_map)")
+    add_out_option(parser, "runs/<study name>/energy_map")
     parser.set_defaults(run=run)
 
 

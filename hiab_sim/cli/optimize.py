@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from hiab_sim.atomic_io import write_atomic
+from hiab_sim.cli.options import add_out_option
 from hiab_sim.errors import BackendUnavailableError
 from hiab_sim.results.design_values import design_words
 from hiab_sim.study.report.summary import SUMMARY_FILE, summary_text
@@ -50,7 +51,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "study", nargs="?", metavar="STUDY.yaml", help="study file or shipped study name (default: xs031_spiral)"
     )
-    parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<study name>)")
+    add_out_option(parser, "runs/<study name>")
     parser.add_argument("--resume", action="store_true", help="continue from the output folder's last checkpoint")
     parser.add_argument(
         "--starts", type=int, metavar="K", help="number of feasible starts (default: 1; with --resume the run's own)"

@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from hiab_sim.cli.options import add_out_option
+
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register the subcommand."""
@@ -25,7 +27,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--against", required=True, choices=("peak_force", "rms_torque"), help="second criterion")
     parser.add_argument("--points", type=int, default=10, metavar="K", help="front points (default 10)")
-    parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<study name>/pareto_<criterion>)")
+    add_out_option(parser, "runs/<study name>/pareto_<criterion>")
     parser.set_defaults(run=run)
 
 

@@ -96,10 +96,7 @@ def run(args: argparse.Namespace) -> int:
     if args.frames:
         return _machine_frames(args) if machine else _crane_frames(args)
     if args.still:
-        from hiab_sim.render.machine_video import render_machine_still
-
-        still = render_machine_still if machine else render_still
-        path = still(args.result_dir, args.still, at_time=args.at, size=args.size, layout=args.layout)
+        path = render_still(args.result_dir, args.still, at_time=args.at, size=args.size, layout=args.layout)
         print(f"wrote still frame: {path}")
         return 0
     output = Path(args.output) if args.output else None

@@ -39,6 +39,7 @@ import math
 import sys
 from pathlib import Path
 
+from hiab_sim.cli.options import add_out_option
 from hiab_sim.cli.simulate_summary import print_results, write_results
 from hiab_sim.errors import InvalidInputError
 
@@ -76,7 +77,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="plant effects: realistic, ideal or a plant YAML file (default: ideal, the planner's own model)",
     )
     parser.add_argument("--cycles", type=int, default=1, metavar="N", help="cycles per run, thermal state carried over")
-    parser.add_argument("--out", metavar="DIR", help="output folder (default: RESULT_DIR)")
+    add_out_option(parser, "RESULT_DIR")
     parser.add_argument("--no-video", action="store_true", help="skip closed_loop.mp4")
     parser.add_argument("--no-figures", action="store_true", help="skip the closed_loop_*.png figures")
     parser.add_argument("--quiet", action="store_true", help="no progress bars")

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from hiab_sim.cli.options import add_out_option
+
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register the subcommand."""
@@ -22,7 +24,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--workers", type=int, metavar="N", help="local worker processes (default 1)")
     where.add_argument("--dask", metavar="ADDRESS", help="Dask scheduler, e.g. tcp://127.0.0.1:8786")
-    parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/sweeps/<sweep name>)")
+    add_out_option(parser, "runs/sweeps/<sweep name>")
     parser.add_argument("--resume", action="store_true", help="skip the points already in DIR/sweep.parquet")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.set_defaults(run=run)

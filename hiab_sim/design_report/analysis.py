@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from hiab_sim.design_report.answer import actuator_table
 from hiab_sim.design_report.page import figure, num, paragraph, section, table
 from hiab_sim.results.schema import Result
+
+T = TypeVar("T")
 
 
 def constraints(result: Result) -> str:
@@ -198,6 +201,17 @@ def duty_mix(result: Result, folder: Path) -> str:
     return section("Duty mix", *parts)
 
 
+def _initial_optimal(
+    initial: Mapping[str, T],
+    optimal: Mapping[str, T],
+    value: Callable[[T], str],
+    detail: Callable[[T], str],
+    set_by: Callable[[str], tuple[str, ...]],
+) -> list[tuple[str, ...]]:
+    """Per name of ``optimal``: the name, both designs' ``value``, the optimal one's ``detail``, ``set_by(name)``."""
+    return [(name, value(initial[name]), value(o), detail(o), *set_by(name)) for name, o in optimal.items()]
+
+
 def structure(result: Result, folder: Path) -> str:
     """Pin loads, screw buckling and natural frequencies of both designs (the result's ``structure`` section).
 
@@ -216,26 +230,20 @@ def structure(result: Result, folder: Path) -> str:
         return (name or "–",)
 
     mix = () if e is None else ("set by task, optimal",)
-    pins = [
-        (
-            name,
-            f"{s.initial.pins[name].peak_N / 1e3:.1f} kN",
-            f"{pin.peak_N / 1e3:.1f} kN",
-            f"{pin.magnitude_range_N / 1e3:.1f} kN",
-            *task(None if e is None else e.pin_peak_task, name),
-        )
-        for name, pin in s.optimal.pins.items()
-    ]
-    screws = [
-        (
-            name,
-            f"{s.initial.buckling[name].max_utilisation:.3f}",
-            f"{b.max_utilisation:.3f}",
-            f"{b.min_critical_load_N / 1e3:.0f} kN at {b.max_column_length_m:.2f} m",
-            *task(None if e is None else e.buckling_task, name),
-        )
-        for name, b in s.optimal.buckling.items()
-    ]
+    pins = _initial_optimal(
+        s.initial.pins,
+        s.optimal.pins,
+        lambda pin: f"{pin.peak_N / 1e3:.1f} kN",
+        lambda pin: f"{pin.magnitude_range_N / 1e3:.1f} kN",
+        lambda name: task(None if e is None else e.pin_peak_task, name),
+    )
+    screws = _initial_optimal(
+        s.initial.buckling,
+        s.optimal.buckling,
+        lambda b: f"{b.max_utilisation:.3f}",
+        lambda b: f"{b.min_critical_load_N / 1e3:.0f} kN at {b.max_column_length_m:.2f} m",
+        lambda name: task(None if e is None else e.buckling_task, name),
+    )
     path_task = None if e is None else e.lowest_frequency_trajectory_task
     grid_task = None if e is None else e.lowest_frequency_working_range_task
     freq = [

@@ -101,15 +101,13 @@ def render_machine_frames(
         return [write_image(folder / f"frame_{i:03d}.png", renderer.frame(i)) for i in range(len(renderer))]
 
 
-def render_machine_still(
-    result_dir: str | Path,
-    output: str | Path,
-    at_time: float | None = None,
-    size: tuple[int, int] = (640, 480),
-    layout: Layout = DEFAULT_LAYOUT,
+def machine_still(
+    result_dir: str | Path, output: str | Path, at_time: float | None, size: tuple[int, int], layout: Layout
 ) -> Path:
-    """Render one frame (.png) of a machine file's result at ``at_time`` [s] (default: the end)."""
-    check_gl_backend()
+    """One frame (.png) of a machine file's result at ``at_time`` [s] (None: the end).
+
+    Reached through :func:`hiab_sim.render.still.render_still`, which checks the OpenGL backend first.
+    """
     output = check_output_path(Path(output), (".png",), "image")
     data = load_machine_playback(result_dir)
     t = data.time[-1] if at_time is None else float(np.clip(at_time, data.time[0], data.time[-1]))

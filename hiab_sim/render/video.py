@@ -258,15 +258,13 @@ def render_result(
         return write_video(renderer, output, size, fps, progress)
 
 
-def render_still(
-    result_dir: str | Path,
-    output: str | Path,
-    at_time: float | None = None,
-    size: tuple[int, int] = (640, 480),
-    layout: Layout = DEFAULT_LAYOUT,
+def crane_still(
+    result_dir: str | Path, output: str | Path, at_time: float | None, size: tuple[int, int], layout: Layout
 ) -> Path:
-    """Render one frame (.png) of the kinematic playback at ``at_time`` [s] (default: the end)."""
-    check_gl_backend()
+    """One frame (.png) of a crane file's result at the 30 fps frame nearest ``at_time`` [s] (None: the last).
+
+    Reached through :func:`hiab_sim.render.still.render_still`, which checks the OpenGL backend first.
+    """
     data = load_playback(result_dir)
     _check_size(size, even=False)
     output = check_output_path(Path(output), (".png",), "image")

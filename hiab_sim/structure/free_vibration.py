@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
@@ -33,6 +34,28 @@ from hiab_sim.structure.natural_frequency import natural_frequencies, static_for
 from hiab_sim.structure.natural_frequency_mujoco import loop_projection, mujoco_mass_matrix
 
 Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class FreeVibration:
+    """How one mode's free vibration is simulated, by the crane's check and by a machine file's.
+
+    Attributes:
+        mode: Index of the mode, 0 the lowest [-].
+        timestep: MuJoCo step [s] (RK4).
+        periods: Length of the record in periods of the mode [-].
+        stroke_amplitude: Largest actuator stroke amplitude of the start velocity along the mode [m].
+
+    """
+
+    mode: int = 0
+    timestep: float = 1e-4
+    periods: float = 30.0
+    stroke_amplitude: float = 1e-5
+
+
+#: The lowest mode, as both checks simulate it unless told otherwise.
+LOWEST_MODE = FreeVibration()
 
 
 def spectrum_peak_Hz(signal: ArrayLike, sample_time: float, pad: int = 64) -> float:
@@ -102,17 +125,15 @@ def free_vibration_frequency(
     emlas: EmlaSet,
     lengths: LinkLengths,
     pose: ArrayLike,
-    mode: int = 0,
-    timestep: float = 1e-4,
-    periods: float = 30.0,
-    stroke_amplitude: float = 1e-5,
+    run: FreeVibration = LOWEST_MODE,
     payload_kg: float = 0.0,
 ) -> float:
-    """Frequency [Hz] of mode ``mode`` at a static pose (n,), from a free-vibration simulation (module docstring).
+    """Frequency [Hz] of mode ``run.mode`` at a static pose (n,), from a free-vibration simulation (module docstring).
 
     ``payload_kg``: a point mass added to the MuJoCo model at the TCP site (its weight and inertia
     then come from MuJoCo); the eigenvalue problem gets it as ``payload_kg`` and a TCP force.
     """
+    mode, timestep = run.mode, run.timestep
     q0 = np.asarray(pose, dtype=float).reshape(1, -1)
     weight = np.array([0.0, -payload_kg * crane.gravity, 0.0]) if payload_kg > 0.0 else None
     modes = natural_frequencies(crane, emlas, lengths, q0, weight, payload_kg=payload_kg)
@@ -137,9 +158,9 @@ def free_vibration_frequency(
     data.qpos[:] = qpos[0]
     mujoco.mj_fwdPosition(model, data)
     Z = loop_projection(model, data, [c.name for c in crane.chains])
-    rate = omega * stroke_amplitude / float(np.max(np.abs(modes.actuator_shape[0][:, mode])))
+    rate = omega * run.stroke_amplitude / float(np.max(np.abs(modes.actuator_shape[0][:, mode])))
     data.qvel[:] = Z @ (phi * rate)
     mass, _ = mujoco_mass_matrix(crane, lengths, q0)
     weights = phi @ mass[0]  # the crane's M without the payload still picks this mode out
     independent = np.array([model.joint(name).qposadr[0] for name in JOINT_NAMES])
-    return modal_peak_Hz(model, data, weights, independent, q0[0], omega, timestep, periods)
+    return modal_peak_Hz(model, data, weights, independent, q0[0], omega, timestep, run.periods)

@@ -26,7 +26,7 @@ from hiab_sim.emla.emla_set import EmlaSet
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.mjcf_build import build_machine_spec
 from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
-from hiab_sim.structure.free_vibration import modal_peak_Hz, spring_mounted_model
+from hiab_sim.structure.free_vibration import LOWEST_MODE, FreeVibration, modal_peak_Hz, spring_mounted_model
 from hiab_sim.structure.machine_modes import actuator_jacobian, machine_natural_frequencies, mass_matrix, static_forces
 
 
@@ -34,16 +34,14 @@ def machine_free_vibration_frequency(
     machine: Machine,
     emlas: EmlaSet,
     pose: ArrayLike,
-    mode: int = 0,
-    timestep: float = 1e-4,
-    periods: float = 30.0,
-    stroke_amplitude: float = 1e-5,
+    run: FreeVibration = LOWEST_MODE,
 ) -> tuple[float, float]:
-    """(simulated, eigenvalue) frequency [Hz] of mode ``mode`` at a static pose (n,) (module docstring).
+    """(simulated, eigenvalue) frequency [Hz] of mode ``run.mode`` at a static pose (n,) (module docstring).
 
     ``machine`` carries the design (``Machine.with_design``); the eigenvalue problem is solved on
     its MuJoCo path, the simulation on its spring-mounted MJCF.
     """
+    mode, timestep = run.mode, run.timestep
     q0 = np.asarray(pose, dtype=float).reshape(1, -1)
     inverse = MujocoMachineDynamics(machine)
     modes = machine_natural_frequencies(machine, inverse, emlas, q0)
@@ -62,11 +60,11 @@ def machine_free_vibration_frequency(
     model = spring_mounted_model(spec, timestep, chains, modes.stiffness_N_per_m[0], force, inverse.model, qpos[0])
     data = mujoco.MjData(model)
     data.qpos[:] = qpos[0]
-    rate = omega * stroke_amplitude / float(np.max(np.abs(modes.actuator_shape[0][:, mode])))
+    rate = omega * run.stroke_amplitude / float(np.max(np.abs(modes.actuator_shape[0][:, mode])))
     data.qvel[:] = Z @ (phi * rate)
     mass = mass_matrix(inverse, q0, actuator_jacobian(inverse, q0))[0]
     weights = phi @ mass
     tree = inverse.tree
     independent = np.array([model.joint(tree.bodies[b].joint).qposadr[0] for b in tree.independent])
-    simulated = modal_peak_Hz(model, data, weights, independent, q0[0], omega, timestep, periods)
+    simulated = modal_peak_Hz(model, data, weights, independent, q0[0], omega, timestep, run.periods)
     return simulated, float(modes.frequency_Hz[0, mode])

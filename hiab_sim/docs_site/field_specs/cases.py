@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from hiab_sim.docs_site.field_specs.rows import Key, from_class, section
+from hiab_sim.docs_site.field_specs.rows import Key, from_class, section, text
 
 
 def cases_keys() -> list[Key]:
@@ -38,11 +38,10 @@ def cases_keys() -> list[Key]:
             length_sets={"description": "Random link-length sets (random_lengths)."},
             description={"description": "Shown in the table."},
         ),
-        Key(
+        text(
             "cases[].payload",
-            type="text",
+            "Run without, with, or without and with the payload force.",
             default="both",
             allowed="one of `none`, `payload`, `both`",
-            description="Run without, with, or without and with the payload force.",
         ),
     ]

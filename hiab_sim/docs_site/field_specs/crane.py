@@ -7,13 +7,13 @@ from __future__ import annotations
 
 from hiab_sim.crane.description import CHAIN_NAMES
 from hiab_sim.crane.names import ACTUATOR_NAMES
-from hiab_sim.docs_site.field_specs.rows import Key, free, number, section, section_of
+from hiab_sim.docs_site.field_specs.rows import Key, free, interval, number, section, section_of, text
 
 
 def crane_keys() -> list[Key]:
     """The crane file (:func:`hiab_sim.crane.loader.crane_from_dict`), source frames and SI units."""
     chain = [
-        Key("parent", type="text", description="Link the chain's cylinder base pivot sits on (e.g. `base`)."),
+        text("parent", "Link the chain's cylinder base pivot sits on (e.g. `base`)."),
         Key(
             "cylinder_base_pivot",
             type="[number, number, number]",
@@ -29,12 +29,11 @@ def crane_keys() -> list[Key]:
         number("Lc", "m", "Rod length (seed's Lc).", allowed="> 0"),
         number("Lc0", "m", "Piston offset (seed's Lc0); x0 = Lc0 + Lc.", allowed="> 0"),
         number("stroke", "m", "Actuator stroke.", allowed="> 0"),
-        Key(
+        interval(
             "joint_range",
-            type="[number, number]",
-            unit="rad",
+            "rad",
+            "Working range of theta the design must serve (const_j at its ends).",
             allowed="low < high",
-            description="Working range of theta the design must serve (const_j at its ends).",
         ),
     ]
     pose = [
@@ -63,8 +62,8 @@ def crane_keys() -> list[Key]:
         ),
     ]
     rows = [
-        Key("name", type="text", description="Crane name, used in reports."),
-        Key("source", type="text", description="Where the data comes from (citation)."),
+        text("name", "Crane name, used in reports."),
+        text("source", "Where the data comes from (citation)."),
         number("gravity", "m/s^2", "Gravitational acceleration, along -y of {W}."),
         section("chains", "The two closed chains (cylinder, rod, boom triangle)."),
     ]
@@ -72,18 +71,12 @@ def crane_keys() -> list[Key]:
         rows += section_of(f"chains.{name}", f"The {name} chain.", chain)
     rows += [
         section("telescope", "The telescope: a prismatic joint xt2 along x of the cylinder frame {P22}."),
-        Key("telescope.parent", type="text", description="Link the telescope cylinder is fixed to."),
+        text("telescope.parent", "Link the telescope cylinder is fixed to."),
         *section_of("telescope.cylinder_frame", "{P22} in the parent link frame.", pose),
         number("telescope.rod_offset", "m", "{B52} at (rod_offset + xt2, 0, 0) in {P22}.", allowed="finite"),
         number("telescope.rod_length", "m", "{B52} -> end-mass frame {P32} along x.", allowed="> 0"),
         number("telescope.stroke", "m", "Telescope stroke.", allowed="> 0"),
-        Key(
-            "telescope.joint_range",
-            type="[number, number]",
-            unit="m",
-            allowed="within [0, stroke]",
-            description="Working range of xt2.",
-        ),
+        interval("telescope.joint_range", "m", "Working range of xt2.", allowed="within [0, stroke]"),
         *section_of("tcp", "TCP frame in the end-mass frame.", pose),
         free("bodies", "Rigid bodies by name, each `{frame, mass, com, inertia}` in its source frame."),
         section("hydraulic_cylinders", "The cylinders the EMLAs replace (hydraulic baseline).", default="none"),

@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from hiab_sim.docs_site.dataclass_fields import checked_fields
-from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, number, section, section_of
+from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, interval, number, section, section_of, text
 
 #: Shown for a vector the loader reads as (x, y) or (x, y, z) (``_vec3``: z defaults to 0).
 POINT = "[x, y] or [x, y, z]"
@@ -153,15 +153,11 @@ def _chains() -> list[Key]:
             "mapping",
         ),
         section(where, "One actuated closed chain driving one joint with one linear actuator."),
-        Key(f"{where}.kind", type="text", allowed=chain["kind"], description="How the actuator drives the joint."),
-        Key(
-            f"{where}.joint",
-            type="text",
-            description="The joint it drives: revolute for a triangle or linkage, prismatic for direct.",
-        ),
+        text(f"{where}.kind", "How the actuator drives the joint.", allowed=chain["kind"]),
+        text(f"{where}.joint", "The joint it drives: revolute for a triangle or linkage, prismatic for direct."),
         free(f"{where}.pivots", f"Role -> pivot; the roles of each kind: {roles}.", "mapping"),
         section(f"{where}.pivots.<role>", "One pin of the chain."),
-        Key(f"{where}.pivots.<role>.link", type="text", description="The link the pin is on."),
+        text(f"{where}.pivots.<role>.link", "The link the pin is on."),
         Key(
             f"{where}.pivots.<role>.position",
             type=POINT,
@@ -186,20 +182,18 @@ def _chains() -> list[Key]:
         *_body(f"{where}.linkage.coupler_body", "The coupler's body, in the coupler frame (origin at H)."),
         free(f"{where}.variables", "Variable name (unique in the chain) -> decision variable.", "mapping"),
         section(f"{where}.variables.<variable>", "One design variable an optimisation may move."),
-        Key(f"{where}.variables.<variable>.kind", type="text", allowed=variable["kind"], description="What it sets."),
-        Key(
+        text(f"{where}.variables.<variable>.kind", "What it sets.", allowed=variable["kind"]),
+        text(
             f"{where}.variables.<variable>.pivot",
-            type="text",
+            "The pivot it moves.",
             default="none",
             allowed="a pivot role of the chain; required for `hinge_distance`, `pivot_x`, `pivot_y`, else none",
-            description="The pivot it moves.",
         ),
-        Key(
+        interval(
             f"{where}.variables.<variable>.bounds",
-            type="[number, number]",
-            unit="m",
+            "m",
+            "Bounds [low, high] of the variable.",
             allowed=variable["bounds"] + "; the file's own value within",
-            description="Bounds [low, high] of the variable.",
         ),
     ]
 
@@ -246,26 +240,23 @@ def machine_keys() -> list[Key]:
         *section_of(
             "tcp",
             "The TCP: its link and its frame there.",
-            [Key("link", type="text", description=top["tcp_link"].description), *_pose(required_r=True)],
+            [text("link", top["tcp_link"].description), *_pose(required_r=True)],
         ),
         *_hydraulic(),
         *section_of(
             "workspace",
             top["workspace"].description,
             [
-                Key(axis, type="[number, number]", unit="m", allowed=workspace[axis], description=text)
+                interval(axis, "m", text, allowed=workspace[axis])
                 for axis, text in (("x", "[x_min, x_max] of the TCP."), ("y", "[y_min, y_max] of the TCP."))
             ],
             "none",
         ),
-        Key(
+        text(
             "realistic_plant",
-            type="text",
+            "The plant `hiab-sim simulate --plant realistic` runs on this machine's results: a shipped plant "
+            "name or a plant file, read next to the machine file (docs/plant.md).",
             default="none (the shipped realistic plant)",
-            description=(
-                "The plant `hiab-sim simulate --plant realistic` runs on this machine's results: a shipped plant "
-                "name or a plant file, read next to the machine file (docs/plant.md)."
-            ),
         ),
         Key("notes", type="text, list or mapping", default="none", description="Free provenance notes, not read."),
     ]

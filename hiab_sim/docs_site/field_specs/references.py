@@ -4,7 +4,17 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from hiab_sim.docs_site.field_specs.rows import Key, from_class, number, section, section_of
+from hiab_sim.docs_site.field_specs.rows import Key, from_class, number, section, section_of, text
+
+
+def control_points_key(path: str, description: str) -> Key:
+    """The control points of a B-spline whose count follows from its duration unless given."""
+    return Key(path, type="integer", default="by duration", allowed=">= 7", description=description)
+
+
+def _kind(allowed: str, default: str = "") -> Key:
+    """A reference section's ``kind`` key."""
+    return text("kind", "The kind of reference.", default=default, allowed=allowed)
 
 
 def reference_keys(where: str) -> list[Key]:
@@ -12,13 +22,7 @@ def reference_keys(where: str) -> list[Key]:
     from hiab_sim.study.references.kinds import PickAndPlace
 
     spiral = [
-        Key(
-            "kind",
-            type="text",
-            default="spiral",
-            allowed="one of `spiral`, `pick_and_place`, `csv`",
-            description="The kind of reference.",
-        ),
+        _kind("one of `spiral`, `pick_and_place`, `csv`", default="spiral"),
         number("duration", "s", "Duration.", allowed="> 0", default="grid.duration"),
         Key(
             "centre_joints",
@@ -35,10 +39,10 @@ def reference_keys(where: str) -> list[Key]:
         number("telescope_start", "m", "xt2 at both ends (prescribed)."),
         number("telescope_amplitude", "m", "xt2 goes out by this much at mid-motion and back.", default="0"),
     ]
-    pick = [Key("kind", type="text", allowed="`pick_and_place`", description="The kind of reference.")]
+    pick = [_kind("`pick_and_place`")]
     pick += [replace(k, default="[1, 1]" if k.path == "dwell" else k.default) for k in from_class("", PickAndPlace)]
     csv = [
-        Key("kind", type="text", allowed="`csv`", description="The kind of reference."),
+        _kind("`csv`"),
         Key(
             "file",
             type="path",
@@ -53,13 +57,7 @@ def reference_keys(where: str) -> list[Key]:
             "The further tracked coordinate (the crane's xt2) when the TCP file has no column for it.",
             default="none",
         ),
-        Key(
-            "control_points",
-            type="integer",
-            default="by duration",
-            allowed=">= 7",
-            description="Control points of the least-squares B-spline fit.",
-        ),
+        control_points_key("control_points", "Control points of the least-squares B-spline fit."),
         number("fit_tolerance", "m", "Largest distance of the fit from any sample.", allowed="> 0", default="0.005"),
     ]
     needed = "one of `reference`, `tasks`" if where == "reference" else "required"
@@ -99,12 +97,11 @@ def soil_keys(where: str) -> list[Key]:
             f"earthmoving equation) on the TCP; needs `{ATTITUDE}` among the machine's `tracked`.",
             default="none",
         ),
-        Key(
+        text(
             f"{where}.soil",
-            type="text",
-            allowed="one of " + ", ".join(f"`{n}`" for n in SOILS) + ", or a soil file",
-            description="A shipped soil or a soil file (see Soil file below); a path is read from the working folder, "
+            "A shipped soil or a soil file (see Soil file below); a path is read from the working folder, "
             "not next to the study.",
+            allowed="one of " + ", ".join(f"`{n}`" for n in SOILS) + ", or a soil file",
         ),
         replace(
             rows["ground"],

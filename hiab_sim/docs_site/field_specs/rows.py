@@ -37,6 +37,16 @@ def number(path: str, unit: str, description: str, *, allowed: str = "", default
     return Key(path, type="number", unit=unit, default=default, allowed=allowed, description=description, form=form)
 
 
+def interval(path: str, unit: str, description: str, *, allowed: str = "") -> Key:
+    """A ``[low, high]`` pair of numbers in ``unit``, with the range it must lie in where one is stated."""
+    return Key(path, type="[number, number]", unit=unit, allowed=allowed, description=description)
+
+
+def text(path: str, description: str, *, default: str = "", allowed: str = "", form: str = "") -> Key:
+    """A text value (a name, a path or one of the words ``allowed`` lists), with its default where one is stated."""
+    return Key(path, type="text", default=default, allowed=allowed, description=description, form=form)
+
+
 def section(path: str, description: str, default: str = "required") -> Key:
     """A mapping whose keys are documented by the rows below it."""
     return Key(path, "section", "mapping", default=default, description=description)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from hiab_sim.docs_site.field_specs.rows import Key, from_class
+from hiab_sim.docs_site.field_specs.rows import Key, from_class, text
 
 
 def soil_keys() -> list[Key]:
@@ -19,7 +19,7 @@ def soil_keys() -> list[Key]:
     sourced = "{value, source}, source starting with " + ", ".join(f"`{w}`" for w in PROVENANCE)
     rows = {k.path: k for k in from_class("", SoilProperties, skip=("source",))}
     return [
-        Key("name", type="text", description="The soil's name (reports: `<name>: <source>`)."),
-        Key("source", type="text", description="Where the file's numbers come from, as a whole (cited sources)."),
+        text("name", "The soil's name (reports: `<name>: <source>`)."),
+        text("source", "Where the file's numbers come from, as a whole (cited sources)."),
         *[replace(rows[key], type=sourced) for key in FIELDS],
     ]

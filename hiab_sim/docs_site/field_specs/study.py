@@ -9,8 +9,8 @@ from __future__ import annotations
 from hiab_sim.crane.description import CHAIN_NAMES
 from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.docs_site.dataclass_fields import field_rows
-from hiab_sim.docs_site.field_specs.references import payload_keys, reference_keys, soil_keys
-from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, in_form, names, section, section_of
+from hiab_sim.docs_site.field_specs.references import control_points_key, payload_keys, reference_keys, soil_keys
+from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, in_form, names, number, section, section_of, text
 
 
 def _structure_keys() -> list[Key]:
@@ -49,13 +49,12 @@ def _mounting_keys() -> list[Key]:
             default="none",
             description="Convex polygon of the tilt base pivot in {B11}.",
         ),
-        Key(
+        number(
             "mounting.clearance",
-            type="number",
-            unit="m",
-            default="0.05",
+            "m",
+            "Centre-to-centre clearance from other pins and the swept boom.",
             allowed="> 0",
-            description="Centre-to-centre clearance from other pins and the swept boom.",
+            default="0.05",
         ),
         Key(
             "mounting.samples",
@@ -79,18 +78,12 @@ def study_keys() -> list[Key]:
     bounds = field_rows(Bounds, ())
 
     rows = [
-        Key("name", type="text", default="the file's stem", description="Study name (result folder, reports)."),
-        Key(
-            "crane",
-            type="text",
-            description="Crane preset name (`xs031`) or a crane file, relative to the study.",
-            form="crane",
-        ),
-        Key(
+        text("name", "Study name (result folder, reports).", default="the file's stem"),
+        text("crane", "Crane preset name (`xs031`) or a crane file, relative to the study.", form="crane"),
+        text(
             "machine",
-            type="text",
+            "Shipped machine name or a machine file, relative to the study.",
             allowed="one of " + ", ".join(f"`{n}`" for n in MACHINE_PRESETS) + ", or a path",
-            description="Shipped machine name or a machine file, relative to the study.",
             form="machine",
         ),
         Key(
@@ -102,11 +95,10 @@ def study_keys() -> list[Key]:
             "the reference's further columns, held within the tracking bands.",
             form="machine",
         ),
-        Key(
+        text(
             "emla",
-            type="text",
+            "EMLA preset name or an EMLA file; its actuator names must be the machine's actuators.",
             default="`default` (crane form); required (machine form)",
-            description="EMLA preset name or an EMLA file; its actuator names must be the machine's actuators.",
         ),
         section(
             "initial_lengths",
@@ -115,7 +107,7 @@ def study_keys() -> list[Key]:
         ),
     ]
     start = [
-        Key(k, type="number", unit="m", allowed="> 0, within the bounds", description=d)
+        number(k, "m", d, allowed="> 0, within the bounds")
         for k, d in (("L", "Base pivot -> boom hinge."), ("Lc0", "Piston offset."), ("Lc", "Rod length."))
     ]
     for chain in CHAIN_NAMES:
@@ -147,15 +139,9 @@ def study_keys() -> list[Key]:
             description="Tasks of a duty mix (instead of `reference` and `payload`).",
         ),
         section("tasks[]", "One task."),
-        Key("tasks[].name", type="text", description="Unique task name."),
-        Key("tasks[].weight", type="number", allowed="> 0", description="Share of the work (e.g. cycles per hour)."),
-        Key(
-            "tasks[].control_points",
-            type="integer",
-            default="by duration",
-            allowed=">= 7",
-            description="The task's spline control points.",
-        ),
+        text("tasks[].name", "Unique task name."),
+        number("tasks[].weight", "", "Share of the work (e.g. cycles per hour).", allowed="> 0"),
+        control_points_key("tasks[].control_points", "The task's spline control points."),
         *reference_keys("tasks[].reference"),
         *payload_keys("tasks[].payload"),
         *soil_keys("tasks[].soil"),
@@ -199,36 +185,33 @@ def study_keys() -> list[Key]:
             description="Joint-velocity limits in the machine's joint order (const_i).",
             form="machine",
         ),
-        Key(
+        number(
             "bounds.triangle_margin_deg",
-            type="number",
-            unit="deg",
-            default="10",
+            "deg",
+            "Smallest interior angle at the boom hinge and its supplement (const_k).",
             allowed="[0, 60)",
-            description="Smallest interior angle at the boom hinge and its supplement (const_k).",
+            default="10",
         ),
-        Key(
+        number(
             "bounds.working_margin_deg",
-            type="number",
-            unit="deg",
-            default="3",
+            "deg",
+            "With `working_range: reference`, the reference's joint range widened by this.",
             allowed="[0, 30]",
-            description="With `working_range: reference`, the reference's joint range widened by this.",
+            default="3",
         ),
-        Key(
+        number(
             "bounds.envelope_margin",
-            type="number",
-            default="0.02",
+            "",
+            "EMLA envelope margins held at the collocation points.",
             allowed="[0, 0.5)",
-            description="EMLA envelope margins held at the collocation points.",
+            default="0.02",
         ),
-        Key(
+        text(
             "bounds.working_range",
-            type="text",
+            "`crane` or `machine`: the design serves the machine's full joint range (the crane's, or "
+            "each joint's working range in the machine file); `reference`: only the reference's.",
             default=bounds["working_range"]["default"],
             allowed=bounds["working_range"]["allowed"],
-            description="`crane` or `machine`: the design serves the machine's full joint range (the crane's, or "
-            "each joint's working range in the machine file); `reference`: only the reference's.",
         ),
     ]
     rows += [
@@ -243,12 +226,11 @@ def study_keys() -> list[Key]:
     ]
     rows += in_form("crane", _mounting_keys())
     rows += [
-        Key(
+        text(
             "objective",
-            type="text",
+            "What the optimiser minimises: the seed's eq. `costf2` or the battery energy.",
             default="costf2",
             allowed="one of " + ", ".join(f"`{n}`" for n in OBJECTIVES),
-            description="What the optimiser minimises: the seed's eq. `costf2` or the battery energy.",
         ),
         section(
             "duty",
@@ -273,7 +255,7 @@ def study_keys() -> list[Key]:
         rows += [
             Key(f"transmission.{name}", type="list", default="the EMLA file's", description=f"Options for {name}."),
             section(f"transmission.{name}[]", "One option."),
-            Key(f"transmission.{name}[].gear_ratio", type="number", allowed="> 1", description="Gearbox ratio G."),
-            Key(f"transmission.{name}[].screw_lead", type="number", unit="m", allowed="> 0", description="Screw lead."),
+            number(f"transmission.{name}[].gear_ratio", "", "Gearbox ratio G.", allowed="> 1"),
+            number(f"transmission.{name}[].screw_lead", "m", "Screw lead.", allowed="> 0"),
         ]
     return rows

@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from hiab_sim.docs_site.field_specs.rows import Key, free, section
+from hiab_sim.docs_site.field_specs.rows import Key, free, section, text
 
 
 def sweep_keys() -> list[Key]:
     """The sweep file (:func:`hiab_sim.sweep.spec.load_sweep`)."""
     return [
-        Key("name", type="text", default="the file's stem", description="Sweep name."),
-        Key("study", type="text", description="Shipped study name or a study path relative to the sweep file."),
+        text("name", "Sweep name.", default="the file's stem"),
+        text("study", "Shipped study name or a study path relative to the sweep file."),
         free("set", "Dotted paths into the study (or `emla.` into its EMLA file) set at every point.", "path: value"),
         free(
             "grid",
