@@ -148,3 +148,19 @@ def test_duty_partials_match_finite_differences(hold: str | None, hot: bool) -> 
             assert de[q][k] == pytest.approx(fd[0], rel=1e-6, abs=1e-9)
             assert dr[q, k] == pytest.approx(fd[1], rel=1e-6, abs=1e-11)
             assert dt_[q, k] == pytest.approx(fd[2], rel=1e-5, abs=1e-11)
+
+
+def test_rms_and_peak_partials_are_computed_once_and_cannot_be_changed_by_a_caller() -> None:
+    """The second call returns the first call's (read-only) arrays; a fresh duty of the same samples gives the same."""
+    t, f, v, a = _samples(9)
+    opts = DutyOptions(Duty(6.25, 20.0), "motor", hot=True)
+    d = drive_duty(LIFT, t, 0.5 * f, v, a, opts)
+    first = d.peak_partials(), d.rms_partials()
+    assert d.peak_partials() is first[0] and d.rms_partials() is first[1]
+    for array in first:
+        with pytest.raises(ValueError, match="read-only"):
+            array[0, 0] = 1.0
+    again = drive_duty(LIFT, t, 0.5 * f, v, a, opts)
+    np.testing.assert_array_equal(again.peak_partials(), first[0])
+    np.testing.assert_array_equal(again.rms_partials(), first[1])
+    assert np.any(first[0] != 0.0) and np.any(first[1] != 0.0)

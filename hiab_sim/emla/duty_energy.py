@@ -28,7 +28,8 @@ the first and last samples' forces.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -93,6 +94,16 @@ class DriveDuty:
     winding: CoupledWinding | None
     hold: RestHold | None
     _parts: _Parts
+    #: rms_partials and peak_partials once computed (read-only arrays): the NLP's rows ask for them at a
+    #: point's values and again for its Jacobian, and each peak costs a (K, K) adjoint solve
+    _memo: dict[str, Array] = field(default_factory=dict, compare=False, repr=False)
+
+    def _memoised(self, key: str, compute: Callable[[], Array]) -> Array:
+        if key not in self._memo:
+            value = compute()
+            value.setflags(write=False)
+            self._memo[key] = value
+        return self._memo[key]
 
     def energy_partials(self, weights: ArrayLike, rest_weight: float) -> tuple[Array, Array, Array]:
         """d(sum_k y_k P_k + z E_rest) / d(f_x, v_x, a_x)_k, each shape (K,) [m/s, N, kg m/s for y in s]."""
@@ -128,7 +139,17 @@ class DriveDuty:
         return dp[0], dp[1], dp[2]
 
     def rms_partials(self) -> Array:
-        """D tau_rms / d(f_x, v_x, a_x)_k, shape (3, K)."""
+        """D tau_rms / d(f_x, v_x, a_x)_k, shape (3, K) (computed once, read-only)."""
+        return self._memoised("rms", self._rms_partials)
+
+    def peak_partials(self) -> Array:
+        """D T_peak / d(f_x, v_x, a_x)_k, shape (3, K), computed once, read-only.
+
+        The peak sample is held; zeros without thermal data.
+        """
+        return self._memoised("peak", self._peak_partials)
+
+    def _rms_partials(self) -> Array:
         p = self._parts
         rms = self.rms_torque
         out = np.zeros((3, p.tau.size))
@@ -141,8 +162,7 @@ class DriveDuty:
             out[0, -1] += self.hold.rest_torque * p.duty.rest_time / (p.duty.period * rms) / p.k
         return out
 
-    def peak_partials(self) -> Array:
-        """D T_peak / d(f_x, v_x, a_x)_k, shape (3, K) (peak sample held; zeros without thermal data)."""
+    def _peak_partials(self) -> Array:
         p = self._parts
         out = np.zeros((3, p.tau.size))
         if self.winding is None or not math.isfinite(self.winding.peak):
