@@ -8,7 +8,10 @@ depends on Xi and on the k + 1 B-spline coefficients per joint whose support cov
 another row (an integral, the working range) on Xi and its task's coefficients; rows of another
 task never depend on a task's coefficients. :func:`task_sparsity` builds that pattern from the
 blocks; the values are the problem's exact-structure Jacobian at the pattern. The Hessian is the
-limited-memory quasi-Newton approximation (L-BFGS), as SLSQP's BFGS.
+limited-memory quasi-Newton approximation (L-BFGS), as SLSQP's BFGS, from the last
+``solver.lbfgs_history`` (step, gradient change) pairs: IPOPT's default 6 forgets the curvature of a
+flat optimum and creeps along it (the excavator's digging study: 282 iterations); the excavator
+studies keep 80 (89 iterations to the same point).
 
 The NLP is the problem's own: min cost(z) s.t. equalities(z) = 0, constraints(z) >= 0, Xi
 bounds, with one change of form: a pair of rows that bound one quantity from both sides
@@ -212,11 +215,13 @@ def _casadi() -> Any:
 
 
 def _callback_class(ca: Any) -> Any:
-    """A CasADi Callback of one output computed from input 0 by a numpy function, copy-free.
+    """A CasADi Callback whose outputs a numpy function computes from input 0, copy-free.
 
-    ``eval_buffer`` hands the inputs' and output's nonzeros as memoryviews (column-major): no DM is
-    built per call (a 200k-nonzero DM from numpy costs ~15 ms). ``jacobian`` (optional) builds the
-    Callback that is this one's Jacobian; ``jac_sparsity`` its structure.
+    ``eval_buffer`` hands the inputs' and outputs' nonzeros as memoryviews (column-major): no DM is
+    built per call (a 200k-nonzero DM from numpy costs ~15 ms). ``fill(z)`` returns one value per
+    output (an output CasADi does not ask for is skipped). ``jacobian`` (optional) builds the
+    Callback that is this one's Jacobian, ``jac_sparsity`` its structure: CasADi asks for them when
+    it builds the NLP's derivative functions, whether or not IPOPT evaluates them.
     """
     Base: Any = ca.Callback
 
@@ -225,41 +230,46 @@ def _callback_class(ca: Any) -> Any:
             self,
             name: str,
             inputs: list[Any],
-            output: Any,
-            fill: Callable[[Array], Array | float],
+            outputs: list[Any],
+            fill: Callable[[Array], tuple[Array | float, ...]],
+            names_in: list[str] | None = None,
+            names_out: list[str] | None = None,
             jacobian: Callable[[], Any] | None = None,
             jac_sparsity: Any = None,
-            names: list[str] | None = None,
         ) -> None:
             ca.Callback.__init__(self)
-            self.inputs, self.output, self.fill = inputs, output, fill
-            self.jacobian, self.jac_sparsity, self.names = jacobian, jac_sparsity, names
+            self.inputs, self.outputs, self.fill = inputs, outputs, fill
+            self.names_in, self.names_out = names_in, names_out
+            self.jacobian, self.jac_sparsity = jacobian, jac_sparsity
             self.construct(name, {} if jacobian is None else {"enable_fd": False})
 
         def get_n_in(self) -> int:
             return len(self.inputs)
 
         def get_n_out(self) -> int:
-            return 1
+            return len(self.outputs)
 
         def get_name_in(self, i: int) -> str:
-            return self.names[i] if self.names is not None else f"i{i}"
+            return self.names_in[i] if self.names_in is not None else f"i{i}"
+
+        def get_name_out(self, i: int) -> str:
+            return self.names_out[i] if self.names_out is not None else f"o{i}"
 
         def get_sparsity_in(self, i: int) -> Any:
             return self.inputs[i]
 
         def get_sparsity_out(self, i: int) -> Any:
-            return self.output
+            return self.outputs[i]
 
         def has_eval_buffer(self) -> bool:
             return True
 
         def eval_buffer(self, arg: Any, res: Any) -> int:
             z = np.frombuffer(arg[0], dtype=np.float64)
-            out = np.frombuffer(res[0], dtype=np.float64) if res[0] is not None else None
-            value = self.fill(z.copy())
-            if out is not None:
-                out[:] = value
+            values = self.fill(z.copy())
+            for buffer, value in zip(res, values, strict=True):
+                if buffer is not None:
+                    np.frombuffer(buffer, dtype=np.float64)[:] = value
             return 0
 
         def has_jacobian(self) -> bool:
@@ -317,31 +327,57 @@ def solve_ipopt(
         keep.append(callback)
         return callback
 
-    def jac_g() -> Any:
-        return made(Callback("jac_g", [dense_z, ca.Sparsity(m, 1)], jac_sparsity, jac.values))
+    scalar, no_p = ca.Sparsity.dense(1, 1), ca.Sparsity.dense(0, 1)
 
-    scalar = ca.Sparsity.dense(1, 1)
+    def derivative(name: str, output: Any, sparsity: Any, values: Callable[[Array], Array]) -> Callable[[], Any]:
+        """The Callback of a Jacobian (inputs z and the nominal output) for CasADi's symbolic derivatives."""
+        return lambda: made(Callback(name, [dense_z, output], [sparsity], lambda z: (values(z),)))
 
-    def grad_f() -> Any:
-        return made(Callback("grad_f", [dense_z, scalar], ca.Sparsity.dense(1, n), cost_gradient))
-
-    f_cb = made(Callback("f", [dense_z], scalar, cost, jacobian=grad_f))
-    g_cb = made(Callback("g", [dense_z], ca.Sparsity.dense(m, 1), jac.rows, jacobian=jac_g, jac_sparsity=jac_sparsity))
+    f_cb = made(
+        Callback(
+            "f", [dense_z], [scalar], lambda z: (cost(z),), jacobian=derivative("df", scalar, dense_z.T, cost_gradient)
+        )
+    )
+    g_out = ca.Sparsity.dense(m, 1)
+    g_jacobian = derivative("dg", ca.Sparsity(m, 1), jac_sparsity, jac.values)
+    g_cb = made(
+        Callback("g", [dense_z], [g_out], lambda z: (jac.rows(z),), jacobian=g_jacobian, jac_sparsity=jac_sparsity)
+    )
+    # IPOPT's gradient and Jacobian functions given to CasADi whole (its options grad_f, jac_g): built
+    # from the callbacks above, CasADi's Jacobian called dg once per 64 of the n columns (7 times here)
+    grad_f = made(
+        Callback(
+            "grad_f",
+            [dense_z, no_p],
+            [scalar, dense_z],
+            lambda z: (cost(z), cost_gradient(z)),
+            ["x", "p"],
+            ["f", "grad_f_x"],
+        )
+    )
+    jac_g = made(
+        Callback(
+            "jac_g",
+            [dense_z, no_p],
+            [g_out, jac_sparsity],
+            lambda z: (jac.rows(z), jac.values(z)),
+            ["x", "p"],
+            ["g", "jac_g_x"],
+        )
+    )
 
     iterates: list[Array] = []
 
-    def record(z: Array) -> float:
+    def record(z: Array) -> tuple[float]:
         iterates.append(z)
         if on_iterate is not None:
             on_iterate(z)
-        return 0.0
+        return (0.0,)
 
     sizes = {"x": (n, 1), "f": (1, 1), "g": (m, 1), "lam_x": (n, 1), "lam_g": (m, 1), "lam_p": (0, 1)}
     names = [str(ca.nlpsol_out(i)) for i in range(ca.nlpsol_n_out())]
     iteration = made(
-        Callback(
-            "iteration", [ca.Sparsity.dense(*sizes[s]) for s in names], ca.Sparsity.dense(1, 1), record, names=names
-        )
+        Callback("iteration", [ca.Sparsity.dense(*sizes[s]) for s in names], [scalar], record, names_in=names)
     )
     x = ca.MX.sym("z", n)
     nlp = {"x": x, "f": f_cb(x), "g": g_cb(x)}
@@ -367,6 +403,8 @@ def solve_ipopt(
         "ipopt.print_timing_statistics": "yes" if os.environ.get("HIAB_IPOPT_PRINT") else "no",
         "print_time": False,
         "iteration_callback": iteration,
+        "grad_f": grad_f,
+        "jac_g": jac_g,
     }
     solver = ca.nlpsol("solver", "ipopt", nlp, options)
     lbx = np.where(np.isfinite(problem.lower), problem.lower, -np.inf)
