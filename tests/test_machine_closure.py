@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -288,3 +290,24 @@ def test_four_bar_pivot_partials_match_finite_differences() -> None:
             x_down = closure.joint_to_stroke(down, down.chain("bucket"), q)
             np.testing.assert_allclose(dx_dv[:, k], (x_up - x_down) / (2 * h), rtol=1e-6, atol=1e-9)
             assert np.max(np.abs(dx_dv[:, k])) > 1e-3  # the pivot matters
+
+
+def test_length_and_rate_are_the_full_closures_numbers_bit_for_bit(machine: Machine) -> None:
+    """The stroke rows' light closure gives s, s' (and a four-bar's pin) equal to the full closure's, bit for bit."""
+    for k, chain in enumerate(machine.chains):
+        q = np.random.default_rng(k).uniform(-np.pi, np.pi, 400)
+        geo = closure.chain_geometry(machine, chain)
+        # a four-bar with its rocker shortened by a third, which cannot close over part of the turn
+        short = dataclasses.replace(geo, rocker_length=geo.rocker_length * 2.0 / 3.0)
+        for g in (geo, short) if chain.kind == "linkage" else (geo,):
+            with np.errstate(invalid="ignore", divide="ignore"):
+                full = closure.geometry_closure(g, q)
+                light = closure.length_and_rate(g, q)
+            np.testing.assert_array_equal(light.length, full.length)
+            np.testing.assert_array_equal(light.length_dq, full.length_dq)
+            if g is short:
+                assert not np.all(full.closes)  # the samples where it cannot close are compared too
+            if chain.kind == "linkage":
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    pin, _, _, _ = closure.pin_position(g, q)
+                np.testing.assert_array_equal(light.pin, pin)

@@ -146,6 +146,41 @@ def geometry_closure(geo: ChainGeometry, q: ArrayLike) -> Closure:
         return _linkage(geo, q)
 
 
+@dataclass(frozen=True)
+class LengthRate:
+    """A chain's length s and ds/dq at joint samples q (the shape of q); a linkage's pin H and coupler pivot C."""
+
+    length: Array
+    length_dq: Array
+    pin: Array | None = None
+    coupler_pivot: Array | None = None
+
+
+def length_and_rate(geo: ChainGeometry, q: ArrayLike) -> LengthRate:
+    """The length s and s' alone, by the same operations as :func:`geometry_closure` (the same numbers, bit for bit).
+
+    For the stroke rows and their design partials, which ask for nothing else: no second derivatives,
+    no body angles.
+    """
+    q = np.asarray(q, dtype=float)
+    if geo.kind == "direct":
+        return LengthRate(geo.x0 + q, np.ones_like(q))
+    if geo.kind == "triangle":
+        base, dbase, _ = _point(geo, "base", q)
+        end, dend, _ = _point(geo, "end", q)
+        v, dv = end - base, dend - dbase
+        s = np.sqrt(_dot(v, v))
+        return LengthRate(s, _dot(v, dv) / s)
+    with np.errstate(divide="ignore", invalid="ignore"):  # as geometry_closure's four-bar
+        H, C, _, _ = pin_position(geo, q)
+        _, dC, _ = _moving_point(geo, geo.moving["coupler"], q)
+        hr, hc = H - geo.fixed["rocker"], H - C
+        dH = _solve2(hr, hc, np.zeros(q.shape), _dot(hc, dC))
+        v = H - geo.fixed["base"]
+        s = np.sqrt(_dot(v, v))
+        return LengthRate(s, _dot(v, dH) / s, H, C)
+
+
 def _point(geo: ChainGeometry, role: str, q: Array) -> tuple[Array, Array, Array]:
     if role in geo.fixed:
         p = np.broadcast_to(geo.fixed[role], (*q.shape, 2))
@@ -214,7 +249,7 @@ def _linkage(geo: ChainGeometry, q: Array) -> Closure:
 def joint_to_stroke(machine: Machine, chain: Chain, q: ArrayLike) -> Array:
     """Actuator stroke x = s(q) - x0 at joint samples q [m]."""
     geo = chain_geometry(machine, chain)
-    return geometry_closure(geo, q).length - geo.x0
+    return length_and_rate(geo, q).length - geo.x0
 
 
 def joint_to_actuator(

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.machine.description import Chain, DecisionVariable, Machine
-from hiab_sim.machine.kinematics.closure import ChainGeometry, chain_geometry, geometry_closure, pin_position
+from hiab_sim.machine.kinematics.closure import ChainGeometry, chain_geometry, length_and_rate
 
 Array = NDArray[np.float64]
 
@@ -40,13 +40,14 @@ def stroke_design_partials(machine: Machine, chain: Chain, q: ArrayLike) -> tupl
     """(dx/dq, dx/dv) at joint samples q: dx/dv has shape (*q.shape, len(chain.variables))."""
     q = np.asarray(q, dtype=float)
     geo = chain_geometry(machine, chain)
-    c = geometry_closure(geo, q)
+    c = length_and_rate(geo, q)
     out = np.zeros((*q.shape, len(chain.variables)))
     driven = machine.joint_link(chain.joint).name
     angle = geo.phi + q
     cos, sin = np.cos(angle), np.sin(angle)
     if chain.kind == "linkage":
-        H, C, _, _ = pin_position(geo, q)
+        H, C = c.pin, c.coupler_pivot
+        assert H is not None and C is not None
         unit = (H - geo.fixed["base"]) / c.length[..., None]
         hr, hc = H - geo.fixed["rocker"], H - C
     elif chain.kind == "triangle":
