@@ -78,7 +78,7 @@ def task_sparsity(problem: TaskProblem) -> sparse.csr_matrix:
             rows.append(np.repeat(cols, per, axis=0))
         else:
             rows.append(np.ones((count, n_xi + n_joints * n_c), bool))
-    return sparse.csr_matrix(np.vstack(rows).astype(float))
+    return sparse.csr_matrix(np.vstack(rows)).astype(float)  # the 0/1 values after the pattern: no dense float copy
 
 
 def range_pairs(problem: TaskProblem) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
