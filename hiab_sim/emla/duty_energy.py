@@ -226,7 +226,7 @@ def drive_duty(
     tau = s * st.motor_torque
     d_tau = [s * d for d in st.d_motor_torque]
     d_tau[1] = d_tau[1] + ds * st.motor_torque
-    p_ref = electrical_power(params, f, v, a, exact)
+    p_ref = electrical_power(params, f, v, a, exact, state=st)
     hold = rest_hold(params, options.hold, float(f[0]), float(f[-1]), duty.cycle_time) if options.hold else None
     c_r = hold.rest_copper_loss_ref if hold is not None else 0.0
     hot = options.hot and params.winding is not None and params.thermal is not None
@@ -251,7 +251,7 @@ def drive_duty(
     tau_r = hold.rest_torque if hold is not None else 0.0
     rms = math.sqrt((float(w @ tau**2) + tau_r**2 * duty.rest_time) / duty.period) if params.thermal else math.nan
     peak = math.nan if winding is None else winding.peak
-    pf, pv, pa = electrical_power_partials(params, f, v, a)
+    pf, pv, pa = electrical_power_partials(params, f, v, a, state=None if exact else st)  # smooth partials
     return DriveDuty(
         power=power,
         reference_power=p_ref,
