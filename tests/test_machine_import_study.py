@@ -220,10 +220,15 @@ def test_the_imported_xs031_default_study_is_the_original_nlp(
     imported: dict[str, tuple[Path, list[float]]], tmp_path: Path
 ) -> None:
     """At a perturbed point, the imported file's default study has the original's cost, rows and cost gradient."""
+    _same_nlp(*_xs031_default_studies(imported, tmp_path))
+
+
+def _same_nlp(original: Path, mine: Path) -> None:
+    """Both study files' NLPs at a perturbed start: cost to 1e-10, rows to 1e-10 of the largest, gradient to 1e-8."""
     from hiab_sim.study.nlp.problem import StudyProblem
     from hiab_sim.study.spec.study_file import load_study
 
-    a, b = (StudyProblem(load_study(path)) for path in _xs031_default_studies(imported, tmp_path))
+    a, b = (StudyProblem(load_study(path)) for path in (original, mine))
     assert a.n == b.n and a.constraint_names == b.constraint_names
     z = a.initial_point(a.study.initial_lengths)
     z = z + 1e-3 * np.random.default_rng(3).standard_normal(len(z))
@@ -235,18 +240,28 @@ def test_the_imported_xs031_default_study_is_the_original_nlp(
     assert float(np.max(np.abs(b.cost_gradient(z) - grad_a))) < 1e-8 * float(np.max(np.abs(grad_a)))
 
 
-def _same_optimum(original: Path, mine: Path, folder: Path) -> tuple[Any, Any]:
+def _same_optimum(
+    original: Path,
+    mine: Path,
+    folder: Path,
+    xi_m: float = 1e-8,
+    energy: float = 1e-9,
+    net: float = 1e-9,
+    iterations: bool = True,
+) -> tuple[Any, Any]:
+    """Both studies solved: Xi within ``xi_m`` [m], battery and net energies within ``energy``, ``net`` (relative)."""
     from hiab_sim.study.run import run_study
     from hiab_sim.study.spec.study_file import load_study
 
     a = run_study(load_study(original), folder / "original", progress=None, figures=False).result
     b = run_study(load_study(mine), folder / "imported", progress=None, figures=False).result
+    assert a.solver.success and b.solver.success
     assert b.optimal.lengths.names == a.optimal.lengths.names
-    assert np.max(np.abs(b.optimal.lengths.as_array() - a.optimal.lengths.as_array())) < 1e-8
-    assert b.solver.iterations == a.solver.iterations
+    assert np.max(np.abs(b.optimal.lengths.as_array() - a.optimal.lengths.as_array())) < xi_m
+    assert b.solver.iterations == a.solver.iterations or not iterations
     assert a.energy is not None and b.energy is not None
-    assert b.energy.optimal.battery_energy_J == pytest.approx(a.energy.optimal.battery_energy_J, rel=1e-9)
-    assert b.optimal.net_electrical_energy_J == pytest.approx(a.optimal.net_electrical_energy_J, rel=1e-9)
+    assert b.energy.optimal.battery_energy_J == pytest.approx(a.energy.optimal.battery_energy_J, rel=energy)
+    assert b.optimal.net_electrical_energy_J == pytest.approx(a.optimal.net_electrical_energy_J, rel=net)
     return a, b
 
 
@@ -263,7 +278,14 @@ def test_the_imported_xs031_default_study_reaches_the_original_optimum(
 def test_the_imported_excavator_digging_study_reaches_the_original_optimum(
     imported: dict[str, tuple[Path, list[float]]], tmp_path: Path
 ) -> None:
-    """``optimize/exact_digging.yaml`` on the imported eXact file: the shipped file's optimum (minutes)."""
+    """``optimize/exact_digging.yaml`` on the imported eXact file: the original's NLP, and its optimum.
+
+    The two NLPs agree at a point to round-off; IPOPT's path then ends micrometres apart along the
+    bucket's base pin, the flat direction of this optimum (measured on 7 December 2026: 3.2e-6 m, the
+    battery energy, the objective, 1.2e-8 relative apart, the net electrical energy 2.9e-7; the
+    study's own three starts spread by 3.5e-5 m): Xi within the multistart's same-optimum tolerance
+    (1e-4 m), the objective within 1e-7 (IPOPT's stop: scaled NLP error 1e-8), the net energy 1e-5.
+    """
     text = (REPO / "optimize" / "exact_digging.yaml").read_text(encoding="utf-8")
     shutil.copy(REPO / "optimize" / "exact_digging_cycle.csv", tmp_path / "exact_digging_cycle.csv")
     adopted = adopt_original_variables(imported["exact"][0], "exact", tmp_path / "exact_adopted.yaml")
@@ -271,7 +293,8 @@ def test_the_imported_excavator_digging_study_reaches_the_original_optimum(
     original.write_text(text, encoding="utf-8")
     mine.write_text(text.replace("machine: exact ", f"machine: {adopted} "), encoding="utf-8")
     assert str(adopted) in mine.read_text(encoding="utf-8")
-    _same_optimum(original, mine, tmp_path)
+    _same_nlp(original, mine)
+    _same_optimum(original, mine, tmp_path, xi_m=1e-4, energy=1e-7, net=1e-5, iterations=False)
 
 
 @pytest.mark.e2e
