@@ -35,12 +35,10 @@ CRANE_MODEL = {
     "crane/mounting.py": "the crane file's mounting rows per chain (lift, tilt)",
     "crane/names.py": "the crane file's joint and actuator names, the one place the crane model defines them",
     "crane/to_machine.py": "converts the crane file into a machine description: maps its names to the file's",
-    "crane/tolerance.py": "the crane file's build tolerance per chain variable",
     "dynamics/analytic_id.py": "the crane file's closed-form inverse dynamics on its named bodies",
     "dynamics/analytic_kinematics.py": "the crane file's closed-form body kinematics",
     "dynamics/analytic_planar.py": "the crane file's planar closed-form dynamics on its named bodies",
     "model/mjcf.py": "builds the crane file's MJCF: bodies, joints and sites named after the crane",
-    "study/figures/design.py": "draws a crane file's design from the crane's closed-form frames",
     "docs_site/field_specs/crane.py": "documents the crane file's top-level telescope section, a key the loader reads",
 }
 #: (module, literal) pairs where the word has another meaning than the machine's name.

@@ -31,6 +31,7 @@ import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -223,7 +224,8 @@ def buildable_crane(
         lo, hi = chain.joint_range
         new = (max(lo, float(theta[0])), min(hi, float(theta[1])))
         chains[chain.name] = replace(chain, joint_range=new)
-    return replace(crane, lift=chains["lift"], tilt=chains["tilt"])
+    narrowed: dict[str, Any] = {chain.name: chains[chain.name] for chain in crane.chains}  # its fields are named so
+    return replace(crane, **narrowed)
 
 
 def range_cost_deg(crane: Crane, stroke_margin: float = DEFAULT_STROKE_MARGIN) -> dict[str, tuple[float, float]]:

@@ -12,14 +12,16 @@
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 from matplotlib.axes import Axes
 
-from hiab_sim.crane.description import Crane, LinkLengths
+from hiab_sim.crane.description import CHAIN_NAMES, Crane, LinkLengths
 from hiab_sim.crane.kinematics import forward_kinematics
+from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.results.analysis_sections import Sensitivity
 from hiab_sim.results.schema import HistoryRow
 from hiab_sim.study.report.summary import limit_in_words
@@ -46,7 +48,9 @@ def draw_crane(ax: Axes, crane: Crane, lengths: LinkLengths, joints: Array, colo
         ax.plot([a[0, 0], b[0, 0]], [a[0, 1], b[0, 1]], color=colour, alpha=alpha, **kw)
 
     origin = np.zeros((1, 3))
-    seg(origin, f.position["lift_boom"], linewidth=4)
+    # the booms in the crane's order (each chain's boom), then the telescope's cylinder and the TCP
+    booms = [f"{chain.name}_boom" for chain in crane.chains] + [f"{ACTUATOR_NAMES[-1]}_cylinder", "tcp"]
+    seg(origin, f.position[booms[0]], linewidth=4)
     for chain in crane.chains:
         xi = getattr(lengths, chain.name)
         base = f.position[f"{chain.name}_cylinder"]
@@ -55,16 +59,15 @@ def draw_crane(ax: Axes, crane: Crane, lengths: LinkLengths, joints: Array, colo
         seg(base, rod_end, linewidth=2, linestyle="-")
         seg(f.position[f"{chain.name}_boom"], rod_end, linewidth=3)
         ax.plot(*base[0, :2], "o", color=colour, alpha=alpha, markersize=5)
-    seg(f.position["lift_boom"], f.position["tilt_boom"], linewidth=4)
-    seg(f.position["tilt_boom"], f.position["telescope_cylinder"], linewidth=4)
-    seg(f.position["telescope_cylinder"], f.position["tcp"], linewidth=3)
+    for k, (a, b) in enumerate(itertools.pairwise(booms)):
+        seg(f.position[a], f.position[b], linewidth=3 if k == len(booms) - 2 else 4)
     ax.plot(*f.position["tcp"][0, :2], "s", color=colour, alpha=alpha, markersize=5)
 
 
 def _lengths_label(name: str, lengths: LinkLengths) -> str:
     return f"{name}: " + ",  ".join(
         f"{c} L {getattr(lengths, c).L:.3f} Lc0 {getattr(lengths, c).Lc0:.3f} Lc {getattr(lengths, c).Lc:.3f}"
-        for c in ("lift", "tilt")
+        for c in CHAIN_NAMES
     )
 
 
@@ -90,7 +93,7 @@ def structure_overlay(
         pivots[name] = {c.name: f.position[f"{c.name}_cylinder"][0, :2] for c in crane.chains}
     names = list(designs)
     if len(names) >= 2:
-        for chain in crane.chains:
+        for k, chain in enumerate(crane.chains):
             a, b = pivots[names[0]][chain.name], pivots[names[-1]][chain.name]
             shift = float(np.hypot(*(b - a)))
             ax.annotate(
@@ -102,7 +105,7 @@ def structure_overlay(
             ax.annotate(
                 f"{chain.name} base pivot\nmoves {shift * 1e3:.0f} mm",
                 xy=(0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])),
-                xytext=(40, 60) if chain.name == "lift" else (60, -60),  # right of the pivot: inside the axes
+                xytext=(40, 60) if k == 0 else (60, -60),  # right of the pivot: inside the axes
                 textcoords="offset points",
                 fontsize=8,
                 arrowprops={"arrowstyle": "-", "color": "0.5", "linewidth": 0.6},
