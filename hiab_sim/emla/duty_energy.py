@@ -40,7 +40,7 @@ from hiab_sim.emla.drive import Array, broadcast_inputs, drive_state
 from hiab_sim.emla.electrothermal import CoupledWinding, coupled_winding_temperature
 from hiab_sim.emla.hold import HOLD_MODES, RestHold, rest_hold
 from hiab_sim.emla.losses import brake_release
-from hiab_sim.emla.model import electrical_power, electrical_power_partials
+from hiab_sim.emla.model import electrical_power_partials, state_power, state_power_partials
 from hiab_sim.emla.thermal import Duty, cycle_time_grid
 
 
@@ -226,7 +226,7 @@ def drive_duty(
     tau = s * st.motor_torque
     d_tau = [s * d for d in st.d_motor_torque]
     d_tau[1] = d_tau[1] + ds * st.motor_torque
-    p_ref = electrical_power(params, f, v, a, exact, state=st)
+    p_ref = state_power(params, st, v, exact)
     hold = rest_hold(params, options.hold, float(f[0]), float(f[-1]), duty.cycle_time) if options.hold else None
     c_r = hold.rest_copper_loss_ref if hold is not None else 0.0
     hot = options.hot and params.winding is not None and params.thermal is not None
@@ -251,7 +251,7 @@ def drive_duty(
     tau_r = hold.rest_torque if hold is not None else 0.0
     rms = math.sqrt((float(w @ tau**2) + tau_r**2 * duty.rest_time) / duty.period) if params.thermal else math.nan
     peak = math.nan if winding is None else winding.peak
-    pf, pv, pa = electrical_power_partials(params, f, v, a, state=None if exact else st)  # smooth partials
+    pf, pv, pa = electrical_power_partials(params, f, v, a) if exact else state_power_partials(params, st, v)
     return DriveDuty(
         power=power,
         reference_power=p_ref,

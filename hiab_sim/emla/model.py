@@ -141,40 +141,39 @@ def _power(params: EmlaParams, s: DriveState, v: Array, exact: bool) -> tuple[Ar
 
 
 def electrical_power(
-    params: EmlaParams,
-    force: ArrayLike,
-    velocity: ArrayLike,
-    acceleration: ArrayLike,
-    exact: bool = False,
-    state: DriveState | None = None,
+    params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike, exact: bool = False
 ) -> Array:
     """Return P_elec [W] at load force [N], velocity [m/s], acceleration [m/s^2].
 
     With the drive-loss options off this is 3/2 (V_d i_d + V_q i_q), which replaces f_x v_x / eta_EMLA
     in the seed's cost (eq. ``costf2``): equal where eta is defined, finite where it is not (holding
-    a load at v_x = 0 costs copper losses unless a holding brake is modelled). ``state``: the drive
-    state at these samples with this ``exact``, when the caller has it already.
+    a load at v_x = 0 costs copper losses unless a holding brake is modelled).
     """
-    s = drive_state(params, force, velocity, acceleration, exact) if state is None else state
+    s = drive_state(params, force, velocity, acceleration, exact)
     v = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (force, velocity, acceleration)))[1]
-    return _power(params, s, v, exact)[0]
+    return state_power(params, s, v, exact)
+
+
+def state_power(params: EmlaParams, state: DriveState, velocity: Array, exact: bool = False) -> Array:
+    """P_elec [W] of :func:`electrical_power` from the drive state at these samples (computed with ``exact``)."""
+    return _power(params, state, velocity, exact)[0]
 
 
 def electrical_power_partials(
-    params: EmlaParams,
-    force: ArrayLike,
-    velocity: ArrayLike,
-    acceleration: ArrayLike,
-    state: DriveState | None = None,
+    params: EmlaParams, force: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
 ) -> tuple[Array, Array, Array]:
     """Return the analytic partials (dP/df_x [m/s], dP/dv_x [N], dP/da_x [kg m/s]) of the smooth P_elec.
 
     With i_d = 0, P_motor = 3/2 V_q i_q, so dP_motor = 3/2 (dV_q i_q + V_q di_q); the brake factor
     s(v_x) and the inverter loss P_inverter(s i_q) add their chain-rule terms (zero when off).
-    ``state``: the smooth model's drive state at these samples, when the caller has it already.
     """
-    s = drive_state(params, force, velocity, acceleration) if state is None else state
+    s = drive_state(params, force, velocity, acceleration)
     v = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (force, velocity, acceleration)))[1]
+    return state_power_partials(params, s, v)
+
+
+def state_power_partials(params: EmlaParams, s: DriveState, v: Array) -> tuple[Array, Array, Array]:
+    """The partials of :func:`electrical_power_partials` from the smooth model's drive state at these samples."""
     losses = params.losses
     release, d_release = brake_release(losses, v, exact=False)
     p_motor = 1.5 * (s.v_d * s.i_d + s.v_q * s.i_q)
