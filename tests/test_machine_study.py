@@ -233,3 +233,42 @@ def test_default_study_on_the_machine_file_reaches_the_crane_files_optimum(tmp_p
     assert crane.energy is not None and machine.energy is not None
     assert machine.energy.optimal.battery_energy_J == pytest.approx(crane.energy.optimal.battery_energy_J, rel=1e-9)
     assert machine.optimal.net_electrical_energy_J == pytest.approx(crane.optimal.net_electrical_energy_J, rel=1e-9)
+
+
+def _excavator_with_catalogue(folder: Path, catalogue: dict) -> Path:
+    """The small excavator study with ``transmission:`` (its move written next to it)."""
+    joint_csv(folder / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
+    path = folder / "study.yaml"
+    path.write_text(yaml.safe_dump({**EXCAVATOR_STUDY, "transmission": catalogue}), encoding="utf-8")
+    return path
+
+
+def test_a_machine_studys_transmission_catalogue_is_keyed_by_its_actuators(tmp_path: Path) -> None:
+    """The catalogue takes the machine file's actuator names; a crane's name there is one line naming them."""
+    from hiab_sim.machine.loader import load_machine
+
+    first = load_machine("exact").actuator_names[0]
+    study = load_study(_excavator_with_catalogue(tmp_path, {first: [{"gear_ratio": 4.0, "screw_lead": 0.005}]}))
+    assert study.energy.transmission is not None
+    assert [name for name, _ in study.energy.transmission.options] == [first]
+    with pytest.raises(ConfigError, match=rf"transmission: unknown key\(s\) \['lift'\].*{first}"):
+        load_study(_excavator_with_catalogue(tmp_path, {"lift": [{"gear_ratio": 4.0, "screw_lead": 0.005}]}))
+
+
+@pytest.mark.e2e
+def test_codesign_runs_on_a_machine_file_and_keeps_the_lowest_battery_energy(tmp_path: Path) -> None:
+    """Mounting optimised per transmission of one excavator EMLA: the file's own first, the best the cheapest."""
+    from hiab_sim.machine.loader import load_machine
+    from hiab_sim.study.run import run_study
+
+    first = load_machine("exact").actuator_names[0]
+    catalogue = {first: [{"gear_ratio": 3.0, "screw_lead": 0.01}, {"gear_ratio": 5.0, "screw_lead": 0.01}]}
+    result = run_study(
+        load_study(_excavator_with_catalogue(tmp_path, catalogue)), tmp_path / "run", progress=None, figures=False
+    ).result
+    codesign = result.codesign
+    assert codesign is not None and len(codesign.rows) == 3 and codesign.reference == 0
+    assert [r.transmission[first].gear_ratio for r in codesign.rows[1:]] == [3.0, 5.0]
+    feasible = [r.battery_energy_J for r in codesign.rows if r.status == "converged" and r.battery_energy_J is not None]
+    assert len(feasible) >= 2 and codesign.rows[codesign.best].battery_energy_J == min(feasible)
+    assert codesign.codesign_battery_energy_J <= codesign.mounting_only_battery_energy_J

@@ -99,6 +99,8 @@ def _study_documents() -> list[Any]:
     of times; a CSV reference's fit there takes :data:`_PROBE_FIT_POINTS` control points (its default
     by duration costs seconds per load; the shipped digging cycle passes its fit tolerance with these).
     """
+    from hiab_sim.machine.loader import load_machine
+
     names = sorted(shipped_names("study"))
     out = []
     for name in names:
@@ -115,6 +117,9 @@ def _study_documents() -> list[Any]:
                 single.update({k: task[k] for k in ("payload",) if k in task})
                 single["spline"] = {**single.get("spline", {}), **{"control_points": task["control_points"]}}
                 out.append(single)
+                # and with a transmission catalogue for its first actuator (the probe reaches the machine form's)
+                first = load_machine(str(document["machine"])).actuator_names[0]
+                out.append({**single, "transmission": {first: [{"gear_ratio": 5.0, "screw_lead": 0.01}]}})
     return out
 
 

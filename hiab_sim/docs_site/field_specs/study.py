@@ -249,13 +249,29 @@ def study_keys() -> list[Key]:
                 "description": "What carries the machine during the rest.",
             },
         ),
-        section("transmission", "Catalogue of (gear ratio, screw lead) options per actuator: co-design.", "none"),
+        *in_form(
+            "crane",
+            [section("transmission", "Catalogue of (gear ratio, screw lead) options per actuator: co-design.", "none")],
+        ),
+        names(
+            "transmission",
+            "Actuator (a chain of the machine file, by name) -> its (gear ratio, screw lead) options: co-design.",
+            "mapping",
+            form="machine",
+            default="none",
+        ),
     ]
-    for name in ACTUATOR_NAMES:
-        rows += [
-            Key(f"transmission.{name}", type="list", default="the EMLA file's", description=f"Options for {name}."),
-            section(f"transmission.{name}[]", "One option."),
-            number(f"transmission.{name}[].gear_ratio", "", "Gearbox ratio G.", allowed="> 1"),
-            number(f"transmission.{name}[].screw_lead", "m", "Screw lead.", allowed="> 0"),
-        ]
+    for name, form, description in (
+        *((name, "crane", f"Options for {name}.") for name in ACTUATOR_NAMES),
+        ("<actuator>", "machine", "Options for one actuator (a chain of the machine file, by its name)."),
+    ):
+        rows += in_form(
+            form,
+            [
+                Key(f"transmission.{name}", type="list", default="the EMLA file's", description=description),
+                section(f"transmission.{name}[]", "One option."),
+                number(f"transmission.{name}[].gear_ratio", "", "Gearbox ratio G.", allowed="> 1"),
+                number(f"transmission.{name}[].screw_lead", "m", "Screw lead.", allowed="> 0"),
+            ],
+        )
     return rows

@@ -14,8 +14,9 @@ Three optional top-level keys of a study file, each validated here into a frozen
   during the rest (:mod:`hiab_sim.emla.hold`); with a duty, the energy and the thermal rows use R_s
   at the winding temperature of EMLAs with ``winding_resistance`` data
   (:mod:`hiab_sim.emla.duty_energy`).
-* ``transmission: {lift: [{gear_ratio: G, screw_lead: rho}, ...], tilt: [...], ...}``: a catalogue
-  of discrete (G, rho) options per actuator; actuators not listed keep the EMLA file's. The
+* ``transmission: {<actuator>: [{gear_ratio: G, screw_lead: rho}, ...], ...}``: a catalogue of
+  discrete (G, rho) options per actuator, keyed by the study's actuator names (a crane file's lift,
+  tilt, telescope; a machine file's chains); actuators not listed keep the EMLA file's. The
   co-design (:mod:`hiab_sim.study.analysis.codesign`) optimises the mounting for every combination.
 """
 
@@ -129,16 +130,21 @@ class TransmissionOption:
 
 @dataclass(frozen=True)
 class TransmissionCatalogue:
-    """Discrete transmission options per actuator, as ((actuator, (option, ...)), ...), each non-empty."""
+    """Discrete transmission options per actuator, as ((actuator, (option, ...)), ...), each non-empty.
+
+    ``actuators``: the study's actuator names the keys must be among (a crane file's, or a machine
+    file's chains).
+    """
 
     options: tuple[tuple[str, tuple[TransmissionOption, ...]], ...]
+    actuators: tuple[str, ...] = ACTUATOR_NAMES
 
     def __post_init__(self) -> None:
         if not self.options:
-            raise InvalidInputError("transmission", "{}", f"must list options for at least one of {ACTUATOR_NAMES}")
+            raise InvalidInputError("transmission", "{}", f"must list options for at least one of {self.actuators}")
         for name, opts in self.options:
-            if name not in ACTUATOR_NAMES:
-                raise InvalidInputError("transmission", name, f"keys must be among {', '.join(ACTUATOR_NAMES)}")
+            if name not in self.actuators:
+                raise InvalidInputError("transmission", name, f"keys must be among {', '.join(self.actuators)}")
             if not opts:
                 raise InvalidInputError(f"transmission.{name}", "[]", "must list at least one {gear_ratio, screw_lead}")
 
@@ -166,8 +172,8 @@ class EnergySettings:
 ENERGY_KEYS = {"objective", "duty", "transmission"}
 
 
-def energy_settings(top: Any) -> EnergySettings:
-    """Read ``objective``, ``duty`` and ``transmission`` from a study's top-level mapping."""
+def energy_settings(top: Any, actuators: tuple[str, ...] = ACTUATOR_NAMES) -> EnergySettings:
+    """Read ``objective``, ``duty`` and ``transmission`` (keyed by ``actuators``) from a study's top-level mapping."""
     objective = top.get("objective", "costf2")  # EnergySettings checks it against the objective registry
     duty = None
     if top.get("duty") is not None:
@@ -180,16 +186,16 @@ def energy_settings(top: Any) -> EnergySettings:
         raise InvalidInputError("duty", None, f"give exactly one of {_ONE_OF}")
     transmission = None
     if "transmission" in top:
-        transmission = _catalogue(top["transmission"])
+        transmission = _catalogue(top["transmission"], actuators)
     return EnergySettings(objective, duty, transmission)
 
 
-def _catalogue(data: Any) -> TransmissionCatalogue:
+def _catalogue(data: Any, actuators: tuple[str, ...]) -> TransmissionCatalogue:
     if data is None:
-        raise InvalidInputError("transmission", None, f"must list options for at least one of {ACTUATOR_NAMES}")
-    d = mapping(data, "transmission", set(ACTUATOR_NAMES), set())
+        raise InvalidInputError("transmission", None, f"must list options for at least one of {actuators}")
+    d = mapping(data, "transmission", set(actuators), set())
     options = []
-    for name in ACTUATOR_NAMES:
+    for name in actuators:
         if name not in d:
             continue
         items = d[name]
@@ -207,4 +213,4 @@ def _catalogue(data: Any) -> TransmissionCatalogue:
                 )
             )
         options.append((name, tuple(opts)))
-    return TransmissionCatalogue(tuple(options))
+    return TransmissionCatalogue(tuple(options), actuators)

@@ -16,6 +16,7 @@ import numpy as np
 
 from hiab_sim.checks import check_choice, check_range
 from hiab_sim.crane.description import CHAIN_NAMES
+from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.resources import Source, recorded_path
 from hiab_sim.study.references.csv_file import ColumnNames
@@ -235,14 +236,17 @@ def bounds_from_mapping(data: Any, chains: bool = True, joints: int = 3) -> Boun
     return Bounds(**values)
 
 
-def shared_sections(top: Mapping[str, Any]) -> dict[str, Any]:
-    """The sections a crane file's and a machine file's study read alike: spline, tracking, solver, build, energy."""
+def shared_sections(top: Mapping[str, Any], actuators: tuple[str, ...] = ACTUATOR_NAMES) -> dict[str, Any]:
+    """The sections a crane file's and a machine file's study read alike: spline, tracking, solver, build, energy.
+
+    ``actuators``: the study's actuator names (the keys of the energy section's transmission catalogue).
+    """
     return {
         "spline": SplineSettings(**section(SplineSettings, top.get("spline"), "spline")),
         "tracking": Tracking(**section(Tracking, top.get("tracking"), "tracking")),
         "solver": SolverSettings(**section(SolverSettings, top.get("solver"), "solver")),
         "build": BuildSettings.from_mapping(top.get("build")),
-        "energy": energy_settings(top),
+        "energy": energy_settings(top, actuators),
     }
 
 
