@@ -11,8 +11,8 @@ from hiab_sim.errors import HiabSimError, InvalidInputError
 from hiab_sim.study.nlp.id_partials import id_length_partials
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import XI_SCALE
-from hiab_sim.study.solvers.ipopt import SparseJacobian, range_pairs, task_rows, task_z
 from hiab_sim.study.solvers.slsqp import solve
+from hiab_sim.study.solvers.sparse_rows import SparseJacobian, range_pairs, task_rows, task_z
 from hiab_sim.study.spec.study_file import study_from_dict
 
 

@@ -12,7 +12,7 @@ from test_study_small import small_study
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.run import run_study
-from hiab_sim.study.solvers.ipopt import SparseJacobian, task_rows
+from hiab_sim.study.solvers.sparse_rows import SparseJacobian, task_rows
 from hiab_sim.study.spec.payload import Payload
 from hiab_sim.study.spec.study_file import Study, study_from_dict
 
