@@ -172,10 +172,7 @@ def length_and_rate(geo: ChainGeometry, q: ArrayLike) -> LengthRate:
         s = np.sqrt(_dot(v, v))
         return LengthRate(s, _dot(v, dv) / s)
     with np.errstate(divide="ignore", invalid="ignore"):  # as geometry_closure's four-bar
-        H, C, _, _ = pin_position(geo, q)
-        _, dC, _ = _moving_point(geo, geo.moving["coupler"], q)
-        hr, hc = H - geo.fixed["rocker"], H - C
-        dH = _solve2(hr, hc, np.zeros(q.shape), _dot(hc, dC))
+        H, C, _, _, _, _, dH, _ = _pin_and_rate(geo, q)
         v = H - geo.fixed["base"]
         s = np.sqrt(_dot(v, v))
         return LengthRate(s, _dot(v, dH) / s, H, C)
@@ -220,12 +217,20 @@ def _solve2(rows_a: Array, rows_b: Array, rhs_a: Array, rhs_b: Array) -> Array:
     return np.stack([x, y], axis=-1)
 
 
-def _linkage(geo: ChainGeometry, q: Array) -> Closure:
-    r, b = geo.fixed["rocker"], geo.fixed["base"]
+def _pin_and_rate(
+    geo: ChainGeometry, q: Array
+) -> tuple[Array, Array, Array, Array, Array, Array, Array, NDArray[np.bool_]]:
+    """A four-bar's pin H, coupler pivot C, C', C'', H - r, H - C and H' at q, and where it closes."""
     H, C, _, closes = pin_position(geo, q)
     _, dC, ddC = _moving_point(geo, geo.moving["coupler"], q)
-    hr, hc = H - r, H - C
+    hr, hc = H - geo.fixed["rocker"], H - C
     dH = _solve2(hr, hc, np.zeros(q.shape), _dot(hc, dC))
+    return H, C, dC, ddC, hr, hc, dH, closes
+
+
+def _linkage(geo: ChainGeometry, q: Array) -> Closure:
+    b = geo.fixed["base"]
+    H, C, dC, ddC, hr, hc, dH, closes = _pin_and_rate(geo, q)
     ddH = _solve2(hr, hc, -_dot(dH, dH), _dot(hc, ddC) - _dot(dH - dC, dH - dC))
     s, ds, dds, a_cyl, da_cyl, dda_cyl = _direction(H - b, dH, ddH)
     _, _, _, a_r, da_r, dda_r = _direction(hr, dH, ddH)
