@@ -32,6 +32,14 @@ def test_a_key_the_loader_rejects_or_an_undocumented_key_is_caught(monkeypatch: 
     assert any("'substeps'" in line and "rejects" in line for line in found)
 
 
+def test_a_fixed_key_beside_names_is_checked_against_the_loader(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Under the machine form's ``mounting`` (actuator names, two settings) a setting the loader rejects is caught."""
+    rows = KEYS["study"]()
+    monkeypatch.setitem(KEYS, "study", lambda: [*rows, Key("mounting.margin", type="number", form="machine")])
+    found = discrepancies("study")
+    assert found == ["study (machine form): mounting: names from another file; the loader rejects 'margin'"], found
+
+
 def test_a_key_documented_for_the_wrong_form_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:
     """`tracked` documented for the crane form only: the machine form's documents hold it and load, so it is reported.
 

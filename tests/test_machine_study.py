@@ -164,8 +164,8 @@ def test_machine_study_refuses_what_it_cannot_take_with_one_line(tmp_path: Path)
             },
             tmp_path / "s.yaml",
         )
-    with pytest.raises(ConfigError, match="'mounting' is not available for a machine file"):
-        study_from_dict({**base, "mounting": {}}, tmp_path / "s.yaml")
+    with pytest.raises(ConfigError, match="'crane' and 'machine' name the same thing"):
+        study_from_dict({**base, "crane": "xs031"}, tmp_path / "s.yaml")
     with pytest.raises(ConfigError, match="names its EMLA file"):
         study_from_dict({k: v for k, v in base.items() if k != "emla"}, tmp_path / "s.yaml")
     with pytest.raises(ConfigError, match=r"bounds\.joint_velocity: expected a list of 3"):

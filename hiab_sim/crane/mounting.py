@@ -46,46 +46,31 @@ stop the pivot from moving past the base's foot or along the lift boom onto anot
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from hiab_sim.crane.description import CHAIN_NAMES, ClosedChain, Crane, LinkLengths
-from hiab_sim.errors import ConfigError, InvalidInputError
-from hiab_sim.yaml_fields import mapping, number, positive
-
-Array = NDArray[np.float64]
-Polygon = tuple[tuple[float, float], ...]
+from hiab_sim.machine.mounting_geometry import (
+    DEFAULT_CLEARANCE,
+    DEFAULT_SAMPLES,
+    Array,
+    Margins,
+    Polygon,
+    check_clearance_and_samples,
+    check_polygon,
+    edge_rows,
+    margins,
+    point_distance,
+    polyline_distance,
+    read_polygon,
+    read_samples,
+)
+from hiab_sim.yaml_fields import mapping, positive
 
 #: Index of each chain's L in Xi = [L, Lc0, Lc (lift), L, Lc0, Lc (tilt)].
 L_INDEX = {"lift": 0, "tilt": 3}
-#: Default centre-to-centre clearance of two pins [m]: two 25 mm pin eyes (our assumption).
-DEFAULT_CLEARANCE = 0.05
-#: Default number of joint samples over the working range for the boom clearance.
-DEFAULT_SAMPLES = 91
-
-
-def _check_polygon(field: str, vertices: Polygon) -> None:
-    """Raise unless ``vertices`` is a strictly convex, counter-clockwise polygon of finite points."""
-    if len(vertices) < 3:
-        raise InvalidInputError(field, len(vertices), "a polygon needs at least 3 vertices")
-    v = np.asarray(vertices, dtype=float)
-    if v.shape != (len(vertices), 2) or not np.all(np.isfinite(v)):
-        raise InvalidInputError(field, str(vertices), "vertices must be finite (x, y) pairs", "m")
-    edges = np.roll(v, -1, axis=0) - v
-    if np.any(np.hypot(edges[:, 0], edges[:, 1]) <= 1e-9):
-        raise InvalidInputError(field, str(vertices), "consecutive vertices must differ", "m")
-    turns = edges[:, 0] * np.roll(edges, -1, axis=0)[:, 1] - edges[:, 1] * np.roll(edges, -1, axis=0)[:, 0]
-    if np.all(turns < 0.0):
-        raise InvalidInputError(field, "clockwise", "vertices must be listed counter-clockwise", "m")
-    if not np.all(turns > 0.0):
-        raise InvalidInputError(field, str(vertices), "the polygon must be strictly convex (no reflex or flat vertex)")
-    winding = np.sum(np.arctan2(turns, np.sum(edges * np.roll(edges, -1, axis=0), axis=1)))
-    if not math.isclose(float(winding), 2.0 * math.pi, abs_tol=1e-6):
-        raise InvalidInputError(field, str(vertices), "the polygon must not cross itself (winds more than once)")
 
 
 @dataclass(frozen=True)
@@ -111,11 +96,8 @@ class MountingSpace:
         for name in CHAIN_NAMES:
             polygon = getattr(self, name)
             if polygon is not None:
-                _check_polygon(f"mounting.{name}", polygon)
-        if not (math.isfinite(self.clearance) and self.clearance > 0.0):
-            raise InvalidInputError("mounting.clearance", self.clearance, "must be a finite distance > 0", "m")
-        if isinstance(self.samples, bool) or not isinstance(self.samples, int) or self.samples < 2:
-            raise InvalidInputError("mounting.samples", self.samples, "must be an integer >= 2")
+                check_polygon(f"mounting.{name}", polygon)
+        check_clearance_and_samples("mounting", self.clearance, self.samples)
 
     def polygon(self, chain: str) -> Polygon | None:
         """The polygon of a chain's base pivot (``lift`` or ``tilt``), or None."""
@@ -133,25 +115,10 @@ class MountingSpace:
               clearance: 0.05                                                              # m
         """
         node = mapping(data, where, {"lift", "tilt", "clearance", "samples"}, required=set())
-        polygons = {name: _polygon(node.get(name), f"{where}.{name}") for name in CHAIN_NAMES}
+        polygons = {name: read_polygon(node.get(name), f"{where}.{name}") for name in CHAIN_NAMES}
         clearance = positive(node.get("clearance", DEFAULT_CLEARANCE), f"{where}.clearance", "m")
-        samples = node.get("samples", DEFAULT_SAMPLES)
-        if isinstance(samples, bool) or not isinstance(samples, int):
-            raise ConfigError(f"{where}.samples: expected an integer, got {samples!r}")
+        samples = read_samples(node.get("samples"), f"{where}.samples")
         return cls(lift=polygons["lift"], tilt=polygons["tilt"], clearance=clearance, samples=samples)
-
-
-def _polygon(data: Any, where: str) -> Polygon | None:
-    if data is None:
-        return None
-    if not isinstance(data, list | tuple):
-        raise ConfigError(f"{where}: expected a list of [x, y] vertices, got {data!r}")
-    out = []
-    for i, vertex in enumerate(data):
-        if not isinstance(vertex, list | tuple) or len(vertex) != 2:
-            raise ConfigError(f"{where}[{i}]: expected [x, y], got {vertex!r}")
-        out.append((number(vertex[0], f"{where}[{i}][0]"), number(vertex[1], f"{where}[{i}][1]")))
-    return tuple(out)
 
 
 def built_space(crane: Crane, along: float = 0.10, across: float = 0.05) -> MountingSpace:
@@ -168,22 +135,6 @@ def built_space(crane: Crane, along: float = 0.10, across: float = 0.05) -> Moun
         corners = [centre + sa * along * a + sn * across * n for sa, sn in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
         polygons[chain.name] = tuple((float(c[0]), float(c[1])) for c in corners)
     return MountingSpace(lift=polygons["lift"], tilt=polygons["tilt"])
-
-
-@dataclass(frozen=True)
-class Margins:
-    """Constraint rows g(Xi) >= 0 with their names and exact Jacobian dg/dXi ((m, 6), [m/m])."""
-
-    names: tuple[str, ...]
-    values: Array
-    jacobian: Array
-
-    def worst(self) -> tuple[str, float]:
-        """The smallest margin and its name [m] (``("none", inf)`` when there are no rows)."""
-        if not self.names:
-            return "none", math.inf
-        k = int(np.argmin(self.values))
-        return self.names[k], float(self.values[k])
 
 
 def base_pivot(chain: ClosedChain, lengths: LinkLengths) -> tuple[Array, Array]:
@@ -240,14 +191,11 @@ def polygon_margins(space: MountingSpace, crane: Crane, lengths: LinkLengths) ->
         if polygon is None:
             continue
         p, dp = base_pivot(chain, lengths)
-        v = np.asarray(polygon)
-        for i in range(len(v)):
-            edge = v[(i + 1) % len(v)] - v[i]
-            normal = np.array([-edge[1], edge[0]]) / np.hypot(edge[0], edge[1])
-            names.append(f"mounting.{chain.name} base pivot inside edge {i}")
-            values.append(float(normal @ (p - v[i])))
-            rows.append(normal @ dp)
-    return _margins(names, values, rows)
+        edge_values, edge_jacobian = edge_rows(polygon, p, dp)
+        names += [f"mounting.{chain.name} base pivot inside edge {i}" for i in range(len(polygon))]
+        values += edge_values
+        rows += edge_jacobian
+    return margins(names, values, rows, 6)
 
 
 def clearance_margins(space: MountingSpace, crane: Crane, lengths: LinkLengths) -> Margins:
@@ -258,46 +206,23 @@ def clearance_margins(space: MountingSpace, crane: Crane, lengths: LinkLengths) 
     for chain in crane.chains:
         p, dp = base_pivot(chain, lengths)
         for label, pin in parent_pins(crane, chain).items():
-            d, grad = _distance(p, pin)
+            d, grad = point_distance(p, pin)
             names.append(f"mounting.{chain.name} base pivot clear of the {label}")
             values.append(d - space.clearance)
             rows.append(grad @ dp)
         theta = np.linspace(*chain.joint_range, space.samples)
         line = _boom_points(chain, theta, boom_centre_line(crane, chain))  # (S, P, 2)
-        d, grad = _distance_to_polylines(p, line)
+        d, grad, _, _ = polyline_distance(p, line)
         names.append(f"mounting.{chain.name} base pivot clear of the {chain.name} boom over its working range")
         values.append(d - space.clearance)
         rows.append(grad @ dp)
-    return _margins(names, values, rows)
+    return margins(names, values, rows, 6)
 
 
 def mounting_margins(space: MountingSpace, crane: Crane, lengths: LinkLengths) -> Margins:
     """All mounting rows: the polygons (if given) then the clearances."""
     a, b = polygon_margins(space, crane, lengths), clearance_margins(space, crane, lengths)
     return Margins(a.names + b.names, np.concatenate([a.values, b.values]), np.vstack([a.jacobian, b.jacobian]))
-
-
-def _distance(p: Array, c: Array) -> tuple[float, Array]:
-    """|p - c| [m] and its gradient w.r.t. p."""
-    delta = p - c
-    d = float(np.hypot(delta[0], delta[1]))
-    return d, delta / d
-
-
-def _distance_to_polylines(p: Array, lines: Array) -> tuple[float, Array]:
-    """Smallest distance [m] from p to the segments of polylines (S, P, 2) and its gradient w.r.t. p."""
-    a, b = lines[:, :-1, :], lines[:, 1:, :]
-    ab = b - a
-    t = np.clip(np.einsum("spk,spk->sp", p - a, ab) / np.einsum("spk,spk->sp", ab, ab), 0.0, 1.0)
-    closest = a + t[..., None] * ab
-    delta = p - closest
-    d = np.hypot(delta[..., 0], delta[..., 1])
-    k = np.unravel_index(int(np.argmin(d)), d.shape)
-    return float(d[k]), delta[k] / d[k]
-
-
-def _margins(names: list[str], values: list[float], rows: list[Array]) -> Margins:
-    return Margins(tuple(names), np.asarray(values, dtype=float), np.asarray(rows, dtype=float).reshape(len(rows), 6))
 
 
 __all__ = [

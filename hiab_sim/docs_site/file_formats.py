@@ -87,9 +87,14 @@ def _compare(fmt: FileFormat, keys: list[Key], form: Form | None) -> list[str]:
             out.append(f"{label}: {where}: the loader accepts any key here; document it as free")
             continue
         if kind == "names":  # names another file defines: the loader checks them; the reference names none
-            # (it may describe every entry under a placeholder such as <actuator>, probed with a document's first)
+            # (it may describe every entry under a placeholder such as <actuator>, probed with a document's first,
+            # and fixed keys beside the names, e.g. a setting, which the loader must accept)
             named = [k for k in documented if not (k.startswith("<") and k.endswith(">"))]
-            out += [f"{label}: {where}: names from another file; the reference documents {k!r}" for k in named]
+            out += [
+                f"{label}: {where}: names from another file; the loader rejects {k!r}"
+                for k in named
+                if k not in accepted
+            ]
             continue
         for key in sorted(accepted - documented):
             if form is not None and (path, key) in elsewhere and _refused(fmt, form, key, path, documents):

@@ -100,6 +100,7 @@ def _study_documents() -> list[Any]:
     by duration costs seconds per load; the shipped digging cycle passes its fit tolerance with these).
     """
     from hiab_sim.machine.loader import load_machine
+    from hiab_sim.machine.mounting import moved_pivots
 
     names = sorted(shipped_names("study"))
     out = []
@@ -117,9 +118,13 @@ def _study_documents() -> list[Any]:
                 single.update({k: task[k] for k in ("payload",) if k in task})
                 single["spline"] = {**single.get("spline", {}), **{"control_points": task["control_points"]}}
                 out.append(single)
-                # and with a transmission catalogue for its first actuator (the probe reaches the machine form's)
-                first = load_machine(str(document["machine"])).actuator_names[0]
+                # and with a transmission catalogue for its first actuator and a polygon on its first moved
+                # pivot (the probe reaches the machine form's entries of both)
+                machine = load_machine(str(document["machine"]))
+                first = machine.actuator_names[0]
                 out.append({**single, "transmission": {first: [{"gear_ratio": 5.0, "screw_lead": 0.01}]}})
+                chain, role = moved_pivots(machine)[0]
+                out.append({**single, "mounting": {chain: {role: [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]}}})
     return out
 
 

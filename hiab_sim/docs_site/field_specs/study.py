@@ -52,7 +52,7 @@ def _mounting_keys() -> list[Key]:
         number(
             "mounting.clearance",
             "m",
-            "Centre-to-centre clearance from other pins and the swept boom.",
+            "Centre-to-centre clearance from other pins and the swept boom (machine form: the swept link).",
             allowed="> 0",
             default="0.05",
         ),
@@ -61,7 +61,41 @@ def _mounting_keys() -> list[Key]:
             type="integer",
             default="(built in)",
             allowed=">= 2",
-            description="Joint samples over the working range for the boom clearance.",
+            description="Joint samples over the working range for the boom (link) clearance.",
+        ),
+    ]
+
+
+def _machine_mounting_keys() -> list[Key]:
+    """A machine file's study's ``mounting`` (:meth:`hiab_sim.machine.mounting.MachineMountingSpace.from_mapping`)."""
+    return [
+        names(
+            "mounting",
+            "Actuator (a chain of the machine file) -> polygons of its pivots; a pin clearance and samples.",
+            "mapping",
+            form="machine",
+            default="none",
+        ),
+        *in_form(
+            "machine",
+            [
+                names(
+                    "mounting.<actuator>",
+                    "Pivot role of that chain (a triangle's `base`, `end`; a linkage's `base`, `rocker`, `coupler`) "
+                    "-> polygon.",
+                    "mapping",
+                    default="none",
+                ),
+                Key(
+                    "mounting.<actuator>.<pivot>",
+                    type="list of [x, y]",
+                    unit="m",
+                    default="none",
+                    description="Convex counter-clockwise polygon of a pivot a decision variable moves, in its "
+                    "link's frame.",
+                ),
+                *_mounting_keys()[-2:],
+            ],
         ),
     ]
 
@@ -224,7 +258,7 @@ def study_keys() -> list[Key]:
         section("build", "Manufacturing tolerance and stroke margin.", "defaults"),
         *from_class("build", BuildSettings),
     ]
-    rows += in_form("crane", _mounting_keys())
+    rows += in_form("crane", _mounting_keys()) + _machine_mounting_keys()
     rows += [
         text(
             "objective",

@@ -25,7 +25,7 @@ from hiab_sim.machine.kinematics.closure import ChainGeometry, chain_geometry, l
 Array = NDArray[np.float64]
 
 
-def _direction(machine: Machine, chain: Chain, variable: DecisionVariable) -> Array:
+def pivot_direction(machine: Machine, chain: Chain, variable: DecisionVariable) -> Array:
     """Unit motion of the pivot per unit of the variable, in the pivot's link frame (x, y)."""
     if variable.kind == "pivot_x":
         return np.array([1.0, 0.0])
@@ -58,7 +58,7 @@ def stroke_design_partials(machine: Machine, chain: Chain, q: ArrayLike) -> tupl
             out[..., k] = -1.0
             continue
         pivot = chain.pivot(str(variable.pivot))
-        d = _direction(machine, chain, variable)
+        d = pivot_direction(machine, chain, variable)
         if pivot.link == driven:
             d_p = np.stack([cos * d[0] - sin * d[1], sin * d[0] + cos * d[1]], axis=-1)
         else:

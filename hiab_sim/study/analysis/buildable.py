@@ -189,8 +189,8 @@ def buildable_blocks(study: Study, working: Sequence[tuple[float, float]], tight
         blocks.append(RobustXi(wr, t, "buildable_range"))
     if study.mounting is not None:
         if tightened:
-            rows = MountingRows(study.mounting, study.crane, ROBUST_CLEARANCE / MOUNTING_SCALE)
+            rows = MountingRows(study, ROBUST_CLEARANCE / MOUNTING_SCALE)
             blocks.append(RobustXi(rows, t, "mounting"))
         else:
-            blocks.append(MountingRows(study.mounting, study.crane))
+            blocks.append(MountingRows(study))
     return blocks

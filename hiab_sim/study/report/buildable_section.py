@@ -20,6 +20,7 @@ import numpy as np
 
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import LinkLengths
+from hiab_sim.crane.mounting import MountingSpace
 from hiab_sim.crane.tolerance import buildable_crane, check_tolerance, design_margins, range_cost_deg
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.results.analysis_sections import Buildable, RoundedCheck
@@ -96,7 +97,9 @@ def buildable_section(problem: StudyProblem, z: Array, optimum: DesignSummary, c
     except InvalidInputError as error:
         crane_check = RoundedCheck(False, str(error), float("nan"), "m")
     lengths = crane_lengths(problem.unpack(z)[0])
-    tol = check_tolerance(design_margins(short, study.mounting), lengths, t)
+    space = study.mounting
+    assert space is None or isinstance(space, MountingSpace)  # a crane file's study reads the crane form
+    tol = check_tolerance(design_margins(short, space), lengths, t)
     label, row, value = tol.worst()
     tolerance_check = RoundedCheck(tol.ok, f"{row} at the {label} design", value, "m")
     return Buildable(

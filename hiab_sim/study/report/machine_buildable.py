@@ -9,7 +9,8 @@ As :mod:`hiab_sim.study.report.buildable_section` for a crane file, through the 
    min(x, stroke - x, Lc - x) >= 0 [m] (the rod stays in its barrel) by the closed-form loop
    closure, interior extremes of a four-bar's stroke included;
 2. every design within +-tolerance of the optimum (the 2^n_xi corners of the box, the nominal
-   and the rounded design) on the same stroke rows;
+   and the rounded design) on the same stroke rows and, with a ``mounting`` section, on the
+   mounting rows (:mod:`hiab_sim.machine.mounting`);
 3. the fine-grid re-check of the rounded design with the optimal trajectory on the other
    inverse-dynamics path: the nominal NLP rows and the energy, every task on its fine grid.
 """
@@ -26,6 +27,7 @@ from hiab_sim.results.analysis_sections import Buildable, RoundedCheck
 from hiab_sim.results.schema import DesignSummary
 from hiab_sim.study.analysis.buildable import buildable_working_range, rounded_values
 from hiab_sim.study.machines.machine_model import MachineModel
+from hiab_sim.study.nlp.mounting_rows import study_mounting_margins
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.report.buildable_section import rounded_recheck
 
@@ -74,11 +76,15 @@ def machine_buildable_section(problem: StudyProblem, z: Array, optimum: DesignSu
     stroke_check = RoundedCheck(value >= 0.0, f"strokes over the buildable working range: {row}", value, "m")
     signs = itertools.product((-1.0, 1.0), repeat=len(optimal.values))
     corners = [optimal.as_array() + t * np.asarray(sign) for sign in signs]
+    mounting = study_mounting_margins(study)
     worst = (math.inf, "none", "nominal")
     for where, values in [("nominal", optimal.as_array()), ("rounded", rounded.as_array())] + [
         (f"corner {k}", v) for k, v in enumerate(corners)
     ]:
-        m, name = stroke_margin(model, model.design(values), ranges)
+        design = model.design(values)
+        m, name = stroke_margin(model, design, ranges)
+        if mounting is not None:
+            name, m = min((name, m), mounting(design).worst(), key=lambda row: row[1])
         if m < worst[0]:
             worst = (m, name, where)
     tolerance_check = RoundedCheck(worst[0] >= 0.0, f"{worst[1]} at the {worst[2]} design", worst[0], "m")

@@ -10,6 +10,7 @@ from hiab_sim.emla.config import load_emla_set
 from hiab_sim.errors import ConfigError
 from hiab_sim.machine.loader import PRESETS as MACHINE_PRESETS
 from hiab_sim.machine.loader import load_machine
+from hiab_sim.machine.mounting import MachineMountingSpace
 from hiab_sim.resources import Source, locate
 from hiab_sim.structure.machine_structure import machine_pin_names
 from hiab_sim.structure.settings import StructureSettings
@@ -31,12 +32,11 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
     ``tracked`` (the tracked coordinates beyond the TCP's x, y: joint names or ``tcp_angle``;
     default ``tcp_angle`` for each), ``initial_lengths`` (a mapping ``chain.variable: value``, default
     the file's values) and ``bounds`` without per-chain bounds (the file declares them). ``mounting``
-    needs a crane file for now and is refused; ``build`` holds the robust rows; ``structure`` names the
-    machine's hinges (joint names) and loop pins in ``pin_load_limits``.
+    gives polygons per chain and pivot (:mod:`hiab_sim.machine.mounting`); ``build`` holds the robust
+    rows; ``structure`` names the machine's hinges (joint names) and loop pins in ``pin_load_limits``.
     """
-    for key in ("crane", "mounting"):
-        if key in top:
-            raise ConfigError(f"study: '{key}' is not available for a machine file (machine:) yet; remove it")
+    if "crane" in top:
+        raise ConfigError("study: 'crane' and 'machine' name the same thing: give one of them")
     source = str(top["machine"])
     path = Path(source)
     folder = Path(str(file.file)).parent
@@ -96,4 +96,5 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
         machine=machine,
         tracked=tracked,
         structure=StructureSettings.from_mapping(top.get("structure"), machine_pin_names(machine)),
+        mounting=None if top.get("mounting") is None else MachineMountingSpace.from_mapping(top["mounting"], machine),
     )

@@ -10,6 +10,7 @@ from hiab_sim.crane.mounting import MountingSpace
 from hiab_sim.emla.config import EmlaSet
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
+from hiab_sim.machine.mounting import MachineMountingSpace
 from hiab_sim.resources import Source
 from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.machines.crane_model import CraneModel
@@ -47,7 +48,7 @@ class Study:
     bounds: Bounds
     solver: SolverSettings
     build: BuildSettings = field(default_factory=BuildSettings)  # manufacturing tolerance, stroke margin
-    mounting: MountingSpace | None = None  # optional mounting polygons of the base pivots
+    mounting: MountingSpace | MachineMountingSpace | None = None  # optional mounting space of the moved pivots
     crane_file: Source | None = field(default=None, repr=False, compare=False)
     #: The built crane's lengths when they lie outside the bounds and the loader moved the start into them.
     start_moved_from: Design | None = field(default=None, repr=False, compare=False)
