@@ -26,7 +26,7 @@ from hiab_sim.crane.mounting import built_space, mounting_margins
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.machine.kinematics.forward import forward_kinematics
 from hiab_sim.machine.loader import load_machine
-from hiab_sim.machine.mounting import MachineMountingSpace, PivotPolygon, machine_mounting_margins, moved_pivots
+from hiab_sim.machine.mounting import MachineMountingSpace, machine_mounting_margins, moved_pivots
 from hiab_sim.study.analysis.buildable import ROBUST_CLEARANCE
 from hiab_sim.study.spec.study_file import load_study
 
@@ -36,9 +36,7 @@ EXACT = load_machine("exact")
 CRANE = load_crane("xs031")
 CRANE_SPACE = built_space(CRANE)
 #: The crane form's built space in the machine form: the same polygons on the same pivots and frames.
-XS031_SPACE = MachineMountingSpace(
-    (PivotPolygon("lift", "base", CRANE_SPACE.lift or ()), PivotPolygon("tilt", "base", CRANE_SPACE.tilt or ()))
-)
+XS031_SPACE = MachineMountingSpace((("lift", "base", CRANE_SPACE.lift or ()), ("tilt", "base", CRANE_SPACE.tilt or ())))
 #: The crane form's labels of the tilt base pivot's pins and the machine form's for the same pins.
 SAME_PINS = {"lift boom hinge": "theta1 hinge", "lift rod-end pivot": "lift end pivot"}
 
@@ -149,7 +147,7 @@ def test_polygon_rows_say_inside_where_a_point_in_polygon_test_does(
     hexagon = tuple((float(centre[0] + r * np.cos(a)), float(centre[1] + r * np.sin(a))) for a in angles)
     values[keys.index("bucket.Gx")] += dx
     values[keys.index("bucket.Gy")] += dy
-    rows = machine_mounting_margins(MachineMountingSpace((PivotPolygon("bucket", "base", hexagon),)), EXACT, values)
+    rows = machine_mounting_margins(MachineMountingSpace((("bucket", "base", hexagon),)), EXACT, values)
     edges = rows.values[[i for i, n in enumerate(rows.names) if " inside edge " in n]]
     assert len(edges) == 6
     if abs(float(np.min(edges))) > 1e-9:  # not on an edge, where the two tests may round apart
@@ -266,6 +264,6 @@ def test_a_binding_polygon_holds_the_excavators_optimum_inside_it_to_the_toleran
     assert x_box[gx] == pytest.approx(-0.084 - inset, abs=1e-9) and x_box[gy] == pytest.approx(0.270 + inset, abs=1e-9)
     assert boxed.optimal.collocation_cost_W2s >= free.optimal.collocation_cost_W2s * (1.0 - 1e-9)
     assert boxed.buildable is not None and boxed.buildable.tolerance_check.passed
-    space = MachineMountingSpace((PivotPolygon("bucket", "base", tuple(map(tuple, BUCKET_BOX))),))
+    space = MachineMountingSpace((("bucket", "base", tuple((x, y) for x, y in BUCKET_BOX)),))
     rounded = machine_mounting_margins(space, EXACT, boxed.buildable.lengths.as_array())
     assert rounded.worst()[1] >= 0.0

@@ -53,26 +53,13 @@ from typing import Any
 import numpy as np
 
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.machine import mounting_geometry as geometry
 from hiab_sim.machine.chains import Chain
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.design import designed_chain
 from hiab_sim.machine.kinematics.closure import chain_geometry
 from hiab_sim.machine.kinematics.design_partials import pivot_direction
-from hiab_sim.machine.mounting_geometry import (
-    DEFAULT_CLEARANCE,
-    DEFAULT_SAMPLES,
-    Array,
-    Margins,
-    Polygon,
-    check_clearance_and_samples,
-    check_polygon,
-    edge_rows,
-    margins,
-    point_distance,
-    polyline_distance,
-    read_polygon,
-    read_samples,
-)
+from hiab_sim.machine.mounting_geometry import Array, Margins, Polygon
 from hiab_sim.yaml_fields import mapping, positive
 
 #: Kinds of decision variable that move a pivot.
@@ -81,16 +68,8 @@ PIVOT_KINDS = ("hinge_distance", "pivot_x", "pivot_y")
 SETTINGS = ("clearance", "samples")
 
 
-@dataclass(frozen=True)
-class PivotPolygon:
-    """Where one pivot may sit: a convex counter-clockwise polygon (x, y) [m] in its link's frame."""
-
-    chain: str
-    pivot: str
-    vertices: Polygon
-
-    def __post_init__(self) -> None:
-        check_polygon(f"mounting.{self.chain}.{self.pivot}", self.vertices)
+#: Where one pivot may sit: (chain, pivot role, a convex counter-clockwise polygon (x, y) [m] in its link's frame).
+PivotPolygon = tuple[str, str, Polygon]
 
 
 @dataclass(frozen=True)
@@ -98,17 +77,19 @@ class MachineMountingSpace:
     """A machine file's mounting space: polygons of moved pivots, a pin clearance [m] and the swept-link samples."""
 
     polygons: tuple[PivotPolygon, ...] = ()
-    clearance: float = DEFAULT_CLEARANCE
-    samples: int = DEFAULT_SAMPLES
+    clearance: float = geometry.DEFAULT_CLEARANCE
+    samples: int = geometry.DEFAULT_SAMPLES
 
     def __post_init__(self) -> None:
-        check_clearance_and_samples("mounting", self.clearance, self.samples)
+        for chain, pivot, vertices in self.polygons:
+            geometry.check_polygon(f"mounting.{chain}.{pivot}", vertices)
+        geometry.check_clearance_and_samples("mounting", self.clearance, self.samples)
 
     def polygon(self, chain: str, pivot: str) -> Polygon | None:
         """The polygon of a chain's pivot, or None."""
-        for p in self.polygons:
-            if (p.chain, p.pivot) == (chain, pivot):
-                return p.vertices
+        for name, role, vertices in self.polygons:
+            if (name, role) == (chain, pivot):
+                return vertices
         return None
 
     @classmethod
@@ -132,11 +113,11 @@ class MachineMountingSpace:
                         + ", ".join(PIVOT_KINDS)
                         + f"); moved pivots: {', '.join(f'{c}.{r}' for c, r in moved) or 'none'}",
                     )
-                polygon = read_polygon(vertices, f"{where}.{name}.{role}")
+                polygon = geometry.read_polygon(vertices, f"{where}.{name}.{role}")
                 assert polygon is not None
-                polygons.append(PivotPolygon(name, role, polygon))
-        clearance = positive(node.get("clearance", DEFAULT_CLEARANCE), f"{where}.clearance", "m")
-        return cls(tuple(polygons), clearance, read_samples(node.get("samples"), f"{where}.samples"))
+                polygons.append((name, role, polygon))
+        clearance = positive(node.get("clearance", geometry.DEFAULT_CLEARANCE), f"{where}.clearance", "m")
+        return cls(tuple(polygons), clearance, geometry.read_samples(node.get("samples"), f"{where}.samples"))
 
 
 def moved_pivots(machine: Machine) -> list[tuple[str, str]]:
@@ -224,7 +205,7 @@ def machine_mounting_margins(space: MachineMountingSpace, machine: Machine, valu
         where = f"mounting.{name} {role} pivot"
         polygon = space.polygon(name, role)
         if polygon is not None:
-            edge_values, edge_jacobian = edge_rows(polygon, me.xy, me.dxy)
+            edge_values, edge_jacobian = geometry.edge_rows(polygon, me.xy, me.dxy)
             polygon_part[0].extend(f"{where} inside edge {i}" for i in range(len(polygon)))
             polygon_part[1].extend(edge_values)
             polygon_part[2].extend(edge_jacobian)
@@ -233,7 +214,7 @@ def machine_mounting_margins(space: MachineMountingSpace, machine: Machine, valu
         pins = [pin for joint, pin in _hinges(machine, pivot.link, n) if not (swept and joint == chain.joint)]
         pins += [pin for c, r, pin in _pivot_pins(machine, chains, pivot.link, n) if (c, r) != (name, role)]
         for pin in pins:
-            d, grad = point_distance(me.xy, pin.xy)
+            d, grad = geometry.point_distance(me.xy, pin.xy)
             clearance_part[0].append(f"{where} clear of the {pin.label}")
             clearance_part[1].append(d - space.clearance)
             clearance_part[2].append(grad @ (me.dxy - pin.dxy))
@@ -242,7 +223,7 @@ def machine_mounting_margins(space: MachineMountingSpace, machine: Machine, valu
             clearance_part[0].append(f"{where} clear of the {driven.name} over its working range")
             clearance_part[1].append(d - space.clearance)
             clearance_part[2].append(row)
-    return Margins.stacked([margins(*polygon_part, n), margins(*clearance_part, n)], n)
+    return Margins.stacked([geometry.margins(*polygon_part, n), geometry.margins(*clearance_part, n)], n)
 
 
 def _swept_clearance(
@@ -260,7 +241,7 @@ def _swept_clearance(
     c, s = np.cos(angle)[:, None, None], np.sin(angle)[:, None, None]
     rotation = np.concatenate([np.concatenate([c, -s], axis=2), np.concatenate([s, c], axis=2)], axis=1)  # (S, 2, 2)
     points = geo.hinge + np.einsum("sij,pj->spi", rotation, local)  # (S, P, 2)
-    d, grad, (k, i), t = polyline_distance(me.xy, points)
+    d, grad, (k, i), t = geometry.polyline_distance(me.xy, points)
     dclosest = rotation[k] @ ((1.0 - t) * dlocal[i] + t * dlocal[i + 1])  # (2, n)
     return d, grad @ (me.dxy - dclosest)
 
