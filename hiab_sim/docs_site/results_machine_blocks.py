@@ -221,13 +221,17 @@ def excavator_studies(runs: RunData) -> str:
 def excavator_designs(runs: RunData) -> str:
     """Every decision variable of the machine file: the file's value and each recorded study's optimum [m]."""
     recorded = _recorded(runs)
-    first = runs.result(recorded[0])("initial.lengths")
-    optima = [runs.result(s)("optimal.lengths")["values"] for s in recorded]
+    columns = [(f"`{s}` optimum", runs.result(s)("optimal.lengths")["values"]) for s in recorded]
+    return _variables_table(runs.result(recorded[0])("initial.lengths"), columns)
+
+
+def _variables_table(first: dict[str, Any], columns: list[tuple[str, list[float]]]) -> str:
+    """Every decision variable [m]: ``first``'s value (the machine file's) and each column's optimum, by label."""
     rows = [
-        (f"`{name}`", f"{first['values'][i]:.3f}", *(f"{o[i]:.3f}" for o in optima))
+        (f"`{name}`", f"{first['values'][i]:.3f}", *(f"{values[i]:.3f}" for _, values in columns))
         for i, name in enumerate(first["names"])
     ]
-    return table(("variable [m]", "machine file", *(f"`{s}` optimum" for s in recorded)), rows)
+    return table(("variable [m]", "machine file", *(label for label, _ in columns)), rows)
 
 
 def excavator_energy(runs: RunData) -> str:
@@ -304,11 +308,7 @@ def excavator_mix_designs(runs: RunData) -> str:
         (f"`{s}` optimum", runs.result(s)("optimal.lengths")["values"]) for s in EXCAVATOR if runs.has(s, "result")
     ]
     columns.append((f"`{EXCAVATOR_MIX}` optimum", r("optimal.lengths")["values"]))
-    rows = [
-        (f"`{name}`", f"{first['values'][i]:.3f}", *(f"{values[i]:.3f}" for _, values in columns))
-        for i, name in enumerate(first["names"])
-    ]
-    return table(("variable [m]", "machine file", *(label for label, _ in columns)), rows)
+    return _variables_table(first, columns)
 
 
 def excavator_mix_cross(runs: RunData) -> str:

@@ -67,9 +67,8 @@ from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.plant.friction import add_joint_friction
 from hiab_sim.env.plant.mismatch import friction_factor, payload_factor, true_drive_arrays, true_machine
 from hiab_sim.env.reference import PlannedMotion, motion_of_plan, physics_times
-from hiab_sim.env.rollout import ClosedLoopRun, run_environment
+from hiab_sim.env.rollout import ClosedLoopRun, check_cycles, run_environment
 from hiab_sim.env.task import CraneTrackingTask
-from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.dynamics.mjcf_build import spec_of_tree
 from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
 from hiab_sim.machine.dynamics.tree import MachineActuatorSamples, SimulationExtras, machine_tree
@@ -236,8 +235,7 @@ def run_machine_closed_loop(
     cycles: int = 1,
 ) -> tuple[ClosedLoopRun, CranePhysics]:
     """``cycles`` cycles of a machine design's plan on ``plant`` under the cascade; the last log and the Physics."""
-    if isinstance(cycles, bool) or not isinstance(cycles, int) or cycles < 1:
-        raise InvalidInputError("cycles", cycles, "must be an integer >= 1")
+    check_cycles(cycles)
     env = machine_environment(plan, plant=plant)
     motion = env.task.motion
     stiffness, lowest = drive_train_resonance(plan.emlas, motion, plant)

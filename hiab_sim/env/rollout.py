@@ -38,6 +38,7 @@ from hiab_sim.env.plan import DesignPlan
 from hiab_sim.env.planned_energy import resampled_prediction
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.quadrature import trapezoid
 
 Array = NDArray[np.float64]
 
@@ -160,7 +161,7 @@ class ClosedLoopRun:
             "actuators": {
                 name: {
                     "net_electrical_energy_J": float(self.cumulative_energy[-1, i]),
-                    "predicted_net_electrical_energy_J": float(_trapezoid(self.predicted_power[:, i], self.plan_time)),
+                    "predicted_net_electrical_energy_J": float(trapezoid(self.predicted_power[:, i], self.plan_time)),
                     "current_limit_fraction": float(self.current_limit_fraction[i]),
                     "voltage_limit_fraction": float(self.voltage_limit_fraction[i]),
                     "peak_current_A": float(np.abs(self.current_dq[:, i, 1]).max()),
@@ -200,8 +201,10 @@ def _total(values: Array | None) -> float:
     return 0.0 if values is None else float(np.sum(values))
 
 
-def _trapezoid(y: Array, t: Array) -> float:
-    return float(0.5 * np.sum((y[1:] + y[:-1]) * np.diff(t)))
+def check_cycles(cycles: int) -> None:
+    """A run's number of cycles: an integer >= 1 (a bool is not one); InvalidInputError naming ``cycles`` else."""
+    if isinstance(cycles, bool) or not isinstance(cycles, int) or cycles < 1:
+        raise InvalidInputError("cycles", cycles, "must be an integer >= 1")
 
 
 def run_closed_loop(
@@ -217,8 +220,7 @@ def run_closed_loop(
     The Physics is returned at the end of the cycle (for rendering the logged ``qpos``); call its
     ``free()`` when done with it. ``gains`` None: the design rules for the plant (module docstring).
     """
-    if isinstance(cycles, bool) or not isinstance(cycles, int) or cycles < 1:
-        raise InvalidInputError("cycles", cycles, "must be an integer >= 1")
+    check_cycles(cycles)
     env = make_environment(plan, payload_error=payload_error, plant=plant)
     design = design_loop(plan, env.task.motion, plant)
     design = replace(design, gains=gains or design.gains)

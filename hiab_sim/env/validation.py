@@ -213,12 +213,11 @@ def render_video(
     inertia, not geometry).
     """
     from hiab_sim.render.backend import video_sink
-    from hiab_sim.render.decor import INITIAL_RGBA, OPTIMAL_RGBA
+    from hiab_sim.render.decor import design_rgba
     from hiab_sim.render.dress import machine_dress
     from hiab_sim.render.frames import Design, PlaybackRenderer
 
     width, height = VIEWPORT
-    colours = {"initial": INITIAL_RGBA, "optimal": OPTIMAL_RGBA}
     at = closed_loop_frame_times(min(run.time[-1] for run in runs))
     frames = len(at)
     models = {run.design: item.model.ptr for run, item in zip(runs, physics, strict=True)}
@@ -232,7 +231,7 @@ def render_video(
         caption = f"{run.design}, {mass}" if run.design != "initial" else "initial (ghost)"
         model = models[run.design]
         return Design(
-            run.design, model, run.qpos[index], colours.get(run.design, OPTIMAL_RGBA), caption, notes,
+            run.design, model, run.qpos[index], design_rgba(run.design), caption, notes,
             dress=machine_dress(model, crane), marks=marks,
         )  # fmt: skip
 

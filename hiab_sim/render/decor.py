@@ -28,6 +28,11 @@ MAX_SEGMENTS = 240
 LINE_WIDTH = 3.0
 
 
+def design_rgba(design: str) -> tuple[float, float, float, float]:
+    """A design's colour (RGBA in [0, 1]): the initial design's, and the optimal one's for any other name."""
+    return INITIAL_RGBA if design == "initial" else OPTIMAL_RGBA
+
+
 def _next_geom(scene: mujoco.MjvScene) -> mujoco.MjvGeom | None:
     return None if scene.ngeom >= scene.maxgeom else scene.geoms[scene.ngeom]
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.render.backend import check_gl_backend, check_output_path, ffmpeg_path, write_image, write_video
-from hiab_sim.render.decor import INITIAL_RGBA, OPTIMAL_RGBA
+from hiab_sim.render.decor import design_rgba
 from hiab_sim.render.dress_machine import machine_file_dress, moved_pivots
 from hiab_sim.render.frames import LAYOUTS, Design, Layout, PlaybackRenderer
 from hiab_sim.render.machine_playback import (
@@ -30,8 +30,6 @@ from hiab_sim.render.machine_playback import (
 )
 from hiab_sim.render.playback import frame_times, resample
 from hiab_sim.render.video import DEFAULT_LAYOUT, VIDEO_NAME, design_texts, held_payload
-
-_COLOURS = {"initial": INITIAL_RGBA, "optimal": OPTIMAL_RGBA}
 
 
 def machine_renderer(
@@ -54,7 +52,7 @@ def machine_renderer(
         dress = machine_file_dress(model, data.machine.with_design(motion.design), data.ground)
         designs.append(
             Design(
-                motion.name, model, qpos, _COLOURS.get(motion.name, OPTIMAL_RGBA), caption, notes,
+                motion.name, model, qpos, design_rgba(motion.name), caption, notes,
                 dress=dress, marks=marks, payload=payload,
             )
         )  # fmt: skip

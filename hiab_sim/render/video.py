@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.model.mjcf import build_model, source_to_world
 from hiab_sim.render.backend import check_gl_backend, check_output_path, ffmpeg_path, write_image, write_video
-from hiab_sim.render.decor import INITIAL_RGBA, OPTIMAL_RGBA
+from hiab_sim.render.decor import design_rgba
 from hiab_sim.render.dress import machine_dress
 from hiab_sim.render.frames import LAYOUTS, Design, Layout, PlaybackRenderer
 from hiab_sim.render.playback import (
@@ -46,7 +46,6 @@ Array = NDArray[np.float64]
 VIDEO_NAME = "playback.mp4"
 #: Default arrangement of the designs.
 DEFAULT_LAYOUT: Layout = "overlay"  # the optimal design opaque, the initial one as a ghost: the difference shows
-_COLOURS = {"initial": INITIAL_RGBA, "optimal": OPTIMAL_RGBA}
 
 
 def playback_renderer(
@@ -85,7 +84,7 @@ def playback_renderer(
         caption, notes = design_texts(motion.name, layout, data, at, power, suffix)
         designs.append(
             Design(
-                motion.name, model, qpos, _COLOURS.get(motion.name, OPTIMAL_RGBA), caption, notes,
+                motion.name, model, qpos, design_rgba(motion.name), caption, notes,
                 dress=machine_dress(model, data.crane), marks=marks, payload=held_payload(data, at),
             )
         )  # fmt: skip
