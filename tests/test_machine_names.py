@@ -24,26 +24,17 @@ FORMAT_WORDS = {role for roles in PIVOT_ROLES.values() for role in roles} | {"cy
 #: notation the paper defines for any chain (a machine file may name its variables after it), not a machine's names.
 NOTATION = {"L", "Lc0", "Lc", "x0"}
 
-#: Modules that keep the XS 031's names: the crane file's closed-form model and its direct users. The crane
-#: file format (hiab_sim/presets/hiab_xs031.yaml) fixes its chains (lift, tilt), joints (theta1, theta2, xt2) and
-#: bodies; moving them into the file would change that format and every crane study, larger than one step.
-#: A machine file (hiab_sim/machine) describes the same crane without any of them.
+#: Modules that keep the XS 031's names. The crane file format (hiab_sim/presets/hiab_xs031.yaml) fixes its
+#: chains (lift, tilt), its telescope section, joints (theta1, theta2, xt2), links and bodies; its schema spells
+#: them once, and the crane file's loader, dataclasses, kinematics, dynamics and MJCF builder import them from
+#: there. A machine file (hiab_sim/machine) describes the same crane without any of them.
 CRANE_MODEL = {
-    "crane/description.py": "the crane file's dataclasses: its two chains and eight links by name",
-    "crane/kinematics.py": "the crane's closed-form kinematics: frames of its telescope bodies",
-    "crane/loader.py": "reads the crane file's sections, which are named after its chains and links",
-    "crane/mounting.py": "the crane file's mounting rows per chain (lift, tilt)",
-    "crane/names.py": "the crane file's joint and actuator names, the one place the crane model defines them",
-    "crane/to_machine.py": "converts the crane file into a machine description: maps its names to the file's",
-    "dynamics/analytic_id.py": "the crane file's closed-form inverse dynamics on its named bodies",
-    "dynamics/analytic_kinematics.py": "the crane file's closed-form body kinematics",
-    "dynamics/analytic_planar.py": "the crane file's planar closed-form dynamics on its named bodies",
-    "model/mjcf.py": "builds the crane file's MJCF: bodies, joints and sites named after the crane",
-    "docs_site/field_specs/crane.py": "documents the crane file's top-level telescope section, a key the loader reads",
+    "crane/names.py": "the crane file format's schema, the one module that spells its fixed section and body names",
 }
 #: (module, literal) pairs where the word has another meaning than the machine's name.
 OTHER_MEANING = {
     ("study/figures/optimisation.py", "alpha"): "matplotlib's opacity keyword",
+    ("model/mjcf.py", "boom"): "the MJCF template's visual default class of structure capsules (crane_template.xml)",
     ("study/references/csv_file.py", "telescope"): "a study key: a TCP file's held third coordinate",
     ("study/references/kinds.py", "telescope"): "a study key of the spiral and pick-and-place kinds",
     ("docs_site/field_specs/references.py", "telescope"): "documents that study key",

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from hiab_sim.checks import check_range
+from hiab_sim.crane.names import CHAIN_NAMES, LINK_NAMES, cylinder_link, rod_link
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.hydraulics.cylinders import HydraulicSystem
 from hiab_sim.machine import parts
@@ -33,18 +34,6 @@ from hiab_sim.machine.parts import check_interval, check_rotation, homogeneous, 
 
 Vector3 = tuple[float, float, float]
 Matrix3 = tuple[Vector3, Vector3, Vector3]
-
-CHAIN_NAMES = ("lift", "tilt")
-LINK_NAMES = (
-    "base",
-    "lift_boom",
-    "lift_cylinder",
-    "lift_rod",
-    "tilt_boom",
-    "tilt_cylinder",
-    "tilt_rod",
-    "telescope_rod",
-)
 
 
 def rot_z(angle: float) -> np.ndarray:
@@ -252,9 +241,9 @@ class Crane:
             factor = 1.0
             for chain, xi in zip(self.chains, lengths, strict=True):
                 default = chain.default_lengths
-                if body.link == f"{chain.name}_cylinder":
+                if body.link == cylinder_link(chain.name):
                     factor = xi.x0 / default.x0
-                elif body.link == f"{chain.name}_rod":
+                elif body.link == rod_link(chain.name):
                     factor = xi.Lc / default.Lc
             scaled.append(scale_slender_body(body, factor) if factor != 1.0 else body)
         return tuple(scaled)

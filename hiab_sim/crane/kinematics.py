@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths, Pose
+from hiab_sim.crane.names import BASE, TELESCOPE, TELESCOPE_CYLINDER, TELESCOPE_ROD, boom_link, cylinder_link, rod_link
 from hiab_sim.machine.kinematics.forward import rotation_z  # the one rotation about z, shared with the generic model
 
 Array = NDArray[np.float64]
@@ -49,17 +50,17 @@ def _add_chain(frames: Frames, chain: ClosedChain, lengths: LinkLengths, theta: 
     _compose(
         frames,
         chain.parent,
-        f"{chain.name}_boom",
+        boom_link(chain.name),
         rotation_z(chain.base_axis_angle + theta - chain.joint_offset),
         hinge,
     )
-    _compose(frames, chain.parent, f"{chain.name}_cylinder", rotation_z(chain.base_axis_angle + q1), pivot)
+    _compose(frames, chain.parent, cylinder_link(chain.name), rotation_z(chain.base_axis_angle + q1), pivot)
     rod_offset = np.zeros((*n, 3))
     rod_offset[..., 0] = xi.Lc0 + x
     _compose(
         frames,
-        f"{chain.name}_cylinder",
-        f"{chain.name}_rod",
+        cylinder_link(chain.name),
+        rod_link(chain.name),
         np.broadcast_to(np.eye(3), (*n, 3, 3)),
         rod_offset,
     )
@@ -72,9 +73,9 @@ def forward_kinematics(
     theta1, theta2, xt2 = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (theta1, theta2, xt2)))
     n = theta1.shape
     frames = Frames(
-        rotation={"base": np.broadcast_to(np.eye(3), (*n, 3, 3))},
-        position={"base": np.zeros((*n, 3))},
-        stroke={"telescope": xt2},
+        rotation={BASE: np.broadcast_to(np.eye(3), (*n, 3, 3))},
+        position={BASE: np.zeros((*n, 3))},
+        stroke={TELESCOPE: xt2},
     )
     _add_chain(frames, crane.lift, lengths, theta1)
     _add_chain(frames, crane.tilt, lengths, theta2)
@@ -83,14 +84,14 @@ def forward_kinematics(
     _compose(
         frames,
         tele.parent,
-        "telescope_cylinder",
+        TELESCOPE_CYLINDER,
         np.broadcast_to(np.asarray(cyl.rotation), (*n, 3, 3)),
         np.broadcast_to(np.asarray(cyl.position), (*n, 3)),
     )
     slide = np.zeros((*n, 3))
     slide[..., 0] = tele.rod_offset + xt2
-    _compose(frames, "telescope_cylinder", "telescope_rod", np.broadcast_to(np.eye(3), (*n, 3, 3)), slide)
-    _attach(frames, "telescope_rod", "tcp", crane.tcp_in_telescope_rod, n)
+    _compose(frames, TELESCOPE_CYLINDER, TELESCOPE_ROD, np.broadcast_to(np.eye(3), (*n, 3, 3)), slide)
+    _attach(frames, TELESCOPE_ROD, "tcp", crane.tcp_in_telescope_rod, n)
     return frames
 
 

@@ -13,7 +13,6 @@ from typing import Any
 import numpy as np
 
 from hiab_sim.crane.description import (
-    CHAIN_NAMES,
     ChainLengths,
     ClosedChain,
     Crane,
@@ -27,7 +26,21 @@ from hiab_sim.crane.description import (
     vec3,
 )
 from hiab_sim.crane.mechanism import check_lengths
-from hiab_sim.crane.names import ACTUATOR_NAMES
+from hiab_sim.crane.names import (
+    ACTUATOR_NAMES,
+    BASE,
+    CHAIN_NAMES,
+    LIFT,
+    LIFT_BOOM,
+    LIFT_CYLINDER,
+    LIFT_ROD,
+    TELESCOPE,
+    TELESCOPE_ROD,
+    TILT,
+    TILT_BOOM,
+    TILT_CYLINDER,
+    TILT_ROD,
+)
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.hydraulics.cylinders import hydraulic_cylinders_from_mapping
 from hiab_sim.resources import Source, locate
@@ -46,23 +59,23 @@ _CHAIN_KEYS = {
     "joint_range",
 }
 _TELESCOPE_KEYS = {"parent", "cylinder_frame", "rod_offset", "rod_length", "stroke", "joint_range"}
-_TOP_KEYS = {"name", "source", "gravity", "chains", "telescope", "tcp", "bodies"}
+_TOP_KEYS = {"name", "source", "gravity", "chains", TELESCOPE, "tcp", "bodies"}
 _BODY_KEYS = {"frame", "mass", "com", "inertia"}
 _POSE_KEYS = {"r", "R"}
 
 #: Source frame -> (link it is rigidly attached to). Frames not listed coincide with a link.
 _FRAME_LINKS = {
-    "Bc1": "base",
-    "B11": "lift_boom",
-    "Bc2": "lift_boom",
-    "B31": "lift_cylinder",
-    "B41": "lift_rod",
-    "B12": "tilt_boom",
-    "B32": "tilt_cylinder",
-    "B42": "tilt_rod",
-    "P22": "tilt_boom",
-    "B52": "telescope_rod",
-    "P32": "telescope_rod",
+    "Bc1": BASE,
+    "B11": LIFT_BOOM,
+    "Bc2": LIFT_BOOM,
+    "B31": LIFT_CYLINDER,
+    "B41": LIFT_ROD,
+    "B12": TILT_BOOM,
+    "B32": TILT_CYLINDER,
+    "B42": TILT_ROD,
+    "P22": TILT_BOOM,
+    "B52": TELESCOPE_ROD,
+    "P32": TELESCOPE_ROD,
 }
 
 
@@ -87,17 +100,17 @@ def crane_from_dict(data: Any, origin: str = "crane") -> Crane:
     gravity = number(top["gravity"], "gravity")
     chains_data = mapping(top["chains"], "chains", set(CHAIN_NAMES))
     chains = {name: _chain(name, chains_data[name]) for name in CHAIN_NAMES}
-    telescope = _telescope(top["telescope"])
+    telescope = _telescope(top[TELESCOPE])
     tcp = _pose(top["tcp"], "tcp")
     bodies_data = mapping(top["bodies"], "bodies", None)
-    placements = _source_frame_placements(chains["lift"], chains["tilt"], telescope)
+    placements = _source_frame_placements(chains[LIFT], chains[TILT], telescope)
     bodies = tuple(_body(name, bodies_data[name], placements) for name in bodies_data)
     crane = Crane(
         name=str(top["name"]),
         source=str(top["source"]),
         gravity=gravity,
-        lift=chains["lift"],
-        tilt=chains["tilt"],
+        lift=chains[LIFT],
+        tilt=chains[TILT],
         telescope=telescope,
         tcp=tcp,
         bodies=bodies,
@@ -162,7 +175,7 @@ def _chain(name: str, data: Any) -> ClosedChain:
 
 
 def _telescope(data: Any) -> Telescope:
-    tele = mapping(data, "telescope", _TELESCOPE_KEYS)
+    tele = mapping(data, TELESCOPE, _TELESCOPE_KEYS)
     return Telescope(
         parent=str(tele["parent"]),
         cylinder_frame=_pose(tele["cylinder_frame"], "telescope.cylinder_frame"),

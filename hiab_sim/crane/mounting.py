@@ -51,7 +51,8 @@ from typing import Any
 
 import numpy as np
 
-from hiab_sim.crane.description import CHAIN_NAMES, ClosedChain, Crane, LinkLengths
+from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths
+from hiab_sim.crane.names import CHAIN_NAMES, LIFT, TILT, boom_link
 from hiab_sim.machine.mounting_geometry import (
     DEFAULT_CLEARANCE,
     DEFAULT_SAMPLES,
@@ -70,7 +71,7 @@ from hiab_sim.machine.mounting_geometry import (
 from hiab_sim.yaml_fields import mapping, positive
 
 #: Index of each chain's L in Xi = [L, Lc0, Lc (lift), L, Lc0, Lc (tilt)].
-L_INDEX = {"lift": 0, "tilt": 3}
+L_INDEX = {LIFT: 0, TILT: 3}
 
 
 @dataclass(frozen=True)
@@ -101,7 +102,7 @@ class MountingSpace:
 
     def polygon(self, chain: str) -> Polygon | None:
         """The polygon of a chain's base pivot (``lift`` or ``tilt``), or None."""
-        return self.lift if chain == "lift" else self.tilt
+        return self.lift if chain == LIFT else self.tilt
 
     @classmethod
     def from_mapping(cls, data: Any, where: str = "mounting") -> MountingSpace:
@@ -114,11 +115,11 @@ class MountingSpace:
               tilt: [[0.390, -0.054], [0.584, -0.006], [0.559, 0.091], [0.365, 0.043]]   # lift boom frame {B11}, m
               clearance: 0.05                                                              # m
         """
-        node = mapping(data, where, {"lift", "tilt", "clearance", "samples"}, required=set())
+        node = mapping(data, where, {LIFT, TILT, "clearance", "samples"}, required=set())
         polygons = {name: read_polygon(node.get(name), f"{where}.{name}") for name in CHAIN_NAMES}
         clearance = positive(node.get("clearance", DEFAULT_CLEARANCE), f"{where}.clearance", "m")
         samples = read_samples(node.get("samples"), f"{where}.samples")
-        return cls(lift=polygons["lift"], tilt=polygons["tilt"], clearance=clearance, samples=samples)
+        return cls(lift=polygons[LIFT], tilt=polygons[TILT], clearance=clearance, samples=samples)
 
 
 def built_space(crane: Crane, along: float = 0.10, across: float = 0.05) -> MountingSpace:
@@ -134,7 +135,7 @@ def built_space(crane: Crane, along: float = 0.10, across: float = 0.05) -> Moun
         n = np.array([-a[1], a[0]])
         corners = [centre + sa * along * a + sn * across * n for sa, sn in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
         polygons[chain.name] = tuple((float(c[0]), float(c[1])) for c in corners)
-    return MountingSpace(lift=polygons["lift"], tilt=polygons["tilt"])
+    return MountingSpace(lift=polygons[LIFT], tilt=polygons[TILT])
 
 
 def base_pivot(chain: ClosedChain, lengths: LinkLengths) -> tuple[Array, Array]:
@@ -165,7 +166,7 @@ def boom_centre_line(crane: Crane, chain: ClosedChain) -> Array:
     for the lift boom, the telescope cylinder frame {P22} for the tilt boom.
     """
     # the tilt chain's parent is the lift boom: its boom_hinge is given in {B11} already
-    tip = crane.tilt.boom_hinge if chain.name == "lift" else np.asarray(crane.telescope.cylinder_frame.position)
+    tip = crane.tilt.boom_hinge if chain.name == LIFT else np.asarray(crane.telescope.cylinder_frame.position)
     return np.array([[0.0, 0.0], [chain.L1, 0.0], [float(tip[0]), float(tip[1])]])
 
 
@@ -175,7 +176,7 @@ def parent_pins(crane: Crane, chain: ClosedChain) -> dict[str, Array]:
     for other in crane.chains:
         if other.parent == chain.parent and other is not chain:
             pins[f"{other.name} boom hinge"] = other.boom_hinge[:2]
-        if f"{other.name}_boom" == chain.parent:
+        if boom_link(other.name) == chain.parent:
             pins[f"{other.name} boom hinge"] = np.zeros(2)
             pins[f"{other.name} rod-end pivot"] = np.array([other.L1, 0.0])
     return pins

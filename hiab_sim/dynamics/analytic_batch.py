@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.crane.description import Crane
+from hiab_sim.crane.names import cylinder_link, rod_link
 from hiab_sim.dynamics.analytic_planar import PlanarInertia, PlanarModel, planar_model, planar_solve
 from hiab_sim.errors import InvalidInputError
 
@@ -48,7 +49,7 @@ def stacked_model(crane: Crane, xi: Array, samples: int) -> PlanarModel:
     for j, chain in enumerate(crane.chains):
         L, Lc0, Lc = (np.repeat(xi[:, 3 * j + k], samples) for k in range(3))
         ref = chain.default_lengths
-        for link, factor in ((f"{chain.name}_cylinder", (Lc0 + Lc) / ref.x0), (f"{chain.name}_rod", Lc / ref.Lc)):
+        for link, factor in ((cylinder_link(chain.name), (Lc0 + Lc) / ref.x0), (rod_link(chain.name), Lc / ref.Lc)):
             base = default.links[link]
             links[link] = PlanarInertia(
                 mass=base.mass * factor,

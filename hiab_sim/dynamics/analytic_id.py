@@ -39,7 +39,17 @@ from numpy.typing import ArrayLike, NDArray
 
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths
 from hiab_sim.crane.mechanism import check_lengths
-from hiab_sim.crane.names import ACTUATOR_NAMES
+from hiab_sim.crane.names import (
+    ACTUATOR_NAMES,
+    LIFT_BOOM,
+    TELESCOPE_ROD,
+    TILT_BOOM,
+    TILT_CYLINDER,
+    TILT_ROD,
+    boom_link,
+    cylinder_link,
+    rod_link,
+)
 from hiab_sim.dynamics.analytic_kinematics import MOVING_LINKS, CraneMotion, crane_motion
 from hiab_sim.dynamics.analytic_planar import planar_inverse_dynamics, planar_model
 from hiab_sim.dynamics.checks import check_joints, tcp_force_samples
@@ -150,14 +160,14 @@ def spatial_inverse_dynamics(
     motion = crane_motion(crane, lengths, joints.position, joints.velocity, joints.acceleration)
     W = link_wrenches(crane, lengths, motion)
     tcp = crane.tcp_in_telescope_rod
-    rod = motion.links["telescope_rod"]
+    rod = motion.links[TELESCOPE_ROD]
     tcp_point = rod.position + rotate(rod.rotation, np.asarray(tcp.position))
-    W["telescope_rod"] = W["telescope_rod"] - np.concatenate([np.cross(tcp_point, external), external], axis=-1)
+    W[TELESCOPE_ROD] = W[TELESCOPE_ROD] - np.concatenate([np.cross(tcp_point, external), external], axis=-1)
 
-    f_telescope = np.einsum("ti,ti->t", rod.rotation[:, :, 0], W["telescope_rod"][:, 3:])
-    tilt_subtree = W["tilt_boom"] + W["telescope_rod"]
+    f_telescope = np.einsum("ti,ti->t", rod.rotation[:, :, 0], W[TELESCOPE_ROD][:, 3:])
+    tilt_subtree = W[TILT_BOOM] + W[TELESCOPE_ROD]
     f_tilt = _chain_force(crane.tilt, lengths, motion, W, tilt_subtree)
-    lift_subtree = tilt_subtree + W["tilt_cylinder"] + W["tilt_rod"] + W["lift_boom"]
+    lift_subtree = tilt_subtree + W[TILT_CYLINDER] + W[TILT_ROD] + W[LIFT_BOOM]
     f_lift = _chain_force(crane.lift, lengths, motion, W, lift_subtree)
 
     act = motion.actuators
@@ -207,10 +217,10 @@ def _chain_force(
 
     ``boom_subtree``: the summed world wrench of the boom and every link it carries.
     """
-    boom = motion.links[f"{chain.name}_boom"]
-    cylinder = motion.links[f"{chain.name}_cylinder"]
-    rod_wrench = W[f"{chain.name}_rod"]
-    pair = W[f"{chain.name}_cylinder"] + rod_wrench
+    boom = motion.links[boom_link(chain.name)]
+    cylinder = motion.links[cylinder_link(chain.name)]
+    rod_wrench = W[rod_link(chain.name)]
+    pair = W[cylinder_link(chain.name)] + rod_wrench
     hinge, pivot = boom.position, cylinder.position
     rod_end = hinge + boom.rotation[:, :, 0] * chain.L1
     e = cylinder.rotation[:, :, 0]
@@ -270,7 +280,7 @@ def energy_rate(crane: Crane, lengths: LinkLengths, joints: JointSamples, step: 
 def tcp_velocity(crane: Crane, lengths: LinkLengths, joints: JointSamples) -> Array:
     """Linear velocity of the TCP point in {W}, (T, 3) [m/s] (for the power of a TCP force)."""
     motion = crane_motion(crane, lengths, joints.position, joints.velocity, joints.acceleration)
-    rod = motion.links["telescope_rod"]
+    rod = motion.links[TELESCOPE_ROD]
     w, v = rod.twist[:, :3], rod.twist[:, 3:]
     local = v + np.cross(w, np.asarray(crane.tcp_in_telescope_rod.position))
     return rotate(rod.rotation, local)

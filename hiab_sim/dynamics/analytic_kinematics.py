@@ -32,8 +32,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.crane import mechanism
-from hiab_sim.crane.description import LINK_NAMES, ClosedChain, Crane, LinkLengths
+from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths
 from hiab_sim.crane.kinematics import rotation_z
+from hiab_sim.crane.names import BASE, LINK_NAMES, TELESCOPE, TELESCOPE_ROD, boom_link, cylinder_link, rod_link
 from hiab_sim.dynamics.spatial import ad, rotate, twist_to_child
 
 Array = NDArray[np.float64]
@@ -104,7 +105,7 @@ def _add_chain(
     _, k2, _ = mechanism.velocity_ratios(x, xi.L, chain.L1, xi.x0)
     _, dk2, _ = mechanism.velocity_ratio_rates(x, dx, xi.L, chain.L1, xi.x0)
     parent = links[chain.parent]
-    links[f"{chain.name}_boom"] = _child(
+    links[boom_link(chain.name)] = _child(
         parent,
         rotation_z(chain.base_axis_angle + mechanism.boom_rotation(chain, theta)),
         chain.boom_hinge,
@@ -120,10 +121,10 @@ def _add_chain(
         k2 * dx,
         dk2 * dx + k2 * ddx,
     )
-    links[f"{chain.name}_cylinder"] = cylinder
+    links[cylinder_link(chain.name)] = cylinder
     slide = np.zeros((x.shape[0], 3))
     slide[:, 0] = xi.Lc0 + x
-    links[f"{chain.name}_rod"] = _child(cylinder, np.eye(3), slide, _PRISMATIC_X, dx, ddx)
+    links[rod_link(chain.name)] = _child(cylinder, np.eye(3), slide, _PRISMATIC_X, dx, ddx)
     return ActuatorState(x, dx, ddx)
 
 
@@ -138,7 +139,7 @@ def crane_motion(
     """
     n = position.shape[0]
     links = {
-        "base": LinkMotion(
+        BASE: LinkMotion(
             rotation=np.broadcast_to(np.eye(3), (n, 3, 3)),
             position=np.zeros((n, 3)),
             twist=np.zeros((n, 6)),
@@ -159,7 +160,7 @@ def crane_motion(
     R = np.asarray(tele.cylinder_frame.rotation)
     xt2, dxt2, ddxt2 = position[:, 2], velocity[:, 2], acceleration[:, 2]
     p = np.asarray(tele.cylinder_frame.position) + np.outer(tele.rod_offset + xt2, R[:, 0])
-    links["telescope_rod"] = _child(links[tele.parent], R, p, _PRISMATIC_X, dxt2, ddxt2)
-    actuators["telescope"] = ActuatorState(xt2.copy(), dxt2.copy(), ddxt2.copy())
-    del links["base"]
+    links[TELESCOPE_ROD] = _child(links[tele.parent], R, p, _PRISMATIC_X, dxt2, ddxt2)
+    actuators[TELESCOPE] = ActuatorState(xt2.copy(), dxt2.copy(), ddxt2.copy())
+    del links[BASE]
     return CraneMotion(links=links, actuators=actuators)

@@ -30,6 +30,18 @@ from numpy.typing import NDArray
 
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths
 from hiab_sim.crane.mechanism import check_lengths
+from hiab_sim.crane.names import (
+    BASE,
+    LIFT,
+    LIFT_BOOM,
+    LIFT_CYLINDER,
+    LIFT_ROD,
+    TELESCOPE_ROD,
+    TILT,
+    TILT_BOOM,
+    TILT_CYLINDER,
+    TILT_ROD,
+)
 
 Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
@@ -77,10 +89,10 @@ def planar_model(crane: Crane, lengths: LinkLengths) -> PlanarModel:
     tele = crane.telescope
     R0 = np.asarray(tele.cylinder_frame.rotation)
     # Rotation of each link's frame relative to its planar frame (identity but for the telescope rod).
-    relative = {"telescope_rod": R0}
+    relative = {TELESCOPE_ROD: R0}
     groups: dict[str, list[tuple[float, Array, Array]]] = {}
     for body in crane.bodies_for(lengths):
-        if body.link == "base":
+        if body.link == BASE:
             continue
         R = relative.get(body.link, np.eye(3))
         groups.setdefault(body.link, []).append(
@@ -233,14 +245,14 @@ def planar_solve(
 
     g, L = crane.gravity, model.links
     wrench = {
-        "lift_boom": _wrench(lift[0], L["lift_boom"], g),
-        "lift_cylinder": _wrench(lift[1], L["lift_cylinder"], g),
-        "lift_rod": _wrench(lift[2], L["lift_rod"], g),
-        "tilt_boom": _wrench(tilt_boom, L["tilt_boom"], g),
-        "tilt_cylinder": _wrench(tilt[1], L["tilt_cylinder"], g),
-        "tilt_rod": _wrench(tilt[2], L["tilt_rod"], g),
+        LIFT_BOOM: _wrench(lift[0], L[LIFT_BOOM], g),
+        LIFT_CYLINDER: _wrench(lift[1], L[LIFT_CYLINDER], g),
+        LIFT_ROD: _wrench(lift[2], L[LIFT_ROD], g),
+        TILT_BOOM: _wrench(tilt_boom, L[TILT_BOOM], g),
+        TILT_CYLINDER: _wrench(tilt[1], L[TILT_CYLINDER], g),
+        TILT_ROD: _wrench(tilt[2], L[TILT_ROD], g),
     }
-    f_rod, m_rod = _wrench(rod, L["telescope_rod"], g)
+    f_rod, m_rod = _wrench(rod, L[TELESCOPE_ROD], g)
     external = tcp_force[:, 0] + 1j * tcp_force[:, 1]
     tcp_point, _, _ = rod.point(model.tcp)
     f_rod, m_rod = f_rod - external, m_rod - _cross(tcp_point, external)
@@ -249,16 +261,16 @@ def planar_solve(
     def add(*names: str) -> tuple[Complex, Array]:
         return sum(wrench[n][0] for n in names), sum(wrench[n][1] for n in names)  # type: ignore[return-value]
 
-    tilt_sub = (wrench["tilt_boom"][0] + f_rod, wrench["tilt_boom"][1] + m_rod)
-    s_tilt = model.x0["tilt"] + tilt[3][0]
+    tilt_sub = (wrench[TILT_BOOM][0] + f_rod, wrench[TILT_BOOM][1] + m_rod)
+    s_tilt = model.x0[TILT] + tilt[3][0]
     f_tilt = _actuator_force(
-        crane.tilt, tilt_boom, tilt[1], s_tilt, tilt_sub, add("tilt_cylinder", "tilt_rod"), wrench["tilt_rod"][0]
+        crane.tilt, tilt_boom, tilt[1], s_tilt, tilt_sub, add(TILT_CYLINDER, TILT_ROD), wrench[TILT_ROD][0]
     )
-    tilt_all = add("lift_boom", "tilt_cylinder", "tilt_rod")
+    tilt_all = add(LIFT_BOOM, TILT_CYLINDER, TILT_ROD)
     lift_sub = (tilt_all[0] + tilt_sub[0], tilt_all[1] + tilt_sub[1])
-    s_lift = model.x0["lift"] + lift[3][0]
+    s_lift = model.x0[LIFT] + lift[3][0]
     f_lift = _actuator_force(
-        crane.lift, lift[0], lift[1], s_lift, lift_sub, add("lift_cylinder", "lift_rod"), wrench["lift_rod"][0]
+        crane.lift, lift[0], lift[1], s_lift, lift_sub, add(LIFT_CYLINDER, LIFT_ROD), wrench[LIFT_ROD][0]
     )
     force = np.stack([f_lift, f_tilt, f_telescope], axis=1)
     states = [

@@ -5,8 +5,7 @@ The crane reader handles its keys by hand (no dataclass per section), so each ro
 
 from __future__ import annotations
 
-from hiab_sim.crane.description import CHAIN_NAMES
-from hiab_sim.crane.names import ACTUATOR_NAMES
+from hiab_sim.crane.names import ACTUATOR_NAMES, CHAIN_NAMES, TELESCOPE
 from hiab_sim.docs_site.field_specs.rows import Key, free, interval, number, section, section_of, text
 
 
@@ -70,7 +69,7 @@ def crane_keys() -> list[Key]:
     for name in CHAIN_NAMES:
         rows += section_of(f"chains.{name}", f"The {name} chain.", chain)
     rows += [
-        section("telescope", "The telescope: a prismatic joint xt2 along x of the cylinder frame {P22}."),
+        section(TELESCOPE, "The telescope: a prismatic joint xt2 along x of the cylinder frame {P22}."),
         text("telescope.parent", "Link the telescope cylinder is fixed to."),
         *section_of("telescope.cylinder_frame", "{P22} in the parent link frame.", pose),
         number("telescope.rod_offset", "m", "{B52} at (rod_offset + xt2, 0, 0) in {P22}.", allowed="finite"),
