@@ -282,7 +282,7 @@ def test_tracking_band_multipliers_predict_a_wider_band(solved: tuple[StudyProbl
     assert actual == pytest.approx(predicted, rel=0.05)
 
 
-@pytest.mark.slow
+@pytest.mark.e2e
 @pytest.mark.parametrize("name", ["xs031_spiral", "xs031_spiral_payload", "seed_scale_spiral"])
 def test_shipped_studies_print_a_rounded_design_that_mjcf_accepts(
     name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]

@@ -46,7 +46,7 @@ def test_missing_csv_task_exits_2_naming_the_file(tmp_path: Path, capsys: pytest
     assert "nowhere.csv" in capsys.readouterr().err and not out.exists()
 
 
-@pytest.mark.slow
+@pytest.mark.e2e
 def test_csv_written_from_the_spiral_reproduces_the_spiral_study(tmp_path: Path) -> None:
     """The small spiral study and the same study reading its spiral from a 100 Hz CSV reach the same optimum."""
     spiral = study_from_dict(small_study(), tmp_path / "s.yaml")

@@ -52,7 +52,7 @@ def test_default_optimum_holds_on_the_fine_grid_with_the_other_path(result: Resu
     assert recheck.force_difference_between_paths_N <= 1e-6
 
 
-@pytest.mark.slow
+@pytest.mark.e2e
 def test_default_starts_reach_one_optimum(tmp_path: Path) -> None:
     """Three feasible starts converge to the same link lengths within 1e-4 m (a full multi-start study)."""
     multistart = run_study(None, tmp_path, starts=3, progress=None, figures=False).result.multistart

@@ -250,7 +250,7 @@ def test_bad_vars_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str], bad
     assert not any(tmp_path.iterdir())
 
 
-@pytest.mark.slow
+@pytest.mark.e2e
 def test_map_at_a_mix_optimum_reads_every_tasks_trajectory(tmp_path: Path) -> None:
     """At a two-task mix's optimum (its result folder) the map gives the run's weighted costf2, energies, objective.
 

@@ -9,7 +9,7 @@ import pytest
 from hiab_sim.results.schema import Result
 from hiab_sim.study.run import run_study
 
-pytestmark = pytest.mark.slow
+pytestmark = pytest.mark.e2e
 
 
 def _converged_from_three_starts(r: Result) -> None:
@@ -57,6 +57,7 @@ def test_codesign_study_converges_and_saves_more_than_mounting_alone(tmp_path: P
     assert r.energy.optimal.battery_energy_J == pytest.approx(c.codesign_battery_energy_J, rel=1e-9)
 
 
+@pytest.mark.slow
 def test_excavator_digging_from_three_starts_reports_its_optima_ranked_by_battery_energy(tmp_path: Path) -> None:
     """exact_digging from 3 starts: all converge; the optima are listed with their battery objective.
 

@@ -265,7 +265,7 @@ def _same_optimum(
     return a, b
 
 
-@pytest.mark.slow
+@pytest.mark.e2e
 def test_the_imported_xs031_default_study_reaches_the_original_optimum(
     imported: dict[str, tuple[Path, list[float]]], tmp_path: Path
 ) -> None:

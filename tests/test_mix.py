@@ -140,7 +140,7 @@ def solved(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return folder / "out"
 
 
-@pytest.mark.slow
+@pytest.mark.e2e
 def test_two_task_mix_converges_feasible_on_every_task_and_rechecks(solved: Path) -> None:
     """Success, violation <= 1e-6 on every task, re-checked on the fine grid with the other ID path."""
     from hiab_sim.results.read import read_result
@@ -153,7 +153,7 @@ def test_two_task_mix_converges_feasible_on_every_task_and_rechecks(solved: Path
     assert r.optimal.net_electrical_energy_J < r.initial.net_electrical_energy_J
 
 
-@pytest.mark.slow
+@pytest.mark.e2e
 def test_cross_evaluation_is_consistent(solved: Path) -> None:
     """The mix optimum costs the mix no more than any task's optimum; each task's optimum is best on its task."""
     from hiab_sim.results.read import read_result

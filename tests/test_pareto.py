@@ -106,7 +106,7 @@ def test_front_is_monotone_from_the_plain_optimum(plain: tuple[StudyProblem, Sol
     assert front[-1].objective > front[0].objective  # the trade-off is real, not a flat line
 
 
-@pytest.mark.slow
+@pytest.mark.e2e
 def test_front_point_of_a_mix_is_feasible_for_every_task(mix: StudyProblem) -> None:
     """Each accepted point of a two-task mix's front holds every task's rows and its epsilon on every task.
 

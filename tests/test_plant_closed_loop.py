@@ -149,7 +149,7 @@ def test_true_mass_prediction_without_errors_is_the_plans_prediction(crane: Cran
     assert heavier > plan.predicted_net_energy
 
 
-@pytest.mark.slow
+@pytest.mark.e2e
 def test_true_mass_prediction_agrees_with_the_optimiser_on_the_true_crane(tmp_path) -> None:  # type: ignore[no-untyped-def]
     """The same-motion prediction at the true masses equals the optimiser's own energy of that design on the true crane.
 

@@ -116,7 +116,7 @@ def test_a_folder_without_a_result_exits_2(tmp_path: Path, capsys: pytest.Captur
     assert len(err) == 1 and str(tmp_path) in err[0] and "result.json" in err[0]
 
 
-@pytest.mark.slow
+@pytest.mark.sim
 def test_default_study_validates_in_closed_loop(tmp_path: Path) -> None:
     """The closed-loop claims on the default study's lossless variant, both designs, end mass 20 % heavier.
 

@@ -82,7 +82,7 @@ def test_payload_held_at_the_tcp_matches_a_free_vibration_with_a_point_mass(cran
     assert loaded.lowest_Hz[0] < 0.9 * empty.lowest_Hz[0]  # the payload matters
 
 
-@pytest.mark.slow
+@pytest.mark.sim
 def test_second_frequency_matches_a_free_vibration_in_mujoco(crane: Crane, emlas: EmlaSet) -> None:
     """The second mode too: the FFT of its free vibration within 1 % of its eigenvalue."""
     pose = (0.0, -2.0, 0.0)

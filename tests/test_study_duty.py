@@ -143,7 +143,7 @@ def test_the_battery_objective_adds_the_rest_through_the_motoring_branches() -> 
     assert rest_battery_energy([rest], problem.emlas.battery)[0] == pytest.approx(rest / 0.975)
 
 
-@pytest.mark.slow
+@pytest.mark.e2e
 def test_seed_faithful_reproduces_the_paper_model_optimum(tmp_path: Path) -> None:
     """optimize/seed_faithful.yaml (emla: paper) gives the earlier default optimum: Xi within 1e-8 m, energies 1e-9."""
     r = run_study("seed_faithful", tmp_path, progress=None, figures=False).result

@@ -15,7 +15,7 @@ from hiab_sim.study.spec.study_file import load_study, study_from_dict
 ROOT = Path(__file__).resolve().parents[1]
 
 
-@pytest.mark.slow
+@pytest.mark.e2e
 def test_shipped_duty_mix_holds_each_xi_only_row_once() -> None:
     """xs031_duty_mix (three tasks, the crane's working range): 12 buildable-range and 12 working-range rows, not 36."""
     problem = StudyProblem(load_study(ROOT / "optimize" / "xs031_duty_mix.yaml"))
@@ -37,7 +37,6 @@ def test_single_task_study_problem_is_its_task_bit_for_bit() -> None:
     assert problem.constraint_names == task.constraint_names
 
 
-@pytest.mark.slow
 @pytest.mark.e2e
 def test_battery_objective_gives_sensitivities_cross_evaluation_and_costf2_in_their_units(tmp_path: Path) -> None:
     """Two tasks, objective battery_energy: sensitivities, cross-evaluation and costs each in their own unit.
