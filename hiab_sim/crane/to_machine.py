@@ -20,20 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from hiab_sim.crane import names
 from hiab_sim.crane.description import ClosedChain, Crane
-from hiab_sim.crane.names import (
-    BASE,
-    LIFT,
-    TELESCOPE,
-    TELESCOPE_ROD,
-    THETA1,
-    THETA2,
-    TILT,
-    XT2,
-    boom_link,
-    cylinder_link,
-    rod_link,
-)
 from hiab_sim.hydraulics.cylinders import HydraulicSystem
 from hiab_sim.machine.chains import Actuator, Chain, DecisionVariable, Pivot
 from hiab_sim.machine.description import Link, Machine
@@ -41,8 +29,8 @@ from hiab_sim.machine.parts import Pose, RigidBody, mat3, rot_z, vec3
 
 #: Bounds of [L, Lc0, Lc] per chain used when none are given [m] (the shipped XS 031 studies').
 DEFAULT_BOUNDS: dict[str, tuple[tuple[float, float], ...]] = {
-    LIFT: ((0.80, 1.25), (0.04, 0.30), (0.60, 1.00)),
-    TILT: ((0.90, 1.35), (0.04, 0.30), (0.60, 1.00)),
+    names.LIFT: ((0.80, 1.25), (0.04, 0.30), (0.60, 1.00)),
+    names.TILT: ((0.90, 1.35), (0.04, 0.30), (0.60, 1.00)),
 }
 
 
@@ -57,13 +45,13 @@ def _body(crane: Crane, link: str) -> RigidBody | None:
 
 def _boom(crane: Crane, chain: ClosedChain, joint: str) -> Link:
     return Link(
-        name=boom_link(chain.name),
+        name=names.boom_link(chain.name),
         parent=chain.parent,
         joint=joint,
         joint_kind="revolute",
         joint_frame=Pose(vec3(chain.boom_hinge), rot_z(chain.base_axis_angle - chain.joint_offset)),
         joint_range=chain.joint_range,
-        parts=_bodies(crane, boom_link(chain.name)),
+        parts=_bodies(crane, names.boom_link(chain.name)),
     )
 
 
@@ -80,13 +68,13 @@ def _triangle(crane: Crane, chain: ClosedChain, joint: str, bounds: tuple[tuple[
             rod_length=xi.Lc,
             emla=chain.name,
             hydraulic_cylinder=chain.name if crane.hydraulic_cylinders is not None else None,
-            cylinder_body=_body(crane, cylinder_link(chain.name)),
-            rod_body=_body(crane, rod_link(chain.name)),
+            cylinder_body=_body(crane, names.cylinder_link(chain.name)),
+            rod_body=_body(crane, names.rod_link(chain.name)),
             body_scaling="slender",
         ),
         pivots=(
             Pivot("base", chain.parent, chain.cylinder_base_pivot),
-            Pivot("end", boom_link(chain.name), (chain.L1, 0.0, 0.0)),
+            Pivot("end", names.boom_link(chain.name), (chain.L1, 0.0, 0.0)),
         ),
         variables=tuple(
             DecisionVariable(chain.name, name, kind, pivot, low, high)
@@ -109,7 +97,7 @@ def _hydraulic(cylinders: HydraulicSystem | None) -> HydraulicSystem | None:
 
 def machine_from_crane(
     crane: Crane,
-    joints: tuple[str, str, str] = (THETA1, THETA2, XT2),
+    joints: tuple[str, str, str] = (names.THETA1, names.THETA2, names.XT2),
     bounds: dict[str, tuple[tuple[float, float], ...]] | None = None,
 ) -> Machine:
     """The crane as a generic :class:`Machine` (same numbers; see the module docstring)."""
@@ -118,29 +106,29 @@ def machine_from_crane(
     cyl = np.asarray(tele.cylinder_frame.rotation)
     slide_origin = np.asarray(tele.cylinder_frame.position) + cyl @ np.array([tele.rod_offset, 0.0, 0.0])
     links = (
-        Link(BASE, None, "base_mount", "fixed", Pose((0.0, 0.0, 0.0)), None, _bodies(crane, BASE)),
+        Link(names.BASE, None, "base_mount", "fixed", Pose((0.0, 0.0, 0.0)), None, _bodies(crane, names.BASE)),
         _boom(crane, crane.lift, joints[0]),
         _boom(crane, crane.tilt, joints[1]),
         Link(
-            name=TELESCOPE_ROD,
+            name=names.TELESCOPE_ROD,
             parent=tele.parent,
             joint=joints[2],
             joint_kind="prismatic",
             joint_frame=Pose(vec3(slide_origin), mat3(cyl)),
             joint_range=tele.joint_range,
-            parts=_bodies(crane, TELESCOPE_ROD),
+            parts=_bodies(crane, names.TELESCOPE_ROD),
         ),
     )
     telescope = Chain(
-        name=TELESCOPE,
+        name=names.TELESCOPE,
         kind="direct",
         joint=joints[2],
         actuator=Actuator(
             stroke=tele.stroke,
             piston_offset=None,
             rod_length=None,
-            emla=TELESCOPE,
-            hydraulic_cylinder=TELESCOPE if crane.hydraulic_cylinders is not None else None,
+            emla=names.TELESCOPE,
+            hydraulic_cylinder=names.TELESCOPE if crane.hydraulic_cylinders is not None else None,
         ),
     )
     return Machine(
@@ -149,11 +137,11 @@ def machine_from_crane(
         gravity=crane.gravity,
         links=links,
         chains=(
-            _triangle(crane, crane.lift, joints[0], chosen[LIFT]),
-            _triangle(crane, crane.tilt, joints[1], chosen[TILT]),
+            _triangle(crane, crane.lift, joints[0], chosen[names.LIFT]),
+            _triangle(crane, crane.tilt, joints[1], chosen[names.TILT]),
             telescope,
         ),
-        tcp_link=TELESCOPE_ROD,
+        tcp_link=names.TELESCOPE_ROD,
         tcp=Pose(crane.tcp_in_telescope_rod.position, crane.tcp_in_telescope_rod.rotation),
         hydraulic=_hydraulic(crane.hydraulic_cylinders),
     )

@@ -37,19 +37,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hiab_sim.crane import names
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths
 from hiab_sim.crane.mechanism import check_lengths
-from hiab_sim.crane.names import (
-    ACTUATOR_NAMES,
-    LIFT_BOOM,
-    TELESCOPE_ROD,
-    TILT_BOOM,
-    TILT_CYLINDER,
-    TILT_ROD,
-    boom_link,
-    cylinder_link,
-    rod_link,
-)
 from hiab_sim.dynamics.analytic_kinematics import MOVING_LINKS, CraneMotion, crane_motion
 from hiab_sim.dynamics.analytic_planar import planar_inverse_dynamics, planar_model
 from hiab_sim.dynamics.checks import check_joints, tcp_force_samples
@@ -160,22 +150,22 @@ def spatial_inverse_dynamics(
     motion = crane_motion(crane, lengths, joints.position, joints.velocity, joints.acceleration)
     W = link_wrenches(crane, lengths, motion)
     tcp = crane.tcp_in_telescope_rod
-    rod = motion.links[TELESCOPE_ROD]
+    rod = motion.links[names.TELESCOPE_ROD]
     tcp_point = rod.position + rotate(rod.rotation, np.asarray(tcp.position))
-    W[TELESCOPE_ROD] = W[TELESCOPE_ROD] - np.concatenate([np.cross(tcp_point, external), external], axis=-1)
+    W[names.TELESCOPE_ROD] = W[names.TELESCOPE_ROD] - np.concatenate([np.cross(tcp_point, external), external], axis=-1)
 
-    f_telescope = np.einsum("ti,ti->t", rod.rotation[:, :, 0], W[TELESCOPE_ROD][:, 3:])
-    tilt_subtree = W[TILT_BOOM] + W[TELESCOPE_ROD]
+    f_telescope = np.einsum("ti,ti->t", rod.rotation[:, :, 0], W[names.TELESCOPE_ROD][:, 3:])
+    tilt_subtree = W[names.TILT_BOOM] + W[names.TELESCOPE_ROD]
     f_tilt = _chain_force(crane.tilt, lengths, motion, W, tilt_subtree)
-    lift_subtree = tilt_subtree + W[TILT_CYLINDER] + W[TILT_ROD] + W[LIFT_BOOM]
+    lift_subtree = tilt_subtree + W[names.TILT_CYLINDER] + W[names.TILT_ROD] + W[names.LIFT_BOOM]
     f_lift = _chain_force(crane.lift, lengths, motion, W, lift_subtree)
 
     act = motion.actuators
     return ActuatorSamples(
         force=np.stack([f_lift, f_tilt, f_telescope], axis=1),
-        velocity=np.stack([act[n].velocity for n in ACTUATOR_NAMES], axis=1),
-        acceleration=np.stack([act[n].acceleration for n in ACTUATOR_NAMES], axis=1),
-        stroke=np.stack([act[n].stroke for n in ACTUATOR_NAMES], axis=1),
+        velocity=np.stack([act[n].velocity for n in names.ACTUATOR_NAMES], axis=1),
+        acceleration=np.stack([act[n].acceleration for n in names.ACTUATOR_NAMES], axis=1),
+        stroke=np.stack([act[n].stroke for n in names.ACTUATOR_NAMES], axis=1),
     )
 
 
@@ -217,10 +207,10 @@ def _chain_force(
 
     ``boom_subtree``: the summed world wrench of the boom and every link it carries.
     """
-    boom = motion.links[boom_link(chain.name)]
-    cylinder = motion.links[cylinder_link(chain.name)]
-    rod_wrench = W[rod_link(chain.name)]
-    pair = W[cylinder_link(chain.name)] + rod_wrench
+    boom = motion.links[names.boom_link(chain.name)]
+    cylinder = motion.links[names.cylinder_link(chain.name)]
+    rod_wrench = W[names.rod_link(chain.name)]
+    pair = W[names.cylinder_link(chain.name)] + rod_wrench
     hinge, pivot = boom.position, cylinder.position
     rod_end = hinge + boom.rotation[:, :, 0] * chain.L1
     e = cylinder.rotation[:, :, 0]
@@ -280,7 +270,7 @@ def energy_rate(crane: Crane, lengths: LinkLengths, joints: JointSamples, step: 
 def tcp_velocity(crane: Crane, lengths: LinkLengths, joints: JointSamples) -> Array:
     """Linear velocity of the TCP point in {W}, (T, 3) [m/s] (for the power of a TCP force)."""
     motion = crane_motion(crane, lengths, joints.position, joints.velocity, joints.acceleration)
-    rod = motion.links[TELESCOPE_ROD]
+    rod = motion.links[names.TELESCOPE_ROD]
     w, v = rod.twist[:, :3], rod.twist[:, 3:]
     local = v + np.cross(w, np.asarray(crane.tcp_in_telescope_rod.position))
     return rotate(rod.rotation, local)

@@ -63,35 +63,20 @@ from xml.etree import ElementTree
 import mujoco
 import numpy as np
 
-from hiab_sim.crane import mechanism
+from hiab_sim.crane import mechanism, names
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths, RigidBody
 from hiab_sim.crane.mechanism import check_lengths
-from hiab_sim.crane.names import (
-    ACTUATOR_NAMES,
-    BASE,
-    JOINT_NAMES,
-    LIFT,
-    TELESCOPE_CYLINDER,
-    TELESCOPE_ROD,
-    THETA1,
-    THETA2,
-    TILT,
-    XT2,
-    boom_link,
-    cylinder_link,
-    rod_link,
-)
 from hiab_sim.errors import ConfigError
 from hiab_sim.model.drives import HomePose, SlideDrives
 from hiab_sim.resources import mjcf_template
 
 #: Independent joints (qpos equals the source's Θ1, Θ2, xt2) and the actuated slides, in order.
-JOINTS = JOINT_NAMES
-SLIDES = ("x1", "x2", XT2)
-ACTUATORS = ACTUATOR_NAMES
+JOINTS = names.JOINT_NAMES
+SLIDES = ("x1", "x2", names.XT2)
+ACTUATORS = names.ACTUATOR_NAMES
 #: Passive joints of the closed chains: cylinder hinge (seed's q1) and stroke, per chain.
 PASSIVE = ("lift_q1", "x1", "tilt_q1", "x2")
-_CHAIN_JOINT = {LIFT: (THETA1, "x1"), TILT: (THETA2, "x2")}
+_CHAIN_JOINT = {names.LIFT: (names.THETA1, "x1"), names.TILT: (names.THETA2, "x2")}
 
 #: Default equality ``solref`` (timeconst [s], damping ratio) and ``solimp``: see replay.py.
 EQUALITY_SOLREF = (0.002, 1.0)
@@ -162,29 +147,29 @@ def _add_chain(
     hinge_name, slide_name = _CHAIN_JOINT[chain.name]
     theta = ref.get(hinge_name, 0.0)
     boom = parent.add_body(
-        name=boom_link(chain.name),
+        name=names.boom_link(chain.name),
         pos=chain.boom_hinge,
         quat=_quat_z(chain.base_axis_angle - chain.joint_offset + theta),
     )
     boom.add_joint(name=hinge_name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0.0, 0.0, 1.0], ref=theta)
     boom.add_site(name=f"{chain.name}_boom_pivot", pos=[chain.L1, 0.0, 0.0])
-    _set_inertial(boom, links[boom_link(chain.name)])
+    _set_inertial(boom, links[names.boom_link(chain.name)])
     _capsule(boom, np.zeros(3), np.array([chain.L1, 0.0, 0.0]), spec.find_default("boom"))
 
     q1 = ref.get(f"{chain.name}_q1", 0.0)
     cylinder = parent.add_body(
-        name=cylinder_link(chain.name), pos=chain.base_pivot(xi), quat=_quat_z(chain.base_axis_angle + q1)
+        name=names.cylinder_link(chain.name), pos=chain.base_pivot(xi), quat=_quat_z(chain.base_axis_angle + q1)
     )
     cylinder.add_joint(name=f"{chain.name}_q1", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0.0, 0.0, 1.0], ref=q1)
     cylinder.add_site(name=f"{chain.name}_base_pivot")
-    _set_inertial(cylinder, links[cylinder_link(chain.name)])
+    _set_inertial(cylinder, links[names.cylinder_link(chain.name)])
     _capsule(cylinder, np.zeros(3), np.array([xi.x0, 0.0, 0.0]), spec.find_default("barrel"))
 
     stroke = ref.get(slide_name, 0.0)
-    rod = cylinder.add_body(name=rod_link(chain.name), pos=[xi.Lc0 + stroke, 0.0, 0.0])
+    rod = cylinder.add_body(name=names.rod_link(chain.name), pos=[xi.Lc0 + stroke, 0.0, 0.0])
     rod.add_joint(name=slide_name, type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1.0, 0.0, 0.0], ref=stroke)
     rod.add_site(name=f"{chain.name}_rod_end", pos=[xi.Lc, 0.0, 0.0])
-    _set_inertial(rod, links[rod_link(chain.name)])
+    _set_inertial(rod, links[names.rod_link(chain.name)])
     _capsule(rod, np.zeros(3), np.array([xi.Lc, 0.0, 0.0]), spec.find_default("rod"))
 
     add_site_connect(spec, f"{chain.name}_loop", f"{chain.name}_rod_end", f"{chain.name}_boom_pivot")
@@ -220,13 +205,13 @@ def build_spec(
     spec = mujoco.MjSpec.from_string(mjcf_template())
     spec.modelname = crane.name
     spec.option.gravity = [0.0, 0.0, -crane.gravity]
-    base = spec.worldbody.add_body(name=BASE, quat=list(SOURCE_TO_WORLD_QUAT))
-    if BASE in links:
-        _set_inertial(base, links[BASE])
-    bodies = {BASE: base}
+    base = spec.worldbody.add_body(name=names.BASE, quat=list(SOURCE_TO_WORLD_QUAT))
+    if names.BASE in links:
+        _set_inertial(base, links[names.BASE])
+    bodies = {names.BASE: base}
     for point in (
-        *(c.base_pivot(getattr(lengths, c.name)) for c in crane.chains if c.parent == BASE),
-        *(c.boom_hinge for c in crane.chains if c.parent == BASE),
+        *(c.base_pivot(getattr(lengths, c.name)) for c in crane.chains if c.parent == names.BASE),
+        *(c.boom_hinge for c in crane.chains if c.parent == names.BASE),
     ):
         _capsule(base, np.array([point[0], 0.0, 0.0]), point, spec.find_default("boom"))
     _capsule(base, np.array([0.0, -0.6, 0.0]), np.zeros(3), spec.find_default("boom"))
@@ -237,9 +222,9 @@ def build_spec(
         if chain is None:
             raise ConfigError(f"chain parent(s) {[c.parent for c in pending]} are not links of the crane")
         pending.remove(chain)
-        bodies[boom_link(chain.name)] = _add_chain(spec, bodies[chain.parent], chain, lengths, links, ref)
+        bodies[names.boom_link(chain.name)] = _add_chain(spec, bodies[chain.parent], chain, lengths, links, ref)
         parent = bodies[chain.parent]
-        if chain.parent != BASE:
+        if chain.parent != names.BASE:
             _capsule(parent, np.zeros(3), chain.boom_hinge, spec.find_default("boom"))
             _capsule(
                 parent, chain.boom_hinge, chain.base_pivot(getattr(lengths, chain.name)), spec.find_default("boom")
@@ -252,16 +237,16 @@ def build_spec(
     frame = tele.cylinder_frame
     rotation = np.asarray(frame.rotation)
     origin = np.asarray(frame.position)
-    carrier.add_site(name=TELESCOPE_CYLINDER, pos=origin, quat=_quat(rotation))
+    carrier.add_site(name=names.TELESCOPE_CYLINDER, pos=origin, quat=_quat(rotation))
     _capsule(carrier, np.zeros(3), origin, spec.find_default("boom"))
     barrel_end = origin + rotation[:, 0] * (tele.rod_offset + tele.stroke)
     _capsule(carrier, origin, barrel_end, spec.find_default("boom"))
-    xt2 = ref.get(XT2, 0.0)
+    xt2 = ref.get(names.XT2, 0.0)
     rod = carrier.add_body(
-        name=TELESCOPE_ROD, pos=origin + rotation[:, 0] * (tele.rod_offset + xt2), quat=_quat(rotation)
+        name=names.TELESCOPE_ROD, pos=origin + rotation[:, 0] * (tele.rod_offset + xt2), quat=_quat(rotation)
     )
-    rod.add_joint(name=XT2, type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1.0, 0.0, 0.0], ref=xt2)
-    _set_inertial(rod, links[TELESCOPE_ROD])
+    rod.add_joint(name=names.XT2, type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1.0, 0.0, 0.0], ref=xt2)
+    _set_inertial(rod, links[names.TELESCOPE_ROD])
     _capsule(rod, np.zeros(3), np.array([tele.rod_length, 0.0, 0.0]), spec.find_default("barrel"))
     tcp = crane.tcp_in_telescope_rod
     _capsule(rod, np.array([tele.rod_length, 0.0, 0.0]), np.asarray(tcp.position), spec.find_default("barrel"))
@@ -281,7 +266,7 @@ def _add_drives(
     spec: mujoco.MjSpec, crane: Crane, lengths: LinkLengths, drives: SlideDrives, home: HomePose | None
 ) -> None:
     """Armature, damping, stops and EMLA force limits of the simulation model (:mod:`hiab_sim.model.drives`)."""
-    stops: dict[str, tuple[float, float]] = {XT2: (0.0, crane.telescope.stroke)}
+    stops: dict[str, tuple[float, float]] = {names.XT2: (0.0, crane.telescope.stroke)}
     for chain in crane.chains:
         xi = getattr(lengths, chain.name)
         hinge, slide = _CHAIN_JOINT[chain.name]
