@@ -16,7 +16,7 @@ from test_mix import two_tasks
 from test_study_small import small_study
 
 from hiab_sim.emla import EmlaSet
-from hiab_sim.study.nlp.block_registry import register_block, unregister_block
+from hiab_sim.study.constraints.block_registry import register_block, unregister_block
 from hiab_sim.study.nlp.interface import (
     Array,
     PerSampleBlock,

@@ -7,7 +7,7 @@ import pytest
 from test_study_small import small_study
 
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.study.nlp.blocks import ObjectiveBound
+from hiab_sim.study.constraints.blocks import ObjectiveBound
 from hiab_sim.study.nlp.interface import ConstraintBlock, DenseRows, Relaxation, SamplePartials, SampleState
 from hiab_sim.study.nlp.objectives import SquaredPowerCost, make_objective
 from hiab_sim.study.nlp.task_problem import TaskProblem

@@ -17,8 +17,8 @@ from hiab_sim.errors import InvalidInputError
 from hiab_sim.results.energy_sections import TransmissionChoice
 from hiab_sim.results.read import read_result
 from hiab_sim.study.analysis.codesign import combinations, solve_combination, with_transmission
+from hiab_sim.study.constraints.thermal_rows import ThermalLimits
 from hiab_sim.study.nlp.task_problem import TaskProblem
-from hiab_sim.study.nlp.thermal_rows import ThermalLimits
 from hiab_sim.study.spec.study_file import study_from_dict
 
 FLAGS = ["--no-video", "--quiet", "--no-figures"]

@@ -40,7 +40,8 @@ from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.tolerance import round_lengths
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.results.design_values import with_values
-from hiab_sim.study.nlp.blocks import STROKE_SCALE, WorkingRange
+from hiab_sim.study.constraints.blocks import STROKE_SCALE, WorkingRange
+from hiab_sim.study.constraints.mounting_rows import MOUNTING_SCALE, MountingRows
 from hiab_sim.study.nlp.interface import (
     Array,
     ConstraintBlock,
@@ -49,7 +50,6 @@ from hiab_sim.study.nlp.interface import (
     SamplePartials,
     SampleState,
 )
-from hiab_sim.study.nlp.mounting_rows import MOUNTING_SCALE, MountingRows
 
 if TYPE_CHECKING:
     from hiab_sim.study.spec.study_file import Study

@@ -24,10 +24,10 @@ Extending (one module and its registration each, docs/extending.md):
 - a block: subclass :class:`PerSampleBlock` (same rows at every sample, return :class:`SampleRows`)
   or :class:`ConstraintBlock` (return :class:`DenseRows`), give its rows' unit
   (:meth:`ConstraintBlock.relaxation`) and register a factory with
-  :func:`hiab_sim.study.nlp.block_registry.register_block`. An integral row (RMS torque over the duty, a thermal
+  :func:`hiab_sim.study.constraints.block_registry.register_block`. An integral row (RMS torque over the duty, a thermal
   steady state) returns ``DenseRows(dq=(m, K, 3 n), dxi=(m, n_xi))``; a row of Xi only (working
   range, mounting-space polygons) ``DenseRows(dxi=...)``; an epsilon constraint on any objective
-  is :class:`hiab_sim.study.nlp.blocks.ObjectiveBound`.
+  is :class:`hiab_sim.study.constraints.blocks.ObjectiveBound`.
 - an objective: a class with ``name``, ``unit``, ``value`` and ``gradient`` registered with
   :func:`hiab_sim.study.nlp.objectives.register_objective` (:data:`~hiab_sim.study.nlp.objectives.OBJECTIVES`).
 - several tasks: each task's blocks read that task's state; :class:`hiab_sim.study.nlp.problem.StudyProblem`

@@ -26,9 +26,9 @@ Constraints, all scaled to O(1) and written g(z) >= 0 (rows named in :attr:`cons
   theta only, so it is part of ``const_h``), which keeps Lc0 + x + Lc < L + L1;
 * ``const_l``, ``const_m`` hold by construction (the chain is solved from its loop closure).
 
-Each inequality group is a constraint block (:mod:`hiab_sim.study.nlp.blocks`) and the cost an objective
+Each inequality group is a constraint block (:mod:`hiab_sim.study.constraints.blocks`) and the cost an objective
 (:mod:`hiab_sim.study.nlp.objectives`); the block registry
-(:data:`hiab_sim.study.nlp.block_registry.BLOCKS`) lists the blocks once, and row names, row layout,
+(:data:`hiab_sim.study.constraints.block_registry.BLOCKS`) lists the blocks once, and row names, row layout,
 clearances and the Jacobian follow from that list (:class:`~hiab_sim.study.nlp.interface.BlockLayout`).
 
 Gradients: per-sample ID partials by batched central differences (all samples and all 3 n
@@ -52,12 +52,12 @@ from hiab_sim.emla import (
 )
 from hiab_sim.emla.duty_energy import drive_duty
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.study.constraints import blocks as bl
+from hiab_sim.study.constraints import builtin_blocks  # noqa: F401  (registers the built-in blocks, in row order)
+from hiab_sim.study.constraints.block_registry import build_blocks
 from hiab_sim.study.machines.protocol import Design
 from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.motion.spline_chain import SplineChain
-from hiab_sim.study.nlp import blocks as bl
-from hiab_sim.study.nlp import builtin_blocks  # noqa: F401  (registers the built-in blocks, in row order)
-from hiab_sim.study.nlp.block_registry import build_blocks
 from hiab_sim.study.nlp.id_partials import id_joint_partials
 from hiab_sim.study.nlp.interface import (
     Array,
@@ -221,7 +221,7 @@ class TaskProblem(ScaledProblem):
         return np.linspace(0.0, self.task.reference.duration, self.study.grid.fine_factor * intervals + 1)
 
     def _build_blocks(self) -> list[ConstraintBlock]:
-        """The inequality blocks in row order: :data:`hiab_sim.study.nlp.block_registry.BLOCKS` for this task."""
+        """The inequality blocks in row order (:data:`~hiab_sim.study.constraints.block_registry.BLOCKS`)."""
         return build_blocks(self)
 
     # -- variables ---------------------------------------------------------------------------

@@ -45,10 +45,10 @@ from hiab_sim.results.energy_sections import (
     HydraulicVariant,
 )
 from hiab_sim.results.schema import Result
+from hiab_sim.study.constraints.thermal_rows import duty_check
 from hiab_sim.study.nlp.interface import SampleState
 from hiab_sim.study.nlp.objectives import SquaredPowerCost
 from hiab_sim.study.nlp.task_problem import TaskProblem
-from hiab_sim.study.nlp.thermal_rows import duty_check
 from hiab_sim.study.report.duty_section import duty_drives, duty_energy
 
 #: Drive-loss energies reported per actuator when an option of :mod:`hiab_sim.emla.losses` is on

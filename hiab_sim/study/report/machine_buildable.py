@@ -26,8 +26,8 @@ from hiab_sim.machine.design import MachineDesign
 from hiab_sim.results.analysis_sections import Buildable, RoundedCheck
 from hiab_sim.results.schema import DesignSummary
 from hiab_sim.study.analysis.buildable import buildable_working_range, rounded_values
+from hiab_sim.study.constraints.mounting_rows import study_mounting_margins
 from hiab_sim.study.machines.machine_model import MachineModel
-from hiab_sim.study.nlp.mounting_rows import study_mounting_margins
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.report.buildable_section import rounded_recheck
 

@@ -33,8 +33,8 @@ from scipy.optimize import minimize
 
 from hiab_sim.errors import InfeasibleStudyError, InvalidInputError
 from hiab_sim.results.analysis_sections import FeasibilityPhase
+from hiab_sim.study.constraints.blocks import STROKE_SCALE
 from hiab_sim.study.machines.protocol import Design
-from hiab_sim.study.nlp.blocks import STROKE_SCALE
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.solvers.ipopt import solve_ipopt
 from hiab_sim.study.solvers.slsqp import start_points

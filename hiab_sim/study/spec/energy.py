@@ -10,7 +10,7 @@ Three optional top-level keys of a study file, each validated here into a frozen
   duty from its own duration T, so ``rest_ratio`` gives every task the same share of rest (r = 0.2:
   a 50-minute working hour, 60/50 - 1) where one ``rest_time`` cannot. With a duty and an EMLA set
   that has thermal data, the NLP holds the motors' thermal limits
-  (:mod:`hiab_sim.study.nlp.thermal_rows`). ``hold: brake | motor`` says what carries the machine
+  (:mod:`hiab_sim.study.constraints.thermal_rows`). ``hold: brake | motor`` says what carries the machine
   during the rest (:mod:`hiab_sim.emla.hold`); with a duty, the energy and the thermal rows use R_s
   at the winding temperature of EMLAs with ``winding_resistance`` data
   (:mod:`hiab_sim.emla.duty_energy`).

@@ -14,7 +14,7 @@ Each block is a :class:`~hiab_sim.study.nlp.interface.PerSampleBlock` (the same 
   partials w.r.t. the sample's positions and Xi by central differences.
 
 :func:`structure_blocks` builds the blocks a study's ``structure`` section asks for, of a crane file
-(:data:`CRANE_ROWS`) or of a machine file (:data:`~hiab_sim.study.nlp.machine_structure_rows.MACHINE_ROWS`);
+(:data:`CRANE_ROWS`) or of a machine file (:data:`~hiab_sim.study.constraints.machine_structure_rows.MACHINE_ROWS`);
 the base classes hold what the two share (names, rows, relaxations).
 """
 
@@ -33,7 +33,7 @@ from hiab_sim.structure.buckling import buckled_actuators, buckling_samples, uti
 from hiab_sim.structure.natural_frequency import natural_frequencies
 from hiab_sim.structure.pin_loads import pin_forces, pins
 from hiab_sim.structure.settings import StructureSettings
-from hiab_sim.study.nlp.differenced_rows import DifferencedRows
+from hiab_sim.study.constraints.differenced_rows import DifferencedRows
 from hiab_sim.study.nlp.interface import Array, PerSampleBlock, Relaxation, SamplePartials, SampleRows, SampleState
 
 
@@ -221,7 +221,7 @@ def structure_blocks(
     """The structural blocks the study's ``structure`` section asks for (none by default).
 
     ``model``: the crane (``kinds`` :data:`CRANE_ROWS`) or the machine model (``kinds``
-    :data:`~hiab_sim.study.nlp.machine_structure_rows.MACHINE_ROWS`); ``tcp_force``: the task's TCP force
+    :data:`~hiab_sim.study.constraints.machine_structure_rows.MACHINE_ROWS`); ``tcp_force``: the task's TCP force
     per sample [N]; ``payload_kg``: its payload, held at the TCP.
     """
     out: list[PerSampleBlock] = []

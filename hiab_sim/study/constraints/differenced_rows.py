@@ -5,7 +5,7 @@ the samples, all perturbed together as the ID partials are) and differences them
 sample's 3 n inputs (positions, rates, accelerations; positions only when :attr:`uses_rates` is
 false) with the step h = ``step`` max(1, |x|), and in each decision variable with the same rule. The
 structural rows of both a crane file's and a machine file's study are built on it
-(:mod:`hiab_sim.study.nlp.structure_rows`, :mod:`hiab_sim.study.nlp.machine_structure_rows`).
+(:mod:`hiab_sim.study.constraints.structure_rows`, :mod:`hiab_sim.study.constraints.machine_structure_rows`).
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 Each factory takes the :class:`~hiab_sim.study.nlp.task_problem.TaskProblem` being built and returns its
 blocks; :mod:`hiab_sim.study.nlp.task_problem` imports this module once, so these come first in every
-problem's rows and blocks registered later (:func:`~hiab_sim.study.nlp.block_registry.register_block`)
+problem's rows and blocks registered later (:func:`~hiab_sim.study.constraints.block_registry.register_block`)
 follow them.
 """
 
@@ -13,14 +13,14 @@ from typing import Any
 import numpy as np
 
 from hiab_sim.study.analysis.buildable import buildable_blocks
+from hiab_sim.study.constraints import blocks as bl
+from hiab_sim.study.constraints.block_registry import register_block
+from hiab_sim.study.constraints.brake_rows import brake_blocks
+from hiab_sim.study.constraints.machine_structure_rows import MACHINE_ROWS
+from hiab_sim.study.constraints.structure_rows import CRANE_ROWS, structure_blocks
+from hiab_sim.study.constraints.thermal_rows import thermal_blocks
 from hiab_sim.study.motion.workspace import tracked_units
-from hiab_sim.study.nlp import blocks as bl
-from hiab_sim.study.nlp.block_registry import register_block
-from hiab_sim.study.nlp.brake_rows import brake_blocks
 from hiab_sim.study.nlp.interface import ConstraintBlock, PerSampleBlock
-from hiab_sim.study.nlp.machine_structure_rows import MACHINE_ROWS
-from hiab_sim.study.nlp.structure_rows import CRANE_ROWS, structure_blocks
-from hiab_sim.study.nlp.thermal_rows import thermal_blocks
 
 
 def _tracking(p: Any) -> list[ConstraintBlock]:

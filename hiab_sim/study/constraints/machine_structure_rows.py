@@ -1,6 +1,6 @@
 """Structural rows of a machine file's NLP: screw buckling, pin peak loads, the lowest natural frequency.
 
-The rows of :mod:`hiab_sim.study.nlp.structure_rows` for a study of a machine file (``machine:``),
+The rows of :mod:`hiab_sim.study.constraints.structure_rows` for a study of a machine file (``machine:``),
 through the machine's description and Newton-Euler path instead of the crane's closed form:
 
 * :class:`MachineBucklingRows` (``structure.buckling``): 1 - n f / P_cr(s) >= 0 per actuator with
@@ -28,9 +28,14 @@ from hiab_sim.machine.dynamics.paths import make_machine_dynamics
 from hiab_sim.structure.buckling import critical_load
 from hiab_sim.structure.machine_modes import machine_natural_frequencies
 from hiab_sim.structure.machine_structure import machine_pin_loads
+from hiab_sim.study.constraints.structure_rows import (
+    BucklingRowsBase,
+    FrequencyRowsBase,
+    PinLoadRowsBase,
+    StructureRowKinds,
+)
 from hiab_sim.study.machines.machine_model import MachineModel
 from hiab_sim.study.nlp.interface import Array, SamplePartials, SampleRows, SampleState
-from hiab_sim.study.nlp.structure_rows import BucklingRowsBase, FrequencyRowsBase, PinLoadRowsBase, StructureRowKinds
 
 
 def _retracted_partials(model: MachineModel, chain: Any) -> Array:
