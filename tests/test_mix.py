@@ -171,6 +171,25 @@ def test_cross_evaluation_is_consistent(solved: Path) -> None:
     assert cross.mix_energy_lost_J[-1] == 0.0
 
 
+@pytest.mark.e2e
+def test_summary_says_when_the_cross_evaluation_drives_the_mix_design_for_less(solved: Path) -> None:
+    """The two-task mix's solve keeps a trajectory of its second task 1.8 % above the fit's: the answer says so.
+
+    The line's percentage is the cross-evaluation's weighted objective against the optimum's own.
+    """
+    from hiab_sim.results.read import read_result
+    from hiab_sim.study.report.summary import summary_lines
+
+    pytest.importorskip("casadi")
+    r = read_result(solved)
+    assert r.cross_evaluation is not None and r.cross_evaluation.mix_objective_value is not None
+    assert r.sensitivity is not None
+    driven, own = r.cross_evaluation.mix_objective_value[-1], r.sensitivity.objective_value
+    assert driven is not None and driven < own * (1.0 - 1e-3)
+    (line,) = [line for line in summary_lines(r, solved) if line.startswith("Local optimum")]
+    assert f"costs {100.0 * (own - driven) / own:.2g} % less" in line
+
+
 @pytest.mark.slow
 def test_duty_mix_converges_from_the_built_crane_and_three_starts_agree(tmp_path: Path) -> None:
     """The shipped duty mix: violation <= 1e-6 on every task (fine grid, other ID path); 3 starts agree or listed."""
