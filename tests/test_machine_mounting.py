@@ -182,6 +182,7 @@ def _study_with(folder: Path, mounting: object) -> Path:
         ({"bucket": {"base": [*TRI[:2], [0.4, 0.1], TRI[2]]}}, InvalidInputError, r"mounting\.bucket\.base.*convex"),
         ({"bucket": {"base": [[float("nan"), 0.0], *TRI[1:]]}}, InvalidInputError, r"mounting\.bucket\.base.*finite"),
         ({"bucket": {"base": TRI[:2]}}, InvalidInputError, r"mounting\.bucket\.base.*at least 3"),
+        ({"bucket": {"base": None}}, ConfigError, r"mounting\.bucket\.base: expected a list"),
         ({"clearance": -0.01}, (ConfigError, InvalidInputError), r"mounting\.clearance"),
         ({"samples": 1}, InvalidInputError, r"mounting\.samples"),
     ],

@@ -32,8 +32,8 @@ Rows, for every pivot a decision variable moves (the "moved pivots"), in chain a
   make the active set degenerate).
 * **Swept link** (a pivot on the parent P of the link D its chain's revolute joint turns): the
   smallest distance, minus the clearance, from p to D's centre line over D's working range: the
-  polyline from D's hinge through D's pins (chain pivots on D and the hinges of D's children) in
-  order of distance from the hinge, turned by the joint at ``samples`` points of its range
+  polyline from D's hinge through D's points (chain pivots on D and the joint frames of D's
+  children, a slide's too) in order of distance from the hinge, turned by the joint at ``samples`` points of its range
   (c = h + Rz(phi + q) c_D in P, :func:`hiab_sim.machine.kinematics.closure.chain_geometry`). A
   pin of D that a variable moves moves the line: the closest point c = a + t (b - a) carries
   dc/dv = (1 - t) da/dv + t db/dv (t fixed to first order).
@@ -52,7 +52,7 @@ from typing import Any
 
 import numpy as np
 
-from hiab_sim.errors import InvalidInputError
+from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.machine import mounting_geometry as geometry
 from hiab_sim.machine.chains import Chain
 from hiab_sim.machine.description import Machine
@@ -114,7 +114,8 @@ class MachineMountingSpace:
                         + f"); moved pivots: {', '.join(f'{c}.{r}' for c, r in moved) or 'none'}",
                     )
                 polygon = geometry.read_polygon(vertices, f"{where}.{name}.{role}")
-                assert polygon is not None
+                if polygon is None:  # an empty key: YAML's null
+                    raise ConfigError(f"{where}.{name}.{role}: expected a list of [x, y] vertices, got None")
                 polygons.append((name, role, polygon))
         clearance = positive(node.get("clearance", geometry.DEFAULT_CLEARANCE), f"{where}.clearance", "m")
         return cls(tuple(polygons), clearance, geometry.read_samples(node.get("samples"), f"{where}.samples"))
