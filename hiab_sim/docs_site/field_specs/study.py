@@ -11,6 +11,7 @@ from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.docs_site.dataclass_fields import field_rows
 from hiab_sim.docs_site.field_specs.references import control_points_key, payload_keys, reference_keys, soil_keys
 from hiab_sim.docs_site.field_specs.rows import Key, free, from_class, in_form, names, number, section, section_of, text
+from hiab_sim.machine.mounting_geometry import DEFAULT_CLEARANCE, DEFAULT_SAMPLES
 
 
 def _structure_keys() -> list[Key]:
@@ -54,12 +55,12 @@ def _mounting_keys() -> list[Key]:
             "m",
             "Centre-to-centre clearance from other pins and the swept boom (machine form: the swept link).",
             allowed="> 0",
-            default="0.05",
+            default=f"{DEFAULT_CLEARANCE:g}",
         ),
         Key(
             "mounting.samples",
             type="integer",
-            default="(built in)",
+            default=str(DEFAULT_SAMPLES),
             allowed=">= 2",
             description="Joint samples over the working range for the boom (link) clearance.",
         ),
