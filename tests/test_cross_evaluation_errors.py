@@ -75,3 +75,33 @@ def test_without_casadi_an_ipopt_study_exits_2_naming_the_extra(
     err = capsys.readouterr().err
     assert "hiab-sim[ipopt]" in err and len(err.strip().splitlines()) == 1
     assert not (out / "result.json").exists()
+
+
+def test_the_best_of_two_starts_answers_when_one_start_fails_and_raises_when_both_do(
+    mix: StudyProblem, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A start whose solve raises leaves the other to answer; when every start raises, the first error is raised."""
+    import numpy as np
+
+    from hiab_sim.errors import InvalidInputError, SolverError
+    from hiab_sim.study.analysis import cross_evaluation as module
+
+    task = mix.problems[0]
+    start = mix.study.initial_lengths
+    fitted = task.initial_point(start)
+
+    def fake(problem: object, lengths: object, coefficients: object) -> tuple[np.ndarray, bool, str]:
+        if coefficients is None:
+            raise SolverError("the fit's start failed")
+        return fitted, True, "from its own trajectory"
+
+    monkeypatch.setattr(module, "fixed_lengths_optimum", fake)
+    z, message = module.best_fixed_lengths_optimum(mix, task, start, [None, np.zeros(3)])
+    assert message == "from its own trajectory" and np.array_equal(z, fitted)
+
+    def failing(problem: object, lengths: object, coefficients: object) -> tuple[np.ndarray, bool, str]:
+        raise (InvalidInputError("lift.L", 0.05, "no triangle") if coefficients is None else SolverError("second"))
+
+    monkeypatch.setattr(module, "fixed_lengths_optimum", failing)
+    with pytest.raises(InvalidInputError, match=r"lift\.L"):
+        module.best_fixed_lengths_optimum(mix, task, start, [None, np.zeros(3)])

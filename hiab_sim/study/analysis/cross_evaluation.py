@@ -80,12 +80,24 @@ def best_fixed_lengths_optimum(
     The fixed-Xi NLP is not convex: on the two-task test study the mix optimum's own trajectory of its
     second task is a local optimum 1.8 % above the one IPOPT reaches from the inverse-kinematics fit
     at the same Xi. ``rows`` is the task's NLP whose violation decides feasibility (:data:`FEASIBLE`);
-    with no feasible end, the first start's end (and its message) is returned.
+    with no feasible end, the first finished start's end (and its message) is returned. A start whose
+    solve raises (a design outside the model's domain, a failed solve) leaves the others to answer;
+    when every start raises, the first error is raised.
     """
-    ends = [fixed_lengths_optimum(problem, lengths, start) for start in starts]
-    feasible = [(z, message) for z, _, message in ends if rows.max_violation(z) <= FEASIBLE]
+    ends: list[tuple[Array, str]] = []
+    errors: list[InvalidInputError | SolverError] = []
+    for start in starts:
+        try:
+            z, _, message = fixed_lengths_optimum(problem, lengths, start)
+        except (InvalidInputError, SolverError) as error:
+            errors.append(error)
+        else:
+            ends.append((z, message))
+    if not ends:
+        raise errors[0]
+    feasible = [end for end in ends if rows.max_violation(end[0]) <= FEASIBLE]
     if not feasible:
-        return ends[0][0], ends[0][2]
+        return ends[0]
     return min(feasible, key=lambda end: rows.evaluate(end[0]).cost)
 
 
