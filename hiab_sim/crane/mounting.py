@@ -222,8 +222,7 @@ def clearance_margins(space: MountingSpace, crane: Crane, lengths: LinkLengths) 
 
 def mounting_margins(space: MountingSpace, crane: Crane, lengths: LinkLengths) -> Margins:
     """All mounting rows: the polygons (if given) then the clearances."""
-    a, b = polygon_margins(space, crane, lengths), clearance_margins(space, crane, lengths)
-    return Margins(a.names + b.names, np.concatenate([a.values, b.values]), np.vstack([a.jacobian, b.jacobian]))
+    return Margins.stacked([polygon_margins(space, crane, lengths), clearance_margins(space, crane, lengths)], 6)
 
 
 __all__ = [

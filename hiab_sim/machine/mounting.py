@@ -202,7 +202,8 @@ def machine_mounting_margins(space: MachineMountingSpace, machine: Machine, valu
     for name, role in moved_pivots(machine):
         chain = machine.chain(name)
         pivot = chains[name].pivot(role)
-        me = next(pin for c, r, pin in _pivot_pins(machine, chains, pivot.link, n) if (c, r) == (name, role))
+        on_link = _pivot_pins(machine, chains, pivot.link, n)
+        me = next(pin for c, r, pin in on_link if (c, r) == (name, role))
         where = f"mounting.{name} {role} pivot"
         polygon = space.polygon(name, role)
         if polygon is not None:
@@ -213,7 +214,7 @@ def machine_mounting_margins(space: MachineMountingSpace, machine: Machine, valu
         driven = machine.joint_link(chain.joint)
         swept = chain.kind != "direct" and driven.joint_kind == "revolute" and driven.parent == pivot.link
         pins = [pin for joint, pin in _hinges(machine, pivot.link, n) if not (swept and joint == chain.joint)]
-        pins += [pin for c, r, pin in _pivot_pins(machine, chains, pivot.link, n) if (c, r) != (name, role)]
+        pins += [pin for c, r, pin in on_link if (c, r) != (name, role)]
         for pin in pins:
             d, grad = geometry.point_distance(me.xy, pin.xy)
             clearance_part[0].append(f"{where} clear of the {pin.label}")
