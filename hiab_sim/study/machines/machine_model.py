@@ -38,7 +38,7 @@ from hiab_sim.machine.dynamics.paths import make_machine_dynamics
 from hiab_sim.machine.kinematics.closure import joint_to_stroke, stroke_to_joint
 from hiab_sim.machine.kinematics.tracked import TrackedKinematics
 from hiab_sim.machine.kinematics.tracked import inverse_kinematics as tracked_ik
-from hiab_sim.study.machines.machine_strokes import StrokeRows
+from hiab_sim.study.machines.machine_strokes import StrokeRows, chains_with_strokes
 from hiab_sim.study.machines.protocol import PointReach
 from hiab_sim.study.motion import trajectory as tr
 
@@ -148,13 +148,13 @@ class MachineModel:
     @property
     def stroke_chains(self) -> tuple[str, ...]:
         """The triangle and linkage chains."""
-        return tuple(c.name for c in self.machine.chains if c.kind != "direct")
+        return tuple(c.name for c in chains_with_strokes(self.machine))
 
     @property
     def stroke_joints(self) -> tuple[int, ...]:
         """Each stroke chain's joint index."""
         names = self.joint_names
-        return tuple(names.index(c.joint) for c in self.machine.chains if c.kind != "direct")
+        return tuple(names.index(c.joint) for c in chains_with_strokes(self.machine))
 
     @property
     def default_design(self) -> MachineDesign:
@@ -225,7 +225,7 @@ class MachineModel:
             raise InvalidInputError(field, stroke_margin, "must be a finite length >= 0", "m")
         ranges = self.joint_ranges()
         out = []
-        for chain, j in zip(self._stroke_chain_list(self.machine), self.stroke_joints, strict=True):
+        for chain, j in zip(chains_with_strokes(self.machine), self.stroke_joints, strict=True):
             lo, hi = ranges[j]
             if stroke_margin == 0.0:
                 out.append((lo, hi))
@@ -292,9 +292,6 @@ class MachineModel:
     def stroke_margin_partials(self, design: Any, q: Array) -> tuple[Array, Array]:
         """Exact partials of :meth:`stroke_margins` w.r.t. q (K, 3 m, n) and Xi (K, 3 m, n_xi)."""
         return self.__dict__["_strokes"].partials(design, q)
-
-    def _stroke_chain_list(self, machine: Machine) -> list[Any]:
-        return [c for c in machine.chains if c.kind != "direct"]
 
     # -- inverse kinematics ---------------------------------------------------------------
 

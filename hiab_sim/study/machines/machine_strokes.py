@@ -26,6 +26,11 @@ Array = NDArray[np.float64]
 CACHE_SIZE = 256
 
 
+def chains_with_strokes(machine: Machine) -> list[Chain]:
+    """The chains with a stroke row of their own (``triangle``, ``linkage``), in the machine's order."""
+    return [c for c in machine.chains if c.kind != "direct"]
+
+
 def _variable_map(chain: Chain, keys: tuple[str, ...]) -> tuple[list[int], Array, Array]:
     """Per variable of a stroke chain: its column in Xi, whether it moves the stroke (1 or 0), d(rod)/dv.
 
@@ -48,7 +53,7 @@ class StrokeRows:
 
     def __init__(self, machine: Machine, joints: tuple[int, ...]) -> None:
         self.machine = machine
-        self.chains = [c for c in machine.chains if c.kind != "direct"]
+        self.chains = chains_with_strokes(machine)
         self.joints = joints
         keys = tuple(machine.variable_keys)
         self.n_xi = len(keys)
