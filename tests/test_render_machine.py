@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import mujoco
@@ -10,6 +11,7 @@ import pytest
 from machine_result_helper import excavator_result
 
 from hiab_sim.cli import main
+from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.dynamics.mjcf_build import build_machine_model
 from hiab_sim.machine.kinematics.forward import forward_kinematics
 from hiab_sim.model.mjcf import SOURCE_TO_WORLD
@@ -78,6 +80,29 @@ def test_render_refuses_simulate_on_a_machine_result(
 
 
 @pytest.mark.sim
+@pytest.mark.skipif(shutil.which("ffmpeg") is None, reason="needs Debian ffmpeg (scripts/setup.sh installs it)")
+def test_render_result_plays_a_machine_result_as_optimize_does(run_dir: Path, tmp_path: Path) -> None:
+    """``render_result``, the call ``optimize`` makes after a run, takes a machine file's result: one frame a tick.
+
+    It read every result as a crane file's and failed on the machine designs' form, so ``optimize``
+    of a machine study without ``--no-video`` exited 2 after writing its result.
+    """
+    import mediapy
+
+    from hiab_sim.render import render_result
+    from hiab_sim.render.machine_playback import load_machine_playback
+    from hiab_sim.render.playback import frame_times
+
+    output = render_result(run_dir, tmp_path / "clip.mp4", fps=4.0, size=(160, 120))
+    assert output == tmp_path / "clip.mp4"
+    assert len(mediapy.read_video(output)) == len(frame_times(load_machine_playback(run_dir).time, 4.0))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["clip.mp4"]
+    with pytest.raises(InvalidInputError, match="kinematic only"):
+        render_result(run_dir, tmp_path / "sim.mp4", mode="simulate")
+    assert not (tmp_path / "sim.mp4").exists()
+
+
+@pytest.mark.sim
 @pytest.mark.parametrize("design", ["initial", "optimal"])
 def test_mjcf_from_machine_result_is_that_design(run_dir: Path, design: str, tmp_path: Path) -> None:
     """``mjcf --from-result RUN --design D`` writes the design the result stores (pins where the builder puts them)."""
@@ -91,6 +116,37 @@ def test_mjcf_from_machine_result_is_that_design(run_dir: Path, design: str, tmp
     written = mujoco.MjModel.from_xml_path(str(out))
     np.testing.assert_allclose(written.site_pos, expected.site_pos, atol=1e-15)
     np.testing.assert_allclose(written.body_pos, expected.body_pos, atol=1e-15)
+
+
+@pytest.mark.sim
+def test_a_result_design_past_its_bound_by_the_solvers_tolerance_renders_and_exports(
+    run_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """IPOPT may end 1e-8 relative past a bound: the result's design still renders and exports; a user's does not.
+
+    The shipped digging study's optimum has boom.Lc 7.5e-9 m under its 0.47 m bound; ``optimize``
+    then failed in its video. Designs read from a result are the solver's (its bounds, its tolerance);
+    a design typed on the command line is checked against the file's bounds.
+    """
+    import json
+    import shutil as files
+
+    from hiab_sim.machine.loader import load_machine
+
+    folder = tmp_path / "past_bound"
+    files.copytree(run_dir, folder)
+    document = json.loads((folder / "result.json").read_text(encoding="utf-8"))
+    variable = load_machine("exact").decision_variables[2]
+    past = variable.low - 5e-9 * max(1.0, abs(variable.low))
+    document["optimal"]["lengths"]["values"][2] = past
+    (folder / "result.json").write_text(json.dumps(document), encoding="utf-8")
+    assert main(["mjcf", "--from-result", str(folder), "-o", str(tmp_path / "m.xml")]) == 0
+    assert main(["render", str(folder), "--still", str(tmp_path / "s.png"), "--size", "160x120"]) == 0
+    capsys.readouterr()
+    typed = ["mjcf", "--machine", "exact", "--design", f"{variable.key}={past!r}", "-o", str(tmp_path / "u.xml")]
+    assert main(typed) == 2
+    assert variable.key in capsys.readouterr().err
+    assert not (tmp_path / "u.xml").exists()
 
 
 @pytest.mark.sim

@@ -50,7 +50,7 @@ def run_machine(args: argparse.Namespace, result_choice: str | None) -> int:
     output = Path(args.output)
     if not output.parent.is_dir():
         raise InvalidInputError("--output", str(output), "its folder must exist")
-    text = machine_mjcf(machine, design)
+    text = machine_mjcf(machine, design, check_bounds=result_choice is None)  # a result's: the solver's bounds
     model = mujoco.MjModel.from_xml_string(text)
     write_atomic(output, text)
     values = ", ".join(f"{k} = {v:.10g}" for k, v in zip(machine.variable_keys, design, strict=True))

@@ -100,12 +100,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote still frame: {path}")
         return 0
     output = Path(args.output) if args.output else None
-    if machine:
-        from hiab_sim.render.machine_video import render_machine_result
-
-        path = render_machine_result(args.result_dir, output, fps=args.fps, size=args.size, layout=args.layout)
-    else:
-        path = render_result(args.result_dir, output, fps=args.fps, size=args.size, mode=args.mode, layout=args.layout)
+    path = render_result(args.result_dir, output, fps=args.fps, size=args.size, mode=args.mode, layout=args.layout)
     print(f"wrote {args.mode} playback: {path} ({time.perf_counter() - start:.1f} s)")
     return 0
 

@@ -302,7 +302,7 @@ def moved_pivots(machine: Machine, designs: list[Array]) -> tuple[str, ...]:
     A base or rocker pivot is the origin of body ``<chain>.cylinder`` / ``<chain>.rocker``; an end or
     coupler pivot is site ``<pin>.b`` of the pin closing on it (:mod:`hiab_sim.machine.dynamics.tree`).
     """
-    built = [machine.with_design(d) for d in designs]
+    built = [machine.with_design(d, check_bounds=False) for d in designs]  # a result's: the solver's bounds
     names = {"base": "{}.cylinder", "rocker": "{}.rocker", "end": "{}.end_pin.b", "coupler": "{}.coupler_pin.b"}
     marks = []
     for chain in machine.chains:

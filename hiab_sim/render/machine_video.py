@@ -49,7 +49,7 @@ def machine_renderer(
     for motion in data.designs:
         model, qpos = machine_model_and_qpos(data.machine, motion.design, resample(data.time, motion.position, at))
         caption, notes = design_texts(motion.name, layout, data, at, motion.power)
-        dress = machine_file_dress(model, data.machine.with_design(motion.design), data.ground)
+        dress = machine_file_dress(model, data.machine.with_design(motion.design, check_bounds=False), data.ground)
         designs.append(
             Design(
                 motion.name, model, qpos, design_rgba(motion.name), caption, notes,

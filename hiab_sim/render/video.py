@@ -231,7 +231,10 @@ def render_result(
     layout: Layout = DEFAULT_LAYOUT,
     progress: Callable[[int, int], None] | None = None,
 ) -> Path:
-    """Render the playback video (.mp4, or .gif) of a result folder; return its path.
+    """Render the playback video (.mp4 or .gif) of a crane file's or a machine file's result folder; return its path.
+
+    A machine file's result (:func:`~hiab_sim.render.machine_playback.is_machine_result`) is drawn by
+    :func:`~hiab_sim.render.machine_video.render_machine_result`, kinematic only.
 
     Args:
         result_dir: folder written by ``hiab-sim optimize`` (``result.json``, ``trajectory.npz``).
@@ -244,10 +247,19 @@ def render_result(
         progress: called with (frames done, frames in all) after each frame.
 
     Raises:
-        HiabSimError: bad result folder or output path, no OpenGL backend, no ffmpeg.
+        HiabSimError: bad result folder or output path, no OpenGL backend, no ffmpeg; ``mode``
+            ``"simulate"`` for a machine file's result.
 
     """
+    from hiab_sim.render.machine_playback import is_machine_result
+
     check_gl_backend()
+    if is_machine_result(result_dir):
+        if mode != "kinematic":
+            raise InvalidInputError("--mode", mode, "a machine file's result plays back kinematic only")
+        from hiab_sim.render.machine_video import render_machine_result
+
+        return render_machine_result(result_dir, output, fps, size, layout, progress)
     data = load_playback(result_dir)
     output = Path(result_dir) / VIDEO_NAME if output is None else Path(output)
     _check_size(size, even=output.suffix.lower() == ".mp4")
