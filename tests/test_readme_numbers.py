@@ -63,3 +63,46 @@ def test_the_plant_effect_rows_are_the_recorded_runs_compact_tables() -> None:
         assert _row(f"{label}: battery energy") == energy, label
         assert _row(f"{label}: TCP max error") == tcp, label
         assert all(cell == "yes" for cell in by_first["optimum stays cheaper (at the battery)"]), label
+
+
+def _result(run: str) -> dict:
+    """The ``result`` of a recorded run (``docs/results/data/<run>.json``)."""
+    return json.loads((DATA / f"{run}.json").read_text())["result"]
+
+
+def _prose() -> str:
+    """The README's text with its line breaks joined (a sentence may wrap)."""
+    return " ".join((ROOT / "README.md").read_text().split())
+
+
+def test_the_prose_numbers_are_the_recorded_runs() -> None:
+    """The answer, the default study's iterations and both excavator studies' energies, rounded as printed.
+
+    The README once said "the same 33 iterations" while the recorded default run took 29: prose
+    numbers outside the tables drift unless something reads them back.
+    """
+    text = _prose()
+    spiral = _result("xs031_spiral")
+    built = spiral["buildable"]["lengths"]
+    lift, tilt = (" / ".join(f"{built[c][k]:.3f}" for k in ("L", "Lc0", "Lc")) for c in ("lift", "tilt"))
+    assert f"lift L / Lc0 / Lc = {lift} m and tilt {tilt} m" in text
+    energy = spiral["energy"]
+    assert (
+        f"{energy['initial']['battery_energy_J'] / 1e3:.2f} kJ per duty period before and "
+        f"{energy['optimal']['battery_energy_J'] / 1e3:.2f} kJ after (−{energy['battery_energy_saved_percent']:.1f} %)"
+    ) in text
+    assert f"the same {spiral['solver']['iterations']} iterations" in text
+    lift = energy["optimal"]["thermal"]["lift"]
+    assert f"runs at {lift['peak_winding_temperature_C']:.0f} °C (RMS torque {lift['rms_torque_Nm']:.1f} of" in text
+    hydraulic = spiral["hydraulic_baseline"]["optimal"]
+    at = {k: v["cycle_battery_energy_J"] / 1e3 for k, v in hydraulic["at_battery"].items()}
+    assert f"the EMLAs take {hydraulic['emla_cycle_battery_energy_J'] / 1e3:.1f} kJ" in text
+    assert f"would take {at['load_sensing']:.1f} kJ (load sensing" in text
+    assert f"or {at['constant_pressure']:.1f} kJ (constant pressure)" in text
+    assert f"(one electro-hydraulic actuator each) {at['pump_controlled']:.1f} kJ" in text
+    for run, unit, digits in (("exact_digging", "kJ per duty period", 1), ("exact_duty_mix", "kJ per working hour", 0)):
+        e = _result(run)["energy"]
+        before, after = (e[d]["battery_energy_J"] / 1e3 for d in ("initial", "optimal"))
+        assert f"{before:.{digits}f} → {after:.{digits}f} {unit} (−{e['battery_energy_saved_percent']:.1f} %" in text, (
+            run
+        )
