@@ -47,7 +47,10 @@ def build_parser() -> argparse.ArgumentParser:
     """Return the top-level parser with every subcommand registered."""
     parser = argparse.ArgumentParser(
         prog="hiab-sim",
-        description="Energy-optimal mounting of electromechanical linear actuators on HIAB loader cranes.",
+        description=(
+            "Energy-optimal mounting of electromechanical linear actuators on planar parallel-serial machines "
+            "(loader cranes, excavator arms): the HIAB XS 031 and the eXact arm ship, any other is a machine file."
+        ),
     )
     parser.add_argument("--version", action="version", version=f"hiab-sim {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")

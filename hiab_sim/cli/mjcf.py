@@ -1,4 +1,4 @@
-"""``hiab-sim mjcf``: write the MJCF crane model for a link-length set.
+"""``hiab-sim mjcf``: write the MJCF model of a crane file or a machine file for one design.
 
 ``--lengths`` takes six numbers in metres, comma-separated, lift chain first:
 ``L,Lc0,Lc,L,Lc0,Lc`` (seed eq. Xi). The file is written atomically (a temporary file in the
@@ -44,10 +44,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register the subcommand."""
     parser = subparsers.add_parser(
         "mjcf",
-        help="write the MJCF crane model for a link-length set",
+        help="write the MJCF model of a machine for one design",
         description=(
-            "Write the MuJoCo MJCF model of the crane for one set of link lengths: the closed chains as connect "
-            "equalities, the EMLAs as stroke servos around the home pose, and cameras that frame the machine. "
+            "Write the MuJoCo MJCF model of a crane file (--crane, --lengths) or a machine file (--machine, --design) "
+            "for one design: the closed chains as connect equalities, the EMLAs as stroke servos around the home "
+            "pose (a machine file's: force motors), and cameras that frame the machine. "
             "Opens in 'python -m mujoco.viewer --mjcf=FILE'."
         ),
     )

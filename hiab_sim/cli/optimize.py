@@ -1,4 +1,4 @@
-"""``hiab-sim optimize``: energy-optimal link lengths of both closed chains.
+"""``hiab-sim optimize``: energy-optimal actuator mounting (every chain's decision variables) of a study.
 
 Runs a study (default ``optimize/xs031_spiral.yaml``) with SQP, prints one line per iteration to
 stderr with ``--verbose``, and writes ``result.json``, ``trajectory.npz``, the figures, the playback
@@ -33,12 +33,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register the subcommand."""
     parser = subparsers.add_parser(
         "optimize",
-        help="Optimise the link lengths of both closed chains for least EMLA energy.",
+        help="Optimise the actuators' mounting (every chain's decision variables) for least EMLA energy.",
         description=(
             "Minimise the seed paper's squared-power cost (costf2 = 1/2 Dt sum over samples of the squared total "
             "EMLA electrical power, in W^2 s; a smooth stand-in for energy, not an energy) over "
-            "both chains' link lengths and the B-spline joint trajectory, subject to inverse dynamics, TCP "
-            "tracking of a spiral, the EMLA envelope, stroke, triangle and joint limits (SLSQP). A study may "
+            "every chain's decision variables (the crane file's link lengths, a machine file's declared ones) and "
+            "the B-spline joint trajectory, subject to inverse dynamics, tracking of the study's tasks, the EMLA "
+            "envelope, stroke, triangle and joint limits (SLSQP or IPOPT). A study may "
             "instead minimise the battery's energy (objective: battery_energy), add the motors' thermal limits "
             "(duty:) and enumerate a transmission catalogue (transmission:); every result reports the battery "
             "energy, costf2, thermal margins and the hydraulic baseline."

@@ -35,14 +35,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "render",
         help="Render a playback video of an optimisation result off-screen (initial vs optimal design).",
         description=(
-            "Render the crane following the study's trajectory with the initial and the optimal link "
-            "lengths: the machine drawn from its description (box-section booms, the cylinders' bores and "
-            "rods, pins, column, truck bed, end mass, hook, the payload while it is held), the reference path "
-            "of the tool (grey), each design's tool trail, the time and each design's battery energy per cycle "
-            "(at the shared DC bus, from result.json; a result without one shows the drives' cumulative net "
-            "energy, named as such). By default the "
-            "optimal design is drawn over a ghost of the initial one, the cylinder pivots the lengths move "
-            "marked. Off-screen through OSMesa (MUJOCO_GL=osmesa, selected automatically; MUJOCO_GL=egl is "
+            "Render the machine (crane file or machine file) following the study's trajectory with the initial "
+            "and the optimal design: the machine drawn from its description (box-section booms, the cylinders' "
+            "bores and rods, pins; a crane's column, truck bed, end mass, hook, the payload while it is held; an "
+            "excavator's bucket and soil), the reference path of the tool (grey), each design's tool trail, the "
+            "time and each design's battery energy per cycle (at the shared DC bus, from result.json; a result "
+            "without one shows the drives' cumulative net energy, named as such). By default the optimal design "
+            "is drawn over a ghost of the initial one, the pivots the decision variables move marked (a machine "
+            "file's result: kinematic playback only). Off-screen through OSMesa (MUJOCO_GL=osmesa, selected "
+            "automatically; MUJOCO_GL=egl is "
             "honoured)."
         ),
     )

@@ -56,7 +56,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "simulate",
         help="validate an optimisation result in closed loop (EMLA drives + tracking controller)",
         description=(
-            "Simulate the study's cycle with the crane built to each design's link lengths, driven by "
+            "Simulate the study's cycle with the machine (crane file or machine file) built to each design, driven by "
             "PMSM drives (current loops, voltage and current limits, rotor inertia and friction) under a "
             "cascade tracking controller; compare the electrical energy with the optimiser's prediction."
         ),
