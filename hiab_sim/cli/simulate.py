@@ -28,8 +28,8 @@ N cycles with the winding temperature carried over; the energies are the last cy
 
 A machine file's result (:mod:`hiab_sim.machine`, e.g. the excavator) runs through
 :mod:`hiab_sim.cli.simulate_machine`: the same report, plant and effect study, each chain's EMLA
-drive on the machine's generic MJCF (:mod:`hiab_sim.env.machine_env`); the crane-only options
-(``--payload-error``, the video) are refused.
+drive on the machine's generic MJCF (:mod:`hiab_sim.env.machine_env`), ``closed_loop.mp4`` in the machine
+file's dressing; the crane-only ``--payload-error`` (the crane's end-mass body) is refused.
 """
 
 from __future__ import annotations

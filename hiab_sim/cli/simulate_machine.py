@@ -7,7 +7,9 @@ effects of :mod:`hiab_sim.env.plant` on the machine's own parts, :mod:`hiab_sim.
 for ``--cycles`` cycles, and with effects on the effect study of :mod:`hiab_sim.env.effects`
 (``plant_effects``, its table and ``closed_loop_plant_effects.png``). What is built on the crane's
 model is refused with one line (exit 2) naming it: ``--payload-error`` (the crane's end-mass body;
-the plant's ``mismatch`` scales a machine's payload) and the video (drawn with the crane's dressing).
+the plant's ``mismatch`` scales a machine's payload). ``closed_loop.mp4`` draws each design's simulation
+model at its recorded states in the machine file's dressing (:mod:`hiab_sim.render.dress_machine`, on the
+soil of the study's tasks where they cut one), the pivots the decision variables move marked.
 """
 
 from __future__ import annotations
@@ -37,10 +39,6 @@ def refuse_crane_only(args: argparse.Namespace) -> None:
             args.payload_error,
             "must be 0 for a machine file's result (the crane's end-mass body; --plant's mismatch scales a payload)",
         )
-    if not args.no_video:
-        raise InvalidInputError(
-            "--no-video", False, "is needed for a machine file's result (closed_loop.mp4 draws the crane)"
-        )
 
 
 def run_machine(args: argparse.Namespace, designs: tuple[str, ...], out: Path) -> int:
@@ -58,24 +56,34 @@ def run_machine(args: argparse.Namespace, designs: tuple[str, ...], out: Path) -
     refuse_crane_only(args)
     plans = [read_machine_plan(args.result_dir, design) for design in designs]  # bad input fails first
     plant = None if args.plant is None else machine_plant(args.plant, plans[0].machine.realistic_plant)
+    if not args.no_video:
+        from hiab_sim.render.backend import ffmpeg_path
+
+        ffmpeg_path()  # a missing ffmpeg fails before the simulation
     out.mkdir(parents=True, exist_ok=True)
-    runs = []
-    for plan in plans:
-        run, physics = run_machine_closed_loop(plan, plant=plant, cycles=args.cycles)
-        physics.free()
-        runs.append(run)
-    report = simulation_report(args.result_dir, runs, [], emlas=plans[0].emlas)
-    settings = report["settings"]
-    assert isinstance(settings, dict)
-    settings.update(energy=MACHINE_ENERGY, tcp_error=MACHINE_TCP, machine=plans[0].machine.name)
-    settings["tcp_load"] = "the plan's TCP force F(t) of the study's first task, applied at site tcp"
-    entries = report["designs"]
-    assert isinstance(entries, dict)
-    for run in runs:
-        entry = entries[run.design]
-        if entry["bandwidth_check"].get("first_natural_frequency_Hz") is None:
-            entry["bandwidth_check"]["note"] = NO_STRUCTURE
-    written, effects = write_results(args, report, runs, [], plant, designs, out)
+    runs, models = [], []
+    try:
+        for plan in plans:
+            run, physics = run_machine_closed_loop(plan, plant=plant, cycles=args.cycles)
+            models.append(physics)
+            runs.append(run)
+        report = simulation_report(args.result_dir, runs, [], emlas=plans[0].emlas)
+        settings = report["settings"]
+        assert isinstance(settings, dict)
+        settings.update(energy=MACHINE_ENERGY, tcp_error=MACHINE_TCP, machine=plans[0].machine.name)
+        settings["tcp_load"] = "the plan's TCP force F(t) of the study's first task, applied at site tcp"
+        entries = report["designs"]
+        assert isinstance(entries, dict)
+        for run in runs:
+            entry = entries[run.design]
+            if entry["bandwidth_check"].get("first_natural_frequency_Hz") is None:
+                entry["bandwidth_check"]["note"] = NO_STRUCTURE
+        written, effects = write_results(args, report, runs, [], plant, designs, out)
+        if not args.no_video:
+            written.append(_video(args, out, plans, runs, models).name)
+    finally:
+        for physics in models:
+            physics.free()
     print_results(report, effects)
     for design, entry in entries.items():
         if entry.get("battery_energy_difference_percent") is not None:
@@ -86,3 +94,25 @@ def run_machine(args: argparse.Namespace, designs: tuple[str, ...], out: Path) -
             )
     print(f"wrote {', '.join(written)} to {out}", file=sys.stderr)
     return 0
+
+
+def _video(args: argparse.Namespace, out: Path, plans: list, runs: list, models: list) -> Path:
+    """``closed_loop.mp4``: the runs drawn on their simulation models in the machine file's dressing."""
+    from hiab_sim.env.validation import closed_loop_video
+    from hiab_sim.render.dress_machine import machine_file_dress, moved_pivots
+    from hiab_sim.render.machine_playback import study_ground
+    from hiab_sim.results.read import read_result
+
+    ground = study_ground(read_result(args.result_dir).study)
+    machines = {plan.design: plan.machine for plan in plans}
+    marks = moved_pivots(plans[0].machine, [plan.machine.design_values() for plan in plans])
+    return closed_loop_video(
+        out / "closed_loop.mp4",
+        runs,
+        models,
+        lambda model, run: machine_file_dress(model, machines[run.design], ground),
+        marks,
+        plans[0].emlas.battery,
+        quiet=args.quiet,
+        load="load",
+    )

@@ -6,8 +6,9 @@ Used by ``hiab-sim simulate`` (:mod:`hiab_sim.cli.simulate`); see there for the 
 from __future__ import annotations
 
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -202,7 +203,7 @@ def render_video(
     nominal: list[ClosedLoopRun] | None = None,
     quiet: bool = False,
 ) -> Path:
-    """Render the closed-loop runs in the playback's visual language (:mod:`hiab_sim.render`).
+    """Render a crane file's closed-loop runs in the playback's visual language (:mod:`hiab_sim.render`).
 
     One panel per end-mass condition (the planned mass when ``nominal`` runs are given, then the
     runs' own), each overlaying the optimal design (opaque) on the initial one (ghost), the
@@ -212,27 +213,50 @@ def render_video(
     A nominal run is drawn with its design's model of ``physics`` (the end-mass error changes
     inertia, not geometry).
     """
+    from hiab_sim.render.dress import machine_dress
+
+    marks = tuple(f"{chain.name}_base_pivot" for chain in crane.chains)
+    return closed_loop_video(
+        path, runs, physics, lambda model, run: machine_dress(model, crane), marks, battery, nominal, quiet
+    )
+
+
+def closed_loop_video(
+    path: Path,
+    runs: list[ClosedLoopRun],
+    physics: list[CranePhysics],
+    dress: Callable[[Any, ClosedLoopRun], Any],
+    marks: tuple[str, ...],
+    battery: BatteryParams,
+    nominal: list[ClosedLoopRun] | None = None,
+    quiet: bool = False,
+    load: str = "end mass",
+) -> Path:
+    """The closed-loop video of any machine: ``dress(model, run)`` draws a run's model, ``marks`` names its pivots.
+
+    The panels, overlay, captions and battery notes of :func:`render_video`; each run is drawn on
+    its own simulation model (``physics``, in ``runs``' order) at its recorded qpos. ``load`` names
+    what ``payload_error`` scales in the captions.
+    """
     from hiab_sim.render.backend import video_sink
     from hiab_sim.render.decor import design_rgba
-    from hiab_sim.render.dress import machine_dress
     from hiab_sim.render.frames import Design, PlaybackRenderer
 
     width, height = VIEWPORT
     at = closed_loop_frame_times(min(run.time[-1] for run in runs))
     frames = len(at)
     models = {run.design: item.model.ptr for run, item in zip(runs, physics, strict=True)}
-    marks = tuple(f"{chain.name}_base_pivot" for chain in crane.chains)
     panels = [nominal, runs] if nominal else [runs]
 
     def design(run: ClosedLoopRun) -> Design:
         index = np.clip(np.searchsorted(run.time, at), 0, len(run.time) - 1)
         notes = battery_notes(run, battery, at)
-        mass = "planned end mass" if run.payload_error == 0 else f"end mass +{100 * run.payload_error:g} %"
+        mass = f"planned {load}" if run.payload_error == 0 else f"{load} +{100 * run.payload_error:g} %"
         caption = f"{run.design}, {mass}" if run.design != "initial" else "initial (ghost)"
         model = models[run.design]
         return Design(
             run.design, model, run.qpos[index], design_rgba(run.design), caption, notes,
-            dress=machine_dress(model, crane), marks=marks,
+            dress=dress(model, run), marks=marks,
         )  # fmt: skip
 
     renderers = []

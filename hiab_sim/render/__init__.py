@@ -19,8 +19,8 @@ from hiab_sim.render.playback import (  # noqa: E402
     resample,
     simulated_qpos,
 )
-from hiab_sim.render.still import render_still  # noqa: E402
-from hiab_sim.render.video import VIDEO_NAME, playback_renderer, render_result  # noqa: E402
+from hiab_sim.render.result_views import render_result, render_still  # noqa: E402
+from hiab_sim.render.video import VIDEO_NAME, playback_renderer  # noqa: E402
 
 __all__ = [
     "VIDEO_NAME",

@@ -104,7 +104,7 @@ def machine_still(
 ) -> Path:
     """One frame (.png) of a machine file's result at ``at_time`` [s] (None: the end).
 
-    Reached through :func:`hiab_sim.render.still.render_still`, which checks the OpenGL backend first.
+    Reached through :func:`hiab_sim.render.result_views.render_still`, which checks the OpenGL backend first.
     """
     output = check_output_path(Path(output), (".png",), "image")
     data = load_machine_playback(result_dir)

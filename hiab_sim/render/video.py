@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.model.mjcf import build_model, source_to_world
-from hiab_sim.render.backend import check_gl_backend, check_output_path, ffmpeg_path, write_image, write_video
+from hiab_sim.render.backend import check_output_path, ffmpeg_path, write_image, write_video
 from hiab_sim.render.decor import design_rgba
 from hiab_sim.render.dress import machine_dress
 from hiab_sim.render.frames import LAYOUTS, Design, Layout, PlaybackRenderer
@@ -222,44 +222,16 @@ def load_power(result_dir: str | Path, data: PlaybackData) -> dict[str, Array]:
     return out
 
 
-def render_result(
+def crane_video(
     result_dir: str | Path,
-    output: str | Path | None = None,
-    fps: float = 30.0,
-    size: tuple[int, int] = (640, 480),
-    mode: Mode = "kinematic",
-    layout: Layout = DEFAULT_LAYOUT,
-    progress: Callable[[int, int], None] | None = None,
+    output: str | Path | None,
+    fps: float,
+    size: tuple[int, int],
+    mode: Mode,
+    layout: Layout,
+    progress: Callable[[int, int], None] | None,
 ) -> Path:
-    """Render the playback video (.mp4 or .gif) of a crane file's or a machine file's result folder; return its path.
-
-    A machine file's result (:func:`~hiab_sim.render.machine_playback.is_machine_result`) is drawn by
-    :func:`~hiab_sim.render.machine_video.render_machine_result`, kinematic only.
-
-    Args:
-        result_dir: folder written by ``hiab-sim optimize`` (``result.json``, ``trajectory.npz``).
-        output: video path (default ``result_dir/playback.mp4``); written atomically.
-        fps: frames per second; the video plays in real time.
-        size: (width, height) [px], both even for H.264.
-        mode: ``"kinematic"`` (planned states) or ``"simulate"`` (forward simulation under the
-            inverse-dynamics forces).
-        layout: ``"stacked"``, ``"side-by-side"`` or ``"overlay"``.
-        progress: called with (frames done, frames in all) after each frame.
-
-    Raises:
-        HiabSimError: bad result folder or output path, no OpenGL backend, no ffmpeg; ``mode``
-            ``"simulate"`` for a machine file's result.
-
-    """
-    from hiab_sim.render.machine_playback import is_machine_result
-
-    check_gl_backend()
-    if is_machine_result(result_dir):
-        if mode != "kinematic":
-            raise InvalidInputError("--mode", mode, "a machine file's result plays back kinematic only")
-        from hiab_sim.render.machine_video import render_machine_result
-
-        return render_machine_result(result_dir, output, fps, size, layout, progress)
+    """The playback video of a crane file's result (:func:`hiab_sim.render.result_views.render_result`'s arguments)."""
     data = load_playback(result_dir)
     output = Path(result_dir) / VIDEO_NAME if output is None else Path(output)
     _check_size(size, even=output.suffix.lower() == ".mp4")
