@@ -18,13 +18,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="Plot an EMLA efficiency map over load force and velocity (all four quadrants).",
         description=(
             "Efficiency of one EMLA over load force and rod velocity at zero acceleration, with the "
-            "feasible envelope (peak torque, rated speed, voltage) and the hydraulic cylinder it replaces."
+            "feasible envelope (peak torque, rated speed, voltage) and the hydraulic cylinder it replaces. "
+            "An EMLA file serves any machine whose actuators it names (a study pairs the two: emla: in the "
+            "study file); --emla exact maps the eXact arm's."
         ),
     )
     parser.add_argument(
         "--actuator",
         metavar="NAME",
-        help="an actuator of the EMLA file (XS 031: lift, tilt, telescope; default: the file's first actuator)",
+        help="an actuator of the EMLA file, by its name there (default: the file's first actuator)",
     )
     parser.add_argument(
         "--emla",
