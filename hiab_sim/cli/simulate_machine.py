@@ -17,8 +17,14 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from hiab_sim.errors import InvalidInputError
+
+if TYPE_CHECKING:
+    from hiab_sim.env.machine_plan import MachinePlan
+    from hiab_sim.env.physics import CranePhysics
+    from hiab_sim.env.rollout import ClosedLoopRun
 
 #: What the report says of the energy boundary and the TCP error of a machine's closed loop.
 MACHINE_ENERGY = (
@@ -96,7 +102,13 @@ def run_machine(args: argparse.Namespace, designs: tuple[str, ...], out: Path) -
     return 0
 
 
-def _video(args: argparse.Namespace, out: Path, plans: list, runs: list, models: list) -> Path:
+def _video(
+    args: argparse.Namespace,
+    out: Path,
+    plans: list[MachinePlan],
+    runs: list[ClosedLoopRun],
+    models: list[CranePhysics],
+) -> Path:
     """``closed_loop.mp4``: the runs drawn on their simulation models in the machine file's dressing."""
     from hiab_sim.env.validation import closed_loop_video
     from hiab_sim.render.dress_machine import machine_file_dress, moved_pivots
