@@ -135,14 +135,14 @@ def framing_points(model: mujoco.MjModel, qpos: Array) -> Array:
     return np.concatenate(corners)
 
 
-def machine_mjcf(machine: Machine, design: Sequence[float] | Array | None = None, *, check_bounds: bool = True) -> str:
+def machine_mjcf(machine: Machine, design: Sequence[float] | Array | None = None) -> str:
     """The MJCF text of the machine at ``design`` with keyframe ``home`` and framed cameras (module docstring).
 
-    ``check_bounds=False`` takes a design outside its declared bounds: a result's, which the solver
-    holds to its own tolerance (IPOPT may end 1e-8 relative past a bound).
+    ``design`` is checked against the declared bounds; pass a machine already set to a design
+    (``with_design(..., check_bounds=False)``) and no ``design`` for one the bounds need not hold.
     """
     if design is not None:
-        machine = machine.with_design(design, check_bounds=check_bounds)
+        machine = machine.with_design(design)
     dynamics = MujocoMachineDynamics(machine)
     home = posed_qpos(dynamics, home_joints(machine)[None])[0]
     points = framing_points(dynamics.model, posed_qpos(dynamics, workspace_joints(machine)))

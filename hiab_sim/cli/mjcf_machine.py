@@ -50,7 +50,8 @@ def run_machine(args: argparse.Namespace, result_choice: str | None) -> int:
     output = Path(args.output)
     if not output.parent.is_dir():
         raise InvalidInputError("--output", str(output), "its folder must exist")
-    text = machine_mjcf(machine, design, check_bounds=result_choice is None)  # a result's: the solver's bounds
+    # a typed design is checked against the file's bounds; a result's is the solver's (IPOPT may end 1e-8 past one)
+    text = machine_mjcf(machine.with_design(design, check_bounds=result_choice is None))
     model = mujoco.MjModel.from_xml_string(text)
     write_atomic(output, text)
     values = ", ".join(f"{k} = {v:.10g}" for k, v in zip(machine.variable_keys, design, strict=True))

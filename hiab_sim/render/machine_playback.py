@@ -135,8 +135,9 @@ def study_ground(study: str) -> float | None:
 def machine_model_and_qpos(machine: Machine, design: Array, position: Array) -> tuple[mujoco.MjModel, Array]:
     """The machine's MJCF model at ``design`` and loop-consistent qpos (N, nq) for joint positions (N, n)."""
     # a result's design: the solver held its bounds to its own tolerance (IPOPT: 1e-8 relative past one)
-    model = mujoco.MjModel.from_xml_string(machine_mjcf(machine, design, check_bounds=False))
-    dynamics = MujocoMachineDynamics(machine.with_design(design, check_bounds=False))
+    designed = machine.with_design(design, check_bounds=False)
+    model = mujoco.MjModel.from_xml_string(machine_mjcf(designed))
+    dynamics = MujocoMachineDynamics(designed)
     ranges = [machine.joint_link(name).joint_range or (0.0, 0.0) for name in machine.joint_names]
     low, high = np.array(ranges).T
     # the samples lie in the ranges; a resampled frame may pass an end by round-off only
