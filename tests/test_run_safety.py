@@ -68,6 +68,22 @@ def test_a_legacy_folder_is_owned_by_its_checkpoints_study(tmp_path: Path) -> No
     check_folder(tmp_path / "new", "a" * 64, resume=False, force=False)  # not there yet: fine
 
 
+def test_a_folder_of_pictures_or_another_commands_output_is_not_a_result(tmp_path: Path) -> None:
+    """Files that match a run's output names (*.png, *.mp4, summary.md) do not make a folder a result folder.
+
+    Without a marker, a checkpoint or result.json the folder is refused, naming what --force would delete;
+    a legacy folder with result.json but no marker is still a result folder.
+    """
+    photos = tmp_path / "photos"
+    _fill(photos, ("holiday.png", "movie.mp4", "summary.md"))
+    with pytest.raises(InvalidInputError, match=r"holds no hiab-sim result.*--force \(which deletes its holiday"):
+        check_folder(photos, "a" * 64, resume=False, force=False)
+    assert sorted(p.name for p in photos.iterdir()) == ["holiday.png", "movie.mp4", "summary.md"]
+    legacy = tmp_path / "legacy"
+    _fill(legacy, ("result.json", "objective.png"))
+    check_folder(legacy, "a" * 64, resume=False, force=False)
+
+
 def test_a_fresh_run_deletes_every_earlier_output_and_nothing_else(tmp_path: Path) -> None:
     """A fresh claim deletes results, checkpoints, figures and video, keeps other files, writes the marker."""
     _fill(tmp_path, (*OUTPUTS, "notes.txt"))

@@ -4,8 +4,9 @@ A run claims its output folder with an ownership marker ``owner.json`` (study pa
 hash :func:`hiab_sim.study.solvers.slsqp.study_digest`, number of starts). Rules:
 
 - a folder owned by another study (another content hash) is refused without ``force``; so is a
-  non-empty folder that is not a result folder (nothing in it is hiab-sim's), so that ``--out``
-  pointing at the wrong place deletes nothing;
+  non-empty folder that is not a result folder (no ``owner.json``, ``result.json`` or checkpoint: a
+  folder of photos, or another command's output such as an energy map, is not one although it
+  holds ``*.png`` or ``summary.md``), so that ``--out`` pointing at the wrong place deletes nothing;
 - a fresh run (not ``resume``) deletes every output of earlier runs (:data:`OUTPUT_PATTERNS`:
   result, trajectory, checkpoints, summary, figures, videos, the closed-loop simulation's report, copied
   crane) before it writes, so a ``--no-figures`` re-run leaves no old figure beside a new result and no
@@ -109,9 +110,14 @@ def check_folder(folder: Path, digest: str, resume: bool, force: bool) -> None:
             f"it; sha256 {str(recorded)[:12]}); the default folder runs/<name> comes from the study's name: field, "
             "so give this study its own name:, pass --out, or use --force to replace the results there"
         )
-    if recorded is None and not outputs(folder):
+    if recorded is None and not (folder / "result.json").is_file():
+        found = [p.name for p in outputs(folder)]
+        deletes = f" (which deletes its {', '.join(found)})" if found else ""
         raise InvalidInputError(
-            "--out", str(folder), "is not empty and holds no hiab-sim result; use another --out, or --force"
+            "--out",
+            str(folder),
+            "is not empty and holds no hiab-sim result (no owner.json, result.json or checkpoint_<k>.json); "
+            f"use another --out, or --force{deletes}",
         )
 
 
