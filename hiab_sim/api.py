@@ -34,13 +34,13 @@ from typing import TextIO
 
 import numpy as np
 
-from hiab_sim.crane.description import ChainLengths, LinkLengths
-from hiab_sim.crane.names import ACTUATOR_NAMES
+from hiab_sim.crane.description import LinkLengths
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.machine.design import MachineDesign
 from hiab_sim.results.energy_sections import DesignEnergy
 from hiab_sim.results.read import read_result
 from hiab_sim.results.schema import DesignSummary, Result
-from hiab_sim.study.nlp.interface import N_XI
+from hiab_sim.study.machines.protocol import Design, StudyMachine
 from hiab_sim.study.spec.study_file import Study, load_study
 
 __all__ = ["DesignEvaluation", "TaskEvaluation", "evaluate", "load_study", "optimize", "read_result"]
@@ -50,9 +50,11 @@ TRAJECTORIES = ("fixed", "reoptimize")
 #: Largest scaled constraint violation at which a design serves a task (the solvers' tolerance).
 FEASIBLE = 1e-6
 
-#: What :func:`evaluate` accepts as a design: typed lengths, the six values of Xi in the result's
-#: order [m], or a mapping chain name -> (L, Lc0, Lc) [m].
-Lengths = LinkLengths | Sequence[float] | np.ndarray | Mapping[str, Sequence[float]]
+#: What :func:`evaluate` accepts as a design of a study's machine: a typed design (a result's
+#: ``lengths``: a crane file's LinkLengths, a machine file's MachineDesign), the values of Xi in the
+#: order of the study's ``model.design_names`` [m], or a mapping from a chain's name to its values in
+#: that order (a crane chain: (L, Lc0, Lc)) or from ``chain.variable`` to one value [m].
+Lengths = Design | Sequence[float] | np.ndarray | Mapping[str, Sequence[float] | float]
 
 
 @dataclass(frozen=True)
@@ -85,7 +87,7 @@ class DesignEvaluation:
     """A design evaluated on every task of a study (see :func:`evaluate`).
 
     Attributes:
-        lengths: The design Xi [m].
+        lengths: The design Xi [m] (the study's machine's design type).
         trajectory: ``"fixed"`` or ``"reoptimize"``.
         tasks: One :class:`TaskEvaluation` per task, in the study's order.
         battery_energy_J: The weighted sum over the tasks of the battery energy [J].
@@ -95,7 +97,7 @@ class DesignEvaluation:
 
     """
 
-    lengths: LinkLengths
+    lengths: Design
     trajectory: str
     tasks: tuple[TaskEvaluation, ...]
     battery_energy_J: float
@@ -108,27 +110,51 @@ def _as_study(study: Study | str | Path) -> Study:
     return study if isinstance(study, Study) else load_study(study)
 
 
-def as_lengths(lengths: Lengths) -> LinkLengths:
-    """A design as :class:`LinkLengths` from any form :func:`evaluate` accepts."""
-    if isinstance(lengths, LinkLengths):
-        return lengths
+def as_design(model: StudyMachine, lengths: Lengths) -> Design:
+    """A design of ``model`` from any form :func:`evaluate` accepts (:data:`Lengths`), checked by name and count.
+
+    Raises:
+        InvalidInputError: names that are not the model's decision variables, a missing one, or the
+            wrong number of values, naming the field and the model's names.
+
+    """
+    names = model.design_names
+    if isinstance(lengths, (LinkLengths, MachineDesign)):
+        if tuple(lengths.names) != names:
+            raise InvalidInputError("lengths", list(lengths.names), f"the study's decision variables are {list(names)}")
+        return model.design(lengths.as_array())
     if isinstance(lengths, Mapping):
-        unknown = sorted(set(lengths) - set(ACTUATOR_NAMES[:2]))
-        if unknown:
-            raise InvalidInputError("lengths", unknown, f"chain names are {list(ACTUATOR_NAMES[:2])}")
-        chains = {}
-        for name in ACTUATOR_NAMES[:2]:
-            if name not in lengths:
-                raise InvalidInputError("lengths", sorted(lengths), f"needs every chain: {list(ACTUATOR_NAMES[:2])}")
-            values = np.asarray(lengths[name], dtype=float)
-            if values.shape != (3,):
-                raise InvalidInputError(f"lengths.{name}", list(values.ravel()), "must be [L, Lc0, Lc]", "m")
-            chains[name] = ChainLengths(*map(float, values))
-        return LinkLengths(**chains)
+        return model.design(_mapped_values(names, lengths))
     values = np.asarray(lengths, dtype=float)
-    if values.shape != (N_XI,):
-        raise InvalidInputError("lengths", list(values.ravel()), f"must be {N_XI} values [L, Lc0, Lc] per chain", "m")
-    return LinkLengths.from_array(values)
+    if values.shape != (len(names),):
+        raise InvalidInputError("lengths", list(values.ravel()), f"must be {len(names)} values, in order {list(names)}")
+    return model.design(values)
+
+
+def _mapped_values(names: tuple[str, ...], lengths: Mapping[str, object]) -> list[float]:
+    """Values in ``names``' order from ``{"chain.var": value}`` or ``{"chain": [values in the chain's order]}``."""
+    chains: dict[str, list[str]] = {}
+    for name in names:
+        chain, _, variable = name.partition(".")
+        chains.setdefault(chain, []).append(variable)
+    unknown = sorted(set(lengths) - set(names) - set(chains))
+    if unknown:
+        allowed = f"keys are the chains {list(chains)} or the variables {list(names)}"
+        raise InvalidInputError("lengths", unknown, allowed)
+    values: dict[str, float] = {}
+    for chain, variables in chains.items():
+        if chain in lengths:
+            given = np.asarray(lengths[chain], dtype=float).ravel()
+            if given.shape != (len(variables),):
+                raise InvalidInputError(f"lengths.{chain}", list(given), f"must be {variables}", "m")
+            values.update({f"{chain}.{v}": float(x) for v, x in zip(variables, given, strict=True)})
+    for name in names:
+        if name in lengths:
+            values[name] = float(np.asarray(lengths[name], dtype=float))
+    missing = [name for name in names if name not in values]
+    if missing:
+        raise InvalidInputError("lengths", sorted(lengths), f"misses {missing} (needs every one of {list(names)})")
+    return [values[name] for name in names]
 
 
 def optimize(
@@ -186,7 +212,7 @@ def evaluate(study: Study | str | Path, lengths: Lengths, trajectory: str = "fix
     from hiab_sim.study.report.energy_section import design_energy
 
     loaded = _as_study(study)
-    design = as_lengths(lengths)
+    design = as_design(loaded.model, lengths)
     tasks = []
     for k, task in enumerate(loaded.tasks):
         alone = task_alone(loaded, k)  # the task's NLP as a study of its own

@@ -103,3 +103,52 @@ def test_bad_evaluate_input_names_the_field(study: hs.api.Study, lengths: object
     with pytest.raises(InvalidInputError) as error:
         hs.evaluate(study, lengths, trajectory=trajectory)  # type: ignore[arg-type]
     assert error.value.field == field
+
+
+@pytest.fixture(scope="module")
+def machine_study() -> hs.api.Study:
+    """The small study on the XS 031's machine file (its own bounds; tracking the telescope's extension)."""
+    from hiab_sim.study.spec.study_file import study_from_dict
+
+    data = small_study()
+    del data["crane"]
+    bounds = {"joint_velocity": [0.6, 0.6, 0.5]}  # the crane study's defaults [rad/s, rad/s, m/s]
+    machine = {"machine": "xs031", "emla": "xs031", "tracked": ["xt2"], "bounds": bounds}
+    return study_from_dict({**data, **machine}, "small_machine.yaml")
+
+
+def test_a_machine_files_study_evaluates_its_own_design_in_every_form(
+    study: hs.api.Study, machine_study: hs.api.Study
+) -> None:
+    """Evaluate takes a machine file's design typed, as values, by chain or by ``chain.variable``.
+
+    Each form gives the same numbers, and those agree with the crane file's closed-form model at the
+    same lengths (two independent descriptions of the XS 031: 1e-9 relative).
+    """
+    design = machine_study.model.default_design
+    names, values = machine_study.model.design_names, design.as_array()
+    by_variable = dict(zip(names, values, strict=True))
+    by_chain = {"lift": values[:3], "tilt": values[3:]}
+    energies = {
+        form: hs.evaluate(machine_study, given, trajectory="fixed").net_electrical_energy_J
+        for form, given in (("typed", design), ("values", values), ("variables", by_variable), ("chains", by_chain))
+    }
+    assert len(set(energies.values())) == 1, energies
+    crane = hs.evaluate(study, values, trajectory="fixed")
+    assert energies["typed"] == pytest.approx(crane.net_electrical_energy_J, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("given", "message"),
+    [
+        ({"lift.L": 1.0}, r"misses \['lift.Lc0'"),
+        ({"boom.L": 1.0}, r"keys are the chains \['lift', 'tilt'\]"),
+        (np.ones(9), r"must be 6 values, in order \['lift.L'"),
+    ],
+)
+def test_a_design_that_is_not_the_machines_names_what_it_needs(
+    machine_study: hs.api.Study, given: object, message: str
+) -> None:
+    """A missing variable, another machine's variable or the wrong count: one line naming the study's variables."""
+    with pytest.raises(InvalidInputError, match=message):
+        hs.evaluate(machine_study, given)  # type: ignore[arg-type]
