@@ -81,10 +81,10 @@ def check_fields(
             check_non_negative(f"{prefix}.{name}", getattr(obj, name), non_negative[name])
 
 
-def check_choice(where: str, value: Any, choices: tuple[str, ...]) -> None:
-    """Raise :class:`InvalidInputError` unless ``value`` is one of ``choices``."""
-    if value not in choices:
-        raise InvalidInputError(where, value, f"must be one of {', '.join(choices)}")
+def check_choice(where: str, value: Any, choices: tuple[Any, ...]) -> None:
+    """Raise :class:`InvalidInputError` unless ``value`` is one of ``choices`` (a bool is no number here)."""
+    if value not in choices or (isinstance(value, bool) and not any(isinstance(c, bool) for c in choices)):
+        raise InvalidInputError(where, value, f"must be one of {', '.join(map(str, choices))}")
 
 
 def check_efficiency(where: str, value: float) -> None:

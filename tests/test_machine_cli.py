@@ -70,6 +70,8 @@ def test_machine_check_lists_each_failure_and_exits_2(tmp_path: Path, capsys: py
         ("links.bucket.bodies.bucket.inertia_zz", -3.0, "links.bucket.bodies.bucket.inertia_zz"),
         ("chains.boom.actuator.stroke", 0.3, "chains.boom.actuator.stroke"),
         ("links.arm.joint", "alpha", "links.arm.joint"),
+        ("chains.bucket.linkage.pin_side", 2, "chains.bucket.linkage.pin_side"),
+        ("chains.bucket.linkage.pin_side", True, "chains.bucket.linkage.pin_side"),
     ],
 )
 def test_bad_machine_file_exits_2_with_one_line_and_writes_nothing(

@@ -150,7 +150,7 @@ class Chain:
         if self.linkage is not None:
             check_positive(f"{where}.linkage.rocker_length", self.linkage.rocker_length, "m")
             check_positive(f"{where}.linkage.coupler_length", self.linkage.coupler_length, "m")
-            check_choice(f"{where}.linkage.pin_side", self.linkage.pin_side, (1, -1))  # type: ignore[arg-type]
+            check_choice(f"{where}.linkage.pin_side", self.linkage.pin_side, (1, -1))
         self._check_variables()
 
     def _check_variables(self) -> None:
