@@ -131,6 +131,11 @@ def test_rerun_removes_the_earlier_simulation_too_and_says_so(
         ("bound tilt.L up = 1.3 m", "tilt base pivot to boom hinge at its upper bound (1300 mm)"),
         ("tracking.position.x_tcp <= band", "TCP tracking band (position), TCP x (horizontal)"),
         ("tracking.velocity.xt2 >= band", "tracking band (velocity), joint xt2"),
+        (
+            "digging: buildable_range.boom.x <= stroke at the up end",
+            "digging: boom end of stroke over the build range at the upper end of the joint range",
+        ),
+        ("grading: envelope.bucket.peak_torque", "grading: bucket motor peak torque"),
     ],
 )
 def test_constraint_rows_read_in_words(row: str, words: str) -> None:

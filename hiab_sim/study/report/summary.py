@@ -50,6 +50,8 @@ _TRACKING = re.compile(r"^tracking\.(\w+)\.(\S+)")
 #: The tool point's tracked coordinates in words; any other tracked coordinate is a joint of the machine.
 _COORDINATE_WORDS = {"x_tcp": "TCP x (horizontal)", "y_tcp": "TCP y (vertical)"}
 _BOUND = re.compile(r"^bound (\w+)\.(\w+) (low|up) = (\S+) m$")
+#: A duty mix's row of one task: ``<task>: <row>``.
+_TASK_ROW = re.compile(r"^([^:]+): (.+)$")
 
 
 def limit_in_words(name: str, detail: bool = True) -> str:
@@ -57,8 +59,12 @@ def limit_in_words(name: str, detail: bool = True) -> str:
 
     Names the sensitivity section groups over samples; an unknown pattern keeps its name with
     underscores as spaces. ``detail`` False drops the coordinate of a tracking band (one phrase
-    for the band, as the summary names it).
+    for the band, as the summary names it). A duty mix's row of one task (``digging: stroke.boom...``,
+    :meth:`hiab_sim.study.nlp.problem.StudyProblem.row_name`) keeps its task in front of the words.
     """
+    task = _TASK_ROW.match(name)
+    if task:
+        return f"{task.group(1)}: {limit_in_words(task.group(2), detail)}"
     match = _BOUND.match(name)
     if match:
         chain, field, side, value = match.groups()
