@@ -75,3 +75,14 @@ def test_crane_mjcf_refuses_design_items_without_a_machine(tmp_path: Path, capsy
     """The crane path keeps ``--design`` for ``--from-result`` only."""
     assert main(["mjcf", "--design", "optimal", "-o", str(tmp_path / "c.xml")]) == 2
     assert "--from-result or --machine" in capsys.readouterr().err
+
+
+def test_machine_mjcf_without_output_writes_machine_xml(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``mjcf --machine`` without ``-o`` writes machine.xml (not crane.xml); --crane beside it is refused."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["mjcf", "--machine", "exact"]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["machine.xml"]
+    assert main(["mjcf", "--machine", "exact", "--crane", "xs031", "-o", "other.xml"]) == 2
+    assert "--crane" in capsys.readouterr().err and not (tmp_path / "other.xml").exists()

@@ -42,11 +42,12 @@ def test_mjcf_from_result_places_the_exact_design(small_run: Path, tmp_path: Pat
 
 
 def test_mjcf_from_result_rejects_a_missing_folder_and_mixed_options(small_run: Path, tmp_path: Path, capsys) -> None:
-    """A missing folder, a folder without result.json and --lengths with --from-result exit 2 with one line."""
+    """A missing folder, a folder without result.json, --lengths or --crane with --from-result: exit 2, one line."""
     for argv in (
         ["mjcf", "--from-result", str(tmp_path / "nope")],
         ["mjcf", "--from-result", str(tmp_path)],
         ["mjcf", "--from-result", str(small_run), "--lengths", "1,0.1,0.7,1.1,0.1,0.7"],
+        ["mjcf", "--from-result", str(small_run), "--crane", "xs031"],  # the result names its crane
     ):
         assert main([*argv, "-o", str(tmp_path / "x.xml")]) == 2
         assert len(capsys.readouterr().err.strip().splitlines()) == 1

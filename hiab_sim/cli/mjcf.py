@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.cli.options import add_crane_option, add_machine_option
+from hiab_sim.cli.options import DEFAULT_CRANE, add_crane_option, add_machine_option
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.errors import ConfigError, HiabSimError, InvalidInputError
@@ -80,8 +80,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="keep M [m] of stroke free at both ends of each chain's joint range, as a study's build.stroke_margin "
         "(the rounded designs of hiab-sim optimize serve that range; default: 0, the crane's full range)",
     )
-    parser.add_argument("-o", "--output", default="crane.xml", metavar="FILE.xml", help="default: crane.xml")
-    parser.set_defaults(run=run)
+    parser.add_argument(
+        "-o", "--output", metavar="FILE.xml", help="default: crane.xml (a crane file), machine.xml (a machine file)"
+    )
+    # --crane is None unless given: with --from-result the result names its machine, and a --crane there is refused
+    parser.set_defaults(run=run, crane=None)
 
 
 def parse_lengths(text: str) -> LinkLengths:
@@ -176,7 +179,7 @@ def home_keyframe(crane: Crane, lengths: LinkLengths) -> tuple[np.ndarray, np.nd
 def _crane_and_lengths(args: argparse.Namespace) -> tuple[Crane, LinkLengths]:
     """The crane and design to export: from ``--from-result`` or from ``--crane`` and ``--lengths``."""
     if args.from_result is None:
-        crane = load_crane(args.crane)
+        crane = load_crane(args.crane or DEFAULT_CRANE)
         return crane, parse_lengths(args.lengths) if args.lengths else crane.default_lengths
     if args.lengths:
         raise InvalidInputError("--lengths", args.lengths, "cannot be combined with --from-result")
@@ -205,7 +208,15 @@ def _is_machine_result(run_dir: str) -> bool:
 
 def run(args: argparse.Namespace) -> int:
     """Build the model, write it and print a one-line summary."""
-    if args.machine is not None or (args.from_result is not None and _is_machine_result(args.from_result)):
+    if args.from_result is not None and args.crane is not None:
+        raise InvalidInputError(
+            "--crane", args.crane, "cannot be combined with --from-result (the result names its machine)"
+        )
+    if args.machine is not None and args.crane is not None:
+        raise InvalidInputError("--crane", args.crane, "cannot be combined with --machine")
+    machine_file = args.machine is not None or (args.from_result is not None and _is_machine_result(args.from_result))
+    args.output = args.output or ("machine.xml" if machine_file else "crane.xml")
+    if machine_file or (args.from_result is not None and _is_machine_result(args.from_result)):
         from hiab_sim.cli.mjcf_machine import run_machine
 
         return run_machine(args, _result_design(args) if args.from_result is not None else None)
