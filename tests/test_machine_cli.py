@@ -46,6 +46,15 @@ def test_machine_show_prints_and_writes_a_png(tmp_path: Path, capsys: pytest.Cap
     assert figure.stat().st_size > 20_000
 
 
+def test_machine_show_names_its_drawing_after_the_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Without --figure: <name>_machine.png, and a file already named ...machine.yaml is not doubled."""
+    monkeypatch.chdir(tmp_path)
+    source = Path(str(resources.files("hiab_sim") / "presets" / "xs031_machine.yaml"))
+    assert main(["machine", "show", "exact"]) == 0
+    assert main(["machine", "show", str(source)]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["exact_machine.png", "xs031_machine.png"]
+
+
 def test_machine_check_lists_each_failure_and_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """A short stroke, a range through a toggle and a TCP outside the workspace: one FAIL line each, exit 2."""
     data = _excavator()

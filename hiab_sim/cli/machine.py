@@ -33,7 +33,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     actions = parser.add_subparsers(dest="machine_command", metavar="ACTION", required=True)
     show = actions.add_parser("show", help="print the machine and write a labelled drawing (PNG)")
     show.add_argument("machine", help="shipped machine name (xs031, exact) or a machine YAML file")
-    show.add_argument("--figure", type=Path, help="PNG to write (default: <name>_machine.png)")
+    show.add_argument(
+        "--figure", type=Path, help="PNG to write (default: <name>_machine.png; <name>.png if it ends in 'machine')"
+    )
     show.add_argument("--no-figure", action="store_true", help="print only")
     show.set_defaults(run=run_show)
     check = actions.add_parser("check", help="assemble every chain over its working range; exit 2 on failure")
@@ -126,7 +128,8 @@ def run_show(args: argparse.Namespace) -> int:
     if not args.no_figure:
         from hiab_sim.machine.drawing import save_drawing
 
-        path = args.figure or Path(f"{Path(str(args.machine)).stem}_machine.png")
+        stem = Path(str(args.machine)).stem
+        path = args.figure or Path(f"{stem}.png" if stem.endswith("machine") else f"{stem}_machine.png")
         print(f"drawing: {save_drawing(machine, path)}")
     return 0
 
