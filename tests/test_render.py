@@ -19,6 +19,7 @@ from playback_result_helper import write_playback_result
 from hiab_sim import _gl
 from hiab_sim.cli import main
 from hiab_sim.crane.description import Crane
+from hiab_sim.errors import InvalidInputError
 from hiab_sim.model.mjcf import source_to_world
 from hiab_sim.render import backend as render_backend
 from hiab_sim.render import (
@@ -253,6 +254,9 @@ def test_still_frame_is_a_png_of_the_requested_size(result_dir: Path, tmp_path: 
 
     path = render_still(result_dir, tmp_path / "still.png", at_time=0.5, size=SIZE)
     assert mediapy.read_image(path).shape == (SIZE[1], SIZE[0], 3)
+    with pytest.raises(InvalidInputError, match="--at"):  # outside the motion: refused, not clamped
+        render_still(result_dir, tmp_path / "late.png", at_time=1e3, size=SIZE)
+    assert not (tmp_path / "late.png").exists()
 
 
 @pytest.mark.sim

@@ -69,6 +69,19 @@ def test_render_still_side_by_side(run_dir: Path, tmp_path: Path) -> None:
 
 
 @pytest.mark.sim
+@pytest.mark.parametrize("at", ["999", "-1", "nan"])
+def test_a_still_outside_the_motion_is_refused(
+    at: str, run_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--at outside the motion's time: one line naming --at and the span, exit 2, no file (it was clamped)."""
+    out = tmp_path / "still.png"
+    assert main(["render", str(run_dir), "--still", str(out), "--at", at, "--size", "160x120"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--at" in err and "must lie in [0," in err
+    assert not out.exists()
+
+
+@pytest.mark.sim
 def test_render_refuses_simulate_on_a_machine_result(
     run_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

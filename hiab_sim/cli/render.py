@@ -72,11 +72,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         metavar="FILE.png",
         help="write only one frame (kinematic) as a PNG instead of a video (see --at)",
     )
-    parser.add_argument("--at", type=float, metavar="SECONDS", help="time of the --still frame (default: the end)")
+    parser.add_argument("--at", type=float, metavar="SECONDS", help="time of the --still frame [s], within the motion (default: the end)")
     parser.add_argument(
         "--frames",
         metavar="DIR",
-        help="write --count frames evenly spaced over the motion as DIR/frame_<i>.png instead of a video",
+        help="write --count frames evenly spaced over the motion as DIR/frame_<i>.png (DIR an existing folder) "
+        "instead of a video",
     )
     parser.add_argument("--count", type=int, default=4, metavar="N", help="frames of --frames (default: 4)")
     parser.set_defaults(run=run)

@@ -16,6 +16,7 @@ Videos and images are written to a temporary name in the target folder and moved
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import shutil
 import warnings
@@ -119,6 +120,15 @@ def check_output_path(path: Path, suffixes: tuple[str, ...], what: str) -> Path:
     if path.is_dir():
         raise HiabSimError(f"cannot write the {what} {path}: it is a folder")
     return path
+
+
+def still_time(at_time: float | None, start: float, end: float) -> float:
+    """The time [s] of a still frame: ``at_time`` (``--at``) within the motion's [start, end], None the end."""
+    if at_time is None:
+        return end
+    if not (math.isfinite(at_time) and start <= at_time <= end):
+        raise InvalidInputError("--at", at_time, f"must lie in [{start:g}, {end:g}] (the motion's time)", "s")
+    return float(at_time)
 
 
 class VideoSink:

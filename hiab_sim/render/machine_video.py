@@ -18,7 +18,14 @@ from pathlib import Path
 import numpy as np
 
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.render.backend import check_gl_backend, check_output_path, ffmpeg_path, write_image, write_video
+from hiab_sim.render.backend import (
+    check_gl_backend,
+    check_output_path,
+    ffmpeg_path,
+    still_time,
+    write_image,
+    write_video,
+)
 from hiab_sim.render.decor import design_rgba
 from hiab_sim.render.dress_machine import machine_file_dress, moved_pivots
 from hiab_sim.render.frames import LAYOUTS, Design, Layout, PlaybackRenderer
@@ -108,6 +115,6 @@ def machine_still(
     """
     output = check_output_path(Path(output), (".png",), "image")
     data = load_machine_playback(result_dir)
-    t = data.time[-1] if at_time is None else float(np.clip(at_time, data.time[0], data.time[-1]))
+    t = still_time(at_time, float(data.time[0]), float(data.time[-1]))
     with machine_renderer(data, size=size, layout=layout, at=np.array([t])) as renderer:
         return write_image(output, renderer.frame(0))

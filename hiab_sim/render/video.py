@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.model.mjcf import build_model, source_to_world
-from hiab_sim.render.backend import check_output_path, ffmpeg_path, write_image, write_video
+from hiab_sim.render.backend import check_output_path, ffmpeg_path, still_time, write_image, write_video
 from hiab_sim.render.decor import design_rgba
 from hiab_sim.render.dress import machine_dress
 from hiab_sim.render.frames import LAYOUTS, Design, Layout, PlaybackRenderer
@@ -251,10 +251,11 @@ def crane_still(
     data = load_playback(result_dir)
     _check_size(size, even=False)
     output = check_output_path(Path(output), (".png",), "image")
+    t = still_time(at_time, float(data.time[0]), float(data.time[-1]))
     fps = 30.0
     with playback_renderer(data, fps, size, "kinematic", layout, energy=load_power(result_dir, data)) as renderer:
         last = len(renderer) - 1
-        index = last if at_time is None else int(np.clip(round((at_time - data.time[0]) * fps), 0, last))
+        index = min(round((t - data.time[0]) * fps), last)
         return write_image(output, renderer.frame(index))
 
 
