@@ -72,7 +72,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         metavar="FILE.png",
         help="write only one frame (kinematic) as a PNG instead of a video (see --at)",
     )
-    parser.add_argument("--at", type=float, metavar="SECONDS", help="time of the --still frame [s], within the motion (default: the end)")
+    parser.add_argument(
+        "--at",
+        type=float,
+        metavar="SECONDS",
+        help="time of the --still frame [s], within the motion (default: the end)",
+    )
     parser.add_argument(
         "--frames",
         metavar="DIR",
