@@ -45,9 +45,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "validate",
         help="Cross-validate MuJoCo and analytic inverse dynamics (forces, velocities, power balance).",
         description=(
-            "Run both inverse-dynamics paths on random states, a smooth trajectory, >= 20 random link-length "
-            "sets and static poses, each with and without a TCP payload; report the errors and each path's "
-            "energy balance. Exit status 1 when any error exceeds its tolerance."
+            "Run both inverse-dynamics paths of the crane file on random states, a smooth trajectory, >= 20 random "
+            "link-length sets and static poses, each with and without a TCP payload; report the errors and each "
+            "path's energy balance. With --machine: a machine file's Newton-Euler and MuJoCo paths on random "
+            "states within its joint ranges, without and with a TCP force (--tcp-force). Exit status 1 when any "
+            "error exceeds its tolerance."
         ),
     )
     add_crane_option(parser, f"crane preset or YAML file (default: {DEFAULT_CRANE})")
