@@ -54,7 +54,8 @@ def test_machine_show_names_the_realistic_plant() -> None:
     from hiab_sim.cli.machine import describe
 
     assert describe(load_machine("exact"))[-1] == "realistic plant (simulate --plant realistic): realistic_exact"
-    assert describe(load_machine("xs031"))[-1].endswith("realistic (the shipped plant; the file names none)")
+    last = describe(load_machine("xs031"))[-1]
+    assert last.endswith("realistic (the shipped plant: the XS 031's estimates; this file names none)")
 
 
 def test_the_xs031_machine_file_keeps_the_shipped_realistic_plant() -> None:

@@ -115,7 +115,7 @@ def describe(machine: Machine) -> list[str]:
         lines.append(f"  {variable.key:<14} {variable.kind}{on} = {value:.5f} m, bounds {bounds}")
     if not machine.decision_variables:
         lines.append("  none")
-    plant = machine.realistic_plant or "realistic (the shipped plant; the file names none)"
+    plant = machine.realistic_plant or "realistic (the shipped plant: the XS 031's estimates; this file names none)"
     lines.append(f"realistic plant (simulate --plant realistic): {plant}")
     return lines
 
