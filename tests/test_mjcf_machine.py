@@ -86,3 +86,22 @@ def test_machine_mjcf_without_output_writes_machine_xml(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["machine.xml"]
     assert main(["mjcf", "--machine", "exact", "--crane", "xs031", "-o", "other.xml"]) == 2
     assert "--crane" in capsys.readouterr().err and not (tmp_path / "other.xml").exists()
+
+
+def test_crane_naming_a_machine_file_is_an_alias_of_machine(tmp_path: Path) -> None:
+    """``--crane exact`` or ``--crane <machine yaml>`` writes what ``--machine`` does; ``--crane xs031`` the crane."""
+    from hiab_sim.resources import shipped_names
+
+    machine_yaml = Path(str(shipped_names("machine")["exact"]))
+    outputs = {}
+    for name, argv in {
+        "machine": ["--machine", "exact"],
+        "crane name": ["--crane", "exact"],
+        "crane file": ["--crane", str(machine_yaml)],
+        "crane xs031": ["--crane", "xs031"],
+    }.items():
+        out = tmp_path / f"{name.replace(' ', '_')}.xml"
+        assert main(["mjcf", *argv, "-o", str(out)]) == 0
+        outputs[name] = out.read_text()
+    assert outputs["crane name"] == outputs["machine"] == outputs["crane file"]
+    assert outputs["crane xs031"] != outputs["machine"] and "telescope" in outputs["crane xs031"]

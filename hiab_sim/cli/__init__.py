@@ -17,6 +17,7 @@ from collections.abc import Sequence
 
 from hiab_sim import __version__
 from hiab_sim._gl import check_gl_backend, select_gl_backend
+from hiab_sim.cli.options import resolve_crane_alias
 from hiab_sim.errors import HiabSimError, InfeasibleStudyError, SolverError
 
 #: Subcommands that import MuJoCo: its OpenGL backend is checked before they run.
@@ -83,6 +84,7 @@ def _main(argv: Sequence[str] | None) -> int:
     if args.command is None:
         parser.print_help()
         return 0
+    resolve_crane_alias(args)
     try:
         if args.command in USES_MUJOCO:
             check_gl_backend()
