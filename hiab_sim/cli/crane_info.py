@@ -6,9 +6,10 @@ import argparse
 
 import numpy as np
 
-from hiab_sim.cli.options import add_crane_option
+from hiab_sim.cli.options import add_crane_option, names_machine_file
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.loader import load_crane
+from hiab_sim.errors import ConfigError
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -28,6 +29,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Print the crane summary."""
+    if names_machine_file(str(args.crane)):
+        raise ConfigError(f"--crane {args.crane}: a machine file, which 'hiab-sim machine show {args.crane}' prints")
     crane = load_crane(args.crane)
     print(f"{crane.name}  (gravity {crane.gravity} m/s^2)")
     print(f"source: {crane.source}")

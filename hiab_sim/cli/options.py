@@ -53,12 +53,17 @@ def resolve_crane_alias(args: argparse.Namespace) -> None:
     machine's name that is no shipped crane's (``exact``; ``xs031`` stays the crane file) or a YAML
     file with the machine format's ``links`` and ``chains``; anything else stays a crane file.
     """
-    from hiab_sim.resources import shipped_names
-
     crane = getattr(args, "crane", None)
     if crane is None or not hasattr(args, "machine") or args.machine is not None:
         return
-    if crane in shipped_names("crane"):
-        return
-    if crane in shipped_names("machine") or _is_machine_file(str(crane)):
+    if names_machine_file(str(crane)):
         args.machine, args.crane = crane, None
+
+
+def names_machine_file(value: str) -> bool:
+    """Whether a ``--crane`` value names a machine file: a shipped machine that is no shipped crane, or such a YAML."""
+    from hiab_sim.resources import shipped_names
+
+    if value in shipped_names("crane"):
+        return False
+    return value in shipped_names("machine") or _is_machine_file(value)
