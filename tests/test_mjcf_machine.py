@@ -108,7 +108,7 @@ def test_crane_naming_a_machine_file_is_an_alias_of_machine(tmp_path: Path) -> N
 
 
 def test_crane_summary_of_a_machine_file_points_to_machine_show(capsys: pytest.CaptureFixture[str]) -> None:
-    """``hiab-sim crane --crane exact``: one line naming ``machine show``, exit 2 (the crane summary reads crane files)."""
+    """``hiab-sim crane --crane exact``: one line naming ``machine show``, exit 2 (it summarises crane files)."""
     assert main(["crane", "--crane", "exact"]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "hiab-sim machine show exact" in err
