@@ -18,8 +18,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "Optimise the study, find the least criterion its constraints allow, and minimise the study's "
             "objective (any registered one, in its unit; for a duty mix the weighted sum over its tasks, every "
             "task's constraints held and the criterion the worst over the tasks) with criterion <= epsilon for "
-            "epsilon from the optimum's criterion down to that least value, each a full SQP optimisation. Crane "
-            "files and machine files alike. Writes pareto.csv, pareto.json and pareto.png."
+            "epsilon from the optimum's criterion down to that least value, each a full optimisation by the study's "
+            "own solver (SLSQP or IPOPT, solver.method). Crane files and machine files alike. Writes pareto.csv, "
+            "pareto.json and pareto.png."
         ),
     )
     parser.add_argument(
