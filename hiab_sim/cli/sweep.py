@@ -15,7 +15,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="Optimise a study at every point of a parameter grid or sample; one table of results.",
         description=(
             "Run a full optimisation at every point of SWEEP.yaml (a base study and a grid or a Latin-hypercube "
-            "sample over dotted study paths such as bounds.lift.up[0], payload, emla.lift.gear_ratio). Every point's "
+            "sample over dotted study paths such as payload, emla.lift.gear_ratio or, in a crane file's study, "
+            "bounds.lift.up[0]; a machine file's study has no bounds.<chain>: its decision variables' bounds are the "
+            "machine file's, moved by sweeping machine over copies of that file). Every point's "
             "study is validated before any work starts. Results: DIR/sweep.parquet (one row per point, written "
             "atomically as points finish), DIR/points/<key>/result.json and summary figures."
         ),
