@@ -33,3 +33,27 @@ def test_emla_map_rejects_a_name_the_file_lacks(tmp_path: Path, capsys: pytest.C
     assert "\n" not in err
     assert "boom, arm, bucket" in err and "'lift'" in err
     assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize(
+    ("arguments", "named"),
+    [
+        (["--resolution", "-5"], "--resolution = -5 is out of range: must be an integer from 3 to 2001"),
+        (["--resolution", "2002"], "--resolution = 2002"),
+        (["-o", "{tmp}/map.jpg"], "--output = '{tmp}/map.jpg' is out of range: must end with .png"),
+        (["--csv", "{tmp}/grid.txt"], "--csv = '{tmp}/grid.txt' is out of range: must end with .csv"),
+        (["--npz", "{tmp}/grid"], "--npz = '{tmp}/grid' is out of range: must end with .npz"),
+    ],
+)
+def test_emla_map_refuses_a_bad_option_naming_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], arguments: list[str], named: str
+) -> None:
+    """A resolution outside 3..2001 or a file without its format's suffix: one line naming the option, no file."""
+    given = [a.replace("{tmp}", str(tmp_path)) for a in arguments]
+    if "-o" not in given:
+        given += ["-o", str(tmp_path / "map.png")]
+    assert main(["emla-map", "--emla", "exact", *given]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "Traceback" not in err
+    assert named.replace("{tmp}", str(tmp_path)) in err
+    assert not list(tmp_path.iterdir())

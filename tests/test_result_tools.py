@@ -64,20 +64,20 @@ def test_compare_table_matches_each_result(small_run: Path, tmp_path: Path, caps
     out = tmp_path / "cmp"
     assert main(["compare", str(small_run), str(second), "--out", str(out)]) == 0
     printed = capsys.readouterr().out
-    assert "saving [%]" in printed and "copy" in printed
+    assert "saving [%]" in printed and "copy: copy, objective costf2" in printed
     assert max(len(line) for line in printed.splitlines() if not line.startswith("wrote")) <= 100
     with (out / "comparison.csv").open() as handle:
         table = list(csv.DictReader(handle))
     assert [(r["run"], r["design"]) for r in table] == [
-        ("small", "initial"), ("small", "optimal"), ("copy", "initial"), ("copy", "optimal")
+        ("out", "initial"), ("out", "optimal"), ("copy", "initial"), ("copy", "optimal")
     ]  # fmt: skip
     result = json.loads((small_run / "result.json").read_text())
     for row in table[:2]:
         lengths = [float(row[f"{c} {k} [mm]"]) for c in ("lift", "tilt") for k in ("L", "Lc0", "Lc")]
         np.testing.assert_allclose(lengths, 1e3 * _xi(result, row["design"]), rtol=1e-15)
         energy = result[row["design"]]["net_electrical_energy_J"]
-        assert float(row["net energy [kJ]"]) == pytest.approx(energy / 1e3, rel=1e-15)
-    saved = float(table[1]["saving vs initial [%]"])
+        assert float(row["net electrical energy at the drives [kJ]"]) == pytest.approx(energy / 1e3, rel=1e-15)
+    saved = float(table[1]["net electrical energy saving vs initial [%]"])
     assert saved == pytest.approx(result["improvement"]["net_energy_saved_percent"], rel=1e-9)
     assert (out / "comparison.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
@@ -85,7 +85,7 @@ def test_compare_table_matches_each_result(small_run: Path, tmp_path: Path, caps
 def test_compare_without_out_writes_nothing_and_fits_100_columns(
     small_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """Without --out, compare only prints (no ./comparison/), every line within 100 columns even for long names."""
+    """Without --out, compare only prints (no ./comparison/); the table's rows fit 100 columns, a long name is whole."""
     second = tmp_path / ("a_rather_long_run_folder_name_" * 4)
     shutil.copytree(small_run, second)
     data = json.loads((second / "result.json").read_text())
@@ -96,9 +96,42 @@ def test_compare_without_out_writes_nothing_and_fits_100_columns(
     monkeypatch.chdir(work)
     assert main(["compare", str(small_run), str(second)]) == 0
     printed = capsys.readouterr().out
-    assert max(len(line) for line in printed.splitlines()) <= 100
-    assert "..." in printed  # the long name is shortened, not wrapped
+    assert max(len(line) for line in printed.splitlines() if not line.startswith(second.name)) <= 100
+    assert f"{second.name}: {second.name}, objective costf2" in printed  # its own line, whole
     assert list(work.iterdir()) == []
+
+
+def test_compare_saving_is_of_the_objectives_energy_and_labels_runs_by_folder(
+    small_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Two folders of one study named ``run`` read ``a/run`` and ``b/run``; each saving is of its objective's energy.
+
+    With the objective ``battery_energy`` the saving is the battery energy's that ``optimize`` wrote
+    (``energy.battery_energy_saved_percent``), with ``costf2`` the net electrical energy's.
+    """
+    result = json.loads((small_run / "result.json").read_text())
+    for parent, objective in (("a", "costf2"), ("b", "battery_energy")):
+        folder = tmp_path / parent / "run"
+        shutil.copytree(small_run, folder)
+        data = json.loads((folder / "result.json").read_text())
+        data["energy"]["objective"] = objective
+        (folder / "result.json").write_text(json.dumps(data))
+    out = tmp_path / "cmp"
+    assert main(["compare", str(tmp_path / "a" / "run"), str(tmp_path / "b" / "run"), "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "a/run: small, objective costf2, saving of its net electrical energy at the drives" in printed
+    assert "b/run: small, objective battery_energy, saving of its battery energy at the battery" in printed
+    battery = result["energy"]["battery_energy_saved_percent"]
+    net = result["improvement"]["net_energy_saved_percent"]
+    assert abs(battery - net) > 0.01  # the two savings differ: the test tells them apart
+    saving = [line.split()[-1] for line in printed.splitlines() if line.startswith("  optimal")]
+    assert saving == [f"{net:+.2f}", f"{battery:+.2f}"]
+    with (out / "comparison.csv").open() as handle:
+        table = list(csv.DictReader(handle))
+    assert [r["run"] for r in table] == ["a/run", "a/run", "b/run", "b/run"]
+    for row in (table[1], table[3]):
+        assert float(row["battery energy saving vs initial [%]"]) == pytest.approx(battery, rel=1e-9)
+        assert float(row["net electrical energy saving vs initial [%]"]) == pytest.approx(net, rel=1e-9)
 
 
 def test_compare_rejects_bad_folders_with_one_line(small_run: Path, tmp_path: Path, capsys) -> None:

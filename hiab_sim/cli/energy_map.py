@@ -19,7 +19,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "battery energies and the constraints that depend on the decision variables on an N x N grid of two "
             "of the machine's decision variables over their bounds, the others and every task's joint trajectory "
             "fixed at the optimum of --result (or the study's start), on the analytic ID path. Crane files and "
-            "machine files alike. Infeasible cells are coloured by their binding constraint."
+            "machine files alike. Infeasible cells are coloured by their binding constraint. Writes "
+            "energy_map.json, energy_map.npz, energy_map.png and summary.md into a folder of its own (a folder "
+            "holding another command's output, e.g. the --result folder, is refused: its summary.md would be "
+            "overwritten)."
         ),
     )
     parser.add_argument(
@@ -51,17 +54,19 @@ def run(args: argparse.Namespace) -> int:
     from hiab_sim.sweep.answers import map_answer
     from hiab_sim.sweep.energy_map import energy_map, optimum_design, parse_variables, result_study, start_design
     from hiab_sim.sweep.map_output import TRAJECTORY_NOTE, energy_words, objective_words, summary, write_map
+    from hiab_sim.sweep.out_folder import check_out_folder
     from hiab_sim.terminal import StatusLine
 
     if args.grid < 2:
         raise InvalidInputError("--grid", args.grid, "must be >= 2")
     study = load_study(args.study or (result_study(args.result) if args.result else DEFAULT_STUDY))
     variables = parse_variables(args.vars, tuple(study.model.design_names))
+    out = Path(args.out) if args.out else Path("runs") / study.name / "energy_map"
+    check_out_folder(out, "energy-map", "energy_map")
     problem = StudyProblem(study, id_path="analytic")
     base = optimum_design(args.result, problem) if args.result else start_design(problem)
     with StatusLine(f"evaluating {args.grid} x {args.grid} mountings on {problem.n_tasks} task(s) ..."):
         m = energy_map(problem, base, variables, args.grid)
-    out = Path(args.out) if args.out else Path("runs") / study.name / "energy_map"
     duty = problem.problems[0].duty_options is not None
     per = "cycle" if not duty else "duty period (the cycle and the rest's hold)"
     paths = write_map(m, out, per.split(" (")[0])

@@ -18,8 +18,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "Optimise the study, find the least criterion its constraints allow, and minimise the study's "
             "objective (any registered one, in its unit; for a duty mix the weighted sum over its tasks, every "
             "task's constraints held and the criterion the worst over the tasks) with criterion <= epsilon for "
-            "epsilon from the optimum's criterion down to that least value, each a full SQP optimisation. Crane "
-            "files and machine files alike. Writes pareto.csv, pareto.json and pareto.png."
+            "epsilon from the optimum's criterion down to that least value, each a full optimisation by the study's "
+            "own solver (SLSQP or IPOPT, solver.method). Crane files and machine files alike. Writes pareto.csv, "
+            "pareto.json, pareto.png and summary.md into a folder of its own (a folder holding another command's "
+            "output, e.g. an optimisation's result.json, is refused: its summary.md would be overwritten)."
         ),
     )
     parser.add_argument(
@@ -41,6 +43,7 @@ def run(args: argparse.Namespace) -> int:
     from hiab_sim.study.solvers.slsqp import check_start, solve
     from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
     from hiab_sim.sweep.answers import front_answer
+    from hiab_sim.sweep.out_folder import check_out_folder
     from hiab_sim.sweep.pareto import CRITERIA, front_figure_png, pareto_front
     from hiab_sim.terminal import StatusLine
 
@@ -49,9 +52,10 @@ def run(args: argparse.Namespace) -> int:
 
         raise InvalidInputError("--points", args.points, "must be >= 2")
     study = load_study(args.study or DEFAULT_STUDY)
+    out = Path(args.out) if args.out else Path("runs") / study.name / f"pareto_{args.against}"
+    check_out_folder(out, "pareto", f"pareto_{args.against}")
     study_problem = make_problem(study)
     check_start(study_problem, study_problem.initial_point(study.initial_lengths))
-    out = Path(args.out) if args.out else Path("runs") / study.name / f"pareto_{args.against}"
     with StatusLine(f"optimising {study.name} and {args.points - 1} limits on the {args.against} ..."):
         optimum = solve(study_problem, study.initial_lengths, progress=None)
         front = pareto_front(study_problem, optimum.z, args.against, args.points)

@@ -15,9 +15,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="Optimise a study at every point of a parameter grid or sample; one table of results.",
         description=(
             "Run a full optimisation at every point of SWEEP.yaml (a base study and a grid or a Latin-hypercube "
-            "sample over dotted study paths such as bounds.lift.up[0], payload, emla.lift.gear_ratio). Every point's "
+            "sample over dotted study paths such as payload, emla.lift.gear_ratio or, in a crane file's study, "
+            "bounds.lift.up[0]; a machine file's study has no bounds.<chain>: its decision variables' bounds are the "
+            "machine file's, moved by sweeping machine over copies of that file). Every point's "
             "study is validated before any work starts. Results: DIR/sweep.parquet (one row per point, written "
-            "atomically as points finish), DIR/points/<key>/result.json and summary figures."
+            "atomically as points finish), DIR/points/<key>/result.json, summary figures and DIR/summary.md; DIR "
+            "holding another command's output (e.g. an optimisation's result.json) is refused."
         ),
     )
     parser.add_argument("sweep", metavar="SWEEP.yaml", help="sweep file")
@@ -37,12 +40,14 @@ def run(args: argparse.Namespace) -> int:
     from hiab_sim.sweep.answers import sweep_answer
     from hiab_sim.sweep.executors import make_executor
     from hiab_sim.sweep.figures import summary_figures
+    from hiab_sim.sweep.out_folder import check_out_folder
     from hiab_sim.sweep.runner import run_sweep
     from hiab_sim.sweep.spec import load_sweep
     from hiab_sim.sweep.table import read_table
 
     sweep = load_sweep(args.sweep)
     out = Path(args.out) if args.out else Path("runs") / "sweeps" / sweep.name
+    check_out_folder(out, "sweep", "sweep")
     where = f"Dask at {args.dask}" if args.dask else f"{args.workers or 1} local process(es)"
     with make_executor(args.workers, args.dask) as executor:
         outcome = run_sweep(sweep, out, executor, resume=args.resume, progress=not args.quiet)

@@ -11,17 +11,32 @@ more, criterion(z) <= epsilon, where the criterion is the worst over the tasks:
   of eq. ``torque_torque`` at the task's collocation samples (a proxy of the motors' thermal load),
   one row epsilon - rms_j >= 0 per task j.
 
-The epsilon rows are appended to the NLP's own rows (:class:`EpsilonProblem` wraps the study's
-problem through its public methods). Their values come from each task's inverse dynamics on its
-machine (crane file or machine file alike: ``TaskProblem.model``); their Jacobian is chained
-exactly through the B-spline matrices from the per-sample ID partials (central differences in
-q9, :func:`hiab_sim.study.nlp.id_partials.id_joint_partials`, and in Xi,
-``StudyMachine.design_partials``) and the motor torque's analytic partials
-(:func:`hiab_sim.emla.drive.drive_state`). The front's epsilon runs from the plain optimum's
-criterion c_0 (epsilon inactive: the plain study) down to the least criterion c_min the constraints
-allow (:func:`minimise_criterion`, the epigraph form min t s.t. -t <= s_k <= t), equally spaced, so
-every epsilon is feasible; each point is warm-started from the previous one (or from the c_min
-design if that fails). Every front point is solved by SLSQP (dense), whatever the study's method.
+The epsilon rows are one more constraint block per task (:mod:`hiab_sim.sweep.epsilon_rows`): their
+values read each task's own inverse dynamics on its machine (crane file or machine file alike), their
+Jacobian its ID partials chained through the B-spline matrices like every other row, and each front
+point is solved by the study's own method with its settings (:func:`solve_point`: SLSQP dense, or
+IPOPT with the sparse pattern the blocks give). The criterion functions below
+(:func:`criterion_samples`, :func:`samples_jacobian`) compute the same quantities on their own, for
+the least-criterion solve and the reported criterion: the forces f_x, or the motor torques of eq.
+``torque_torque`` (:func:`hiab_sim.emla.drive.drive_state`), their Jacobian chained exactly through
+the B-spline matrices from the per-sample ID partials (central differences in q9,
+:func:`hiab_sim.study.nlp.id_partials.id_joint_partials`, and in Xi, ``StudyMachine.design_partials``)
+and the motor torque's analytic partials.
+
+The front's epsilon runs from the plain optimum's criterion c_0 (epsilon inactive: the plain study)
+down to the least criterion c_min the constraints allow (:func:`minimise_criterion`, the epigraph
+form min t s.t. -t <= s_k <= t, dense SLSQP whatever the study's method: the extra variable t is not
+one of the study's), equally spaced, so every epsilon is feasible. Each point starts from the
+previous one; if that fails, from the study's start, then from the c_min design z_min. The study's
+start is the plain optimisation's, which IPOPT can evaluate: IPOPT first moves a start lying on a
+bound inside by up to 1 % of the variable's range (its bound_push and bound_frac), and from a design
+on a bound where the working range binds that can leave the model's domain (measured on the XS 031
+test study: the warm start fails at its first evaluation). z_min is feasible for every epsilon
+>= c_min, but it is not the far end's answer: it minimises the criterion alone, and where several
+designs reach c_min (only the samples at the peak fix it) it need not have the least objective among
+them (measured: the grading study's z_min 0.9543 of its start's objective, its far end solved from
+there 0.9513; the XS 031 test study's 0.9252 and 0.9230). So the far end is solved like every
+point, and reported not converged if it fails.
 """
 
 from __future__ import annotations
@@ -39,7 +54,10 @@ from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import C_SCALE, XI_SCALE, TaskProblem
+from hiab_sim.study.solvers.ipopt import solve_ipopt
+from hiab_sim.study.solvers.threads import single_blas_thread
 from hiab_sim.style import colour
+from hiab_sim.sweep.epsilon_rows import epsilon_problem
 
 Array = NDArray[np.float64]
 CRITERIA = {"peak_force": "N", "rms_torque": "N m"}
@@ -125,61 +143,45 @@ def criterion(problem: StudyProblem, z: Array, name: str) -> float:
     return float(np.max(np.abs(criterion_samples(problem, z, name))))
 
 
-class EpsilonProblem:
-    """The study's NLP with criterion <= epsilon appended (rows scaled by ``scale``)."""
+def solve_point(problem: StudyProblem, z0: Array) -> tuple[Array, bool, str, int]:
+    """Minimise the cost from z0 (need not be feasible) by the study's method: (z, accepted, message, iterations).
 
-    def __init__(self, problem: StudyProblem, name: str, epsilon: float, scale: float) -> None:
-        self.problem, self.name, self.epsilon, self.scale = problem, name, float(epsilon), float(scale)
-
-    def rows(self, z: Array) -> Array:
-        """Scaled epsilon rows, feasible where >= 0."""
-        s = criterion_samples(self.problem, z, self.name)
-        if self.name == "peak_force":
-            return np.concatenate([self.epsilon - s, self.epsilon + s]) / self.scale
-        return (self.epsilon - s) / self.scale
-
-    def rows_jacobian(self, z: Array) -> Array:
-        """Jacobian of :meth:`rows` with respect to z, (m, n)."""
-        d = samples_jacobian(self.problem, z, self.name) / self.scale
-        return np.vstack([-d, d]) if self.name == "peak_force" else -d
-
-    def constraints(self, z: Array) -> Array:
-        """The study's inequality rows and the epsilon rows."""
-        return np.concatenate([self.problem.constraints(z), self.rows(z)])
-
-    def constraints_jacobian(self, z: Array) -> Array:
-        """Their Jacobian."""
-        return np.vstack([self.problem.constraints_jacobian(z), self.rows_jacobian(z)])
-
-    def max_violation(self, z: Array) -> float:
-        """Largest scaled violation of the study's rows, bounds and the epsilon rows."""
-        return max(self.problem.max_violation(z), float(max(0.0, -self.rows(z).min())))
-
-    def solve(self, z0: Array, maxiter: int) -> tuple[Array, bool, str, int]:
-        """SLSQP from z0 (need not be feasible): (z, accepted, message, iterations)."""
-        p = self.problem
-        bounds = [
-            (lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None)
-            for lo, hi in zip(p.lower, p.upper, strict=True)
-        ]
-        try:
-            res = minimize(
-                p.cost,
-                np.asarray(z0, dtype=float),
-                jac=p.cost_gradient,
-                method="SLSQP",
-                bounds=bounds,
-                constraints=[
-                    {"type": "eq", "fun": p.equalities, "jac": p.equalities_jacobian},
-                    {"type": "ineq", "fun": self.constraints, "jac": self.constraints_jacobian},
-                ],
-                options={"maxiter": maxiter, "ftol": p.study.solver.ftol},
-            )
-        except InvalidInputError as error:  # a trial point left the model's domain
-            return np.asarray(z0, dtype=float), False, f"a trial point left the model's domain: {error}", 0
-        z = np.asarray(res.x, dtype=float)
-        accepted = bool(res.success) and self.max_violation(z) <= FEASIBLE
-        return z, accepted, str(res.message), int(res.nit)
+    The study's ``solver`` settings as :func:`hiab_sim.study.solvers.slsqp.solve` uses them: ``method``
+    (``slsqp``: scipy's dense SLSQP; ``ipopt``: IPOPT with the blocks' sparse Jacobian and an L-BFGS
+    Hessian of ``lbfgs_history`` pairs), ``maxiter`` and ``ftol``; one BLAS thread. That function
+    checks that its start is feasible: a front point starts from the previous point, which its
+    tighter epsilon cuts off. Accepted: the solver reports success and the point holds every row
+    (epsilon rows included) to :data:`FEASIBLE`.
+    """
+    settings = problem.study.solver
+    z0 = np.asarray(z0, dtype=float)
+    try:
+        with single_blas_thread():
+            if settings.method == "ipopt":
+                outcome = solve_ipopt(problem, z0, settings.maxiter, settings.ftol, history=settings.lbfgs_history)
+                z, success, message, iterations = outcome.z, outcome.success, outcome.message, outcome.iterations
+            else:
+                bounds = [
+                    (lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None)
+                    for lo, hi in zip(problem.lower, problem.upper, strict=True)
+                ]
+                res = minimize(
+                    problem.cost,
+                    z0,
+                    jac=problem.cost_gradient,
+                    method="SLSQP",
+                    bounds=bounds,
+                    constraints=[
+                        {"type": "eq", "fun": problem.equalities, "jac": problem.equalities_jacobian},
+                        {"type": "ineq", "fun": problem.constraints, "jac": problem.constraints_jacobian},
+                    ],
+                    options={"maxiter": settings.maxiter, "ftol": settings.ftol},
+                )
+                z, success, message, iterations = res.x, bool(res.success), str(res.message), int(res.nit)
+    except InvalidInputError as error:  # a trial point left the model's domain
+        return z0, False, f"a trial point left the model's domain: {error}", 0
+    z = np.asarray(z, dtype=float)
+    return z, success and problem.max_violation(z) <= FEASIBLE, message, iterations
 
 
 @dataclass(frozen=True)
@@ -286,11 +288,13 @@ def pareto_front(problem: StudyProblem, z_optimum: Array, name: str, points: int
         raise SolverError(f"minimising {name} subject to the study's constraints did not converge")
     front = [_point(problem, z_optimum, name, c0, True, "the plain optimum (epsilon inactive)", 0)]
     z = z_optimum
+    z_start = problem.initial_point(problem.study.initial_lengths)
     for epsilon in np.linspace(c0, c_min, points)[1:]:
-        eps_problem = EpsilonProblem(problem, name, float(epsilon), c0)
-        z_new, accepted, message, iterations = eps_problem.solve(z, problem.study.solver.maxiter)
-        if not accepted:
-            z_new, accepted, message, iterations = eps_problem.solve(z_min, problem.study.solver.maxiter)
+        bounded = epsilon_problem(problem, name, float(epsilon), c0)
+        for start in (z, z_start, z_min):  # the first that converges
+            z_new, accepted, message, iterations = solve_point(bounded, start)
+            if accepted:
+                break
         front.append(_point(problem, z_new, name, float(epsilon), accepted, message, iterations))
         if accepted:
             z = z_new

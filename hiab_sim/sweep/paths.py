@@ -27,16 +27,23 @@ def set_path(document: dict[str, Any], path: str, value: Any, steps: list[str | 
     """Set ``path`` in ``document`` in place.
 
     A missing mapping key on the way is created (the loader then rejects keys it does not know);
-    a list index must exist. A value written as ``{value: ..., source: ...}`` (the EMLA files)
-    gets its ``value`` replaced and ``source`` set to ``"model: set by a sweep"``.
+    a list index must exist, in a list the document has (an index below a missing key names that
+    key). A value written as ``{value: ..., source: ...}`` (the EMLA files) gets its ``value``
+    replaced and ``source`` set to ``"model: set by a sweep"``.
     """
     steps = parse_path(path) if steps is None else steps
     node: Any = document
+    missing: str | None = None  # the first key on the way the document does not have
     for k, step in enumerate(steps):
         last = k == len(steps) - 1
         if isinstance(step, int):
-            if not isinstance(node, list) or not 0 <= step < len(node):
-                raise ConfigError(f"{path}: no list item [{step}] there")
+            if missing is not None:
+                raise ConfigError(f"{path}: {missing} is not in the file, so it has no item [{step}]")
+            if not isinstance(node, list):
+                raise ConfigError(f"{path}: {_dotted(steps[:k])} is not a list, so it has no item [{step}]")
+            if not 0 <= step < len(node):
+                items = f"{len(node)} items, [0] to [{len(node) - 1}]" if node else "no items"
+                raise ConfigError(f"{path}: {_dotted(steps[:k])} has {items}")
             if last:
                 node[step] = value
                 return
@@ -51,5 +58,11 @@ def set_path(document: dict[str, Any], path: str, value: Any, steps: list[str | 
                 node[step] = value
             return
         if step not in node:
+            missing = missing or _dotted(steps[: k + 1])
             node[step] = [] if isinstance(steps[k + 1], int) else {}
         node = node[step]
+
+
+def _dotted(steps: list[str | int]) -> str:
+    """``["a", "b", 1]`` as ``a.b[1]``."""
+    return "".join(f"[{s}]" if isinstance(s, int) else f".{s}" for s in steps).lstrip(".")

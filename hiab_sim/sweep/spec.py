@@ -16,7 +16,9 @@ A sweep file (YAML)::
       seed: 1
       ranges: {payload: [0, 300], emla.lift.gear_ratio: [3, 8]}
 
-Paths address the study's YAML mapping (``bounds.lift.up[0]``, ``payload``, ``solver.maxiter``);
+Paths address the study's YAML mapping (``payload``, ``solver.maxiter``, a crane file's chain bounds
+``bounds.lift.up[0]``; a machine file's study has none, its bounds are the machine file's, and a sweep
+over ``machine`` with paths of copies of that file moves them);
 paths under ``emla.`` address the study's EMLA file (``emla.lift.gear_ratio`` is its
 ``actuators.lift.gear_ratio``, ``emla.pmsm.peak_torque`` its ``pmsm.peak_torque``; an actuator is
 any name under the file's ``actuators``, e.g. ``emla.boom.gear_ratio`` of the eXact arm's). The base
@@ -186,9 +188,13 @@ def load_sweep(path: str | Path) -> Sweep:
     fixed = data.get("set", {}) or {}
     if not isinstance(fixed, dict):
         raise ConfigError("set: expected a mapping of paths to values")
-    design_names = tuple(_validate(base, None, study_file, []).model.design_names)
+    base_study = _validate(base, None, study_file, [])
+    design_names = tuple(base_study.model.design_names)
     columns, raw, axes = _grid_points(data["grid"]) if "grid" in data else _sample_points(data["sample"])
     paths = [c for c in columns if c not in _axis_names(data)]
+    if base_study.machine is not None:
+        for p in [*fixed, *paths]:
+            _check_machine_bounds(str(p), base, base_study)
     emla_base = _emla_document(base) if any(p.startswith("emla.") for p in [*fixed, *paths]) else None
     points = []
     for values in raw:
@@ -225,6 +231,29 @@ def _emla_document(study: dict[str, Any]) -> dict[str, Any]:
     if not isinstance(document, dict):
         raise ConfigError(f"{file}: the EMLA file is not a mapping")
     return document
+
+
+def _check_machine_bounds(path: str, study: dict[str, Any], built: Study) -> None:
+    """Refuse ``bounds.<name>.…`` in a machine file's study that lacks it: the chains' bounds are the machine file's.
+
+    A crane file's study gives each chain's ``low`` and ``up`` under ``bounds``; a machine file's
+    study does not (:func:`hiab_sim.study.spec.machine_study.machine_study_from_dict`), its decision
+    variables' bounds are ``chains.<chain>.variables.<variable>.bounds`` in the machine file. A sweep
+    sets the study's keys, one of which is the machine file itself.
+    """
+    steps = parse_path(path)
+    bounds = study.get("bounds")
+    if steps[0] != "bounds" or len(steps) < 3 or not isinstance(steps[1], str):
+        return
+    if isinstance(bounds, dict) and steps[1] in bounds:
+        return
+    chains = list(dict.fromkeys(name.split(".", 1)[0] for name in built.model.design_names))
+    machine = built.crane_file.label if built.crane_file is not None else built.crane_source
+    raise ConfigError(
+        f"{path}: a machine file's study has no bounds.{steps[1]}: its decision variables' bounds are in the "
+        f"machine file {machine} (chains.<chain>.variables.<variable>.bounds; chains {', '.join(chains)}); to sweep "
+        "them, sweep machine over copies of that file with other bounds (paths absolute or relative to the study file)"
+    )
 
 
 def _assign(study: dict[str, Any], emla: dict[str, Any] | None, path: str, value: Any) -> None:
