@@ -25,7 +25,6 @@ import numpy as np
 from hiab_sim.emla import EmlaSet
 from hiab_sim.emla.drive import drive_state
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.study.constraints.block_registry import register_block, unregister_block
 from hiab_sim.study.constraints.blocks import opposite_rows
 from hiab_sim.study.nlp.interface import (
     Array,
@@ -38,9 +37,6 @@ from hiab_sim.study.nlp.interface import (
     SampleState,
 )
 from hiab_sim.study.nlp.problem import StudyProblem
-
-#: The registry name the epsilon rows are built under while :func:`epsilon_problem` builds a problem.
-EPSILON_BLOCK = "pareto_epsilon"
 
 
 def _check_scale(field: str, scale: float, unit: str) -> None:
@@ -153,18 +149,14 @@ def epsilon_problem(problem: StudyProblem, name: str, epsilon: float, scale: flo
     """``problem``'s study with criterion ``name`` <= ``epsilon`` appended to every task's rows.
 
     The same variables, scaling (each task's cost scale is ``problem``'s) and rows, then the epsilon
-    block of each task. Built through the block registry (the rows are registered while the tasks
-    are built, then removed): not for problems built concurrently in other threads.
+    block of each task (``extra_blocks``: this problem's own, the block registry untouched).
     """
-    register_block(EPSILON_BLOCK, lambda task: [epsilon_block(task, name, epsilon, scale)])
-    try:
-        return StudyProblem(
-            problem.study,
-            problem.emlas,
-            problem.id_path,
-            tightened=problem.tightened,
-            objective=problem.objective.name,
-            cost_scales=[p.cost_scale for p in problem.problems],
-        )
-    finally:
-        unregister_block(EPSILON_BLOCK)
+    return StudyProblem(
+        problem.study,
+        problem.emlas,
+        problem.id_path,
+        tightened=problem.tightened,
+        objective=problem.objective.name,
+        cost_scales=[p.cost_scale for p in problem.problems],
+        extra_blocks=lambda task: [epsilon_block(task, name, epsilon, scale)],
+    )

@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.emla import EmlaSet
+from hiab_sim.study.constraints.block_registry import BlockFactory
 from hiab_sim.study.machines.protocol import Design
 from hiab_sim.study.nlp.interface import Array, ConstraintBlock, ScaledProblem
 from hiab_sim.study.nlp.task_problem import Evaluation, TaskProblem
@@ -73,6 +74,8 @@ class StudyProblem(ScaledProblem):
         fine: Evaluate every task on its fine grid (reports), not its collocation grid.
         cost_scales: Each task's cost scale (default: its objective at the study's start); pass a
             problem's own to evaluate the same scaling on another grid.
+        extra_blocks: Each task's blocks of this problem only, after the registered ones
+            (:class:`~hiab_sim.study.nlp.task_problem.TaskProblem`; a Pareto point's epsilon rows).
 
     """
 
@@ -85,6 +88,7 @@ class StudyProblem(ScaledProblem):
         objective: str | None = None,
         fine: bool = False,
         cost_scales: list[float] | None = None,
+        extra_blocks: BlockFactory | None = None,
     ) -> None:
         self.study = study
         self.tasks = study.tasks
@@ -92,7 +96,14 @@ class StudyProblem(ScaledProblem):
         for k, task in enumerate(study.tasks):
             scale = None if cost_scales is None else cost_scales[k]
             base = TaskProblem(
-                study, emlas, id_path, cost_scale=scale, tightened=tightened, objective=objective, task=task
+                study,
+                emlas,
+                id_path,
+                cost_scale=scale,
+                tightened=tightened,
+                objective=objective,
+                task=task,
+                extra_blocks=extra_blocks,
             )
             if fine:
                 base = TaskProblem(
@@ -104,6 +115,7 @@ class StudyProblem(ScaledProblem):
                     tightened=tightened,
                     objective=objective,
                     task=task,
+                    extra_blocks=extra_blocks,
                 )
             problems.append(base)
         self.problems: tuple[TaskProblem, ...] = tuple(problems)

@@ -54,7 +54,7 @@ from hiab_sim.emla.duty_energy import drive_duty
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.constraints import blocks as bl
 from hiab_sim.study.constraints import builtin_blocks  # noqa: F401  (registers the built-in blocks, in row order)
-from hiab_sim.study.constraints.block_registry import build_blocks
+from hiab_sim.study.constraints.block_registry import BlockFactory, build_blocks
 from hiab_sim.study.machines.protocol import Design
 from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.motion.spline_chain import SplineChain
@@ -115,6 +115,7 @@ class TaskProblem(ScaledProblem):
             step over the task's duration, its spline the study's density of control points (or
             the task's own), its reference and payload force its own (:meth:`Task.id_force`);
             :class:`hiab_sim.study.nlp.problem.StudyProblem` composes one problem per task.
+        extra_blocks: Blocks of this problem only, after the registered ones (a Pareto point's bound).
 
     """
 
@@ -128,6 +129,7 @@ class TaskProblem(ScaledProblem):
         tightened: bool = True,
         objective: str | None = None,
         task: Task | None = None,
+        extra_blocks: BlockFactory | None = None,
     ) -> None:
         if task is None:
             if len(study.tasks) != 1:
@@ -135,6 +137,7 @@ class TaskProblem(ScaledProblem):
             task = study.tasks[0]
         self.study = study
         self.task = task
+        self._extra_blocks = extra_blocks  # one problem's own rows after the registered ones (a Pareto point's)
         self.tightened = tightened
         self.band_fraction = study.tracking.collocation_fraction if tightened else 1.0
         self.envelope_margin = study.bounds.envelope_margin if tightened else 0.0
@@ -221,8 +224,8 @@ class TaskProblem(ScaledProblem):
         return np.linspace(0.0, self.task.reference.duration, self.study.grid.fine_factor * intervals + 1)
 
     def _build_blocks(self) -> list[ConstraintBlock]:
-        """The inequality blocks in row order (:data:`~hiab_sim.study.constraints.block_registry.BLOCKS`)."""
-        return build_blocks(self)
+        """The inequality blocks in row order: the registered ones, then this problem's extra ones."""
+        return build_blocks(self) + ([] if self._extra_blocks is None else list(self._extra_blocks(self)))
 
     # -- variables ---------------------------------------------------------------------------
 
