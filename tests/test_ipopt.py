@@ -176,3 +176,35 @@ def test_a_jacobian_written_point_after_point_into_one_buffer_is_the_fresh_one(m
             got = p.constraints_jacobian(task_z(again, z, k))
             assert got is p.jacobian_buffer
             np.testing.assert_array_equal(got, expected[k])
+
+
+def test_a_trial_point_outside_the_models_domain_is_an_evaluation_error_ipopt_backs_off_from(
+    mix: StudyProblem, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """An objective that leaves the domain past a radius: IPOPT cuts its steps back and ends inside it.
+
+    The objective |z - z_target|^2 with z_target outside the domain (InvalidInputError beyond 0.05 of
+    the start): CasADi prints no Python traceback, and a solve that starts outside says why in its message.
+    """
+    pytest.importorskip("casadi")
+    from hiab_sim.study.solvers.ipopt import solve_ipopt
+
+    z0 = mix.initial_point(mix.study.initial_lengths)
+    step = np.zeros_like(z0)
+    step[-1] = 1.0  # the last spline coefficient: the model itself stays in its domain
+    target = z0 + step
+
+    def value(z: np.ndarray) -> float:
+        if np.linalg.norm(z - z0) > 0.05:
+            raise InvalidInputError("design", "a trial point", "inside the domain (a test's edge)")
+        return float(np.sum((z - target) ** 2))
+
+    def gradient(z: np.ndarray) -> np.ndarray:
+        value(z)
+        return 2.0 * (z - target)
+
+    outcome = solve_ipopt(mix, z0, 50, 1e-9, objective=(value, gradient))
+    assert np.linalg.norm(outcome.z - z0) <= 0.05
+    failed = solve_ipopt(mix, z0 + 0.1 * step, 5, 1e-9, objective=(value, gradient))
+    assert not failed.success and "outside the model's domain" in failed.message and "a test's edge" in failed.message
+    assert "Traceback" not in capfd.readouterr().err

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from hiab_sim.errors import BackendUnavailableError
+from hiab_sim.errors import BackendUnavailableError, InvalidInputError
 from hiab_sim.study.nlp.interface import Array
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.solvers.sparse_rows import SparseJacobian
@@ -56,8 +56,13 @@ def _casadi() -> Any:
     return casadi
 
 
-def _callback_class(ca: Any) -> Any:
+def _callback_class(ca: Any, failures: list[str]) -> Any:
     """A CasADi Callback whose outputs a numpy function computes from input 0, copy-free.
+
+    A point outside the model's domain (:class:`InvalidInputError` from the model, e.g. a chain that
+    cannot close at a trial design) is an evaluation error IPOPT handles itself (it cuts the step
+    back): the callback returns failure instead of raising, so CasADi prints no Python traceback,
+    and appends the error to ``failures``, which the solve's message reports when it fails.
 
     ``eval_buffer`` hands the inputs' and outputs' nonzeros as memoryviews (column-major): no DM is
     built per call (a 200k-nonzero DM from numpy costs ~15 ms). ``fill(z)`` returns one value per
@@ -108,7 +113,11 @@ def _callback_class(ca: Any) -> Any:
 
         def eval_buffer(self, arg: Any, res: Any) -> int:
             z = np.frombuffer(arg[0], dtype=np.float64)
-            values = self.fill(z.copy())
+            try:
+                values = self.fill(z.copy())
+            except InvalidInputError as error:
+                failures.append(str(error))
+                return 1
             for buffer, value in zip(res, values, strict=True):
                 if buffer is not None:
                     np.frombuffer(buffer, dtype=np.float64)[:] = value
@@ -157,7 +166,8 @@ def solve_ipopt(
     """
     cost, cost_gradient = (problem.cost, problem.cost_gradient) if objective is None else objective
     ca = _casadi()
-    Callback = _callback_class(ca)
+    failures: list[str] = []
+    Callback = _callback_class(ca, failures)
     n = problem.n
     jac = SparseJacobian(problem, z0)
     m = jac.shape[0]
@@ -267,10 +277,14 @@ def solve_ipopt(
             t.problem.jacobian_buffer = None
     stats = solver.stats()
     z = np.asarray(out["x"]).ravel()
+    success = stats.get("return_status") in SUCCESS
+    message = str(stats.get("return_status", ""))
+    if failures and not success:
+        message += f" ({len(failures)} trial point(s) outside the model's domain; the last: {failures[-1]})"
     return IpoptOutcome(
         z=z,
-        success=stats.get("return_status") in SUCCESS,
-        message=str(stats.get("return_status", "")),
+        success=success,
+        message=message,
         iterations=int(stats.get("iter_count", len(iterates))),
         iterates=iterates,
     )
