@@ -33,7 +33,10 @@ MACHINE_ENERGY = (
     "one drive's regeneration to the others; no battery); the prediction is the same sum of the plan's P_elec "
     "per drive"
 )
-MACHINE_TCP = "distance of the simulated TCP to the study's TCP reference (x_tcp, y_tcp) in the machine's plane"
+MACHINE_TCP = (
+    "distance of the simulated TCP to the study's TCP reference (x_tcp, y_tcp) in the machine's plane, placed at "
+    "the TCP's out-of-plane coordinate z_tcp (the plane the TCP moves in)"
+)
 NO_STRUCTURE = "the EMLA file lacks screw or drive_stiffness data for the machine's natural frequencies"
 
 

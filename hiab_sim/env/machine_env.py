@@ -66,7 +66,7 @@ from hiab_sim.env.plant.assembly import (
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.plant.friction import add_joint_friction
 from hiab_sim.env.plant.mismatch import friction_factor, payload_factor, true_drive_arrays, true_machine
-from hiab_sim.env.reference import PlannedMotion, motion_of_plan, physics_times
+from hiab_sim.env.reference import PlannedMotion, motion_of_plan, physics_times, reference_at
 from hiab_sim.env.rollout import ClosedLoopRun, check_cycles, run_environment
 from hiab_sim.env.task import CraneTrackingTask
 from hiab_sim.machine.dynamics.mjcf_build import spec_of_tree
@@ -109,8 +109,9 @@ def machine_motion(plan: MachinePlan, timestep: float) -> tuple[PlannedMotion, A
         qpos, qvel, _ = dynamics.state(pos, vel, acc)
         return actuators, qpos, qvel
 
-    reference = np.stack([np.interp(times, plan.time, plan.reference_tcp[:, i]) for i in range(2)], axis=1)
-    motion = motion_of_plan(plan, times, dynamics.model, loaded_dynamics, plan.emlas, _to_world(reference))
+    # The reference at the TCP's out-of-plane z (the XS 031 machine file's TCP sits at z = -9.23 mm in {W},
+    # off the mechanism's plane by the tool's side offset), as on a crane file: reference_at's docstring.
+    motion = motion_of_plan(plan, times, dynamics.model, loaded_dynamics, plan.emlas, reference_at(plan, times))
     return motion, _to_world(force[:, :2])
 
 

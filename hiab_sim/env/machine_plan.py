@@ -39,7 +39,7 @@ class MachinePlan(PlannedDesign):
 
     ``emlas`` is the study's EMLA set, one per chain in chain order; ``position``, ``velocity`` and
     ``acceleration`` are the independent joints in the machine's joint order, (K, J) [rad or m];
-    ``reference_tcp`` is (x_tcp, y_tcp, extra tracked) in {W}, (K, 3) [m, m, rad or m];
+    ``reference_tcp`` is (x_tcp, y_tcp, z_tcp) in {W}, (K, 3) [m], z_tcp the TCP's out-of-plane coordinate;
     ``predicted_electrical_power`` is per drive, (K, A) [W].
 
     Attributes:

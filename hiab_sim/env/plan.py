@@ -41,7 +41,8 @@ class PlannedDesign:
         time: Fine-grid sample times [s], (K,), from 0 to the cycle duration.
         position, velocity, acceleration: Planned independent joints and their rates, (K, J)
             [rad or m; per s; per s^2] (the crane's Θ1, Θ2, xt2).
-        reference_tcp: The study's reference in the source frame {W}, (K, 3) [m, m, rad or m].
+        reference_tcp: The study's TCP reference (x_tcp, y_tcp, z_tcp) in the source frame {W}, (K, 3) [m]:
+            the path in the machine's plane at the TCP's out-of-plane coordinate z_tcp.
         predicted_electrical_power: Planned P_elec per actuator, (K, A) [W].
         predicted_net_energy: The optimiser's net electrical energy of the design [J].
 
