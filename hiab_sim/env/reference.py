@@ -153,7 +153,7 @@ def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
     """Sample a crane file's plan every ``timestep`` [s] (see the module docstring)."""
     times = physics_times(plan, timestep)
     dynamics = MujocoInverseDynamics(plan.crane, plan.lengths)
-    tcp_force = None if plan.payload == 0.0 else np.array([0.0, -plan.payload * plan.crane.gravity, 0.0])
+    tcp_force = plan.id_tcp_force(times)  # the payload's weight, or the task's F(t) where it is one per sample
 
     def crane_dynamics(pos: Array, vel: Array, acc: Array) -> tuple[ActuatorSamples, Array, Array]:
         joints = JointSamples(pos, vel, acc)
