@@ -160,7 +160,7 @@ def test_a_heavier_payload_is_held_by_the_current_of_its_inverse_dynamics(plan: 
     The holding current comes from the machine's inverse dynamics with the TCP force F + e P
     (:class:`~hiab_sim.machine.dynamics.mujoco_path.MujocoMachineDynamics`) through the planner's
     steady-state drive (:func:`hiab_sim.emla.drive.drive_state`): an independent path to the load
-    the simulation applies (:class:`~hiab_sim.env.machine_env.TcpLoad`).
+    the simulation applies (:class:`~hiab_sim.env.tcp_load.TcpLoad`).
     """
     from hiab_sim.emla.drive import drive_state
 

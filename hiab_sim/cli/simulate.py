@@ -26,6 +26,14 @@ prints its table, writes ``effects.md`` (a five-line table, one column per varia
 :func:`hiab_sim.env.effect_report.effect_markdown`) and ``closed_loop_plant_effects.png``. ``--cycles N`` runs
 N cycles with the winding temperature carried over; the energies are the last cycle's.
 
+A duty mix's result (``result.json`` ``tasks``) is simulated task by task: each design of each task
+on the task's own plan (its motion, payload and duty), compared with the task's own energies of one
+cycle (``tasks[k].<design>``), not with the mix's weighted sums; ``simulation.json`` holds ``tasks``
+(per task its ``designs``) and ``mix`` (per design sum_k w_k E_k, closed loop against the result's),
+the table a row per task and design, the figures and videos one set per task (``_task<k>`` before the
+extension). The effect study (a plant with effects on) takes one plan per design and is refused on a
+mix with one line (exit 2).
+
 A machine file's result (:mod:`hiab_sim.machine`, e.g. the excavator) runs through
 :mod:`hiab_sim.cli.simulate_machine`: the same report, plant and effect study, each chain's EMLA
 drive on the machine's generic MJCF (:mod:`hiab_sim.env.machine_env`), ``closed_loop.mp4`` in the machine
@@ -40,7 +48,7 @@ import sys
 from pathlib import Path
 
 from hiab_sim.cli.options import add_out_option
-from hiab_sim.cli.simulate_summary import print_results, write_results
+from hiab_sim.cli.simulate_summary import print_results, refuse_mix_effects, task_indices, task_runs, write_results
 from hiab_sim.errors import InvalidInputError
 
 #: Closed-loop checks: energy within this fraction of the prediction, TCP error rms and max [mm].
@@ -98,16 +106,20 @@ def run(args: argparse.Namespace) -> int:
     if out.exists() and not out.is_dir():
         raise InvalidInputError("--out", str(out), "must be a folder")
     from hiab_sim.env.machine_plan import is_machine_result
+    from hiab_sim.env.plan import mix_tasks
 
+    tasks = task_indices(mix_tasks(args.result_dir))
     if is_machine_result(args.result_dir):  # its plant: the machine file's realistic one, read there
         from hiab_sim.cli.simulate_machine import run_machine
 
-        return run_machine(args, designs, out)
+        return run_machine(args, designs, out, tasks)
     from hiab_sim.env.plant import load_plant
 
     plant = load_plant(args.plant) if args.plant is not None else None
-    for design in designs:
-        read_plan(args.result_dir, design)  # bad input fails before any simulation
+    refuse_mix_effects(args, plant, tasks)
+    for task in tasks:
+        for design in designs:
+            read_plan(args.result_dir, design, task)  # bad input fails before any simulation
     out.mkdir(parents=True, exist_ok=True)
     if not args.no_video:
         from hiab_sim.render.backend import ffmpeg_path
@@ -118,16 +130,26 @@ def run(args: argparse.Namespace) -> int:
     from hiab_sim.env.validation import render_video, simulate_designs, simulation_report
 
     runs, nominal, physics = simulate_designs(
-        args.result_dir, designs, error, quiet=args.quiet, plant=plant, cycles=args.cycles
+        args.result_dir, designs, error, quiet=args.quiet, plant=plant, cycles=args.cycles, tasks=tasks
     )
     report = simulation_report(args.result_dir, runs, nominal)
     written, effects = write_results(args, report, runs, nominal, plant, designs, out)
     if not args.no_video:
-        plan = read_plan(args.result_dir, runs[0].design)
-        video = render_video(
-            out / "closed_loop.mp4", runs, physics, plan.crane, plan.emlas.battery, nominal or None, quiet=args.quiet
-        )
-        written.append(video.name)
+        plan = read_plan(args.result_dir, runs[0].design, tasks[0])
+        model_of = {id(run): item for run, item in zip(runs, physics, strict=True)}
+        for suffix, of_task in task_runs(runs):
+            drawn = [model_of[id(run)] for run in of_task]
+            of_nominal = [run for run in nominal if run.task == of_task[0].task]
+            video = render_video(
+                out / f"closed_loop{suffix}.mp4",
+                of_task,
+                drawn,
+                plan.crane,
+                plan.emlas.battery,
+                of_nominal or None,
+                quiet=args.quiet,
+            )
+            written.append(video.name)
     for item in physics:
         item.free()
     print_results(report, effects)

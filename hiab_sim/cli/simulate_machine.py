@@ -33,7 +33,10 @@ MACHINE_ENERGY = (
     "one drive's regeneration to the others; no battery); the prediction is the same sum of the plan's P_elec "
     "per drive"
 )
-MACHINE_TCP = "distance of the simulated TCP to the study's TCP reference (x_tcp, y_tcp) in the machine's plane"
+MACHINE_TCP = (
+    "distance of the simulated TCP to the study's TCP reference (x_tcp, y_tcp) in the machine's plane, placed at "
+    "the TCP's out-of-plane coordinate z_tcp (the plane the TCP moves in)"
+)
 NO_STRUCTURE = "the EMLA file lacks screw or drive_stiffness data for the machine's natural frequencies"
 
 
@@ -47,21 +50,25 @@ def refuse_crane_only(args: argparse.Namespace) -> None:
         )
 
 
-def run_machine(args: argparse.Namespace, designs: tuple[str, ...], out: Path) -> int:
-    """Simulate every design of a machine file's result, write ``simulation.json`` (and figures), print the table.
+def run_machine(
+    args: argparse.Namespace, designs: tuple[str, ...], out: Path, tasks: tuple[int | None, ...] = (None,)
+) -> int:
+    """Simulate every design (of every task) of a machine file's result, write ``simulation.json`` (and figures), print.
 
     ``--plant realistic`` is the machine file's own realistic plant where it names one
-    (:func:`hiab_sim.env.plant.load.machine_plant`).
+    (:func:`hiab_sim.env.plant.load.machine_plant`). ``tasks``: a duty mix's task indices, each task's
+    designs on the task's own plan, or (None,) for a single-task result.
     """
-    from hiab_sim.cli.simulate_summary import print_results, write_results
+    from hiab_sim.cli.simulate_summary import print_results, refuse_mix_effects, task_runs, write_results
     from hiab_sim.env.machine_env import run_machine_closed_loop
     from hiab_sim.env.machine_plan import read_machine_plan
     from hiab_sim.env.plant.load import machine_plant
-    from hiab_sim.env.validation import simulation_report
+    from hiab_sim.env.validation import run_groups, simulation_report
 
     refuse_crane_only(args)
-    plans = [read_machine_plan(args.result_dir, design) for design in designs]  # bad input fails first
+    plans = [read_machine_plan(args.result_dir, design, task) for task in tasks for design in designs]  # fails first
     plant = None if args.plant is None else machine_plant(args.plant, plans[0].machine.realistic_plant)
+    refuse_mix_effects(args, plant, tasks)
     if not args.no_video:
         from hiab_sim.render.backend import ffmpeg_path
 
@@ -77,39 +84,42 @@ def run_machine(args: argparse.Namespace, designs: tuple[str, ...], out: Path) -
         settings = report["settings"]
         assert isinstance(settings, dict)
         settings.update(energy=MACHINE_ENERGY, tcp_error=MACHINE_TCP, machine=plans[0].machine.name)
-        settings["tcp_load"] = "the plan's TCP force F(t) of the study's first task, applied at site tcp"
-        entries = report["designs"]
-        assert isinstance(entries, dict)
-        for run in runs:
-            entry = entries[run.design]
-            if entry["bandwidth_check"].get("first_natural_frequency_Hz") is None:
-                entry["bandwidth_check"]["note"] = NO_STRUCTURE
+        settings["tcp_load"] = "the plan's TCP force F(t) of the run's task, applied at site tcp"
+        groups = list(run_groups(report))
+        for _, entries in groups:
+            for entry in entries.values():
+                if entry["bandwidth_check"].get("first_natural_frequency_Hz") is None:
+                    entry["bandwidth_check"]["note"] = NO_STRUCTURE
         written, effects = write_results(args, report, runs, [], plant, designs, out)
         if not args.no_video:
-            written.append(_video(args, out, plans, runs, models).name)
+            model_of = {id(run): physics for run, physics in zip(runs, models, strict=True)}
+            for suffix, of_task in task_runs(runs):
+                drawn = [model_of[id(run)] for run in of_task]
+                written.append(_video(args, out / f"closed_loop{suffix}.mp4", plans, of_task, drawn).name)
     finally:
         for physics in models:
             physics.free()
     print_results(report, effects)
-    for design, entry in entries.items():
-        if entry.get("battery_energy_difference_percent") is not None:
-            print(
-                f"{design}: battery energy {entry['battery_energy_J']:.1f} J closed loop against "
-                f"{entry['predicted_battery_energy_J']:.1f} J planned "
-                f"({entry['battery_energy_difference_percent']:+.2f} %)."
-            )
+    for task, entries in groups:
+        for design, entry in entries.items():
+            if entry.get("battery_energy_difference_percent") is not None:
+                print(
+                    f"{'' if task is None else f'{task}, '}{design}: battery energy {entry['battery_energy_J']:.1f} J "
+                    f"closed loop against {entry['predicted_battery_energy_J']:.1f} J planned "
+                    f"({entry['battery_energy_difference_percent']:+.2f} %)."
+                )
     print(f"wrote {', '.join(written)} to {out}", file=sys.stderr)
     return 0
 
 
 def _video(
     args: argparse.Namespace,
-    out: Path,
+    path: Path,
     plans: list[MachinePlan],
     runs: list[ClosedLoopRun],
     models: list[CranePhysics],
 ) -> Path:
-    """``closed_loop.mp4``: the runs drawn on their simulation models in the machine file's dressing."""
+    """``closed_loop.mp4`` (a duty mix: per task): the runs on their simulation models in the machine's dressing."""
     from hiab_sim.env.validation import closed_loop_video
     from hiab_sim.render.dress_machine import machine_file_dress, moved_pivots
     from hiab_sim.render.machine_playback import study_ground
@@ -117,9 +127,9 @@ def _video(
 
     ground = study_ground(read_result(args.result_dir).study)
     machines = {plan.design: plan.machine for plan in plans}
-    marks = moved_pivots(plans[0].machine, [plan.machine.design_values() for plan in plans])
+    marks = moved_pivots(plans[0].machine, [machine.design_values() for machine in machines.values()])
     return closed_loop_video(
-        out / "closed_loop.mp4",
+        path,
         runs,
         models,
         lambda model, run: machine_file_dress(model, machines[run.design], ground),

@@ -4,13 +4,46 @@ from __future__ import annotations
 
 import argparse
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from hiab_sim.errors import InvalidInputError
 
 if TYPE_CHECKING:
     from hiab_sim.env.plant.config import Plant
     from hiab_sim.env.rollout import ClosedLoopRun
+
+
+def task_indices(tasks: Sequence[object]) -> tuple[int | None, ...]:
+    """The task indices a result's plans are read with: 0 .. n-1 of a duty mix's n tasks, (None,) for a single task."""
+    return tuple(range(len(tasks))) if tasks else (None,)
+
+
+def task_runs(runs: list[ClosedLoopRun]) -> list[tuple[str, list[ClosedLoopRun]]]:
+    """The runs of each task with the suffix of its files: ``""`` for a single task, ``_task<k>`` for a mix's task k.
+
+    ``runs`` hold every task of a duty mix's result, in the result's order (as :func:`task_indices` reads them).
+    """
+    names = list(dict.fromkeys(run.task for run in runs))
+    if names == [None]:
+        return [("", runs)]
+    return [(f"_task{k}", [run for run in runs if run.task == name]) for k, name in enumerate(names)]
+
+
+def refuse_mix_effects(args: argparse.Namespace, plant: Plant | None, tasks: tuple[int | None, ...]) -> None:
+    """One line (exit 2) where a plant with effects on would run the effect study on a duty mix's result.
+
+    The effect study (:mod:`hiab_sim.env.effects`) compares one plan's variants and re-plans the study
+    for the true masses; a duty mix's plans are its tasks', one per task, which it does not take.
+    """
+    if plant is not None and plant.enabled and tasks != (None,):
+        raise InvalidInputError(
+            "--plant",
+            args.plant,
+            "must have every effect off for a duty mix's result (the effect study takes one plan per design; "
+            "leave --plant out to simulate each task on the ideal plant)",
+        )
 
 
 def write_results(
@@ -43,7 +76,9 @@ def write_results(
     if not args.no_figures:
         from hiab_sim.env.figures import write_figures
 
-        written += [p.name for p in write_figures(out, runs, nominal)]
+        for suffix, of_task in task_runs(runs):
+            of_nominal = [run for run in nominal if run.task == of_task[0].task]
+            written += [p.name for p in write_figures(out, of_task, of_nominal, suffix)]
         if effects is not None:
             from hiab_sim.env.effect_report import effect_figure
 
@@ -69,16 +104,38 @@ def print_results(report: dict[str, object], effects: dict[str, object] | None) 
 
 
 def closing_lines(report: dict[str, object]) -> list[str]:
-    """The answer in words: per design the closed loop against the plan, and what a heavier end mass costs."""
-    designs = report["designs"]
-    assert isinstance(designs, dict)
+    """The answer in words: per design (and task) the closed loop against the plan, what a heavier end mass costs.
+
+    A duty mix's also gives its weighted sum over the tasks per design against the result's (``mix``).
+    """
+    from hiab_sim.env.validation import run_groups
+
+    lines = []
+    for task, designs in run_groups(report):
+        lines += _design_lines(designs, "" if task is None else f"{task}, ")
+    mix = report.get("mix")
+    for design, entry in mix.items() if isinstance(mix, dict) else ():
+        lines.append(
+            f"{design}, the duty mix (sum of weight x energy over the tasks): {entry['net_electrical_energy_J']:.1f} J "
+            f"closed loop against {entry['predicted_net_electrical_energy_J']:.1f} J planned "
+            f"({entry['energy_difference_percent']:+.2f} %)."
+        )
+    boundary = report.get("energy_boundary")
+    if boundary is not None:
+        lines.append(f"Energy boundary: {boundary}.")
+    return lines
+
+
+def _design_lines(designs: Mapping[str, Any], task: str) -> list[str]:
+    """Per design of ``designs`` the closing line and its bandwidth line, each opened by ``task``."""
     lines = []
     for design, entry in designs.items():
         rows = [entry["nominal"], entry] if "nominal" in entry else [entry]
         planned = rows[0]
         fine = planned.get("energy_difference_to_5ms_grid_percent")
         text = (
-            f"{design}: the closed loop uses {planned['energy_difference_percent']:+.2f} % energy against the plan"
+            f"{task}{design}: the closed loop uses {planned['energy_difference_percent']:+.2f} % energy "
+            "against the plan"
             + ("" if fine is None else f" ({fine:+.2f} % against the planner's energy of the plan on a 5 ms grid)")
             + f", tracking within {planned['tcp_error_mm']['max']:.2f} mm"
         )
@@ -92,10 +149,7 @@ def closing_lines(report: dict[str, object]) -> list[str]:
         lines.append(text + ".")
         check = planned.get("bandwidth_check") or {}
         if check:
-            lines.append(bandwidth_line(design, check))
-    boundary = report.get("energy_boundary")
-    if boundary is not None:
-        lines.append(f"Energy boundary: {boundary}.")
+            lines.append(bandwidth_line(f"{task}{design}", check))
     return lines
 
 

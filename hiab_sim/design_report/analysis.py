@@ -133,19 +133,22 @@ def closed_loop(folder: Path) -> str:
         return ""
     report: dict[str, Any] = json.loads(path.read_text())
     rows = []
-    for design, entry in report["designs"].items():
-        for row in [entry["nominal"], entry] if "nominal" in entry else [entry]:
-            mass = "planned" if row["payload_error"] == 0 else f"+{100 * row['payload_error']:g} %"
-            rows.append(
-                (
-                    design,
-                    mass,
-                    f"{row['predicted_net_electrical_energy_J']:.1f} J",
-                    f"{row['net_electrical_energy_J']:.1f} J",
-                    f"{row['energy_difference_percent']:+.2f} %",
-                    f"{row['tcp_error_mm']['rms']:.2f} / {row['tcp_error_mm']['max']:.2f} mm",
+    # a duty mix's simulation.json holds its runs per task, each against the task's own plan
+    groups = [(g["task"], g["designs"]) for g in report["tasks"]] if "tasks" in report else [(None, report["designs"])]
+    for task, designs in groups:
+        for design, entry in designs.items():
+            for row in [entry["nominal"], entry] if "nominal" in entry else [entry]:
+                mass = "planned" if row["payload_error"] == 0 else f"+{100 * row['payload_error']:g} %"
+                rows.append(
+                    (
+                        design if task is None else f"{task}: {design}",
+                        mass,
+                        f"{row['predicted_net_electrical_energy_J']:.1f} J",
+                        f"{row['net_electrical_energy_J']:.1f} J",
+                        f"{row['energy_difference_percent']:+.2f} %",
+                        f"{row['tcp_error_mm']['rms']:.2f} / {row['tcp_error_mm']['max']:.2f} mm",
+                    )
                 )
-            )
     return section(
         "Closed-loop validation",
         paragraph(
@@ -157,7 +160,14 @@ def closed_loop(folder: Path) -> str:
             rows,
             numeric=(2, 3, 4, 5),
         ),
-        figure(folder / "closed_loop_energy.png", "Cumulative energy, closed loop against prediction"),
+        *(
+            figure(folder / f"closed_loop_energy{suffix}.png", f"Cumulative energy{of}, closed loop against prediction")
+            for suffix, of in (
+                [(f"_task{k}", f" of task {task}") for k, (task, _) in enumerate(groups)]
+                if "tasks" in report
+                else [("", "")]
+            )
+        ),
     )
 
 

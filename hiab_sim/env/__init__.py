@@ -68,6 +68,7 @@ def load(
     physics_timestep: float = PHYSICS_TIMESTEP,
     current_bandwidth_hz: float = CURRENT_BANDWIDTH_HZ,
     plant: Plant | None = None,
+    task: int | None = None,
 ) -> control.Environment:
     """Closed-loop environment of one design of an ``hiab-sim optimize`` result.
 
@@ -79,12 +80,14 @@ def load(
         physics_timestep: MuJoCo step [s].
         current_bandwidth_hz: Current-loop bandwidth of the drives [Hz] (of the continuous loop).
         plant: The plant's effects (:mod:`hiab_sim.env.plant`); None or every effect off: the planner's model.
+        task: The index of a duty mix's task whose plan runs (:func:`hiab_sim.env.plan.read_plan`); None for
+            a single-task result.
 
     Raises:
-        InvalidInputError: a value out of range (the field is named).
+        InvalidInputError: a value out of range (the field is named), or a duty mix's result without a task.
 
     """
-    plan = read_plan(default_result_dir() if result_dir is None else result_dir, design)
+    plan = read_plan(default_result_dir() if result_dir is None else result_dir, design, task)
     return make_environment(
         plan,
         payload_error=payload_error,

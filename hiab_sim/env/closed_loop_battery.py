@@ -41,11 +41,16 @@ def cumulative_battery_energy(run: ClosedLoopRun, battery: BatteryParams) -> Arr
     return np.concatenate([[0.0], np.cumsum(p_bat * np.diff(run.time))])
 
 
-def predicted_cycle_battery_energy(result_dir: str | Path) -> dict[str, float]:
-    """The result's battery energy of one cycle per design [J] (empty where the result has no energy section)."""
+def predicted_cycle_battery_energy(result_dir: str | Path, task: int | None = None) -> dict[str, float]:
+    """The result's battery energy of one cycle per design [J] (empty where the result has no energy section).
+
+    ``task``: the index k of a duty mix's task, whose own cycle's energy is ``tasks[k].energy`` (the
+    top-level one is the mix's per hour); None for a single-task result.
+    """
     from hiab_sim.results.read import read_result
 
-    energy = read_result(result_dir).energy
+    result = read_result(result_dir)
+    energy = result.energy if task is None else (result.tasks or ())[task].energy
     if energy is None:
         return {}
     return {

@@ -86,8 +86,7 @@ def _true_actuators(plan: DesignPlan | MachinePlan, plant: Plant) -> ActuatorSam
     crane = true_crane(plan.crane, plant.mismatch)
     joints = JointSamples(plan.position, plan.velocity, plan.acceleration)
     dynamics = MujocoInverseDynamics(crane, plan.lengths)
-    tcp_force = None if plan.payload == 0.0 else np.array([0.0, -plan.payload * crane.gravity, 0.0])
-    return dynamics(joints, tcp_force)
+    return dynamics(joints, plan.id_tcp_force())
 
 
 def true_mass_prediction(plan: DesignPlan | MachinePlan, plant: Plant) -> float:

@@ -25,7 +25,8 @@ DRIVE_COLOURS = ("tab:green", "tab:purple", "tab:orange")
 
 def _label(run: ClosedLoopRun) -> str:
     extra = f", end mass +{100 * run.payload_error:g} %" if run.payload_error else ""
-    return f"{run.design}{extra}"
+    task = "" if run.task is None else f", task {run.task}"
+    return f"{run.design}{task}{extra}"
 
 
 def _cumulative(power: np.ndarray, time: np.ndarray) -> np.ndarray:
@@ -44,10 +45,13 @@ def _style(run: ClosedLoopRun) -> dict[str, Any]:
     }
 
 
-def write_figures(folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedLoopRun] | None = None) -> list[Path]:
-    """Write the four figures of the module docstring; return their paths.
+def write_figures(
+    folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedLoopRun] | None = None, suffix: str = ""
+) -> list[Path]:
+    """Write the four figures of the module docstring, ``suffix`` before ``.png``; return their paths.
 
     The drive figure shows ``runs``; the others also the ``nominal`` runs of a payload-error study.
+    A duty mix's tasks each get their own (``suffix`` ``_task<k>``).
     """
     paths = []
     every = [*(nominal or []), *runs]
@@ -68,7 +72,7 @@ def write_figures(folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedL
     ax.set(xlabel="time [s]", ylabel="TCP error [mm]", title="Closed-loop TCP tracking error")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    paths.append(save_png(fig, folder / "closed_loop_tcp_error.png", DPI))
+    paths.append(save_png(fig, folder / f"closed_loop_tcp_error{suffix}.png", DPI))
 
     fig = new_figure((4.2 * len(runs), 5.6))
     axes = fig.subplots(2, len(runs), squeeze=False, sharex=True)
@@ -88,11 +92,11 @@ def write_figures(folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedL
         for ax in (top, bottom):
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7)
-    paths.append(save_png(fig, folder / "closed_loop_drives.png", DPI))
+    paths.append(save_png(fig, folder / f"closed_loop_drives{suffix}.png", DPI))
 
     paths.append(
         _closed_vs_predicted(
-            folder / "closed_loop_power.png",
+            folder / f"closed_loop_power{suffix}.png",
             every,
             runs,
             lambda run: run.electrical_power.sum(axis=1) / 1e3,
@@ -103,7 +107,7 @@ def write_figures(folder: Path, runs: list[ClosedLoopRun], nominal: list[ClosedL
     )
     paths.append(
         _closed_vs_predicted(
-            folder / "closed_loop_energy.png",
+            folder / f"closed_loop_energy{suffix}.png",
             every,
             runs,
             lambda run: run.cumulative_energy.sum(axis=1) / 1e3,

@@ -95,8 +95,9 @@ def first_natural_frequency(plan: DesignPlan) -> float | None:
     """f_1 [Hz]: the structure's lowest natural frequency over the plan's samples, or None without the data."""
     if not has_stiffness(plan.emlas):
         return None
-    tcp_force = None if plan.payload == 0.0 else np.array([0.0, -plan.payload * plan.crane.gravity, 0.0])
-    modes = natural_frequencies(plan.crane, plan.emlas, plan.lengths, plan.position, tcp_force, payload_kg=plan.payload)
+    modes = natural_frequencies(
+        plan.crane, plan.emlas, plan.lengths, plan.position, plan.id_tcp_force(), payload_kg=plan.payload
+    )
     return float(np.min(modes.lowest_Hz))
 
 

@@ -66,9 +66,10 @@ from hiab_sim.env.plant.assembly import (
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.plant.friction import add_joint_friction
 from hiab_sim.env.plant.mismatch import friction_factor, payload_factor, true_drive_arrays, true_machine
-from hiab_sim.env.reference import PlannedMotion, motion_of_plan, physics_times
+from hiab_sim.env.reference import PlannedMotion, motion_of_plan, physics_times, reference_at
 from hiab_sim.env.rollout import ClosedLoopRun, check_cycles, run_environment
 from hiab_sim.env.task import CraneTrackingTask
+from hiab_sim.env.tcp_load import TcpLoad
 from hiab_sim.machine.dynamics.mjcf_build import spec_of_tree
 from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
 from hiab_sim.machine.dynamics.tree import MachineActuatorSamples, SimulationExtras, machine_tree
@@ -109,8 +110,9 @@ def machine_motion(plan: MachinePlan, timestep: float) -> tuple[PlannedMotion, A
         qpos, qvel, _ = dynamics.state(pos, vel, acc)
         return actuators, qpos, qvel
 
-    reference = np.stack([np.interp(times, plan.time, plan.reference_tcp[:, i]) for i in range(2)], axis=1)
-    motion = motion_of_plan(plan, times, dynamics.model, loaded_dynamics, plan.emlas, _to_world(reference))
+    # The reference at the TCP's out-of-plane z (the XS 031 machine file's TCP sits at z = -9.23 mm in {W},
+    # off the mechanism's plane by the tool's side offset), as on a crane file: reference_at's docstring.
+    motion = motion_of_plan(plan, times, dynamics.model, loaded_dynamics, plan.emlas, reference_at(plan, times))
     return motion, _to_world(force[:, :2])
 
 
@@ -136,47 +138,6 @@ def machine_load_mass(plan: MachinePlan, motion: PlannedMotion) -> Array:
         masses[k] = np.diag(inverse.T @ joint_mass @ inverse)
     grid = plan.time - plan.time[0]
     return np.stack([np.interp(motion.time, grid, masses[:, a]) for a in range(len(slides))], axis=1)
-
-
-class TcpLoad:
-    """The plan's TCP force applied at site ``tcp`` each physics step (module docstring).
-
-    With a payload mismatch (``payload``: the payload's share P of the force, MuJoCo world (N, 3)
-    [N]) the true load is the rest F - P at the site and (1 + e_end) P at the site shifted by
-    ``offset`` [m] in the site's frame (:mod:`hiab_sim.env.plant.mismatch`).
-    """
-
-    def __init__(
-        self,
-        model: mujoco.MjModel,
-        force: Array,
-        timestep: float,
-        payload: Array | None = None,
-        factor: float = 1.0,
-        offset: Array | None = None,
-    ) -> None:
-        self.site = int(model.site("tcp").id)
-        self.body = int(model.site_bodyid[self.site])
-        self.force = force
-        self.timestep = timestep
-        self.payload = payload
-        self.factor = factor
-        self.offset = np.zeros(3) if offset is None else np.asarray(offset, dtype=float)
-
-    def apply(self, model: mujoco.MjModel, data: mujoco.MjData, holding: bool) -> None:
-        """Set ``xfrc_applied`` of the TCP's body to F at the site (force and moment about the com)."""
-        k = 0 if holding else int(min(max(round(data.time / self.timestep), 0), len(self.force) - 1))
-        force = self.force[k]
-        arm = data.site_xpos[self.site] - data.xipos[self.body]
-        if self.payload is None:
-            data.xfrc_applied[self.body, :3] = force
-            data.xfrc_applied[self.body, 3:] = np.cross(arm, force)
-            return
-        rest = force - self.payload[k]
-        true = self.factor * self.payload[k]
-        lever = arm + data.site_xmat[self.site].reshape(3, 3) @ self.offset
-        data.xfrc_applied[self.body, :3] = rest + true
-        data.xfrc_applied[self.body, 3:] = np.cross(arm, rest) + np.cross(lever, true)
 
 
 def machine_environment(
@@ -244,4 +205,4 @@ def run_machine_closed_loop(
     run = run_environment(
         env, design, drives, plan.design, 0.0, plan, progress, plant, cycles, actuator_names=plan.actuator_names
     )
-    return replace(run, resampled_prediction=resampled_prediction(plan, motion)), env.physics
+    return replace(run, resampled_prediction=resampled_prediction(plan, motion), task=plan.task), env.physics

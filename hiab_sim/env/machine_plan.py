@@ -1,16 +1,18 @@
-"""The optimiser's plan for one design of a machine file's result (:mod:`hiab_sim.machine`).
+"""The optimiser's plan for one design (and task of a duty mix) of a machine file's result (:mod:`hiab_sim.machine`).
 
-``read_machine_plan(result_dir, design)`` returns what the closed loop of
+``read_machine_plan(result_dir, design, task)`` returns what the closed loop of
 :mod:`hiab_sim.env.machine_env` needs, through the one result-folder reader
 (:func:`hiab_sim.results.read.open_run`): the machine built to the design's values
 (:class:`~hiab_sim.machine.design.MachineDesign`, :func:`hiab_sim.results.read.result_machine`),
 the study's EMLA set in chain order, the planned independent-joint trajectory on the fine grid, the
-study's reference, the predicted P_elec per drive and net electrical energy, and the study's TCP
-force F(t) of its first task (:meth:`hiab_sim.study.spec.tasks.Task.id_force`: the payload's
-weight, a scheduled or inertial payload, soil), the same force the optimiser's inverse dynamics
-took, so that the ideal plant is the planner's own model, and the payload's share of it (F(t)
-less the soil's force: what a payload mismatch scales, :mod:`hiab_sim.env.plant.mismatch`), and
-the study's duty model of the cycle (hot windings, the rest's hold), as a crane file's plan has it.
+study's reference, the predicted P_elec per drive and net electrical energy, and the TCP force F(t)
+of the task (:meth:`hiab_sim.study.spec.tasks.Task.id_force`: the payload's weight, a scheduled or
+inertial payload, soil), the same force the optimiser's inverse dynamics took, so that the ideal
+plant is the planner's own model, and the payload's share of it (F(t) less the soil's force: what a
+payload mismatch scales, :mod:`hiab_sim.env.plant.mismatch`), and the study's duty model of the
+task's cycle (hot windings, the rest's hold), as a crane file's plan has it. A duty mix's result is
+read per task (:func:`hiab_sim.env.plan.open_design`): its motion, energies, payload and duty are the
+task's own.
 """
 
 from __future__ import annotations
@@ -39,13 +41,13 @@ class MachinePlan(PlannedDesign):
 
     ``emlas`` is the study's EMLA set, one per chain in chain order; ``position``, ``velocity`` and
     ``acceleration`` are the independent joints in the machine's joint order, (K, J) [rad or m];
-    ``reference_tcp`` is (x_tcp, y_tcp, extra tracked) in {W}, (K, 3) [m, m, rad or m];
+    ``reference_tcp`` is (x_tcp, y_tcp, z_tcp) in {W}, (K, 3) [m], z_tcp the TCP's out-of-plane coordinate;
     ``predicted_electrical_power`` is per drive, (K, A) [W].
 
     Attributes:
         machine: The machine with the design's decision variables set.
         tcp_force: The force on the TCP the plan's inverse dynamics took, (K, 3) [N] in {W}.
-        payload_kg: The first task's payload mass [kg], held at the TCP for the natural frequencies
+        payload_kg: The task's payload mass [kg], held at the TCP for the natural frequencies
             (its weight is in ``tcp_force``).
         tracked: The study's tracked coordinates beyond the TCP's x, y (the payload's kinematics), or
             None: ``tcp_angle`` for each.
@@ -73,16 +75,19 @@ def is_machine_result(result_dir: str | Path) -> bool:
     return isinstance(open_run(result_dir, Result).result.optimal.lengths, MachineDesign)
 
 
-def read_machine_plan(result_dir: str | Path, design: str) -> MachinePlan:
+def read_machine_plan(result_dir: str | Path, design: str, task: int | None = None) -> MachinePlan:
     """Read ``result.json``, ``trajectory.npz`` and the study file of a machine file's result for one design.
 
+    ``task`` is the index k of a duty mix's task, None for a single-task result.
+
     Raises:
-        InvalidInputError: unknown design, or a crane file's result.
+        InvalidInputError: unknown design, a task index out of range (none for a duty mix), or a
+            crane file's result.
         ConfigError: the folder holds no result, its files are malformed, or the study file is gone
             (its EMLA set and TCP force are needed; one line naming it).
 
     """
-    found = open_design(result_dir, design)
+    found = open_design(result_dir, design, task)
     run, values = found.run, found.summary.lengths
     if not isinstance(values, MachineDesign):
         raise InvalidInputError("result", str(result_dir), "is a crane file's result (read it with read_plan)")
@@ -95,10 +100,10 @@ def read_machine_plan(result_dir: str | Path, design: str) -> MachinePlan:
             f"{run.folder}: the study file {result.study} is needed for its EMLA set and TCP force ({error})"
         ) from error
     time = found.planned["time"]
-    task = study.tasks[0]
+    of_task = study.tasks[found.task_index]
     kinematics, gravity = study.model.kinematics, study.model.gravity
-    tcp_force = _samples(task.id_force(kinematics, gravity, time), len(time))
-    payload = tcp_force - _samples(task.soil_force(kinematics, gravity, time), len(time))
+    tcp_force = _samples(of_task.id_force(kinematics, gravity, time), len(time))
+    payload = tcp_force - _samples(of_task.soil_force(kinematics, gravity, time), len(time))
     from hiab_sim.study.nlp.task_setup import duty_options
 
     return MachinePlan(
@@ -107,7 +112,7 @@ def read_machine_plan(result_dir: str | Path, design: str) -> MachinePlan:
         emlas=study.emlas,
         tcp_force=tcp_force,
         payload_force=payload,
-        payload_kg=task.payload.mass,
+        payload_kg=of_task.payload.mass,
         tracked=getattr(study.model, "extra", None),
         duty=duty_options(study, study.emlas, float(time[-1] - time[0])),
     )

@@ -4,7 +4,9 @@
 lengths (armature J_m k^2, damping b_f, stops, EMLA force limits), placed at the plan's start pose
 (joint ``ref``, so ``reset`` lands there), with the end mass made heavier by ``payload_error`` (an
 extra body with the end mass's centre of mass and scaled inertia) and the study's payload as a point
-mass at the TCP, also scaled. :class:`CranePhysics` steps the drives of
+mass at the TCP, also scaled; a payload whose force the plan took per sample (a duty mix task's
+schedule or inertia, F(t) = m(t) (g - a_ref)) is that force applied at the TCP instead, x (1 + payload_error)
+(:mod:`hiab_sim.env.tcp_load`). :class:`CranePhysics` steps the drives of
 :mod:`hiab_sim.emla.drive_sim` once per physics step, at the speeds of the slides
 (omega_m = k v_x), and applies their rod forces as the actuators' ``ctrl`` before ``mj_step``.
 
@@ -49,9 +51,10 @@ from hiab_sim.env.plant.mismatch import true_crane, true_drives
 from hiab_sim.env.plant.sensors import CurrentSensorError, MotionSensor
 from hiab_sim.env.plant.thermal import WindingTemperature
 from hiab_sim.env.reference import PlannedMotion
+from hiab_sim.env.tcp_load import TcpLoad
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.model.drives import HomePose, SlideDrives
-from hiab_sim.model.mjcf import ACTUATORS, JOINTS, SLIDES, build_spec
+from hiab_sim.model.mjcf import ACTUATORS, JOINTS, SLIDES, build_spec, source_to_world
 
 Array = NDArray[np.float64]
 
@@ -77,7 +80,7 @@ threading._register_atexit(_free_live_physics)  # type: ignore[attr-defined]
 
 
 class ExternalLoad(Protocol):
-    """A force set before every ``mj_step``: a machine's planned TCP force (:mod:`hiab_sim.env.machine_env`)."""
+    """A force set before every ``mj_step``: a plan's TCP force (:mod:`hiab_sim.env.tcp_load`)."""
 
     def apply(self, model: mujoco.MjModel, data: mujoco.MjData, holding: bool) -> None:
         """Set ``data.xfrc_applied``; ``holding``: during a settled start's hold (the first sample's load)."""
@@ -86,7 +89,8 @@ class ExternalLoad(Protocol):
 class CranePhysics(dm_mujoco.Physics):
     """dm-control Physics whose ``step`` runs the EMLA drives at the physics rate (module docstring)."""
 
-    #: External load applied before each ``mj_step`` (none on the crane) and whether the cycle's start is held.
+    #: External load applied before each ``mj_step`` (a crane's only with a per-sample payload force) and whether
+    #: the cycle's start is held.
     tcp_load: ExternalLoad | None = None
     holding: bool = False
 
@@ -332,6 +336,13 @@ def crane_physics(
     physics = CranePhysics.from_model(dm_mujoco.wrapper.MjModel(spec.compile()))
     parts = plant_parts(physics.model.ptr, plan, motion, arrays, plant, stiffness, friction, bandwidth_hz)
     physics.attach_parts(parts, plant, SLIDES, ACTUATORS)
+    if plan.tcp_force is not None and plan.payload_force is not None:  # the task's F(t), as the plan's ID took it
+        at = plan.time[0] + motion.time
+        force, payload = (
+            source_to_world(np.stack([np.interp(at, plan.time, f[:, i]) for i in range(3)], axis=1))
+            for f in (plan.tcp_force, plan.payload_force)
+        )
+        physics.tcp_load = TcpLoad(physics.model.ptr, force, timestep, payload, 1.0 + payload_error)
     return physics
 
 
@@ -350,7 +361,12 @@ def _add_view(spec: mujoco.MjSpec, motion: PlannedMotion) -> None:
 
 
 def _add_payload(spec: mujoco.MjSpec, plan: DesignPlan, payload_error: float) -> None:
-    """Extra end mass (payload_error x end mass) and the study's payload x (1 + payload_error) at the TCP."""
+    """Extra end mass (payload_error x end mass) and the study's payload x (1 + payload_error) at the TCP.
+
+    The payload is a point mass at the TCP unless the plan carries its force per sample
+    (:attr:`~hiab_sim.env.plan.DesignPlan.tcp_force`: a schedule or its inertia), which
+    :func:`crane_physics` applies as the plan's force instead.
+    """
     rod = spec.body(TOOL_LINK)
     if payload_error != 0.0:
         end = next(body for body in plan.crane.bodies if body.name == LOAD_BODY)
@@ -360,7 +376,7 @@ def _add_payload(spec: mujoco.MjSpec, plan: DesignPlan, payload_error: float) ->
         extra.mass = end.mass * payload_error
         extra.ipos = [0.0, 0.0, 0.0]
         extra.fullinertia = [inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]]
-    if plan.payload > 0.0:
+    if plan.payload > 0.0 and plan.tcp_force is None:  # a plan's F(t) is applied as a force (crane_physics)
         tcp = plan.crane.tcp_in_telescope_rod
         body = rod.add_body(name="payload", pos=list(tcp.position))
         body.explicitinertial = True

@@ -1,4 +1,4 @@
-"""The optimiser's plan for one design, read from a result folder.
+"""The optimiser's plan for one design (and one task of a duty mix), read from a result folder.
 
 :func:`open_design` reads one design of any result folder (``result.json`` and ``trajectory.npz``)
 into the fields every plan has (:class:`PlannedDesign`); a crane file's plan (:class:`DesignPlan`)
@@ -8,11 +8,17 @@ set and the payload of the study, the design's link lengths, its planned joint t
 (positions, rates, accelerations on the fine grid), the study's TCP reference and the optimiser's
 predicted net electrical energy, through the one result-folder reader
 (:func:`hiab_sim.results.read.open_run`).
+
+A duty mix's result (``result.json`` ``tasks``) holds one plan per task: its own motion on its own
+fine grid (``trajectory.npz`` ``task<k>_*``), its own payload and its own energies
+(``tasks[k].<design>``); the top-level energies are the mix's weighted sums per hour, which no single
+cycle can be compared with. Its plans are read per task (``task`` = k, :func:`mix_tasks`), and a
+mix's plan is refused without one.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -25,7 +31,8 @@ from hiab_sim.emla.duty_energy import DutyOptions
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.results.design_values import crane_lengths
 from hiab_sim.results.read import DESIGNS, RunFolder, open_run, result_crane
-from hiab_sim.results.schema import DesignSummary, Result
+from hiab_sim.results.schema import DesignSummary, Result, TaskResult
+from hiab_sim.study.spec.study import Study
 from hiab_sim.study.spec.study_file import load_study
 
 Array = NDArray[np.float64]
@@ -41,9 +48,12 @@ class PlannedDesign:
         time: Fine-grid sample times [s], (K,), from 0 to the cycle duration.
         position, velocity, acceleration: Planned independent joints and their rates, (K, J)
             [rad or m; per s; per s^2] (the crane's Θ1, Θ2, xt2).
-        reference_tcp: The study's reference in the source frame {W}, (K, 3) [m, m, rad or m].
+        reference_tcp: The study's TCP reference (x_tcp, y_tcp, z_tcp) in the source frame {W}, (K, 3) [m]:
+            the path in the machine's plane at the TCP's out-of-plane coordinate z_tcp.
         predicted_electrical_power: Planned P_elec per actuator, (K, A) [W].
-        predicted_net_energy: The optimiser's net electrical energy of the design [J].
+        predicted_net_energy: The optimiser's net electrical energy of the design over one cycle [J] (a
+            duty mix's task: the task's own, ``tasks[k].<design>``).
+        task: The task's name in a duty mix's result, None for a single-task result.
 
     """
 
@@ -56,6 +66,7 @@ class PlannedDesign:
     reference_tcp: Array
     predicted_electrical_power: Array
     predicted_net_energy: float
+    task: str | None = field(default=None, kw_only=True)
 
     @property
     def duration(self) -> float:
@@ -70,9 +81,16 @@ class DesignPlan(PlannedDesign):
     Attributes:
         crane: The crane description.
         lengths: The design's link lengths Xi [m].
-        payload: Mass hanging at the TCP in the study [kg].
+        payload: Mass hanging at the TCP in the study (the task's) [kg].
         duty: The study's duty model of the cycle (hot windings, the rest's hold), or None: the
             paper's per-sample model (:func:`hiab_sim.study.nlp.task_setup.duty_options`).
+        tcp_force: The payload's force on the TCP the plan's inverse dynamics took, (K, 3) [N] in {W}
+            on the fine grid, where it is one per sample (a schedule m(t) or the payload's inertia:
+            F(t) = m(t) (g - a_ref), :meth:`hiab_sim.study.spec.tasks.Task.id_force`); the closed loop
+            applies it at the TCP. None: a constant weight, simulated as a point mass of ``payload``
+            at the TCP.
+        payload_force: The payload's share of ``tcp_force`` (without a soil's force), (K, 3) [N] in
+            {W}: what an end-mass error scales; None with ``tcp_force`` None.
 
     """
 
@@ -80,6 +98,21 @@ class DesignPlan(PlannedDesign):
     lengths: LinkLengths
     payload: float
     duty: DutyOptions | None = None
+    tcp_force: Array | None = None
+    payload_force: Array | None = None
+
+    def id_tcp_force(self, times: Array | None = None) -> Array | None:
+        """The TCP force of the plan's inverse dynamics [N] in {W} at ``times`` [s] (None: the fine grid's).
+
+        (N, 3) where the plan has one per sample (linear between the fine grid's samples), else the
+        payload's weight (0, -m g, 0), or None without a payload.
+        """
+        if self.tcp_force is not None:
+            at = self.time if times is None else np.asarray(times, dtype=float)
+            return np.stack([np.interp(at, self.time, self.tcp_force[:, i]) for i in range(3)], axis=1)
+        if self.payload == 0.0:
+            return None
+        return np.array([0.0, -self.payload * self.crane.gravity, 0.0])
 
 
 @dataclass(frozen=True)
@@ -88,69 +121,110 @@ class DesignRun:
 
     Attributes:
         run: The folder as :func:`hiab_sim.results.read.open_run` read it.
-        summary: The design's summary in ``result.json``.
+        summary: The design's summary in ``result.json`` (a duty mix's task: the task's own).
         planned: The design's planned fields (:class:`PlannedDesign`'s, all but ``emlas``) from ``trajectory.npz``.
+        task: The task of a duty mix's result (``result.json`` ``tasks[k]``), None for a single-task result.
+        task_index: k of ``task`` (0 for a single-task result).
 
     """
 
     run: RunFolder[Result]
     summary: DesignSummary
     planned: dict[str, Any]
+    task: TaskResult | None = None
+    task_index: int = 0
 
 
-def open_design(result_dir: str | Path, design: str) -> DesignRun:
-    """Read ``result.json`` and ``trajectory.npz`` of an ``hiab-sim optimize`` folder for one design.
+def mix_tasks(result_dir: str | Path) -> tuple[TaskResult, ...]:
+    """The tasks of a duty mix's result (``result.json`` ``tasks``), in their order; empty for a single-task result."""
+    return tuple(open_run(result_dir, Result).result.tasks or ())
+
+
+def open_design(result_dir: str | Path, design: str, task: int | None = None) -> DesignRun:
+    """Read ``result.json`` and ``trajectory.npz`` of an ``hiab-sim optimize`` folder for one design (and task).
+
+    ``task`` is the index k of a duty mix's task (module docstring), None for a single-task result.
 
     Raises:
-        InvalidInputError: unknown design.
+        InvalidInputError: unknown design; a task index out of range, none for a duty mix, or one for a
+            single-task result.
         ConfigError: the folder holds no result, or its files are malformed (one line naming them).
 
     """
     if design not in DESIGNS:
         raise InvalidInputError("design", design, f"must be one of {', '.join(DESIGNS)}")
     run = open_run(result_dir, Result)
+    tasks = run.result.tasks or ()
+    if tasks and not (isinstance(task, int) and 0 <= task < len(tasks)):
+        names = ", ".join(f"{k}: {t.name}" for k, t in enumerate(tasks))
+        raise InvalidInputError("task", task, f"must be a task index of the duty mix's result ({names})")
+    if not tasks and task is not None:
+        raise InvalidInputError("task", task, "must be None for a single-task result (it holds one plan per design)")
     trajectory = run.trajectory
-    summary = run.result.optimal if design == "optimal" else run.result.initial
+    of_task = tasks[task] if tasks and task is not None else None
+    holder = run.result if of_task is None else of_task
+    summary = holder.optimal if design == "optimal" else holder.initial
+    prefix = "" if of_task is None else f"task{task}_"
     planned = {
         "design": design,
-        "time": trajectory.time(),
-        "position": trajectory.design(design, "position"),
-        "velocity": trajectory.design(design, "velocity"),
-        "acceleration": trajectory.design(design, "acceleration"),
-        "reference_tcp": trajectory.get("reference_tcp"),
-        "predicted_electrical_power": trajectory.design(design, "electrical_power"),
+        "time": trajectory.time(prefix),
+        "position": trajectory.design(design, "position", prefix),
+        "velocity": trajectory.design(design, "velocity", prefix),
+        "acceleration": trajectory.design(design, "acceleration", prefix),
+        "reference_tcp": trajectory.get("reference_tcp", prefix),
+        "predicted_electrical_power": trajectory.design(design, "electrical_power", prefix),
         "predicted_net_energy": float(summary.net_electrical_energy_J),
+        "task": None if of_task is None else of_task.name,
     }
-    return DesignRun(run, summary, planned)
+    return DesignRun(run, summary, planned, of_task, task or 0)
 
 
-def read_plan(result_dir: str | Path, design: str) -> DesignPlan:
-    """The plan of one design of a crane file's result (:func:`open_design`, the study's crane and EMLA set).
+def read_plan(result_dir: str | Path, design: str, task: int | None = None) -> DesignPlan:
+    """The plan of one design (and task) of a crane file's result (:func:`open_design`, the study's crane and EMLA set).
+
+    The payload is the task's: its mass, and its force F(t) on the TCP where the plan's inverse dynamics
+    took one per sample (:attr:`DesignPlan.tcp_force`; the study file is needed for it).
 
     Raises:
-        InvalidInputError: unknown design.
-        ConfigError: the folder holds no result, or its files are malformed (one line naming them).
+        InvalidInputError: unknown design, or a task index out of range (:func:`open_design`).
+        ConfigError: the folder holds no result, or its files are malformed (one line naming them); a
+            duty mix's study file is gone (its tasks' payload forces are needed).
 
     """
-    found = open_design(result_dir, design)
+    found = open_design(result_dir, design, task)
     result = found.run.result
-    emlas, duty = _study_emlas(result.study, found.planned["time"])
+    time = found.planned["time"]
+    spec = _study(result.study, required=found.task is not None, folder=found.run.folder)
+    emlas, duty, tcp_force, payload_force = load_emla_set(None), None, None, None
+    if spec is not None:
+        from hiab_sim.study.nlp.task_setup import duty_options
+
+        emlas, duty = spec.emlas, duty_options(spec, spec.emlas, float(time[-1] - time[0]))
+        of_task, kinematics, gravity = spec.tasks[found.task_index], spec.model.kinematics, spec.model.gravity
+        force = of_task.id_force(kinematics, gravity, time)
+        if force is not None and np.ndim(force) == 2:
+            soil = of_task.soil_force(kinematics, gravity, time)
+            tcp_force = np.asarray(force, dtype=float)
+            payload_force = tcp_force if soil is None else tcp_force - soil
     return DesignPlan(
         **found.planned,
         crane=result_crane(found.run.folder, result.crane),
         emlas=emlas,
         lengths=crane_lengths(found.summary.lengths, "result"),
-        payload=float(result.settings.payload_kg),
+        payload=float(result.settings.payload_kg if found.task is None else found.task.payload_kg),
         duty=duty,
+        tcp_force=tcp_force,
+        payload_force=payload_force,
     )
 
 
-def _study_emlas(study: str, time: Array) -> tuple[EmlaSet, DutyOptions | None]:
-    """The study's EMLA set and duty model for a cycle on ``time`` [s] (the preset and none when the file is gone)."""
-    from hiab_sim.study.nlp.task_setup import duty_options
-
+def _study(study: str, required: bool, folder: Path) -> Study | None:
+    """The result's study file, or None where it is gone and not ``required`` (the EMLA preset and no duty then)."""
     try:
-        spec = load_study(study)
-    except ConfigError:
-        return load_emla_set(None), None
-    return spec.emlas, duty_options(spec, spec.emlas, float(time[-1] - time[0]))
+        return load_study(study)
+    except ConfigError as error:
+        if required:
+            raise ConfigError(
+                f"{folder}: the study file {study} is needed for its tasks' payload forces ({error})"
+            ) from error
+        return None

@@ -138,11 +138,22 @@ def motion_of_plan(
     )
 
 
+def reference_at(plan: PlannedDesign, times: Array) -> Array:
+    """The study's TCP reference at ``times`` [s] in MuJoCo world coordinates (N, 3) [m], a cubic spline of the plan's.
+
+    All three coordinates (x_tcp, y_tcp, z_tcp) of {W}: the reference is a path in the plane the TCP moves
+    in, z = z_tcp (the TCP's out-of-plane offset, constant when every joint turns about, or slides along, the
+    plane), so its distance to the simulated TCP is the in-plane tracking error, and any out-of-plane motion
+    of the TCP still counts (a projection onto the plane would hide it).
+    """
+    return source_to_world(CubicSpline(plan.time, plan.reference_tcp, axis=0)(times))
+
+
 def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
     """Sample a crane file's plan every ``timestep`` [s] (see the module docstring)."""
     times = physics_times(plan, timestep)
     dynamics = MujocoInverseDynamics(plan.crane, plan.lengths)
-    tcp_force = None if plan.payload == 0.0 else np.array([0.0, -plan.payload * plan.crane.gravity, 0.0])
+    tcp_force = plan.id_tcp_force(times)  # the payload's weight, or the task's F(t) where it is one per sample
 
     def crane_dynamics(pos: Array, vel: Array, acc: Array) -> tuple[ActuatorSamples, Array, Array]:
         joints = JointSamples(pos, vel, acc)
@@ -153,5 +164,4 @@ def planned_motion(plan: DesignPlan, timestep: float) -> PlannedMotion:
     # the feedforward inverts the simulated drive, which has the EMLA file's screw and gearbox efficiency
     # (hiab_sim.env.drive_losses): the planner's own drive model, transmission loss included
     drives = list(plan.emlas)
-    reference = source_to_world(CubicSpline(plan.time, plan.reference_tcp, axis=0)(times))
-    return motion_of_plan(plan, times, dynamics.model, crane_dynamics, drives, reference)
+    return motion_of_plan(plan, times, dynamics.model, crane_dynamics, drives, reference_at(plan, times))

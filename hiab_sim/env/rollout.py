@@ -93,6 +93,8 @@ class ClosedLoopRun:
         settle_time_s: Simulated hold before each cycle (:func:`settled_start`) [s], not in ``time``.
         resampled_prediction: The planner's energy of the plan on a 5 ms grid [J] (:func:`resampled_prediction`),
             or None.
+        task: The name of the duty mix's task whose plan ran (:attr:`hiab_sim.env.plan.PlannedDesign.task`),
+            None for a single-task result.
 
     """
 
@@ -131,6 +133,7 @@ class ClosedLoopRun:
     settle_time_s: float = 0.0
     actuator_names: tuple[str, ...] = ACTUATOR_NAMES
     resampled_prediction: float | None = None
+    task: str | None = None
 
     @property
     def net_energy(self) -> float:
@@ -226,7 +229,7 @@ def run_closed_loop(
     design = replace(design, gains=gains or design.gains)
     drives = DriveArrays.from_params(plan.emlas)
     run = run_environment(env, design, drives, plan.design, payload_error, plan, progress, plant, cycles)
-    return replace(run, resampled_prediction=resampled_prediction(plan, env.task.motion)), env.physics
+    return replace(run, resampled_prediction=resampled_prediction(plan, env.task.motion), task=plan.task), env.physics
 
 
 def run_environment(

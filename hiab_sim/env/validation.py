@@ -1,12 +1,18 @@
 """Closed-loop validation of a result: simulate designs, report against the prediction, render a video.
 
-Used by ``hiab-sim simulate`` (:mod:`hiab_sim.cli.simulate`); see there for the outputs.
+Used by ``hiab-sim simulate`` (:mod:`hiab_sim.cli.simulate`); see there for the outputs. A duty mix's
+result is simulated task by task, each design of each task on the task's own plan, and each run is
+compared with its task's own prediction (:mod:`hiab_sim.env.plan`): ``simulation.json`` then holds
+``tasks`` (per task its name, weight and ``designs``) where a single-task result holds ``designs``,
+and ``mix``: per design the weighted sum over the tasks, sum_k w_k E_k, closed loop (at the planned
+end mass) against the result's own (``result.json`` ``<design>.net_electrical_energy_J``, per hour where the weights are
+cycles per hour).
 """
 
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -26,9 +32,10 @@ from hiab_sim.env.closed_loop_battery import (
     predicted_cycle_battery_energy,
 )
 from hiab_sim.env.physics import CranePhysics
-from hiab_sim.env.plan import read_plan
+from hiab_sim.env.plan import mix_tasks, read_plan
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.rollout import ClosedLoopRun, run_closed_loop
+from hiab_sim.results.schema import TaskResult
 from hiab_sim.terminal import progress_wanted
 
 Array = NDArray[np.float64]
@@ -45,8 +52,12 @@ def simulate_designs(
     quiet: bool = False,
     plant: Plant | None = None,
     cycles: int = 1,
+    tasks: Sequence[int | None] = (None,),
 ) -> tuple[list[ClosedLoopRun], list[ClosedLoopRun], list[CranePhysics]]:
     """Run every design at ``payload_error`` (and, when it is not 0, nominally too) on ``plant`` for ``cycles``.
+
+    ``tasks``: the duty mix's task indices whose plans run (every design of each), or (None,) for a
+    single-task result.
 
     Returns:
         The runs at ``payload_error``, the nominal runs (empty when payload_error is 0) and the
@@ -54,11 +65,12 @@ def simulate_designs(
 
     """
     runs, nominal, physics = [], [], []
-    for design in designs:
-        plan = read_plan(result_dir, design)
+    for task, design in [(task, design) for task in tasks for design in designs]:
+        plan = read_plan(result_dir, design, task)
         conditions = [payload_error] if payload_error == 0.0 else [0.0, payload_error]
         for error in conditions:
             label = design if error == 0.0 else f"{design} end mass +{100 * error:g} %"
+            label = label if plan.task is None else f"{plan.task}: {label}"
             with tqdm(
                 total=1, desc=label, unit="step", disable=quiet or not progress_wanted(), file=sys.stderr, leave=False
             ) as bar:
@@ -86,29 +98,28 @@ def simulation_report(
     """The content of ``simulation.json``; ``emlas`` the runs' EMLA set (None: the crane result's, read from it).
 
     Every run's entry carries its battery energy (:func:`hiab_sim.env.closed_loop_battery.battery_entry`)
-    against the result's battery energy of one cycle; a nominal run's against the same plan.
+    against the result's battery energy of one cycle (a duty mix's task: the task's own); a nominal run's
+    against the same plan. Runs of a duty mix's tasks are grouped per task (module docstring).
     """
+    tasks = mix_tasks(result_dir) if any(run.task is not None for run in runs) else ()
     if emlas is None and runs:
-        emlas = read_plan(result_dir, runs[0].design).emlas
-    predicted = predicted_cycle_battery_energy(result_dir) if runs else {}
-    designs: dict[str, object] = {}
-    for run in runs:
-        entry = run.summary()
-        if emlas is not None:
-            entry.update(battery_entry(run, emlas.battery, predicted.get(run.design)))
-        match = next((n for n in nominal if n.design == run.design), None)
-        if match is not None:
-            nominal_entry = match.summary()
-            if emlas is not None:
-                nominal_entry.update(battery_entry(match, emlas.battery, predicted.get(match.design)))
-            entry["nominal"] = nominal_entry
-            entry["extra_energy_J"] = run.net_energy - match.net_energy
-            entry["extra_energy_vs_predicted_J"] = run.net_energy - run.predicted_net_energy
-        designs[run.design] = entry
+        emlas = read_plan(result_dir, runs[0].design, 0 if tasks else None).emlas
+    report: dict[str, object] = {"result_dir": str(Path(result_dir).resolve())}
+    if tasks:
+        groups = []
+        for k, task in enumerate(tasks):
+            of_task = [run for run in runs if run.task == task.name]
+            if of_task:
+                predicted = predicted_cycle_battery_energy(result_dir, k)
+                entries = _design_entries(of_task, [n for n in nominal if n.task == task.name], emlas, predicted)
+                groups.append({"task": task.name, "weight": task.weight, "designs": entries, **_cheaper(of_task)})
+        report["tasks"] = groups
+        report["mix"] = _mix_entry(result_dir, nominal or runs, tasks)  # at the planned end mass
+    else:
+        predicted = predicted_cycle_battery_energy(result_dir) if runs else {}
+        report["designs"] = _design_entries(runs, nominal, emlas, predicted)
     gains = runs[0].gains if runs else CascadeGains()
-    report: dict[str, object] = {
-        "result_dir": str(Path(result_dir).resolve()),
-        "designs": designs,
+    report.update({
         "settings": {
             "physics_timestep_s": PHYSICS_TIMESTEP,
             "control_timestep_s": float(runs[0].time[1] - runs[0].time[0]),
@@ -124,14 +135,87 @@ def simulation_report(
             "battery_energy": BATTERY_NOTE,
             "plant": runs[0].plant if runs else "ideal",
         },
-    }
+    })  # fmt: skip
+    if tasks:
+        settings = report["settings"]
+        assert isinstance(settings, dict)
+        settings["tasks"] = MIX_NOTE
     boundary = energy_boundary(emlas) if emlas is not None else None
     if boundary is not None:
         report["energy_boundary"] = boundary
+    if not tasks:
+        report.update(_cheaper(runs))
+    return report
+
+
+#: What ``simulation.json`` says of a duty mix's runs.
+MIX_NOTE = (
+    "a duty mix's result: each design of each task simulated on the task's own plan (trajectory.npz "
+    "task<k>_*, its payload and duty) and compared with the task's own prediction of one cycle (result.json "
+    "tasks[k].<design>); mix: per design sum_k w_k E_k over the tasks, closed loop against the result's "
+    "<design>.net_electrical_energy_J (per hour where the weights are cycles per hour)"
+)
+
+
+def _design_entries(
+    runs: list[ClosedLoopRun], nominal: list[ClosedLoopRun], emlas: EmlaSet | None, predicted: dict[str, float]
+) -> dict[str, object]:
+    """Per design: the run's summary, its battery energy against ``predicted`` [J] and, with one, its nominal run."""
+    designs: dict[str, object] = {}
+    for run in runs:
+        entry = run.summary()
+        if emlas is not None:
+            entry.update(battery_entry(run, emlas.battery, predicted.get(run.design)))
+        match = next((n for n in nominal if n.design == run.design), None)
+        if match is not None:
+            nominal_entry = match.summary()
+            if emlas is not None:
+                nominal_entry.update(battery_entry(match, emlas.battery, predicted.get(match.design)))
+            entry["nominal"] = nominal_entry
+            entry["extra_energy_J"] = run.net_energy - match.net_energy
+            entry["extra_energy_vs_predicted_J"] = run.net_energy - run.predicted_net_energy
+        designs[run.design] = entry
+    return designs
+
+
+def _cheaper(runs: list[ClosedLoopRun]) -> dict[str, bool]:
+    """``optimal_below_initial``: whether the optimal design's closed loop uses less energy (with both designs run)."""
     by_design = {run.design: run for run in runs}
     if {"initial", "optimal"} <= by_design.keys():
-        report["optimal_below_initial"] = by_design["optimal"].net_energy < by_design["initial"].net_energy
-    return report
+        return {"optimal_below_initial": by_design["optimal"].net_energy < by_design["initial"].net_energy}
+    return {}
+
+
+def _mix_entry(result_dir: str | Path, runs: list[ClosedLoopRun], tasks: Sequence[TaskResult]) -> dict[str, object]:
+    """Per design run on every task: sum_k w_k E_k closed loop and the result's weighted sum [J] (module docstring)."""
+    from hiab_sim.results.read import read_result
+
+    result = read_result(result_dir)
+    mix: dict[str, object] = {}
+    for design in dict.fromkeys(run.design for run in runs):
+        energy = {run.task: run.net_energy for run in runs if run.design == design}
+        if not all(task.name in energy for task in tasks):
+            continue
+        closed = float(sum(task.weight * energy[task.name] for task in tasks))
+        planned = float((result.optimal if design == "optimal" else result.initial).net_electrical_energy_J)
+        mix[design] = {
+            "net_electrical_energy_J": closed,
+            "predicted_net_electrical_energy_J": planned,
+            "energy_difference_percent": 100.0 * (closed / planned - 1.0),
+        }
+    return mix
+
+
+def run_groups(report: dict[str, object]) -> Iterator[tuple[str | None, dict[str, Any]]]:
+    """(task, designs) of a ``simulation.json``: one group per duty mix task, or (None, designs) of a single task."""
+    tasks = report.get("tasks")
+    if isinstance(tasks, list):
+        for group in tasks:
+            yield group["task"], group["designs"]
+        return
+    designs = report["designs"]
+    assert isinstance(designs, dict)
+    yield None, designs
 
 
 def energy_boundary(emlas: EmlaSet) -> str | None:
@@ -159,29 +243,37 @@ def energy_boundary(emlas: EmlaSet) -> str | None:
 
 
 def table(report: dict[str, object]) -> str:
-    """Markdown table of predicted vs closed-loop energy and tracking errors (docs/results/closed-loop.md)."""
+    """Markdown table of predicted vs closed-loop energy and tracking errors (docs/results/closed-loop.md).
+
+    A duty mix's report has a first column ``task``: one row per task and design, each against its task's plan.
+    """
+    mix = "tasks" in report
     lines = [
-        "| design | end mass | predicted energy [J] | closed-loop energy [J] | difference | vs 5 ms grid"
+        ("| task " if mix else "")
+        + "| design | end mass | predicted energy [J] | closed-loop energy [J] | difference | vs 5 ms grid"
         " | TCP error rms / max [mm] | at current limit | at voltage limit | extra energy [J] |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        ("|---" if mix else "") + "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
-    designs = report["designs"]
-    assert isinstance(designs, dict)
-    for design, entry in designs.items():
-        rows = [entry["nominal"], entry] if "nominal" in entry else [entry]
-        for row in rows:
-            tcp = row["tcp_error_mm"]
-            mass = "planned" if row["payload_error"] == 0 else f"+{100 * row['payload_error']:g} %"
-            fine = row.get("energy_difference_to_5ms_grid_percent")
-            lines.append(
-                f"| {design} | {mass} | {row['predicted_net_electrical_energy_J']:.1f} "
-                f"| {row['net_electrical_energy_J']:.1f} | {row['energy_difference_percent']:+.2f} % "
-                f"| {'' if fine is None else format(fine, '+.2f') + ' %'} "
-                f"| {tcp['rms']:.2f} / {tcp['max']:.2f} | {100 * row['current_limit_fraction']:.1f} % "
-                f"| {100 * row['voltage_limit_fraction']:.1f} % "
-                f"| {'' if 'extra_energy_J' not in row else format(row['extra_energy_J'], '+.1f')} |"
-            )
+    for task, designs in run_groups(report):
+        for design, entry in designs.items():
+            rows = [entry["nominal"], entry] if "nominal" in entry else [entry]
+            lines += [("" if task is None else f"| {task} ") + _table_row(design, row) for row in rows]
     return "\n".join(lines)
+
+
+def _table_row(design: str, row: dict[str, Any]) -> str:
+    """One run's row of :func:`table` (without a task column)."""
+    tcp = row["tcp_error_mm"]
+    mass = "planned" if row["payload_error"] == 0 else f"+{100 * row['payload_error']:g} %"
+    fine = row.get("energy_difference_to_5ms_grid_percent")
+    return (
+        f"| {design} | {mass} | {row['predicted_net_electrical_energy_J']:.1f} "
+        f"| {row['net_electrical_energy_J']:.1f} | {row['energy_difference_percent']:+.2f} % "
+        f"| {'' if fine is None else format(fine, '+.2f') + ' %'} "
+        f"| {tcp['rms']:.2f} / {tcp['max']:.2f} | {100 * row['current_limit_fraction']:.1f} % "
+        f"| {100 * row['voltage_limit_fraction']:.1f} % "
+        f"| {'' if 'extra_energy_J' not in row else format(row['extra_energy_J'], '+.1f')} |"
+    )
 
 
 def closed_loop_frame_times(duration: float) -> Array:

@@ -62,7 +62,10 @@ class ArraySpec:
 ARRAYS: tuple[ArraySpec, ...] = (
     ArraySpec("time", "K", "s", "sample instants of the task's fine grid, increasing"),
     ArraySpec(
-        "reference_tcp", "K, 3", "m", "the reference: TCP x, y in the source world frame {W} and telescope extension"
+        "reference_tcp",
+        "K, 3",
+        "m",
+        "the reference: TCP x, y in the source world frame {W} and the TCP's out-of-plane z there (constant)",
     ),
     ArraySpec("{design}_position", "K, J", "rad or m", "independent joint positions of the design's trajectory"),
     ArraySpec("{design}_velocity", "K, J", "rad/s or m/s", "their time derivatives"),

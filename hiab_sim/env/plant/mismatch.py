@@ -9,7 +9,7 @@ On a machine file (:mod:`hiab_sim.machine`) the same errors act on the machine d
 (:func:`true_machine`): every rigid part of every link and every chain body (cylinder, rod, rocker,
 coupler) is a link body; the end mass is the study's payload at the TCP (its weight, the load the
 plan's TCP force carries, :mod:`hiab_sim.env.machine_plan`), whose force is scaled by (1 + e_end)
-and applied at the TCP shifted by the offset in the TCP frame (:class:`hiab_sim.env.machine_env.TcpLoad`).
+and applied at the TCP shifted by the offset in the TCP frame (:class:`hiab_sim.env.tcp_load.TcpLoad`).
 A machine file has no body of its own for the load, so a machine with no payload has no end-mass error.
 
 The controller keeps the planned model; only the simulated plant changes.
