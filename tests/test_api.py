@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_study_small import small_study
+from test_study_small import machine_form, small_study
 
 import hiab_sim as hs
 from hiab_sim.errors import InvalidInputError
@@ -110,11 +110,7 @@ def machine_study() -> hs.api.Study:
     """The small study on the XS 031's machine file (its own bounds; tracking the telescope's extension)."""
     from hiab_sim.study.spec.study_file import study_from_dict
 
-    data = small_study()
-    del data["crane"]
-    bounds = {"joint_velocity": [0.6, 0.6, 0.5]}  # the crane study's defaults [rad/s, rad/s, m/s]
-    machine = {"machine": "xs031", "emla": "xs031", "tracked": ["xt2"], "bounds": bounds}
-    return study_from_dict({**data, **machine}, "small_machine.yaml")
+    return study_from_dict(machine_form(small_study()), "small_machine.yaml")
 
 
 def test_a_machine_files_study_evaluates_its_own_design_in_every_form(

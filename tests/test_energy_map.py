@@ -16,8 +16,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from lengths_helper import CRANE, feasible_lengths
-from test_study_small import small_study, write_study
-from test_sweep import TINY, machine_form
+from test_study_small import TINY, machine_form, small_study, write_study
 
 from hiab_sim.cli import main
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics

@@ -58,3 +58,18 @@ def test_small_study_loads_with_a_feasible_start() -> None:
     study = study_from_dict(small_study(), "small.yaml")
     problem = TaskProblem(study)
     assert problem.max_violation(problem.initial_point(study.initial_lengths)) <= 1e-9
+
+
+def machine_form(crane: dict[str, Any]) -> dict[str, Any]:
+    """A crane file's study mapping of the XS 031 as the same study of its machine file (tracking xt2).
+
+    The crane file's study keeps the crane's full joint range, the machine file's the machine's (the
+    same range); the machine file declares the decision variables' bounds.
+    """
+    machine = {k: v for k, v in crane.items() if k not in ("crane", "bounds")}
+    return machine | {
+        "machine": "xs031",
+        "emla": "default",
+        "tracked": ["xt2"],
+        "bounds": {"joint_velocity": [0.6, 0.6, 0.5], "working_range": "machine"},
+    }

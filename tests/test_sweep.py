@@ -8,7 +8,7 @@ from typing import Any
 import pandas as pd
 import pytest
 import yaml
-from test_study_small import TINY, small_study, write_study
+from test_study_small import TINY, machine_form, small_study, write_study
 
 from hiab_sim.cli import main
 from hiab_sim.crane.loader import load_crane
@@ -31,21 +31,6 @@ def write_sweep(folder: Path, body: dict[str, Any], name: str = "sweep.yaml") ->
     path = folder / name
     path.write_text(yaml.safe_dump({"study": "study.yaml", **body}, sort_keys=False))
     return path
-
-
-def machine_form(crane: dict[str, Any]) -> dict[str, Any]:
-    """A crane file's study mapping of the XS 031 as the same study of its machine file (tracking xt2).
-
-    The crane file's study keeps the crane's full joint range, the machine file's the machine's (the
-    same range); the machine file declares the decision variables' bounds.
-    """
-    machine = {k: v for k, v in crane.items() if k not in ("crane", "bounds")}
-    return machine | {
-        "machine": "xs031",
-        "emla": "default",
-        "tracked": ["xt2"],
-        "bounds": {"joint_velocity": [0.6, 0.6, 0.5], "working_range": "machine"},
-    }
 
 
 def comparable(frame: pd.DataFrame) -> pd.DataFrame:

@@ -7,7 +7,7 @@ from typing import Any
 
 import pytest
 import yaml
-from test_study_small import TINY, small_study
+from test_study_small import TINY, machine_form, small_study
 
 from hiab_sim.cli import main
 from hiab_sim.errors import ConfigError
@@ -15,17 +15,6 @@ from hiab_sim.resources import locate
 from hiab_sim.study.spec.study_file import study_from_dict
 from hiab_sim.sweep.paths import set_path
 from hiab_sim.sweep.spec import load_sweep
-
-
-def machine_study(crane: dict[str, Any]) -> dict[str, Any]:
-    """The tiny crane-file study as the same study of the XS 031's machine file (its bounds the machine file's)."""
-    study = {k: v for k, v in crane.items() if k not in ("crane", "bounds")}
-    return study | {
-        "machine": "xs031",
-        "emla": "default",
-        "tracked": ["xt2"],
-        "bounds": {"joint_velocity": [0.6, 0.6, 0.5], "working_range": "machine"},
-    }
 
 
 def write(folder: Path, study: dict[str, Any], grid: dict[str, Any]) -> Path:
@@ -51,7 +40,7 @@ def test_machine_study_chain_bounds_are_refused_naming_the_machine_file(
 
     The way it names works: a sweep over ``machine`` with a copy of the machine file moves the bounds.
     """
-    study = machine_study(small_study(**TINY))
+    study = machine_form(small_study(**TINY))
     path = write(tmp_path, study, {"bounds.lift.up[0]": [1.2, 1.25]})
     assert main(["sweep", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 2
     err = capsys.readouterr().err.strip()
