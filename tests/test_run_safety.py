@@ -79,9 +79,9 @@ def test_a_folder_of_pictures_or_another_commands_output_is_not_a_result(tmp_pat
     with pytest.raises(InvalidInputError, match=r"holds no hiab-sim result.*--force \(which deletes its holiday"):
         check_folder(photos, "a" * 64, resume=False, force=False)
     assert sorted(p.name for p in photos.iterdir()) == ["holiday.png", "movie.mp4", "summary.md"]
-    legacy = tmp_path / "legacy"
-    _fill(legacy, ("result.json", "objective.png"))
-    check_folder(legacy, "a" * 64, resume=False, force=False)
+    for legacy in ("result.json", "checkpoint_0.json"):  # a folder written before the marker: a result folder
+        _fill(tmp_path / legacy, (legacy, "objective.png"))
+        check_folder(tmp_path / legacy, "a" * 64, resume=False, force=False)
 
 
 def test_a_fresh_run_deletes_every_earlier_output_and_nothing_else(tmp_path: Path) -> None:

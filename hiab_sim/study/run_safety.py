@@ -110,7 +110,7 @@ def check_folder(folder: Path, digest: str, resume: bool, force: bool) -> None:
             f"it; sha256 {str(recorded)[:12]}); the default folder runs/<name> comes from the study's name: field, "
             "so give this study its own name:, pass --out, or use --force to replace the results there"
         )
-    if recorded is None and not (folder / "result.json").is_file():
+    if recorded is None and not (folder / "result.json").is_file() and not checkpoints(folder):
         found = [p.name for p in outputs(folder)]
         deletes = f" (which deletes its {', '.join(found)})" if found else ""
         raise InvalidInputError(
