@@ -22,7 +22,7 @@ from hiab_sim.resources import Source, recorded_path
 from hiab_sim.study.references.csv_file import ColumnNames
 from hiab_sim.study.spec.build import BuildSettings
 from hiab_sim.study.spec.energy import energy_settings
-from hiab_sim.study.spec.tasks import study_tasks
+from hiab_sim.study.spec.tasks import tasks_from_mapping
 from hiab_sim.yaml_fields import mapping, number, section, vector
 
 ID_PATHS = ("mujoco", "analytic")
@@ -259,5 +259,5 @@ def work_sections(top: Mapping[str, Any], file: Source, names: ColumnNames) -> d
     """
     grid = GridSettings(**section(GridSettings, top.get("grid"), "grid"))
     name = str(top.get("name", Path(str(file.file)).stem))
-    tasks = study_tasks(top, Path(str(file.file)).parent, grid.duration, name, names)
+    tasks = tasks_from_mapping(top, Path(str(file.file)).parent, grid.duration, name, names)
     return {"name": name, "path": recorded_path(file), "grid": grid, "tasks": tasks}

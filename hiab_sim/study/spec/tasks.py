@@ -128,6 +128,9 @@ def tasks_from_mapping(
 ) -> tuple[Task, ...]:
     """The study's tasks from its top-level mapping (``tasks:`` or today's ``reference:`` + ``payload:``).
 
+    In the single-reference form a plain ``payload: <kg>`` keeps today's meaning: its weight only (no
+    inertia); a payload mapping or a task's payload says whether it has inertia.
+
     Args:
         top: The study file's parsed top level.
         folder: The study file's folder (CSV paths resolve there).
@@ -136,9 +139,15 @@ def tasks_from_mapping(
         names: The machine's tracked coordinates beyond the TCP's x, y, and its joints (CSV columns).
 
     """
+    if "tasks" not in top and "reference" not in top:
+        raise ConfigError("study: give 'tasks:' (a list of tasks) or 'reference:' (one task)")
     if "tasks" not in top:
         reference = reference_from_mapping(top["reference"], "reference", folder, grid_duration, names)
-        return (Task(study_name, 1.0, reference, Payload.from_value(top.get("payload", 0.0))),)
+        value = top.get("payload", 0.0)
+        payload = Payload.from_value(value)
+        if isinstance(value, int | float):
+            payload = replace(payload, inertia=False)
+        return (Task(study_name, 1.0, reference, payload),)
     if "reference" in top or "payload" in top:
         raise ConfigError("study: give either 'tasks:' or 'reference:' (with 'payload:'), not both")
     entries = top["tasks"]
@@ -169,25 +178,6 @@ def tasks_from_mapping(
     if duplicate is not None:
         raise ConfigError(f"tasks: the name {duplicate!r} is used twice; task names must be unique")
     return tuple(tasks)
-
-
-def study_tasks(
-    top: Mapping[str, Any],
-    folder: Path,
-    grid_duration: float,
-    study_name: str,
-    names: ColumnNames,
-) -> tuple[Task, ...]:
-    """A study file's tasks (:func:`tasks_from_mapping`), its single-reference form keeping a plain payload's meaning.
-
-    In that form a plain ``payload: <kg>`` is today's payload, its weight only (no inertia).
-    """
-    if "tasks" not in top and "reference" not in top:
-        raise ConfigError("study: give 'tasks:' (a list of tasks) or 'reference:' (one task)")
-    tasks = tasks_from_mapping(top, folder, grid_duration, study_name, names)
-    if "tasks" not in top and isinstance(top.get("payload", 0.0), int | float):
-        tasks = (replace(tasks[0], payload=replace(tasks[0].payload, inertia=False)),)
-    return tasks
 
 
 def column_names(model: StudyMachine) -> ColumnNames:
