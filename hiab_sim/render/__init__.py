@@ -10,30 +10,9 @@ from hiab_sim.render.backend import import_mujoco
 import_mujoco()
 
 from hiab_sim.render.camera import fit_camera  # noqa: E402
-from hiab_sim.render.frames import Design, PlaybackRenderer  # noqa: E402
-from hiab_sim.render.playback import (  # noqa: E402
-    PlaybackData,
-    frame_times,
-    load_playback,
-    planned_qpos,
-    resample,
-    simulated_qpos,
-)
+from hiab_sim.render.playback import frame_times, load_playback  # noqa: E402
 from hiab_sim.render.result_views import render_result, render_still  # noqa: E402
-from hiab_sim.render.video import VIDEO_NAME, playback_renderer  # noqa: E402
+from hiab_sim.render.video import playback_renderer  # noqa: E402
 
-__all__ = [
-    "VIDEO_NAME",
-    "Design",
-    "PlaybackData",
-    "PlaybackRenderer",
-    "fit_camera",
-    "frame_times",
-    "load_playback",
-    "planned_qpos",
-    "playback_renderer",
-    "render_result",
-    "render_still",
-    "resample",
-    "simulated_qpos",
-]
+#: What scripts use (the CLI's render and optimize, the tests, the render benchmark); the rest from its module.
+__all__ = ["fit_camera", "frame_times", "load_playback", "playback_renderer", "render_result", "render_still"]
