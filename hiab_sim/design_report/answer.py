@@ -46,7 +46,9 @@ def _variables_text(machine: Crane | Machine) -> str:
 def question(result: Result, machine: Crane | Machine) -> str:
     """What was asked, of which machine (a crane file's or a machine file's), for which work."""
     tasks = (
-        f"{len(result.tasks)} tasks (a duty mix: " + ", ".join(f"{t.name} x {t.weight:g}" for t in result.tasks) + ")"
+        f"{len(result.tasks)} task{'s' if len(result.tasks) > 1 else ''} (a duty mix: "
+        + ", ".join(f"{t.name} x {t.weight:g}" for t in result.tasks)
+        + ")"
         if result.tasks
         else f"the study's reference motion ({result.settings.fine_grid_points} fine-grid samples)"
     )

@@ -251,7 +251,7 @@ class HistoryRow:
 
 @dataclass(frozen=True)
 class TaskResult:
-    """One task of a study of several tasks: share, load, grid, designs on its fine grid, re-check.
+    """One task of a duty mix (or of a study of one task of weight other than 1): share, load, grid, designs, re-check.
 
     Written by :func:`hiab_sim.study.report.result_folder.build_result`.
 
@@ -298,6 +298,7 @@ class Result:
     energy: EnergyReport | None = optional()  # battery energy and costf2, thermal
     hydraulic_baseline: HydraulicBaseline | None = optional()
     codesign: Codesign | None = optional()
+    # each task's own cycle: a duty mix, or one task of weight w != 1 (the top level then being w times it)
     tasks: tuple[TaskResult, ...] | None = optional()
     cross_evaluation: CrossEvaluation | None = optional()
     buildable: Buildable | None = optional()

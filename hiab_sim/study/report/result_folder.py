@@ -134,7 +134,7 @@ def build_result(
         if k == 0:
             first_checks = checks
             arrays.update(task_arrays)
-        if problem.n_tasks > 1:
+        if not one:  # a mix, or one task of another weight: the top level is a weighted sum, each task its own
             arrays.update({f"task{k}_{key}": value for key, value in task_arrays.items()})
     initial = weighted_summary([t.initial for t in task_results], w, names)
     optimal = weighted_summary([t.optimal for t in task_results], w, names)
@@ -217,7 +217,7 @@ def build_result(
             if one
             else None
         ),
-        tasks=tuple(task_results) if problem.n_tasks > 1 else None,
+        tasks=None if one else tuple(task_results),
         cross_evaluation=cross,
         # one task: its own section; a mix: the envelope over its tasks (each task's own under tasks)
         structure=structures[0] if problem.n_tasks == 1 else mix_structure(structures, names),
