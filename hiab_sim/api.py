@@ -125,10 +125,8 @@ def as_design(model: StudyMachine, lengths: Lengths) -> Design:
         return model.design(lengths.as_array())
     if isinstance(lengths, Mapping):
         return model.design(_mapped_values(names, lengths))
-    values = np.asarray(lengths, dtype=float)
-    if values.shape != (len(names),):
-        raise InvalidInputError("lengths", list(values.ravel()), f"must be {len(names)} values, in order {list(names)}")
-    return model.design(values)
+    order = f"must be {len(names)} values, in order {list(names)}"
+    return model.design(_numbers("lengths", lengths, len(names), order))
 
 
 def _mapped_values(names: tuple[str, ...], lengths: Mapping[str, object]) -> list[float]:
@@ -144,17 +142,30 @@ def _mapped_values(names: tuple[str, ...], lengths: Mapping[str, object]) -> lis
     values: dict[str, float] = {}
     for chain, variables in chains.items():
         if chain in lengths:
-            given = np.asarray(lengths[chain], dtype=float).ravel()
-            if given.shape != (len(variables),):
-                raise InvalidInputError(f"lengths.{chain}", list(given), f"must be {variables}", "m")
-            values.update({f"{chain}.{v}": float(x) for v, x in zip(variables, given, strict=True)})
+            twice = [f"{chain}.{v}" for v in variables if f"{chain}.{v}" in lengths]
+            if twice:
+                raise InvalidInputError(f"lengths.{chain}", twice, "give a chain's values or its variables, not both")
+            given = _numbers(f"lengths.{chain}", lengths[chain], len(variables), f"must be {variables}")
+            values.update({f"{chain}.{v}": x for v, x in zip(variables, given, strict=True)})
     for name in names:
         if name in lengths:
-            values[name] = float(np.asarray(lengths[name], dtype=float))
+            values[name] = _numbers(f"lengths.{name}", lengths[name], None, "must be one finite number")[0]
     missing = [name for name in names if name not in values]
     if missing:
         raise InvalidInputError("lengths", sorted(lengths), f"misses {missing} (needs every one of {list(names)})")
     return [values[name] for name in names]
+
+
+def _numbers(field: str, given: object, count: int | None, allowed: str) -> list[float]:
+    """``given`` as ``count`` finite numbers [m] (None: one scalar), else one line naming ``field``."""
+    try:
+        values = np.asarray(given, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidInputError(field, given, allowed, "m") from None
+    shape_ok = values.shape == (() if count is None else (count,))
+    if not shape_ok or not np.all(np.isfinite(values)):
+        raise InvalidInputError(field, given, allowed, "m")
+    return [float(v) for v in values.ravel()]
 
 
 def optimize(

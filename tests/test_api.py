@@ -140,6 +140,12 @@ def test_a_machine_files_study_evaluates_its_own_design_in_every_form(
         ({"lift.L": 1.0}, r"misses \['lift.Lc0'"),
         ({"boom.L": 1.0}, r"keys are the chains \['lift', 'tilt'\]"),
         (np.ones(9), r"must be 6 values, in order \['lift.L'"),
+        ({"lift.L": [1.0, 2.0], "lift": [1.0, 0.1, 0.7]}, r"lengths.lift .*not both"),
+        ({"lift": [1.0, 0.1, 0.7], "tilt": [1.1, 0.1, 0.7], "lift.L": 1.0}, r"lengths.lift .*not both"),
+        ({"lift": ["a", 0.1, 0.7], "tilt": [1.1, 0.1, 0.7]}, r"lengths.lift "),
+        ({"lift.L": [1.0, 2.0]}, r"lengths.lift.L .*one finite number"),
+        (["1.0", "x", 0, 0, 0, 0], r"lengths .*must be 6 values"),
+        ([1.0, float("nan"), 0.7, 1.1, 0.1, 0.7], r"lengths .*must be 6 values"),
     ],
 )
 def test_a_design_that_is_not_the_machines_names_what_it_needs(
