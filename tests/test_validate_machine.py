@@ -73,3 +73,11 @@ def test_validate_machine_refuses_a_bad_tcp_force(
     assert main(["validate", "--machine", "exact", "--tcp-force", value, "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "--tcp-force" in err
+
+
+def test_validate_refuses_a_crane_file_beside_a_machine(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--crane FILE beside --machine: one line naming --crane, exit 2, nothing written (it was silently ignored)."""
+    out = tmp_path / "v"
+    assert main(["validate", "--machine", "exact", "--crane", "xs031", "--samples", "4", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--crane" in err and not out.exists()

@@ -216,7 +216,7 @@ def run(args: argparse.Namespace) -> int:
         raise InvalidInputError("--crane", args.crane, "cannot be combined with --machine")
     machine_file = args.machine is not None or (args.from_result is not None and _is_machine_result(args.from_result))
     args.output = args.output or ("machine.xml" if machine_file else "crane.xml")
-    if machine_file or (args.from_result is not None and _is_machine_result(args.from_result)):
+    if machine_file:
         from hiab_sim.cli.mjcf_machine import run_machine
 
         return run_machine(args, _result_design(args) if args.from_result is not None else None)

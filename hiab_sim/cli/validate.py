@@ -75,7 +75,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--out", type=Path, default=Path("runs/validate"), help="output folder (default: runs/validate)"
     )
-    parser.set_defaults(run=run)
+    parser.set_defaults(run=run, crane=None)  # --crane unless given: None (DEFAULT_CRANE on the crane path)
 
 
 #: ``--machine``'s samples per case with ``--samples full`` (the default).
@@ -154,6 +154,8 @@ def verdict(results: Sequence[CaseOutcome]) -> int:
 def run(args: argparse.Namespace) -> int:
     """Run every case, write the report files and return 0 (all within tolerance) or 1."""
     if args.machine is not None:
+        if args.crane is not None:
+            raise InvalidInputError("--crane", args.crane, "cannot be combined with --machine")
         return run_machine(args)
     if args.tcp_force is not None:
         raise InvalidInputError("--tcp-force", args.tcp_force, "needs --machine (the crane's cases set their payload)")
@@ -161,7 +163,7 @@ def run(args: argparse.Namespace) -> int:
     from hiab_sim.validation import DEFAULT_CASES, load_cases, mujoco_path, run_case, with_samples
     from hiab_sim.validation_report import write_report
 
-    crane = load_crane(args.crane)
+    crane = load_crane(args.crane or DEFAULT_CRANE)
     tolerances, specs = load_cases(args.cases or DEFAULT_CASES)
     if args.samples is not None:
         specs = with_samples(specs, args.samples)
