@@ -31,6 +31,7 @@ def commands(folder: Path, out: Path) -> dict[str, list[str]]:
         ("pareto", "result.json", "optimize"),
         ("sweep", "result.json", "optimize"),
         ("energy-map", "owner.json", "optimize"),
+        ("sweep", "checkpoint_0.json", "optimize"),  # an optimisation from before owner.json
         ("pareto", "energy_map.json", "energy-map"),
         ("energy-map", "pareto.json", "pareto"),
     ],

@@ -17,10 +17,11 @@ from pathlib import Path
 
 from hiab_sim.errors import InvalidInputError
 
-#: The files that mark a folder as a command's output: (file, the command that writes it).
+#: The files that mark a folder as a command's output: (file name or glob pattern, the command that writes it).
 MARKERS = (
     ("result.json", "optimize"),
     ("owner.json", "optimize"),  # an optimisation's claim on its folder, before its result is written
+    ("checkpoint_*.json", "optimize"),  # an optimisation's iterations (a folder from before owner.json)
     ("energy_map.json", "energy-map"),
     ("pareto.json", "pareto"),
     ("sweep.parquet", "sweep"),
@@ -37,11 +38,12 @@ def check_out_folder(out: Path, command: str, instead: str) -> None:
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise InvalidInputError("--out", str(out), "must be a folder (it is a file)")
-    for marker, owner in MARKERS:
-        if owner != command and (out / marker).is_file():
+    for pattern, owner in MARKERS:
+        found = sorted(p.name for p in out.glob(pattern) if p.is_file()) if owner != command else []
+        if found:
             raise InvalidInputError(
                 "--out",
                 str(out),
-                f"it holds the output of hiab-sim {owner} ({marker}), whose summary.md {command} would overwrite "
+                f"it holds the output of hiab-sim {owner} ({found[0]}), whose summary.md {command} would overwrite "
                 f"with its own: give {command} a folder of its own, e.g. {out / instead}",
             )
