@@ -74,6 +74,8 @@ def test_report_shows_the_closed_loop_of_simulation_json(run_dir: Path, tmp_path
         "net_electrical_energy_J": 3976.0,
         "energy_difference_percent": -0.06,
         "tcp_error_mm": {"rms": 0.63, "max": 0.83},
+        "current_limit_fraction": 0.0,
+        "voltage_limit_fraction": 0.0,
     }
     (run_dir / "simulation.json").write_text(json.dumps({"designs": {"optimal": design}}))
     try:
@@ -82,7 +84,7 @@ def test_report_shows_the_closed_loop_of_simulation_json(run_dir: Path, tmp_path
         html = out.read_text()
     finally:
         (run_dir / "simulation.json").unlink()
-    assert "<h2>Closed-loop validation</h2>" in html and "3976.0 J" in html and "-0.06 %" in html
+    assert "<h2>Closed-loop validation</h2>" in html and '<td class="num">3976.0</td>' in html and "-0.06 %" in html
 
 
 def test_report_of_a_folder_without_a_result_exits_2_and_writes_nothing(tmp_path: Path) -> None:

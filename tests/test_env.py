@@ -29,6 +29,17 @@ class CraneEnvironmentConformance(test_utils.EnvironmentTestMixin, absltest.Test
             yield motion.current[min(k, len(motion.time) - 1)]
 
 
+def test_a_force_of_the_fine_grid_is_linear_between_its_samples() -> None:
+    """A force linear in time comes back exactly between the plan's samples; outside the cycle its ends hold."""
+    plan = synthetic_plan(CRANE)
+    start, slope = np.array([15.0, -981.0, 2.0]), np.array([40.0, -12.0, 0.5])  # [N], [N/s]
+    force = start + np.outer(plan.time, slope)
+    times = np.array([-0.2, 0.0, 0.0123, 0.777, plan.time[-1], plan.time[-1] + 0.4])
+    expected = start + np.outer(np.clip(times, plan.time[0], plan.time[-1]), slope)
+    np.testing.assert_allclose(plan.force_at(force, times), expected, rtol=1e-12, atol=1e-9)
+    np.testing.assert_array_equal(plan.force_at(force), force)
+
+
 @pytest.mark.sim
 def test_closed_loop_energy_matches_the_steady_state_model() -> None:
     """Cascade control on the simulated drives draws the steady-state model's energy within 1 % and tracks to 0.5 mm.

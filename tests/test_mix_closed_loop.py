@@ -12,7 +12,10 @@ and an excavator's two joint moves (the second with 80 kg held from 0.5 s to 2.0
 from __future__ import annotations
 
 import json
+import shutil
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -76,8 +79,7 @@ def test_each_task_of_a_mix_uses_its_own_planned_energy(
 
     Measured: the crane's mix -0.02 % / -0.13 % (battery +0.02 % / -0.27 %), the excavator's +0.01 % /
     -0.04 % (battery -0.06 % / -0.06 %); the weighted sums of the closed loops -0.09 % and -0.02 % from
-    the results'. Before, only the first task ran (on the crane with the mix's largest payload), against
-    the weighted sums: -52 % on the crane's mix.
+    the results'.
     """
     from hiab_sim.design_report.analysis import closed_loop
     from hiab_sim.results.read import read_result
@@ -106,7 +108,9 @@ def test_each_task_of_a_mix_uses_its_own_planned_energy(
     weighted = report["mix"]["optimal"]
     assert weighted["net_electrical_energy_J"] == pytest.approx(result.optimal.net_electrical_energy_J, rel=0.01)
     page = closed_loop(tmp_path)  # the design report's section: a row and a figure per task
-    assert all(f"{task.name}: optimal" in page and f"of task {task.name}" in page for task in result.tasks)
+    assert all(
+        f"<td>{task.name}</td><td>optimal</td>" in page and f"of task {task.name}" in page for task in result.tasks
+    )
 
 
 def test_a_mix_plan_needs_its_task(crane_mix: Path) -> None:
@@ -117,6 +121,55 @@ def test_a_mix_plan_needs_its_task(crane_mix: Path) -> None:
         with pytest.raises(InvalidInputError, match="task"):
             read_plan(crane_mix, "optimal", task)
     assert read_plan(crane_mix, "optimal", 1).task == "second"
+
+
+def test_a_task_index_is_any_integer_but_a_bool(crane_mix: Path) -> None:
+    """A NumPy integer indexes a mix's tasks as Python's does; True (an int to Python) is refused naming ``task``."""
+    from hiab_sim.env.plan import read_plan
+
+    assert read_plan(crane_mix, "optimal", np.int64(1)).task == "second"
+    assert read_plan(crane_mix, "optimal", np.uint8(0)).task == "spiral"
+    for task in (True, 1.0):
+        with pytest.raises(InvalidInputError, match="task"):
+            read_plan(crane_mix, "optimal", task)  # type: ignore[arg-type]
+
+
+def _edited_copy(result_dir: Path, folder: Path, edit: Callable[[list[dict[str, Any]]], None]) -> Path:
+    """A copy of ``result_dir`` whose study file (a copy next to it) has had ``edit`` applied to its tasks."""
+    shutil.copytree(result_dir.parent, folder)
+    study = yaml.safe_load((folder / "study.yaml").read_text(encoding="utf-8"))
+    edit(study["tasks"])
+    (folder / "study.yaml").write_text(yaml.safe_dump(study), encoding="utf-8")
+    result_file = folder / result_dir.name / "result.json"
+    result = json.loads(result_file.read_text(encoding="utf-8"))
+    result["study"] = str(folder / "study.yaml")
+    result_file.write_text(json.dumps(result), encoding="utf-8")
+    return folder / result_dir.name
+
+
+@pytest.mark.parametrize("mix", ["crane_mix", "excavator_mix"])
+@pytest.mark.parametrize("edit", ["reordered", "removed"])
+def test_a_study_edited_after_the_run_is_refused(
+    mix: str, edit: str, request: pytest.FixtureRequest, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A study file whose tasks moved or went since the run is refused in one line naming the file and the task.
+
+    The task's force F(t) comes from the study file by the task's place: reordered, task 1's plan would
+    take task 0's force; removed, there is none.
+    """
+    from hiab_sim.env.machine_plan import read_machine_plan
+    from hiab_sim.env.plan import read_plan
+    from hiab_sim.errors import ConfigError
+
+    result_dir = request.getfixturevalue(mix)
+    copy = _edited_copy(result_dir, tmp_path / "copy", list.reverse if edit == "reordered" else list.pop)
+    read = read_plan if mix == "crane_mix" else read_machine_plan
+    second = yaml.safe_load((result_dir.parent / "study.yaml").read_text(encoding="utf-8"))["tasks"][1]["name"]
+    with pytest.raises(ConfigError, match=rf"study\.yaml.*'?{second}"):
+        read(copy, "optimal", 1)
+    assert main(["simulate", str(copy), "--out", str(tmp_path / "out"), "--no-video", "--quiet"]) == 2
+    error = capsys.readouterr().err
+    assert "study.yaml" in error and second in error and "Traceback" not in error and len(error.splitlines()) == 1
 
 
 def test_a_scheduled_payload_is_the_plans_force(crane_mix: Path) -> None:

@@ -66,7 +66,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description=(
             "Simulate the study's cycle with the machine (crane file or machine file) built to each design, driven by "
             "PMSM drives (current loops, voltage and current limits, rotor inertia and friction) under a "
-            "cascade tracking controller; compare the electrical energy with the optimiser's prediction."
+            "cascade tracking controller; compare the electrical energy with the optimiser's prediction. A duty "
+            "mix's result runs per task and per design, each on the task's own plan against the task's own "
+            "prediction, its figures and video suffixed _task0, _task1, ..."
         ),
     )
     parser.add_argument("result_dir", metavar="RESULT_DIR", help="folder written by 'hiab-sim optimize'")
@@ -86,8 +88,16 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--cycles", type=int, default=1, metavar="N", help="cycles per run, thermal state carried over")
     add_out_option(parser, "RESULT_DIR")
-    parser.add_argument("--no-video", action="store_true", help="skip closed_loop.mp4")
-    parser.add_argument("--no-figures", action="store_true", help="skip the closed_loop_*.png figures")
+    parser.add_argument(
+        "--no-video",
+        action="store_true",
+        help="skip closed_loop.mp4 (a duty mix: closed_loop_task0.mp4, ... one per task)",
+    )
+    parser.add_argument(
+        "--no-figures",
+        action="store_true",
+        help="skip the closed_loop_*.png figures (a duty mix: one set per task, _task0, ...)",
+    )
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
     parser.set_defaults(run=run)
 
@@ -130,7 +140,14 @@ def run(args: argparse.Namespace) -> int:
     from hiab_sim.env.validation import render_video, simulate_designs, simulation_report
 
     runs, nominal, physics = simulate_designs(
-        args.result_dir, designs, error, quiet=args.quiet, plant=plant, cycles=args.cycles, tasks=tasks
+        args.result_dir,
+        designs,
+        error,
+        quiet=args.quiet,
+        plant=plant,
+        cycles=args.cycles,
+        tasks=tasks,
+        keep_physics=not args.no_video,
     )
     report = simulation_report(args.result_dir, runs, nominal)
     written, effects = write_results(args, report, runs, nominal, plant, designs, out)

@@ -60,10 +60,11 @@ def run_machine(
     designs on the task's own plan, or (None,) for a single-task result.
     """
     from hiab_sim.cli.simulate_summary import print_results, refuse_mix_effects, task_runs, write_results
+    from hiab_sim.design_report.simulation_table import run_groups
     from hiab_sim.env.machine_env import run_machine_closed_loop
     from hiab_sim.env.machine_plan import read_machine_plan
     from hiab_sim.env.plant.load import machine_plant
-    from hiab_sim.env.validation import run_groups, simulation_report
+    from hiab_sim.env.validation import simulation_report
 
     refuse_crane_only(args)
     plans = [read_machine_plan(args.result_dir, design, task) for task in tasks for design in designs]  # fails first
@@ -78,16 +79,19 @@ def run_machine(
     try:
         for plan in plans:
             run, physics = run_machine_closed_loop(plan, plant=plant, cycles=args.cycles)
-            models.append(physics)
             runs.append(run)
+            if args.no_video:  # nothing to draw: one Physics alive at a time
+                physics.free()
+            else:
+                models.append(physics)
         report = simulation_report(args.result_dir, runs, [], emlas=plans[0].emlas)
         settings = report["settings"]
         assert isinstance(settings, dict)
         settings.update(energy=MACHINE_ENERGY, tcp_error=MACHINE_TCP, machine=plans[0].machine.name)
         settings["tcp_load"] = "the plan's TCP force F(t) of the run's task, applied at site tcp"
         groups = list(run_groups(report))
-        for _, entries in groups:
-            for entry in entries.values():
+        for group in groups:
+            for entry in group.designs.values():
                 if entry["bandwidth_check"].get("first_natural_frequency_Hz") is None:
                     entry["bandwidth_check"]["note"] = NO_STRUCTURE
         written, effects = write_results(args, report, runs, [], plant, designs, out)
@@ -100,11 +104,12 @@ def run_machine(
         for physics in models:
             physics.free()
     print_results(report, effects)
-    for task, entries in groups:
-        for design, entry in entries.items():
+    for group in groups:
+        opened = "" if group.task is None else f"{group.task}, "
+        for design, entry in group.designs.items():
             if entry.get("battery_energy_difference_percent") is not None:
                 print(
-                    f"{'' if task is None else f'{task}, '}{design}: battery energy {entry['battery_energy_J']:.1f} J "
+                    f"{opened}{design}: battery energy {entry['battery_energy_J']:.1f} J "
                     f"closed loop against {entry['predicted_battery_energy_J']:.1f} J planned "
                     f"({entry['battery_energy_difference_percent']:+.2f} %)."
                 )

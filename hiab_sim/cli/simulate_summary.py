@@ -25,10 +25,12 @@ def task_runs(runs: list[ClosedLoopRun]) -> list[tuple[str, list[ClosedLoopRun]]
 
     ``runs`` hold every task of a duty mix's result, in the result's order (as :func:`task_indices` reads them).
     """
+    from hiab_sim.design_report.simulation_table import task_suffix
+
     names = list(dict.fromkeys(run.task for run in runs))
     if names == [None]:
-        return [("", runs)]
-    return [(f"_task{k}", [run for run in runs if run.task == name]) for k, name in enumerate(names)]
+        return [(task_suffix(None), runs)]
+    return [(task_suffix(k), [run for run in runs if run.task == name]) for k, name in enumerate(names)]
 
 
 def refuse_mix_effects(args: argparse.Namespace, plant: Plant | None, tasks: tuple[int | None, ...]) -> None:
@@ -88,9 +90,9 @@ def write_results(
 
 def print_results(report: dict[str, object], effects: dict[str, object] | None) -> None:
     """Print the table, the effect study's table and lines (with one) and the closing lines."""
-    from hiab_sim.env.validation import table
+    from hiab_sim.design_report.simulation_table import markdown_table
 
-    print(table(report))
+    print(markdown_table(report))
     if effects is not None:
         from hiab_sim.env.effect_report import effect_lines, effect_table
 
@@ -108,11 +110,11 @@ def closing_lines(report: dict[str, object]) -> list[str]:
 
     A duty mix's also gives its weighted sum over the tasks per design against the result's (``mix``).
     """
-    from hiab_sim.env.validation import run_groups
+    from hiab_sim.design_report.simulation_table import run_groups
 
     lines = []
-    for task, designs in run_groups(report):
-        lines += _design_lines(designs, "" if task is None else f"{task}, ")
+    for group in run_groups(report):
+        lines += _design_lines(group.designs, "" if group.task is None else f"{group.task}, ")
     mix = report.get("mix")
     for design, entry in mix.items() if isinstance(mix, dict) else ():
         lines.append(
@@ -128,9 +130,11 @@ def closing_lines(report: dict[str, object]) -> list[str]:
 
 def _design_lines(designs: Mapping[str, Any], task: str) -> list[str]:
     """Per design of ``designs`` the closing line and its bandwidth line, each opened by ``task``."""
+    from hiab_sim.design_report.simulation_table import entry_runs
+
     lines = []
     for design, entry in designs.items():
-        rows = [entry["nominal"], entry] if "nominal" in entry else [entry]
+        rows = entry_runs(entry)
         planned = rows[0]
         fine = planned.get("energy_difference_to_5ms_grid_percent")
         text = (

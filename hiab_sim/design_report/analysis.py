@@ -9,6 +9,7 @@ from typing import Any, TypeVar
 
 from hiab_sim.design_report.answer import actuator_table
 from hiab_sim.design_report.page import figure, num, paragraph, section, table
+from hiab_sim.design_report.simulation_table import COLUMNS, NUMERIC, run_groups, table_header, table_rows
 from hiab_sim.results.schema import Result
 
 T = TypeVar("T")
@@ -127,46 +128,31 @@ def hydraulics(result: Result, folder: Path) -> str:
 
 
 def closed_loop(folder: Path) -> str:
-    """The closed-loop validation of ``hiab-sim simulate`` when ``simulation.json`` exists."""
+    """The closed-loop validation of ``hiab-sim simulate`` when ``simulation.json`` exists.
+
+    The table is the one ``hiab-sim simulate`` prints (:mod:`hiab_sim.design_report.simulation_table`):
+    a duty mix's a row per task and design, each against its task's own plan, and a figure per task.
+    """
     path = folder / "simulation.json"
     if not path.is_file():
         return ""
     report: dict[str, Any] = json.loads(path.read_text())
-    rows = []
-    # a duty mix's simulation.json holds its runs per task, each against the task's own plan
-    groups = [(g["task"], g["designs"]) for g in report["tasks"]] if "tasks" in report else [(None, report["designs"])]
-    for task, designs in groups:
-        for design, entry in designs.items():
-            for row in [entry["nominal"], entry] if "nominal" in entry else [entry]:
-                mass = "planned" if row["payload_error"] == 0 else f"+{100 * row['payload_error']:g} %"
-                rows.append(
-                    (
-                        design if task is None else f"{task}: {design}",
-                        mass,
-                        f"{row['predicted_net_electrical_energy_J']:.1f} J",
-                        f"{row['net_electrical_energy_J']:.1f} J",
-                        f"{row['energy_difference_percent']:+.2f} %",
-                        f"{row['tcp_error_mm']['rms']:.2f} / {row['tcp_error_mm']['max']:.2f} mm",
-                    )
-                )
+    header = table_header(report)
+    shift = len(header) - len(COLUMNS)
     return section(
         "Closed-loop validation",
         paragraph(
             "Each design driven by simulated EMLA drives (dq current dynamics, voltage and current limits) under "
             "a tracking controller through the study's cycle; energy integrated at the motor terminals."
         ),
-        table(
-            ("design", "end mass", "predicted", "closed loop", "difference", "TCP error rms / max"),
-            rows,
-            numeric=(2, 3, 4, 5),
-        ),
+        table(header, table_rows(report), numeric=tuple(i + shift for i in NUMERIC)),
         *(
-            figure(folder / f"closed_loop_energy{suffix}.png", f"Cumulative energy{of}, closed loop against prediction")
-            for suffix, of in (
-                [(f"_task{k}", f" of task {task}") for k, (task, _) in enumerate(groups)]
-                if "tasks" in report
-                else [("", "")]
+            figure(
+                folder / f"closed_loop_energy{group.suffix}.png",
+                f"Cumulative energy{'' if group.task is None else f' of task {group.task}'}, "
+                "closed loop against prediction",
             )
+            for group in run_groups(report)
         ),
     )
 

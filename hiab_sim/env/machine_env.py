@@ -94,15 +94,10 @@ def _to_world(points: Array) -> Array:
     return source_to_world(full)
 
 
-def _at(times: Array, plan: MachinePlan, force: Array) -> Array:
-    """A (K, 3) force of the plan's fine grid at ``times`` (N, 3) [N], linear interpolation."""
-    return np.stack([np.interp(times, plan.time, force[:, i]) for i in range(3)], axis=1)
-
-
 def machine_motion(plan: MachinePlan, timestep: float) -> tuple[PlannedMotion, Array]:
     """The plan every ``timestep`` [s] (module docstring) and the TCP force there, MuJoCo world (N, 3) [N]."""
     times = physics_times(plan, timestep)
-    force = _at(times, plan, plan.tcp_force)
+    force = plan.force_at(plan.tcp_force, times)
     dynamics = MujocoMachineDynamics(plan.machine)
 
     def loaded_dynamics(pos: Array, vel: Array, acc: Array) -> tuple[MachineActuatorSamples, Array, Array]:
@@ -177,7 +172,7 @@ def machine_environment(
     parts = plant_parts(physics.model.ptr, plan, motion, arrays, plant, stiffness, friction, current_bandwidth_hz)
     physics.attach_parts(parts, plant, joints, actuators)
     if active is not None and active.mismatch.enabled:
-        payload = _to_world(_at(physics_times(plan, physics_timestep), plan, plan.payload_force)[:, :2])
+        payload = _to_world(plan.force_at(plan.payload_force, physics_times(plan, physics_timestep))[:, :2])
         offset = np.asarray(active.mismatch.end_mass_com_offset_m, dtype=float)
         physics.tcp_load = TcpLoad(
             physics.model.ptr, force, physics_timestep, payload, payload_factor(active.mismatch), offset

@@ -24,13 +24,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.emla.duty_energy import DutyOptions
-from hiab_sim.env.plan import PlannedDesign, open_design
-from hiab_sim.errors import ConfigError, InvalidInputError
+from hiab_sim.env.plan import PlannedDesign, open_design, result_study
+from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.design import MachineDesign
 from hiab_sim.results.read import open_run, result_machine
 from hiab_sim.results.schema import Result
-from hiab_sim.study.spec.study_file import load_study
 
 Array = NDArray[np.float64]
 
@@ -84,7 +83,8 @@ def read_machine_plan(result_dir: str | Path, design: str, task: int | None = No
         InvalidInputError: unknown design, a task index out of range (none for a duty mix), or a
             crane file's result.
         ConfigError: the folder holds no result, its files are malformed, or the study file is gone
-            (its EMLA set and TCP force are needed; one line naming it).
+            (its EMLA set and TCP force are needed) or no longer holds the result's tasks
+            (:func:`hiab_sim.env.plan.result_study`; one line naming it).
 
     """
     found = open_design(result_dir, design, task)
@@ -93,14 +93,10 @@ def read_machine_plan(result_dir: str | Path, design: str, task: int | None = No
         raise InvalidInputError("result", str(result_dir), "is a crane file's result (read it with read_plan)")
     result = run.result
     machine = result_machine(run.folder, result).with_design(values.values, check_bounds=False)
-    try:
-        study = load_study(result.study)
-    except ConfigError as error:
-        raise ConfigError(
-            f"{run.folder}: the study file {result.study} is needed for its EMLA set and TCP force ({error})"
-        ) from error
+    studied = result_study(found, "its EMLA set and TCP force")
+    assert studied is not None  # needed: a study file that is gone raised
+    study, of_task = studied
     time = found.planned["time"]
-    of_task = study.tasks[found.task_index]
     kinematics, gravity = study.model.kinematics, study.model.gravity
     tcp_force = _samples(of_task.id_force(kinematics, gravity, time), len(time))
     payload = tcp_force - _samples(of_task.soil_force(kinematics, gravity, time), len(time))

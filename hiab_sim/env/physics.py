@@ -338,10 +338,7 @@ def crane_physics(
     physics.attach_parts(parts, plant, SLIDES, ACTUATORS)
     if plan.tcp_force is not None and plan.payload_force is not None:  # the task's F(t), as the plan's ID took it
         at = plan.time[0] + motion.time
-        force, payload = (
-            source_to_world(np.stack([np.interp(at, plan.time, f[:, i]) for i in range(3)], axis=1))
-            for f in (plan.tcp_force, plan.payload_force)
-        )
+        force, payload = (source_to_world(plan.force_at(f, at)) for f in (plan.tcp_force, plan.payload_force))
         physics.tcp_load = TcpLoad(physics.model.ptr, force, timestep, payload, 1.0 + payload_error)
     return physics
 

@@ -13,11 +13,13 @@ A duty mix's result (``result.json`` ``tasks``) holds one plan per task: its own
 fine grid (``trajectory.npz`` ``task<k>_*``), its own payload and its own energies
 (``tasks[k].<design>``); the top-level energies are the mix's weighted sums per hour, which no single
 cycle can be compared with. Its plans are read per task (``task`` = k, :func:`mix_tasks`), and a
-mix's plan is refused without one.
+mix's plan is refused without one. The study file a result names gives each task's payload force F(t);
+it is read only where it still holds the result's tasks, in the result's order (:func:`result_study`).
 """
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -34,6 +36,7 @@ from hiab_sim.results.read import DESIGNS, RunFolder, open_run, result_crane
 from hiab_sim.results.schema import DesignSummary, Result, TaskResult
 from hiab_sim.study.spec.study import Study
 from hiab_sim.study.spec.study_file import load_study
+from hiab_sim.study.spec.tasks import Task
 
 Array = NDArray[np.float64]
 
@@ -73,6 +76,15 @@ class PlannedDesign:
         """Cycle duration [s]."""
         return float(self.time[-1] - self.time[0])
 
+    def force_at(self, force: Array, times: Array | None = None) -> Array:
+        """A force of the fine grid, (K, 3) [N], at ``times`` [s] (N,): (N, 3), linear between the samples.
+
+        ``times`` None: the fine grid's own (a copy of ``force``); before its first or after its last
+        sample the end sample's force holds.
+        """
+        at = self.time if times is None else np.asarray(times, dtype=float)
+        return np.stack([np.interp(at, self.time, force[:, i]) for i in range(3)], axis=1)
+
 
 @dataclass(frozen=True)
 class DesignPlan(PlannedDesign):
@@ -108,8 +120,7 @@ class DesignPlan(PlannedDesign):
         payload's weight (0, -m g, 0), or None without a payload.
         """
         if self.tcp_force is not None:
-            at = self.time if times is None else np.asarray(times, dtype=float)
-            return np.stack([np.interp(at, self.time, self.tcp_force[:, i]) for i in range(3)], axis=1)
+            return self.force_at(self.tcp_force, times)
         if self.payload == 0.0:
             return None
         return np.array([0.0, -self.payload * self.crane.gravity, 0.0])
@@ -155,16 +166,14 @@ def open_design(result_dir: str | Path, design: str, task: int | None = None) ->
         raise InvalidInputError("design", design, f"must be one of {', '.join(DESIGNS)}")
     run = open_run(result_dir, Result)
     tasks = run.result.tasks or ()
-    if tasks and not (isinstance(task, int) and 0 <= task < len(tasks)):
-        names = ", ".join(f"{k}: {t.name}" for k, t in enumerate(tasks))
-        raise InvalidInputError("task", task, f"must be a task index of the duty mix's result ({names})")
     if not tasks and task is not None:
         raise InvalidInputError("task", task, "must be None for a single-task result (it holds one plan per design)")
+    index = _task_index(task, tasks) if tasks else None
     trajectory = run.trajectory
-    of_task = tasks[task] if tasks and task is not None else None
+    of_task = None if index is None else tasks[index]
     holder = run.result if of_task is None else of_task
     summary = holder.optimal if design == "optimal" else holder.initial
-    prefix = "" if of_task is None else f"task{task}_"
+    prefix = "" if of_task is None else f"task{index}_"
     planned = {
         "design": design,
         "time": trajectory.time(prefix),
@@ -176,7 +185,15 @@ def open_design(result_dir: str | Path, design: str, task: int | None = None) ->
         "predicted_net_energy": float(summary.net_electrical_energy_J),
         "task": None if of_task is None else of_task.name,
     }
-    return DesignRun(run, summary, planned, of_task, task or 0)
+    return DesignRun(run, summary, planned, of_task, index or 0)
+
+
+def _task_index(task: object, tasks: tuple[TaskResult, ...]) -> int:
+    """``task`` as an index k of a duty mix's ``tasks`` (any integer type but bool, 0 <= k < n)."""
+    if isinstance(task, numbers.Integral) and not isinstance(task, bool) and 0 <= int(task) < len(tasks):
+        return int(task)
+    names = ", ".join(f"{k}: {t.name}" for k, t in enumerate(tasks))
+    raise InvalidInputError("task", task, f"must be a task index of the duty mix's result ({names})")
 
 
 def read_plan(result_dir: str | Path, design: str, task: int | None = None) -> DesignPlan:
@@ -188,19 +205,21 @@ def read_plan(result_dir: str | Path, design: str, task: int | None = None) -> D
     Raises:
         InvalidInputError: unknown design, or a task index out of range (:func:`open_design`).
         ConfigError: the folder holds no result, or its files are malformed (one line naming them); a
-            duty mix's study file is gone (its tasks' payload forces are needed).
+            duty mix's study file is gone (its tasks' payload forces are needed); the study file no
+            longer holds the result's tasks (:func:`result_study`).
 
     """
     found = open_design(result_dir, design, task)
     result = found.run.result
     time = found.planned["time"]
-    spec = _study(result.study, required=found.task is not None, folder=found.run.folder)
+    studied = result_study(found, None if found.task is None else "its tasks' payload forces")
     emlas, duty, tcp_force, payload_force = load_emla_set(None), None, None, None
-    if spec is not None:
+    if studied is not None:
         from hiab_sim.study.nlp.task_setup import duty_options
 
+        spec, of_task = studied
         emlas, duty = spec.emlas, duty_options(spec, spec.emlas, float(time[-1] - time[0]))
-        of_task, kinematics, gravity = spec.tasks[found.task_index], spec.model.kinematics, spec.model.gravity
+        kinematics, gravity = spec.model.kinematics, spec.model.gravity
         force = of_task.id_force(kinematics, gravity, time)
         if force is not None and np.ndim(force) == 2:
             soil = of_task.soil_force(kinematics, gravity, time)
@@ -218,13 +237,33 @@ def read_plan(result_dir: str | Path, design: str, task: int | None = None) -> D
     )
 
 
-def _study(study: str, required: bool, folder: Path) -> Study | None:
-    """The result's study file, or None where it is gone and not ``required`` (the EMLA preset and no duty then)."""
+def result_study(found: DesignRun, needed_for: str | None) -> tuple[Study, Task] | None:
+    """The study file the result names and its task of ``found``, checked against the result.
+
+    The file may have changed since the run: it must hold as many tasks as the result (one for a
+    single-task result) and, for a duty mix, the result's task k as its task k (by name), else a
+    task's force F(t) would be another task's. ``needed_for`` says what the file is needed for; None:
+    a file that is gone gives None (a crane's single task then runs on the EMLA preset, without duty).
+
+    Raises:
+        ConfigError: the file is gone (with ``needed_for``), malformed, or no longer holds the result's
+            tasks in the result's order (one line naming the file and the task).
+
+    """
+    result, folder = found.run.result, found.run.folder
     try:
-        return load_study(study)
+        spec = load_study(result.study)
     except ConfigError as error:
-        if required:
-            raise ConfigError(
-                f"{folder}: the study file {study} is needed for its tasks' payload forces ({error})"
-            ) from error
-        return None
+        if needed_for is None:
+            return None
+        raise ConfigError(f"{folder}: the study file {result.study} is needed for {needed_for} ({error})") from error
+    planned = tuple(t.name for t in result.tasks or ())
+    names, k = tuple(t.name for t in spec.tasks), found.task_index
+    where = f"{folder}: the study file {result.study} holds"
+    fix = "restore the study file the result was optimised with, or optimize again"
+    if len(names) != max(len(planned), 1):
+        held = f"the tasks ({', '.join(planned)})" if planned else "one task"
+        raise ConfigError(f"{where} the tasks ({', '.join(names)}) where the result holds {held}; {fix}")
+    if planned and names[k] != planned[k]:
+        raise ConfigError(f"{where} {names[k]!r} as task {k} where the result's task {k} is {planned[k]!r}; {fix}")
+    return spec, spec.tasks[k]

@@ -12,7 +12,7 @@ cycles per hour).
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -53,18 +53,22 @@ def simulate_designs(
     plant: Plant | None = None,
     cycles: int = 1,
     tasks: Sequence[int | None] = (None,),
+    keep_physics: bool = True,
 ) -> tuple[list[ClosedLoopRun], list[ClosedLoopRun], list[CranePhysics]]:
     """Run every design at ``payload_error`` (and, when it is not 0, nominally too) on ``plant`` for ``cycles``.
 
     ``tasks``: the duty mix's task indices whose plans run (every design of each), or (None,) for a
-    single-task result.
+    single-task result. ``keep_physics`` False (no video to render): each run's Physics is freed as
+    soon as the run ends, so that one lives at a time however many tasks and designs run.
 
     Returns:
         The runs at ``payload_error``, the nominal runs (empty when payload_error is 0) and the
-        Physics of the first list (for rendering; free them when done).
+        Physics of the first list (for rendering; free them when done), empty without ``keep_physics``.
 
     """
-    runs, nominal, physics = [], [], []
+    runs: list[ClosedLoopRun] = []
+    nominal: list[ClosedLoopRun] = []
+    physics: list[CranePhysics] = []
     for task, design in [(task, design) for task in tasks for design in designs]:
         plan = read_plan(result_dir, design, task)
         conditions = [payload_error] if payload_error == 0.0 else [0.0, payload_error]
@@ -83,11 +87,10 @@ def simulate_designs(
                         bar.refresh()
 
                 run, item = run_closed_loop(plan, error, progress=progress, plant=plant, cycles=cycles)
-            if error == payload_error:
-                runs.append(run)
+            (runs if error == payload_error else nominal).append(run)
+            if keep_physics and error == payload_error:
                 physics.append(item)
             else:
-                nominal.append(run)
                 item.free()
     return runs, nominal, physics
 
@@ -206,18 +209,6 @@ def _mix_entry(result_dir: str | Path, runs: list[ClosedLoopRun], tasks: Sequenc
     return mix
 
 
-def run_groups(report: dict[str, object]) -> Iterator[tuple[str | None, dict[str, Any]]]:
-    """(task, designs) of a ``simulation.json``: one group per duty mix task, or (None, designs) of a single task."""
-    tasks = report.get("tasks")
-    if isinstance(tasks, list):
-        for group in tasks:
-            yield group["task"], group["designs"]
-        return
-    designs = report["designs"]
-    assert isinstance(designs, dict)
-    yield None, designs
-
-
 def energy_boundary(emlas: EmlaSet) -> str | None:
     """The boundary at which the prediction and the closed loop are compared, or None for the paper's drive.
 
@@ -240,40 +231,6 @@ def energy_boundary(emlas: EmlaSet) -> str | None:
             "holding below the brake speed)"
         )
     return text
-
-
-def table(report: dict[str, object]) -> str:
-    """Markdown table of predicted vs closed-loop energy and tracking errors (docs/results/closed-loop.md).
-
-    A duty mix's report has a first column ``task``: one row per task and design, each against its task's plan.
-    """
-    mix = "tasks" in report
-    lines = [
-        ("| task " if mix else "")
-        + "| design | end mass | predicted energy [J] | closed-loop energy [J] | difference | vs 5 ms grid"
-        " | TCP error rms / max [mm] | at current limit | at voltage limit | extra energy [J] |",
-        ("|---" if mix else "") + "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
-    ]
-    for task, designs in run_groups(report):
-        for design, entry in designs.items():
-            rows = [entry["nominal"], entry] if "nominal" in entry else [entry]
-            lines += [("" if task is None else f"| {task} ") + _table_row(design, row) for row in rows]
-    return "\n".join(lines)
-
-
-def _table_row(design: str, row: dict[str, Any]) -> str:
-    """One run's row of :func:`table` (without a task column)."""
-    tcp = row["tcp_error_mm"]
-    mass = "planned" if row["payload_error"] == 0 else f"+{100 * row['payload_error']:g} %"
-    fine = row.get("energy_difference_to_5ms_grid_percent")
-    return (
-        f"| {design} | {mass} | {row['predicted_net_electrical_energy_J']:.1f} "
-        f"| {row['net_electrical_energy_J']:.1f} | {row['energy_difference_percent']:+.2f} % "
-        f"| {'' if fine is None else format(fine, '+.2f') + ' %'} "
-        f"| {tcp['rms']:.2f} / {tcp['max']:.2f} | {100 * row['current_limit_fraction']:.1f} % "
-        f"| {100 * row['voltage_limit_fraction']:.1f} % "
-        f"| {'' if 'extra_energy_J' not in row else format(row['extra_energy_J'], '+.1f')} |"
-    )
 
 
 def closed_loop_frame_times(duration: float) -> Array:
