@@ -142,10 +142,10 @@ def test_xs031_machine_file_tracks_as_the_crane_file_does(tmp_path: Path) -> Non
     One tiny spiral study on the crane file and on the machine file (the same crane); the built crane's
     plan (the initial design, the same on both) in closed loop. The reference is the path in the plane
     the TCP moves in (at its out-of-plane coordinate), so the two errors agree to a few micrometres
-    (measured 1.4 um; the crane's 0.14 / 0.34 mm rms / max). Before, the machine file's reference lay
-    in the mechanism's plane and its error was 9.23 mm at every step.
+    (measured 1.4 um; the crane's 0.14 / 0.34 mm rms / max); a reference in the mechanism's plane
+    would miss by 9.23 mm at every step.
     """
-    from test_study_small import TINY, small_study, write_study
+    from test_study_small import TINY, machine_form, small_study, write_study
 
     from hiab_sim.env.machine_plan import read_machine_plan
     from hiab_sim.env.plan import read_plan
@@ -154,8 +154,7 @@ def test_xs031_machine_file_tracks_as_the_crane_file_does(tmp_path: Path) -> Non
     from hiab_sim.study.spec.study_file import load_study
 
     crane_study = small_study(**TINY)
-    machine_study = {key: value for key, value in crane_study.items() if key not in ("crane", "bounds")}
-    machine_study.update(machine="xs031", emla="default", tracked=["xt2"], bounds={"joint_velocity": [0.6, 0.6, 0.5]})
+    machine_study = machine_form(crane_study)
     for name, study in (("crane", crane_study), ("machine", machine_study)):
         path = write_study(tmp_path, study, f"{name}.yaml")
         run_study(load_study(path), tmp_path / name, figures=False, progress=None, cross=False)
