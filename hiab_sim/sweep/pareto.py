@@ -46,7 +46,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import minimize
 
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla.drive import drive_state
@@ -54,7 +53,7 @@ from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import C_SCALE, XI_SCALE, TaskProblem
-from hiab_sim.study.solvers.ipopt import solve_ipopt
+from hiab_sim.study.solvers.single_solve import run_slsqp, slsqp_bounds, solve_once
 from hiab_sim.study.solvers.threads import single_blas_thread
 from hiab_sim.style import colour
 from hiab_sim.sweep.epsilon_rows import epsilon_problem
@@ -157,31 +156,11 @@ def solve_point(problem: StudyProblem, z0: Array) -> tuple[Array, bool, str, int
     z0 = np.asarray(z0, dtype=float)
     try:
         with single_blas_thread():
-            if settings.method == "ipopt":
-                outcome = solve_ipopt(problem, z0, settings.maxiter, settings.ftol, history=settings.lbfgs_history)
-                z, success, message, iterations = outcome.z, outcome.success, outcome.message, outcome.iterations
-            else:
-                bounds = [
-                    (lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None)
-                    for lo, hi in zip(problem.lower, problem.upper, strict=True)
-                ]
-                res = minimize(
-                    problem.cost,
-                    z0,
-                    jac=problem.cost_gradient,
-                    method="SLSQP",
-                    bounds=bounds,
-                    constraints=[
-                        {"type": "eq", "fun": problem.equalities, "jac": problem.equalities_jacobian},
-                        {"type": "ineq", "fun": problem.constraints, "jac": problem.constraints_jacobian},
-                    ],
-                    options={"maxiter": settings.maxiter, "ftol": settings.ftol},
-                )
-                z, success, message, iterations = res.x, bool(res.success), str(res.message), int(res.nit)
+            outcome = solve_once(problem, z0, settings.maxiter, settings.ftol)
     except InvalidInputError as error:  # a trial point left the model's domain
         return z0, False, f"a trial point left the model's domain: {error}", 0
-    z = np.asarray(z, dtype=float)
-    return z, success and problem.max_violation(z) <= FEASIBLE, message, iterations
+    z = outcome.z
+    return z, outcome.success and problem.max_violation(z) <= FEASIBLE, outcome.message, outcome.iterations
 
 
 @dataclass(frozen=True)
@@ -244,29 +223,19 @@ def minimise_criterion(problem: StudyProblem, z0: Array, name: str) -> tuple[Arr
         top = np.hstack([p.constraints_jacobian(x[:n]), np.zeros((len(p.constraint_names), 1))])
         return np.vstack([top, rows_jacobian(x)])
 
-    bounds = [
-        (lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None)
-        for lo, hi in zip(p.lower, p.upper, strict=True)
-    ]
-    x0 = np.append(np.asarray(z0, dtype=float), 1.0)
-    res = minimize(
+    zeros = np.zeros((len(p.equality_names), 1))
+    res = run_slsqp(
         lambda x: x[n],
-        x0,
-        jac=lambda x: np.eye(n + 1)[n],
-        method="SLSQP",
-        bounds=[*bounds, (0.0, None)],
-        constraints=[
-            {
-                "type": "eq",
-                "fun": lambda x: p.equalities(x[:n]),
-                "jac": lambda x: np.hstack([p.equalities_jacobian(x[:n]), np.zeros((len(p.equality_names), 1))]),
-            },
-            {"type": "ineq", "fun": ineq, "jac": ineq_jacobian},
-        ],
-        options={"maxiter": CRITERION_MAXITER_FACTOR * p.study.solver.maxiter, "ftol": p.study.solver.ftol},
+        lambda x: np.eye(n + 1)[n],
+        np.append(np.asarray(z0, dtype=float), 1.0),
+        [*slsqp_bounds(p.lower, p.upper), (0.0, None)],
+        (lambda x: p.equalities(x[:n]), lambda x: np.hstack([p.equalities_jacobian(x[:n]), zeros])),
+        (ineq, ineq_jacobian),
+        CRITERION_MAXITER_FACTOR * p.study.solver.maxiter,
+        p.study.solver.ftol,
     )
-    z = np.asarray(res.x[:n], dtype=float)
-    return z, criterion(p, z, name), bool(res.success) and p.max_violation(z) <= FEASIBLE
+    z = res.z[:n]
+    return z, criterion(p, z, name), res.success and p.max_violation(z) <= FEASIBLE
 
 
 def pareto_front(problem: StudyProblem, z_optimum: Array, name: str, points: int) -> list[FrontPoint]:
