@@ -27,11 +27,13 @@ The front's epsilon runs from the plain optimum's criterion c_0 (epsilon inactiv
 down to the least criterion c_min the constraints allow (:func:`minimise_criterion`, the epigraph
 form min t s.t. -t <= s_k <= t, dense SLSQP whatever the study's method: the extra variable t is not
 one of the study's), equally spaced, so every epsilon is feasible. Each point starts from the
-previous one; if that fails, from the study's start, then from the c_min design z_min. The study's
-start is the plain optimisation's, which IPOPT can evaluate: IPOPT first moves a start lying on a
-bound inside by up to 1 % of the variable's range (its bound_push and bound_frac), and from a design
-on a bound where the working range binds that can leave the model's domain (measured on the XS 031
-test study: the warm start fails at its first evaluation). z_min is feasible for every epsilon
+previous one; if that fails, from the study's start, then from the c_min design z_min; a point
+tried from more than one start keeps each try's message (``from the previous point: ...; from the
+study's start: ...``). The study's start is the plain optimisation's, which IPOPT can evaluate:
+IPOPT first moves a start lying on a bound inside by up to 1 % of the variable's range (its
+bound_push and bound_frac), and from a design on a bound where the working range binds that can
+leave the model's domain (measured on the XS 031 test study: the warm start fails at its first
+evaluation). z_min is feasible for every epsilon
 >= c_min, but it is not the far end's answer: it minimises the criterion alone, and where several
 designs reach c_min (only the samples at the peak fix it) it need not have the least objective among
 them (measured: the grading study's z_min 0.9543 of its start's objective, its far end solved from
@@ -260,10 +262,17 @@ def pareto_front(problem: StudyProblem, z_optimum: Array, name: str, points: int
     z_start = problem.initial_point(problem.study.initial_lengths)
     for epsilon in np.linspace(c0, c_min, points)[1:]:
         bounded = epsilon_problem(problem, name, float(epsilon), c0)
-        for start in (z, z_start, z_min):  # the first that converges
-            z_new, accepted, message, iterations = solve_point(bounded, start)
+        tried = []
+        for start, label in (
+            (z, "the previous point"),
+            (z_start, "the study's start"),
+            (z_min, "the least-criterion design"),
+        ):
+            z_new, accepted, message, iterations = solve_point(bounded, start)  # the first accepted ends it
+            tried.append(f"from {label}: {message}")
             if accepted:
                 break
+        message = message if len(tried) == 1 else "; ".join(tried)
         front.append(_point(problem, z_new, name, float(epsilon), accepted, message, iterations))
         if accepted:
             z = z_new
