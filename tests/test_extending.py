@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -38,6 +39,7 @@ class SquaredForceCost:
 
     name = "squared_force"
     unit = "N^2 s"
+    measured_by: ClassVar[str | None] = None  # no energy measures it: compare reports the net electrical energy
 
     def __init__(self, emlas: EmlaSet, dt: float) -> None:
         self.dt = dt
@@ -161,3 +163,25 @@ def test_a_violated_registered_row_is_described_in_its_own_unit(registered: None
     # scaled row -0.01 = 1 mm below the floor (FLOOR_SCALE 0.1 m per unit)
     text = describe_violation(problem, index, -0.01)
     assert text.startswith("tcp_floor.y_tcp >= floor") and text.endswith("violated by 1 mm")
+
+
+class DrawnForceCost(SquaredForceCost):
+    """The example objective claiming an energy no result gives for every design (the energy drawn)."""
+
+    measured_by = "drawn_energy"
+
+
+def test_an_objective_must_declare_the_energy_that_measures_it() -> None:
+    """A factory without ``measured_by``, or naming no result energy, is refused in one line naming the field."""
+    from hiab_sim.errors import InvalidInputError
+    from hiab_sim.study.nlp.objectives import OBJECTIVES
+
+    for factory, shown in ((lambda emlas, dt: SquaredForceCost(emlas, dt), "'(not declared)'"),
+                           (DrawnForceCost, "'drawn_energy'")):  # fmt: skip
+        with pytest.raises(InvalidInputError) as info:
+            register_objective("undeclared", factory)
+        assert str(info.value) == (
+            f"objective undeclared: measured_by = {shown} is out of range: must be None (no energy measures it) "
+            "or one of net_electrical_energy, battery_energy"
+        )
+    assert "undeclared" not in OBJECTIVES

@@ -18,6 +18,7 @@ from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.solvers.slsqp import SolveResult, solve
 from hiab_sim.study.spec.study_file import study_from_dict
+from hiab_sim.sweep import pareto
 from hiab_sim.sweep.epsilon_rows import epsilon_problem
 from hiab_sim.sweep.pareto import (
     FEASIBLE,
@@ -127,7 +128,8 @@ def test_front_of_an_ipopt_study_is_solved_by_ipopt_to_its_far_end() -> None:
     assert converged
     front = pareto_front(problem, optimum.z, "peak_force", 3)
     assert all(p.accepted for p in front), [p.message for p in front]
-    assert all(p.message in ("Solve_Succeeded", "Solved_To_Acceptable_Level") for p in front[1:])
+    accepted_try = [p.message.rsplit("; from ", 1)[-1].split(": ")[-1] for p in front[1:]]  # after any retry
+    assert all(m in ("Solve_Succeeded", "Solved_To_Acceptable_Level") for m in accepted_try), accepted_try
     far = front[-1]
     assert far.epsilon == c_min
     assert far.criterion <= c_min * (1.0 + FEASIBLE)
@@ -142,6 +144,28 @@ def test_inactive_epsilon_reproduces_the_plain_optimum(plain: tuple[StudyProblem
     assert accepted, message
     assert problem.evaluate(z).cost == pytest.approx(problem.evaluate(result.z).cost, rel=1e-9)
     np.testing.assert_allclose(z[: problem.n_xi], result.z[: problem.n_xi], atol=1e-8)
+
+
+def test_a_point_tried_from_several_starts_keeps_every_tries_message(
+    plain: tuple[StudyProblem, SolveResult], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each try's message is kept, named by its start: all three failed, or one failed and the next accepted.
+
+    The solver is replaced by one that answers a scripted (accepted, message) per call; a point
+    accepted at its first try keeps that try's message alone.
+    """
+    problem, result = plain
+    c0 = criterion(problem, result.z, "peak_force")
+    monkeypatch.setattr(pareto, "minimise_criterion", lambda p, z, name: (result.z, 0.99 * c0, True))
+    answers = iter([(False, "a"), (False, "b"), (False, "c"), (False, "d"), (True, "e"), (True, "f")])
+    monkeypatch.setattr(pareto, "solve_point", lambda bounded, z0: (z0, *next(answers), 1))
+    front = pareto_front(problem, result.z, "peak_force", 4)
+    assert [p.message for p in front[1:]] == [
+        "from the previous point: a; from the study's start: b; from the least-criterion design: c",
+        "from the previous point: d; from the study's start: e",
+        "f",
+    ]
+    assert [p.accepted for p in front[1:]] == [False, True, True]
 
 
 @pytest.mark.e2e

@@ -134,6 +134,84 @@ def test_compare_saving_is_of_the_objectives_energy_and_labels_runs_by_folder(
         assert float(row["net electrical energy saving vs initial [%]"]) == pytest.approx(net, rel=1e-9)
 
 
+def _copies(small_run: Path, tmp_path: Path, objectives: tuple[str, ...]) -> list[Path]:
+    """Copies of the small run's folder, one per objective, each result naming that objective."""
+    folders = []
+    for objective in objectives:
+        folder = tmp_path / objective
+        shutil.copytree(small_run, folder)
+        data = json.loads((folder / "result.json").read_text())
+        data["energy"]["objective"] = objective
+        (folder / "result.json").write_text(json.dumps(data))
+        folders.append(folder)
+    return folders
+
+
+def test_compare_saving_of_a_registered_objective_is_of_the_energy_it_declares(small_run: Path, tmp_path: Path) -> None:
+    """An objective registered as measured by the battery energy gets the battery energy's saving.
+
+    Its name is not ``battery_energy``: what counts is its ``measured_by``. An objective this process
+    has not registered gets the net electrical energy's.
+    """
+    from hiab_sim.study.analysis.compare import BATTERY, NET, read_runs, rows
+    from hiab_sim.study.nlp.objectives import BatteryEnergyCost, register_objective, unregister_objective
+
+    class BatteryCopy(BatteryEnergyCost):
+        name = "battery_copy"
+
+    folders = _copies(small_run, tmp_path, ("battery_copy", "elsewhere_registered"))
+    register_objective("battery_copy", BatteryCopy)
+    try:
+        runs = read_runs(folders)
+    finally:
+        unregister_objective("battery_copy")
+    assert [run.saved for run in runs] == [BATTERY, NET]
+    result = json.loads((small_run / "result.json").read_text())
+    optimal = [row for row in rows(runs) if row.design == "optimal"]
+    assert optimal[0].saving == pytest.approx(result["energy"]["battery_energy_saved_percent"], rel=1e-9)
+    assert optimal[1].saving == pytest.approx(result["improvement"]["net_energy_saved_percent"], rel=1e-9)
+
+
+def test_compare_reads_each_result_once(small_run: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``read_runs`` reads each folder's result.json once (its summary holds the objective)."""
+    from hiab_sim.results import read
+    from hiab_sim.study.analysis.compare import read_runs
+
+    folders = _copies(small_run, tmp_path, ("costf2", "battery_energy"))
+    reads: list[Path] = []
+    original = read.read_json_as
+
+    def counted(kind: type, path: Path) -> object:
+        reads.append(Path(path))
+        return original(kind, path)
+
+    monkeypatch.setattr(read, "read_json_as", counted)
+    assert [run.objective for run in read_runs(folders)] == ["costf2", "battery_energy"]
+    assert [p for p in reads if p.name == "result.json"] == [f / "result.json" for f in folders]
+
+
+def test_every_result_energy_an_objective_may_name_has_a_compare_column() -> None:
+    """Each of the objective registry's RESULT_ENERGIES maps to one of compare's energy columns with a saving."""
+    from hiab_sim.study.analysis.compare import MEASURED, SAVING
+    from hiab_sim.study.nlp.objectives import OBJECTIVES, RESULT_ENERGIES
+
+    assert set(MEASURED) == set(RESULT_ENERGIES)
+    assert all(column in SAVING for column in MEASURED.values())
+    assert {name: factory.measured_by for name, factory in OBJECTIVES.items()} == {
+        "costf2": None,
+        "battery_energy": "battery_energy",
+    }
+
+
+def test_run_labels_carry_no_root() -> None:
+    """A folder whose whole path ends another's is labelled by that path less the root: ``a/run``, not ``//a/run``."""
+    from hiab_sim.study.analysis.compare import run_labels
+
+    assert run_labels(["/a/run", "/b/a/run"]) == ["a/run", "b/a/run"]
+    assert run_labels(["/b/a/run", "/a/run"]) == ["b/a/run", "a/run"]
+    assert run_labels(["/x/run", "/y/run", "/x/run"]) == ["x/run", "y/run", "x/run (2)"]
+
+
 def test_compare_rejects_bad_folders_with_one_line(small_run: Path, tmp_path: Path, capsys) -> None:
     """A missing folder, a folder without a result and a truncated result exit 2 with one line; nothing is written."""
     broken = tmp_path / "broken"

@@ -53,7 +53,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
             "run its initial and optimal design, their net electrical energy at the drives and battery energy at "
             "the battery, the smallest EMLA envelope margin (fraction of the motor's limit left), the largest "
             "constraint violation and the saving against the run's own initial design of the energy its objective "
-            "minimises (the battery energy for battery_energy, the net electrical energy for costf2). Energies of "
+            "declares (the battery energy for battery_energy, the net electrical energy for costf2). Energies of "
             "runs with different tasks are comparable only with their own initial design. --out DIR writes the "
             "full table (decision variables, peak forces and powers, both savings) and a figure."
         ),

@@ -58,6 +58,7 @@ class RunSummary:
     designs: dict[str, DesignSummary]
     saved_percent: float  # net energy saved by the optimum [%]
     recheck_max_violation: float  # fine-grid re-check of the optimum (scaled)
+    objective: str  # the study's objective (energy.objective; costf2 for a result without an energy section)
 
 
 @dataclass(frozen=True)
@@ -154,6 +155,7 @@ def summarise(run_dir: str | Path) -> RunSummary:
         designs=designs,
         saved_percent=result.improvement.net_energy_saved_percent,
         recheck_max_violation=result.recheck.max_violation_scaled,
+        objective="costf2" if result.energy is None else result.energy.objective,
     )
 
 

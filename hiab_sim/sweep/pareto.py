@@ -27,11 +27,13 @@ The front's epsilon runs from the plain optimum's criterion c_0 (epsilon inactiv
 down to the least criterion c_min the constraints allow (:func:`minimise_criterion`, the epigraph
 form min t s.t. -t <= s_k <= t, dense SLSQP whatever the study's method: the extra variable t is not
 one of the study's), equally spaced, so every epsilon is feasible. Each point starts from the
-previous one; if that fails, from the study's start, then from the c_min design z_min. The study's
-start is the plain optimisation's, which IPOPT can evaluate: IPOPT first moves a start lying on a
-bound inside by up to 1 % of the variable's range (its bound_push and bound_frac), and from a design
-on a bound where the working range binds that can leave the model's domain (measured on the XS 031
-test study: the warm start fails at its first evaluation). z_min is feasible for every epsilon
+previous one; if that fails, from the study's start, then from the c_min design z_min; a point
+tried from more than one start keeps each try's message (``from the previous point: ...; from the
+study's start: ...``). The study's start is the plain optimisation's, which IPOPT can evaluate:
+IPOPT first moves a start lying on a bound inside by up to 1 % of the variable's range (its
+bound_push and bound_frac), and from a design on a bound where the working range binds that can
+leave the model's domain (measured on the XS 031 test study: the warm start fails at its first
+evaluation). z_min is feasible for every epsilon
 >= c_min, but it is not the far end's answer: it minimises the criterion alone, and where several
 designs reach c_min (only the samples at the peak fix it) it need not have the least objective among
 them (measured: the grading study's z_min 0.9543 of its start's objective, its far end solved from
@@ -46,7 +48,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import minimize
 
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla.drive import drive_state
@@ -54,7 +55,7 @@ from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import C_SCALE, XI_SCALE, TaskProblem
-from hiab_sim.study.solvers.ipopt import solve_ipopt
+from hiab_sim.study.solvers.single_solve import run_slsqp, slsqp_bounds, solve_once
 from hiab_sim.study.solvers.threads import single_blas_thread
 from hiab_sim.style import colour
 from hiab_sim.sweep.epsilon_rows import epsilon_problem
@@ -157,31 +158,11 @@ def solve_point(problem: StudyProblem, z0: Array) -> tuple[Array, bool, str, int
     z0 = np.asarray(z0, dtype=float)
     try:
         with single_blas_thread():
-            if settings.method == "ipopt":
-                outcome = solve_ipopt(problem, z0, settings.maxiter, settings.ftol, history=settings.lbfgs_history)
-                z, success, message, iterations = outcome.z, outcome.success, outcome.message, outcome.iterations
-            else:
-                bounds = [
-                    (lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None)
-                    for lo, hi in zip(problem.lower, problem.upper, strict=True)
-                ]
-                res = minimize(
-                    problem.cost,
-                    z0,
-                    jac=problem.cost_gradient,
-                    method="SLSQP",
-                    bounds=bounds,
-                    constraints=[
-                        {"type": "eq", "fun": problem.equalities, "jac": problem.equalities_jacobian},
-                        {"type": "ineq", "fun": problem.constraints, "jac": problem.constraints_jacobian},
-                    ],
-                    options={"maxiter": settings.maxiter, "ftol": settings.ftol},
-                )
-                z, success, message, iterations = res.x, bool(res.success), str(res.message), int(res.nit)
+            outcome = solve_once(problem, z0, settings.maxiter, settings.ftol)
     except InvalidInputError as error:  # a trial point left the model's domain
         return z0, False, f"a trial point left the model's domain: {error}", 0
-    z = np.asarray(z, dtype=float)
-    return z, success and problem.max_violation(z) <= FEASIBLE, message, iterations
+    z = outcome.z
+    return z, outcome.success and problem.max_violation(z) <= FEASIBLE, outcome.message, outcome.iterations
 
 
 @dataclass(frozen=True)
@@ -244,29 +225,19 @@ def minimise_criterion(problem: StudyProblem, z0: Array, name: str) -> tuple[Arr
         top = np.hstack([p.constraints_jacobian(x[:n]), np.zeros((len(p.constraint_names), 1))])
         return np.vstack([top, rows_jacobian(x)])
 
-    bounds = [
-        (lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None)
-        for lo, hi in zip(p.lower, p.upper, strict=True)
-    ]
-    x0 = np.append(np.asarray(z0, dtype=float), 1.0)
-    res = minimize(
+    zeros = np.zeros((len(p.equality_names), 1))
+    res = run_slsqp(
         lambda x: x[n],
-        x0,
-        jac=lambda x: np.eye(n + 1)[n],
-        method="SLSQP",
-        bounds=[*bounds, (0.0, None)],
-        constraints=[
-            {
-                "type": "eq",
-                "fun": lambda x: p.equalities(x[:n]),
-                "jac": lambda x: np.hstack([p.equalities_jacobian(x[:n]), np.zeros((len(p.equality_names), 1))]),
-            },
-            {"type": "ineq", "fun": ineq, "jac": ineq_jacobian},
-        ],
-        options={"maxiter": CRITERION_MAXITER_FACTOR * p.study.solver.maxiter, "ftol": p.study.solver.ftol},
+        lambda x: np.eye(n + 1)[n],
+        np.append(np.asarray(z0, dtype=float), 1.0),
+        [*slsqp_bounds(p.lower, p.upper), (0.0, None)],
+        (lambda x: p.equalities(x[:n]), lambda x: np.hstack([p.equalities_jacobian(x[:n]), zeros])),
+        (ineq, ineq_jacobian),
+        CRITERION_MAXITER_FACTOR * p.study.solver.maxiter,
+        p.study.solver.ftol,
     )
-    z = np.asarray(res.x[:n], dtype=float)
-    return z, criterion(p, z, name), bool(res.success) and p.max_violation(z) <= FEASIBLE
+    z = res.z[:n]
+    return z, criterion(p, z, name), res.success and p.max_violation(z) <= FEASIBLE
 
 
 def pareto_front(problem: StudyProblem, z_optimum: Array, name: str, points: int) -> list[FrontPoint]:
@@ -291,10 +262,17 @@ def pareto_front(problem: StudyProblem, z_optimum: Array, name: str, points: int
     z_start = problem.initial_point(problem.study.initial_lengths)
     for epsilon in np.linspace(c0, c_min, points)[1:]:
         bounded = epsilon_problem(problem, name, float(epsilon), c0)
-        for start in (z, z_start, z_min):  # the first that converges
-            z_new, accepted, message, iterations = solve_point(bounded, start)
+        tried = []
+        for start, label in (
+            (z, "the previous point"),
+            (z_start, "the study's start"),
+            (z_min, "the least-criterion design"),
+        ):
+            z_new, accepted, message, iterations = solve_point(bounded, start)  # the first accepted ends it
+            tried.append(f"from {label}: {message}")
             if accepted:
                 break
+        message = message if len(tried) == 1 else "; ".join(tried)
         front.append(_point(problem, z_new, name, float(epsilon), accepted, message, iterations))
         if accepted:
             z = z_new

@@ -27,9 +27,11 @@ def set_path(document: dict[str, Any], path: str, value: Any, steps: list[str | 
     """Set ``path`` in ``document`` in place.
 
     A missing mapping key on the way is created (the loader then rejects keys it does not know);
-    a list index must exist, in a list the document has (an index below a missing key names that
-    key). A value written as ``{value: ..., source: ...}`` (the EMLA files) gets its ``value``
-    replaced and ``source`` set to ``"model: set by a sweep"``.
+    a list index must exist, in a list the document has: an index below a missing key names that
+    key and the two ways to sweep it (a setting left to its default, e.g. a crane study's
+    ``bounds.joint_velocity``, is not filled in from the default: give it in the file first). A
+    value written as ``{value: ..., source: ...}`` (the EMLA files) gets its ``value`` replaced and
+    ``source`` set to ``"model: set by a sweep"``.
     """
     steps = parse_path(path) if steps is None else steps
     node: Any = document
@@ -38,7 +40,10 @@ def set_path(document: dict[str, Any], path: str, value: Any, steps: list[str | 
         last = k == len(steps) - 1
         if isinstance(step, int):
             if missing is not None:
-                raise ConfigError(f"{path}: {missing} is not in the file, so it has no item [{step}]")
+                raise ConfigError(
+                    f"{path}: {missing} is not in the file, so it has no item [{step}]; to sweep one item, give "
+                    f"{missing} in the file (its default, if it has one), or sweep {missing} as a whole"
+                )
             if not isinstance(node, list):
                 raise ConfigError(f"{path}: {_dotted(steps[:k])} is not a list, so it has no item [{step}]")
             if not 0 <= step < len(node):

@@ -18,7 +18,9 @@ A sweep file (YAML)::
 
 Paths address the study's YAML mapping (``payload``, ``solver.maxiter``, a crane file's chain bounds
 ``bounds.lift.up[0]``; a machine file's study has none, its bounds are the machine file's, and a sweep
-over ``machine`` with paths of copies of that file moves them);
+over ``machine`` with paths of copies of that file moves them; an item of a list the study leaves to
+its default, such as a crane study's ``bounds.joint_velocity[0]`` without ``bounds.joint_velocity``,
+is refused: the default is not filled in, give the list in the study or sweep it whole);
 paths under ``emla.`` address the study's EMLA file (``emla.lift.gear_ratio`` is its
 ``actuators.lift.gear_ratio``, ``emla.pmsm.peak_torque`` its ``pmsm.peak_torque``; an actuator is
 any name under the file's ``actuators``, e.g. ``emla.boom.gear_ratio`` of the eXact arm's). The base
@@ -194,7 +196,7 @@ def load_sweep(path: str | Path) -> Sweep:
     paths = [c for c in columns if c not in _axis_names(data)]
     if base_study.machine is not None:
         for p in [*fixed, *paths]:
-            _check_machine_bounds(str(p), base, base_study)
+            _check_machine_bounds(str(p), base_study)
     emla_base = _emla_document(base) if any(p.startswith("emla.") for p in [*fixed, *paths]) else None
     points = []
     for values in raw:
@@ -233,21 +235,19 @@ def _emla_document(study: dict[str, Any]) -> dict[str, Any]:
     return document
 
 
-def _check_machine_bounds(path: str, study: dict[str, Any], built: Study) -> None:
-    """Refuse ``bounds.<name>.…`` in a machine file's study that lacks it: the chains' bounds are the machine file's.
+def _check_machine_bounds(path: str, built: Study) -> None:
+    """Refuse ``bounds.<chain>…`` of a machine file's study: the machine's chains' bounds are the machine file's.
 
     A crane file's study gives each chain's ``low`` and ``up`` under ``bounds``; a machine file's
     study does not (:func:`hiab_sim.study.spec.machine_study.machine_study_from_dict`), its decision
     variables' bounds are ``chains.<chain>.variables.<variable>.bounds`` in the machine file. A sweep
-    sets the study's keys, one of which is the machine file itself.
+    sets the study's keys, one of which is the machine file itself. Any other ``bounds.<key>`` is the
+    study's own, set (or refused) like every path.
     """
     steps = parse_path(path)
-    bounds = study.get("bounds")
-    if steps[0] != "bounds" or len(steps) < 3 or not isinstance(steps[1], str):
-        return
-    if isinstance(bounds, dict) and steps[1] in bounds:
-        return
     chains = list(dict.fromkeys(name.split(".", 1)[0] for name in built.model.design_names))
+    if steps[0] != "bounds" or len(steps) < 2 or steps[1] not in chains:
+        return
     machine = built.crane_file.label if built.crane_file is not None else built.crane_source
     raise ConfigError(
         f"{path}: a machine file's study has no bounds.{steps[1]}: its decision variables' bounds are in the "

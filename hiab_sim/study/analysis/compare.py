@@ -10,9 +10,11 @@ drawn at the drives (the positive part of that summed power) and the battery ene
 and peak electrical power [kW] of each actuator whose mounting the decision variables move; the
 smallest EMLA envelope margin over all actuators (fraction of the limit); the design's max
 constraint violation (scaled); and the saving against the same run's initial design [%] of both
-energies. The run's objective names the energy its saving is read from (:func:`saved_energy`): the
-battery energy for ``battery_energy``, the net electrical energy for ``costf2`` (a squared power,
-not an energy, whose paper reports that saving) or a result without a battery model. Runs of
+energies. The run's objective declares the energy its saving is read from (:func:`saved_energy`,
+the objective's ``measured_by`` in :mod:`hiab_sim.study.nlp.objectives`): the battery energy for
+``battery_energy``; the net electrical energy for ``costf2`` (a squared power, not an energy, whose
+paper reports that saving), for an objective not registered in this process and for a result
+without a battery model. Runs of
 different machines share the columns they have in common; a column a run lacks is NaN (``n/a``).
 Energies of runs with different tasks (reference, payload) are not comparable with each other, only
 with their own initial design.
@@ -28,7 +30,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from hiab_sim.atomic_io import write_atomic
-from hiab_sim.results.read import DESIGNS, RunSummary, read_result, summarise
+from hiab_sim.results.read import DESIGNS, RunSummary, summarise
+from hiab_sim.study.nlp.objectives import measured_by
 from hiab_sim.style import colour
 
 #: The energies by boundary: column name -> the :class:`~hiab_sim.results.read.DesignSummary` field [J].
@@ -37,6 +40,8 @@ DRAWN = "drawn energy at the drives"
 BATTERY = "battery energy at the battery"
 #: The saving of each energy against the run's initial design, by that energy's column.
 SAVING = {NET: "net electrical energy saving vs initial", BATTERY: "battery energy saving vs initial"}
+#: The column of each energy an objective's ``measured_by`` names (objectives.RESULT_ENERGIES).
+MEASURED = {"net_electrical_energy": NET, "battery_energy": BATTERY}
 #: Columns after the decision variables and before the peaks: name -> (unit, format).
 _ENERGIES = {NET: ("kJ", "{:.3f}"), DRAWN: ("kJ", "{:.3f}"), BATTERY: ("kJ", "{:.3f}")}
 #: The last columns: name -> (unit, format).
@@ -54,18 +59,24 @@ class ComparedRun:
 
     label: str  # the folder's name, distinct among the runs compared (:func:`run_labels`)
     summary: RunSummary
-    objective: str  # the study's objective (``result.json`` energy.objective; costf2 without an energy section)
+    saved: str  # the energy whose saving answers the run's objective, :data:`BATTERY` or :data:`NET` (saved_energy)
 
     @property
-    def saved(self) -> str:
-        """The energy whose saving answers the run's objective: :data:`BATTERY` or :data:`NET`."""
-        return saved_energy(self.objective, self.summary)
+    def objective(self) -> str:
+        """The study's objective (``result.json`` energy.objective; costf2 without an energy section)."""
+        return self.summary.objective
 
 
 def saved_energy(objective: str, run: RunSummary) -> str:
-    """:data:`BATTERY` for a battery-energy objective whose result has the battery energy, else :data:`NET`."""
+    """The column of the energy that measures ``objective`` (its ``measured_by``), :data:`NET` where none does.
+
+    :data:`NET` also where the objective is not registered in this process or the result lacks that
+    energy (a battery energy without the result's battery model).
+    """
+    energy = measured_by(objective)
+    column = NET if energy is None else MEASURED[energy]
     has_battery = all(run.designs[name].battery_energy_J is not None for name in DESIGNS)
-    return BATTERY if objective == "battery_energy" and has_battery else NET
+    return BATTERY if column == BATTERY and has_battery else NET
 
 
 def run_labels(folders: Sequence[str | Path]) -> list[str]:
@@ -73,14 +84,15 @@ def run_labels(folders: Sequence[str | Path]) -> list[str]:
 
     The same folder given twice is labelled ``<name> (2)`` the second time.
     """
-    parts = [Path(folder).resolve().parts for folder in folders]
+    paths = [Path(folder).resolve() for folder in folders]
+    parts = [p.relative_to(p.anchor).parts or (p.anchor,) for p in paths]  # without the root: "/a/run" is a, run
     depth = [1] * len(parts)
     while True:
         labels = ["/".join(p[-d:]) for p, d in zip(parts, depth, strict=True)]
         clash = [
             k
             for k, label in enumerate(labels)
-            if depth[k] < len(parts[k]) and any(labels[j] == label and parts[j] != parts[k] for j in range(len(parts)))
+            if depth[k] < len(parts[k]) and any(labels[j] == label and paths[j] != paths[k] for j in range(len(parts)))
         ]
         if not clash:
             break
@@ -95,15 +107,14 @@ def run_labels(folders: Sequence[str | Path]) -> list[str]:
 
 
 def read_runs(folders: Sequence[str | Path]) -> list[ComparedRun]:
-    """Every folder's summary and objective, labelled (:func:`run_labels`); a bad folder raises before any is used."""
+    """Every folder's summary (its result read once), labelled (:func:`run_labels`), with its saved energy.
+
+    A bad folder raises before any is used.
+    """
     summaries = [summarise(folder) for folder in folders]
-    objectives = []
-    for folder in folders:
-        energy = read_result(folder).energy
-        objectives.append("costf2" if energy is None else energy.objective)
     return [
-        ComparedRun(label, summary, objective)
-        for label, summary, objective in zip(run_labels(folders), summaries, objectives, strict=True)
+        ComparedRun(label, summary, saved_energy(summary.objective, summary))
+        for label, summary in zip(run_labels(folders), summaries, strict=True)
     ]
 
 

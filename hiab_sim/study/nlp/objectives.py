@@ -17,13 +17,16 @@ With a duty model the drive powers P_i are those at the winding temperature (R_s
 dependence on every sample (the adjoint of the coupled winding model).
 
 An objective is chosen by name with :func:`make_objective`; a new one is a class with ``name``,
-``unit``, ``value(state)`` and ``gradient(state, partials)`` registered with
-:func:`register_objective` (docs/extending.md).
+``unit``, ``measured_by``, ``value(state)`` and ``gradient(state, partials)`` registered with
+:func:`register_objective` (docs/extending.md). ``measured_by`` names the energy of
+:data:`RESULT_ENERGIES` whose saving answers the objective (``hiab-sim compare`` reports that one),
+or is None where no energy measures it (``costf2``, a squared power: the net electrical energy's
+saving is reported, as its paper does).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from typing import ClassVar, Protocol
 
 import numpy as np
 
@@ -52,6 +55,7 @@ class SquaredPowerCost(EmlaObjective):
 
     name = "costf2"
     unit = "W^2 s"
+    measured_by: ClassVar[str | None] = None  # a squared power, not an energy
 
     def value(self, state: SampleState) -> float:
         """1/2 Dt sum_k (sum_i P_i)^2 [W^2 s]."""
@@ -75,6 +79,7 @@ class BatteryEnergyCost(EmlaObjective):
 
     name = "battery_energy"
     unit = "J"
+    measured_by: ClassVar[str | None] = "battery_energy"
 
     def value(self, state: SampleState) -> float:
         """Smooth battery energy [J] of the cycle, plus the rest's (exact, it only draws) with a duty model."""
@@ -135,8 +140,25 @@ def _chain(
     return np.einsum("ky,kyq->kq", dY, partials.id_q), np.einsum("ky,kyx->x", dY, partials.id_xi)
 
 
-#: Builds an objective from (EMLA set, sample step Dt [s]).
-ObjectiveFactory = Callable[[EmlaSet, float], Objective]
+#: The energies a result gives for every design that an objective's ``measured_by`` may name: the net
+#: electrical energy at the drives' terminals (regeneration credited) and the energy the battery
+#: delivers (through the inverters, the shared DC bus and the battery's efficiencies).
+RESULT_ENERGIES = ("net_electrical_energy", "battery_energy")
+
+
+class ObjectiveFactory(Protocol):
+    """Builds an objective from (EMLA set, sample step Dt [s]): the objective's class.
+
+    ``measured_by``: the energy of :data:`RESULT_ENERGIES` whose saving answers the objective, or
+    None where no energy measures it (the net electrical energy's saving is then reported).
+    """
+
+    measured_by: str | None
+
+    def __call__(self, emlas: EmlaSet, dt: float) -> Objective:
+        """The objective on the EMLA set ``emlas`` with sample step ``dt`` [s]."""
+        ...
+
 
 #: The one registry of objectives, by the name a study gives (``objective:``); the study loader,
 #: the NLP, co-design, the energy map, the Pareto front and the reports read it.
@@ -147,11 +169,21 @@ OBJECTIVES: dict[str, ObjectiveFactory] = {
 
 
 def register_objective(name: str, factory: ObjectiveFactory) -> None:
-    """Make ``objective: <name>`` available to every study (``factory(emlas, dt)`` builds it)."""
+    """Make ``objective: <name>`` available to every study (``factory(emlas, dt)`` builds it).
+
+    The factory declares ``measured_by`` (:class:`ObjectiveFactory`): None or one of :data:`RESULT_ENERGIES`.
+    """
     if not name.isidentifier():
         raise InvalidInputError("objective name", name, "must be an identifier (letters, digits, _)")
     if name in OBJECTIVES:
         raise InvalidInputError("objective name", name, f"already registered; registered: {', '.join(OBJECTIVES)}")
+    measured = getattr(factory, "measured_by", "(not declared)")
+    if measured is not None and measured not in RESULT_ENERGIES:
+        raise InvalidInputError(
+            f"objective {name}: measured_by",
+            measured,
+            f"must be None (no energy measures it) or one of {', '.join(RESULT_ENERGIES)}",
+        )
     OBJECTIVES[name] = factory
 
 
@@ -167,6 +199,16 @@ def check_objective_name(name: object, field: str = "objective") -> str:
     if not isinstance(name, str) or name not in OBJECTIVES:
         raise InvalidInputError(field, name, f"must be one of {', '.join(OBJECTIVES)}")
     return name
+
+
+def measured_by(name: str) -> str | None:
+    """The energy of :data:`RESULT_ENERGIES` that measures the objective called ``name``.
+
+    None where none does (``costf2``) or where no objective of that name is registered in this
+    process (a result of an objective registered by another program).
+    """
+    factory = OBJECTIVES.get(name)
+    return None if factory is None else factory.measured_by
 
 
 def make_objective(name: str, emlas: EmlaSet, dt: float) -> Objective:

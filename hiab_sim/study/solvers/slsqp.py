@@ -22,7 +22,6 @@ from typing import Any, TextIO
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import OptimizeResult, minimize
 
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
@@ -30,8 +29,7 @@ from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.machine.design import MachineDesign
 from hiab_sim.results.design_values import DesignValues
 from hiab_sim.study.nlp.problem import StudyProblem
-from hiab_sim.study.solvers.ipopt import solve_ipopt
-from hiab_sim.study.solvers.threads import single_blas_thread
+from hiab_sim.study.solvers.single_solve import solve_once
 
 Array = NDArray[np.float64]
 #: Largest violation [scaled units] of a nominal constraint (:meth:`TaskProblem.margins`) a start
@@ -308,37 +306,21 @@ def solve(
 
     if not result.history:
         record(z_begin)
-    ineq: dict[str, Any] = {"type": "ineq", "fun": problem.constraints}
-    eq: dict[str, Any] = {"type": "eq", "fun": problem.equalities}
-    if use_gradients:
-        ineq["jac"] = problem.constraints_jacobian
-        eq["jac"] = problem.equalities_jacobian
-    bounds = list(zip(problem.lower, problem.upper, strict=True))
-    bounds = [(lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None) for lo, hi in bounds]
     try:
-        if problem.study.solver.method == "ipopt":
-            res = _ipopt(problem, z_begin, limit, record)
-        else:
-            with single_blas_thread():  # small matrices: pooled BLAS threads only contend (solvers.threads)
-                res = minimize(
-                    problem.cost,
-                    z_begin,
-                    jac=problem.cost_gradient if use_gradients else None,
-                    method="SLSQP",
-                    bounds=bounds,
-                    constraints=[eq, ineq],
-                    callback=record,
-                    options={"maxiter": limit, "ftol": problem.study.solver.ftol},
-                )
+        outcome = solve_once(
+            problem, z_begin, limit, problem.study.solver.ftol, callback=record, use_gradients=use_gradients
+        )
     except InvalidInputError as error:
         result.message = f"a trial point left the model's domain: {error}"
         if out is not None:
             _save_checkpoint(out, result, result.z, done=False, identity=identity)
         raise SolverError(f"start {start}: {result.message} (partial history kept)") from error
-    result.z = np.asarray(res.x, dtype=float)
-    result.success = bool(res.success)
-    result.status = int(res.status)
-    result.message = str(res.message)
+    result.z, result.success, result.status, result.message = (
+        outcome.z,
+        outcome.success,
+        outcome.status,
+        outcome.message,
+    )
     result.iterations = len(result.history) - 1
     result.wall_time = previous_wall + time.perf_counter() - t0
     result.n_evaluations = problem.n_evaluations
@@ -355,22 +337,6 @@ def solve(
             "(partial history kept in the output folder)"
         )
     return result
-
-
-def _ipopt(problem: StudyProblem, z: Array, limit: int, record: Callable[[Array], None]) -> OptimizeResult:
-    """IPOPT (:mod:`hiab_sim.study.solvers.ipopt`) in SLSQP's result shape; every iterate after the start is kept."""
-    seen: list[int] = []
-
-    def on_iterate(x: Array) -> None:
-        if seen:  # IPOPT's iteration 0 is the start, already recorded
-            record(x)
-        seen.append(1)
-
-    outcome = solve_ipopt(
-        problem, z, limit, problem.study.solver.ftol, on_iterate, history=problem.study.solver.lbfgs_history
-    )
-    status = 0 if outcome.success else 1
-    return OptimizeResult(x=outcome.z, success=outcome.success, status=status, message=outcome.message)
 
 
 def xi_table(lengths: DesignValues) -> dict[str, Any]:
