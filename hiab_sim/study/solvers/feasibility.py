@@ -37,6 +37,7 @@ from hiab_sim.study.constraints.blocks import STROKE_SCALE
 from hiab_sim.study.machines.protocol import Design
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.solvers.ipopt import solve_ipopt
+from hiab_sim.study.solvers.single_solve import run_slsqp, slsqp_bounds
 from hiab_sim.study.solvers.slsqp import start_points
 
 Array = np.ndarray
@@ -178,29 +179,19 @@ def _least_max_violation(
     unit = np.zeros(n + 1)
     unit[n] = 1.0
     try:
-        res = minimize(
-            lambda x: (float(x[n]), unit),
+        res = run_slsqp(
+            lambda x: float(x[n]),
+            lambda x: unit,
             np.append(z, v0),
-            jac=True,
-            method="SLSQP",
-            bounds=[*bounds, (-TARGET, None)],
-            constraints=[
-                {
-                    "type": "ineq",
-                    "fun": rows_plus_v,
-                    "jac": rows_jacobian,
-                },
-                {
-                    "type": "eq",
-                    "fun": lambda x: e0 + E @ (x[:n] - z),
-                    "jac": lambda x: np.hstack([E, np.zeros((E.shape[0], 1))]),
-                },
-            ],
-            options={"maxiter": maxiter, "ftol": 1e-12},
+            [*bounds, (-TARGET, None)],
+            (lambda x: e0 + E @ (x[:n] - z), lambda x: np.hstack([E, np.zeros((E.shape[0], 1))])),
+            (rows_plus_v, rows_jacobian),
+            maxiter,
+            1e-12,
         )
     except InvalidInputError:
         return z
-    out = np.asarray(res.x[:n], dtype=float)
+    out = np.asarray(res.z[:n], dtype=float)
     try:
         better = problem.constraints(out).min() > problem.constraints(z).min()
     except InvalidInputError:  # SLSQP may end on a trial point outside the model's domain
@@ -237,10 +228,7 @@ def feasible_start(
         violation0, worst_name = math.inf, f"not an admissible crane: {error}"
     if violation0 <= START_TOLERANCE:
         return z0, None
-    bounds = [
-        (lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None)
-        for lo, hi in zip(problem.lower, problem.upper, strict=True)
-    ]
+    bounds = slsqp_bounds(problem.lower, problem.upper)
     res = minimize(
         lambda z: _phi(problem, z),
         z0,

@@ -59,7 +59,8 @@ def run_slsqp(
 ) -> Outcome:
     """Minimise cost(z) by scipy's SLSQP s.t. equalities(z) = 0, inequalities(z) >= 0 and ``bounds``, from z0.
 
-    The one call of SLSQP (the study's solve, a Pareto point, the least-criterion solve); ``callback``
+    The one call of SLSQP (the study's solve, a Pareto point, the least-criterion solve, the
+    feasibility phase's least largest violation); ``callback``
     gets each iterate after the start. The caller chooses the BLAS threads.
     """
     constraints = []
@@ -91,7 +92,8 @@ def solve_once(
     ``slsqp``: :func:`run_slsqp` with one BLAS thread; ``ipopt``: :func:`~hiab_sim.study.solvers.ipopt.solve_ipopt`
     with the study's ``lbfgs_history`` (status 0 on success, else 1). ``callback`` gets each iterate
     after the start; ``use_gradients`` False leaves SLSQP's derivatives to finite differences.
-    A trial point outside the model's domain raises :class:`InvalidInputError`.
+    A trial point outside the model's domain raises :class:`InvalidInputError` under SLSQP; IPOPT cuts
+    its step back from it (and a failed solve's message names it, :mod:`hiab_sim.study.solvers.ipopt`).
     """
     settings = problem.study.solver
     if settings.method == "ipopt":
