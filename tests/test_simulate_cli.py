@@ -109,6 +109,28 @@ def test_bad_input_exits_2_with_one_line(
     assert not out.exists()
 
 
+def test_a_result_whose_study_file_is_gone_exits_2(
+    small_result: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The study file names the plan's EMLA set and duty (here the paper's drive): gone, simulate refuses.
+
+    One line naming the file and what it is needed for; without it the closed loop ran on the preset
+    EMLA set and compared another drive with the plan.
+    """
+    import json
+    import shutil
+
+    copy = tmp_path / "copy"
+    shutil.copytree(small_result, copy)
+    data = json.loads((copy / "result.json").read_text(encoding="utf-8"))
+    data["study"] = str(tmp_path / "gone.yaml")
+    (copy / "result.json").write_text(json.dumps(data), encoding="utf-8")
+    out = tmp_path / "sim"
+    assert main(["simulate", str(copy), "--no-video", "--quiet", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "gone.yaml" in err[0] and "EMLA set" in err[0] and not out.exists()
+
+
 def test_a_folder_without_a_result_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """RESULT_DIR without result.json: a one-line error naming the folder and the missing file, exit 2."""
     assert main(["simulate", str(tmp_path), "--no-video", "--quiet"]) == 2

@@ -93,9 +93,7 @@ def read_machine_plan(result_dir: str | Path, design: str, task: int | None = No
         raise InvalidInputError("result", str(result_dir), "is a crane file's result (read it with read_plan)")
     result = run.result
     machine = result_machine(run.folder, result).with_design(values.values, check_bounds=False)
-    studied = result_study(found, "its EMLA set and TCP force")
-    assert studied is not None  # needed: a study file that is gone raised
-    study, of_task = studied
+    study, of_task = result_study(found, "its EMLA set and TCP force")
     time = found.planned["time"]
     kinematics, gravity = study.model.kinematics, study.model.gravity
     tcp_force = _samples(of_task.id_force(kinematics, gravity, time), len(time))

@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.crane.description import Crane, LinkLengths
-from hiab_sim.emla.config import EmlaSet, load_emla_set
+from hiab_sim.emla.config import EmlaSet
 from hiab_sim.emla.duty_energy import DutyOptions
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.results.design_values import crane_lengths
@@ -205,26 +205,24 @@ def read_plan(result_dir: str | Path, design: str, task: int | None = None) -> D
     Raises:
         InvalidInputError: unknown design, or a task index out of range (:func:`open_design`).
         ConfigError: the folder holds no result, or its files are malformed (one line naming them); a
-            duty mix's study file is gone (its tasks' payload forces are needed); the study file no
-            longer holds the result's tasks (:func:`result_study`).
+            study file is gone (the plan's EMLA set, duty and payload forces are its); the study file
+            no longer holds the result's tasks (:func:`result_study`).
 
     """
     found = open_design(result_dir, design, task)
     result = found.run.result
     time = found.planned["time"]
-    studied = result_study(found, None if found.task is None else "its tasks' payload forces")
-    emlas, duty, tcp_force, payload_force = load_emla_set(None), None, None, None
-    if studied is not None:
-        from hiab_sim.study.nlp.task_setup import duty_options
+    from hiab_sim.study.nlp.task_setup import duty_options
 
-        spec, of_task = studied
-        emlas, duty = spec.emlas, duty_options(spec, spec.emlas, float(time[-1] - time[0]))
-        kinematics, gravity = spec.model.kinematics, spec.model.gravity
-        force = of_task.id_force(kinematics, gravity, time)
-        if force is not None and np.ndim(force) == 2:
-            soil = of_task.soil_force(kinematics, gravity, time)
-            tcp_force = np.asarray(force, dtype=float)
-            payload_force = tcp_force if soil is None else tcp_force - soil
+    spec, of_task = result_study(found, "its EMLA set, duty and payload forces")
+    emlas, duty = spec.emlas, duty_options(spec, spec.emlas, float(time[-1] - time[0]))
+    tcp_force, payload_force = None, None
+    kinematics, gravity = spec.model.kinematics, spec.model.gravity
+    force = of_task.id_force(kinematics, gravity, time)
+    if force is not None and np.ndim(force) == 2:
+        soil = of_task.soil_force(kinematics, gravity, time)
+        tcp_force = np.asarray(force, dtype=float)
+        payload_force = tcp_force if soil is None else tcp_force - soil
     return DesignPlan(
         **found.planned,
         crane=result_crane(found.run.folder, result.crane),
@@ -237,16 +235,16 @@ def read_plan(result_dir: str | Path, design: str, task: int | None = None) -> D
     )
 
 
-def result_study(found: DesignRun, needed_for: str | None) -> tuple[Study, Task] | None:
+def result_study(found: DesignRun, needed_for: str) -> tuple[Study, Task]:
     """The study file the result names and its task of ``found``, checked against the result.
 
     The file may have changed since the run: it must hold as many tasks as the result (one for a
     single-task result) and, for a duty mix, the result's task k as its task k (by name), else a
-    task's force F(t) would be another task's. ``needed_for`` says what the file is needed for; None:
-    a file that is gone gives None (a crane's single task then runs on the EMLA preset, without duty).
+    task's force F(t) would be another task's. ``needed_for`` says what the file is needed for (a
+    closed loop on another EMLA set or duty than the plan's would compare unlike with unlike).
 
     Raises:
-        ConfigError: the file is gone (with ``needed_for``), malformed, or no longer holds the result's
+        ConfigError: the file is gone or malformed (naming ``needed_for``), or no longer holds the result's
             tasks in the result's order (one line naming the file and the task).
 
     """
@@ -254,8 +252,6 @@ def result_study(found: DesignRun, needed_for: str | None) -> tuple[Study, Task]
     try:
         spec = load_study(result.study)
     except ConfigError as error:
-        if needed_for is None:
-            return None
         raise ConfigError(f"{folder}: the study file {result.study} is needed for {needed_for} ({error})") from error
     planned = tuple(t.name for t in result.tasks or ())
     names, k = tuple(t.name for t in spec.tasks), found.task_index
