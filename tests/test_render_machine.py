@@ -30,9 +30,9 @@ def test_replayed_qpos_close_every_loop_and_put_the_tcp_where_the_kinematics_doe
     data = load_machine_playback(run_dir)
     assert [m.name for m in data.designs] == ["initial", "optimal"]
     for motion in data.designs:
-        model, qpos = machine_model_and_qpos(data.machine, motion.design, motion.position)
-        state = mujoco.MjData(model)
         machine = data.machine.with_design(motion.design)
+        model, qpos = machine_model_and_qpos(machine, motion.position)
+        state = mujoco.MjData(model)
         tcp = forward_kinematics(machine, motion.position).tcp_position @ SOURCE_TO_WORLD.T
         for k in range(0, len(qpos), 7):
             state.qpos[:] = qpos[k]

@@ -106,7 +106,7 @@ def test_dressed_excavator_frame_spans_the_machine_and_its_captions_read(playbac
 @pytest.mark.sim
 def test_ground_and_base_stand_at_the_studys_ground_level(playback: MachinePlayback, machine: Machine) -> None:
     """The base block's bottom and the ground slab's top are the ground level; the base reaches up to the chassis."""
-    model, _ = machine_model_and_qpos(machine, machine.design_values(), playback.designs[0].position[:1])
+    model, _ = machine_model_and_qpos(machine, playback.designs[0].position[:1])
     base, soil = machine_file_dress(model, machine, GROUND).slabs
     assert base.centre[2] - base.half[2] == pytest.approx(GROUND, abs=1e-12)
     assert soil.centre[2] + soil.half[2] == pytest.approx(GROUND, abs=1e-12)
@@ -132,7 +132,7 @@ def test_actuator_radii_come_from_the_cylinder_data_or_the_bodies(machine: Machi
 
     The eXact file states its EMLA bodies as uniform cylinders of radius 0.06 m and rods of 0.025 m.
     """
-    model, _ = machine_model_and_qpos(machine, machine.design_values(), np.array([[0.0, -1.8, -1.0]]))
+    model, _ = machine_model_and_qpos(machine, np.array([[0.0, -1.8, -1.0]]))
     dress = machine_file_dress(model, machine, GROUND)
     barrels = sorted(r for g, r in dress.radius.items() if dress.kind[g] == "barrel")
     rods = sorted(r for g, r in dress.radius.items() if dress.kind[g] == "rod")

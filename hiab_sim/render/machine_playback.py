@@ -132,13 +132,15 @@ def study_ground(study: str) -> float | None:
     return next((task.soil.ground for task in load_study(study).tasks if task.soil is not None), None)
 
 
-def machine_model_and_qpos(machine: Machine, design: Array, position: Array) -> tuple[mujoco.MjModel, Array]:
-    """The machine's MJCF model at ``design`` and loop-consistent qpos (N, nq) for joint positions (N, n)."""
-    # a result's design: the solver held its bounds to its own tolerance (IPOPT: 1e-8 relative past one)
-    designed = machine.with_design(design, check_bounds=False)
+def machine_model_and_qpos(designed: Machine, position: Array) -> tuple[mujoco.MjModel, Array]:
+    """The MJCF model of a machine set to its design and loop-consistent qpos (N, nq) for joint positions (N, n).
+
+    A result's design is set by the caller with ``with_design(..., check_bounds=False)``: the solver held
+    its bounds to its own tolerance (IPOPT: 1e-8 relative past one).
+    """
     model = mujoco.MjModel.from_xml_string(machine_mjcf(designed))
     dynamics = MujocoMachineDynamics(designed)
-    ranges = [machine.joint_link(name).joint_range or (0.0, 0.0) for name in machine.joint_names]
+    ranges = [designed.joint_link(name).joint_range or (0.0, 0.0) for name in designed.joint_names]
     low, high = np.array(ranges).T
     # the samples lie in the ranges; a resampled frame may pass an end by round-off only
     return model, posed_qpos(dynamics, np.clip(position, low, high))

@@ -54,9 +54,10 @@ def machine_renderer(
     marks = moved_pivots(data.machine, [motion.design for motion in data.designs])
     payload = held_payload(data, at)
     for motion in data.designs:
-        model, qpos = machine_model_and_qpos(data.machine, motion.design, resample(data.time, motion.position, at))
+        designed = data.machine.with_design(motion.design, check_bounds=False)  # a result's: the solver's bounds
+        model, qpos = machine_model_and_qpos(designed, resample(data.time, motion.position, at))
         caption, notes = design_texts(motion.name, layout, data, at, motion.power)
-        dress = machine_file_dress(model, data.machine.with_design(motion.design, check_bounds=False), data.ground)
+        dress = machine_file_dress(model, designed, data.ground)
         designs.append(
             Design(
                 motion.name, model, qpos, design_rgba(motion.name), caption, notes,
