@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from hiab_sim.emla.duty_energy import DutyOptions
-from hiab_sim.env.plan import PlannedDesign, open_design, result_study
+from hiab_sim.env.plan import PlannedDesign, open_design, studied_task
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.design import MachineDesign
@@ -93,22 +93,18 @@ def read_machine_plan(result_dir: str | Path, design: str, task: int | None = No
         raise InvalidInputError("result", str(result_dir), "is a crane file's result (read it with read_plan)")
     result = run.result
     machine = result_machine(run.folder, result).with_design(values.values, check_bounds=False)
-    study, of_task = result_study(found, "its EMLA set and TCP force")
-    time = found.planned["time"]
-    kinematics, gravity = study.model.kinematics, study.model.gravity
-    tcp_force = _samples(of_task.id_force(kinematics, gravity, time), len(time))
-    payload = tcp_force - _samples(of_task.soil_force(kinematics, gravity, time), len(time))
-    from hiab_sim.study.nlp.task_setup import duty_options
-
+    studied = studied_task(found, "its EMLA set and TCP force")
+    count = len(found.planned["time"])
+    tcp_force = _samples(studied.force, count)
     return MachinePlan(
         **found.planned,
         machine=machine,
-        emlas=study.emlas,
+        emlas=studied.study.emlas,
         tcp_force=tcp_force,
-        payload_force=payload,
-        payload_kg=of_task.payload.mass,
-        tracked=getattr(study.model, "extra", None),
-        duty=duty_options(study, study.emlas, float(time[-1] - time[0])),
+        payload_force=tcp_force - _samples(studied.soil, count),
+        payload_kg=studied.task.payload.mass,
+        tracked=getattr(studied.study.model, "extra", None),
+        duty=studied.duty,
     )
 
 

@@ -211,27 +211,57 @@ def read_plan(result_dir: str | Path, design: str, task: int | None = None) -> D
     """
     found = open_design(result_dir, design, task)
     result = found.run.result
-    time = found.planned["time"]
-    from hiab_sim.study.nlp.task_setup import duty_options
-
-    spec, of_task = result_study(found, "its EMLA set, duty and payload forces")
-    emlas, duty = spec.emlas, duty_options(spec, spec.emlas, float(time[-1] - time[0]))
+    studied = studied_task(found, "its EMLA set, duty and payload forces")
     tcp_force, payload_force = None, None
-    kinematics, gravity = spec.model.kinematics, spec.model.gravity
-    force = of_task.id_force(kinematics, gravity, time)
-    if force is not None and np.ndim(force) == 2:
-        soil = of_task.soil_force(kinematics, gravity, time)
-        tcp_force = np.asarray(force, dtype=float)
-        payload_force = tcp_force if soil is None else tcp_force - soil
+    if studied.force is not None and np.ndim(studied.force) == 2:  # one per sample: applied as a force
+        tcp_force = np.asarray(studied.force, dtype=float)
+        payload_force = tcp_force if studied.soil is None else tcp_force - studied.soil
     return DesignPlan(
         **found.planned,
         crane=result_crane(found.run.folder, result.crane),
-        emlas=emlas,
+        emlas=studied.study.emlas,
         lengths=crane_lengths(found.summary.lengths, "result"),
         payload=float(result.settings.payload_kg if found.task is None else found.task.payload_kg),
-        duty=duty,
+        duty=studied.duty,
         tcp_force=tcp_force,
         payload_force=payload_force,
+    )
+
+
+@dataclass(frozen=True)
+class StudiedTask:
+    """What a plan takes from the study file of its result for its task (:func:`studied_task`).
+
+    Attributes:
+        study: The study file, checked against the result (:func:`result_study`).
+        task: The plan's task in it.
+        duty: The study's duty model of the task's cycle, or None (the paper's per-sample model).
+        force: The TCP force the optimiser's inverse dynamics took on the fine grid [N] in {W}
+            (:meth:`~hiab_sim.study.spec.tasks.Task.id_force`: None, (3,) or (K, 3)).
+        soil: The soil's share of it, (K, 3) [N], or None without soil.
+
+    """
+
+    study: Study
+    task: Task
+    duty: DutyOptions | None
+    force: Array | None
+    soil: Array | None
+
+
+def studied_task(found: DesignRun, needed_for: str) -> StudiedTask:
+    """The study, task, duty model and TCP forces of a plan's task on its fine grid (crane and machine alike)."""
+    from hiab_sim.study.nlp.task_setup import duty_options
+
+    spec, of_task = result_study(found, needed_for)
+    time = found.planned["time"]
+    kinematics, gravity = spec.model.kinematics, spec.model.gravity
+    return StudiedTask(
+        spec,
+        of_task,
+        duty_options(spec, spec.emlas, float(time[-1] - time[0])),
+        of_task.id_force(kinematics, gravity, time),
+        of_task.soil_force(kinematics, gravity, time),
     )
 
 
