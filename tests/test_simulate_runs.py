@@ -47,11 +47,9 @@ def test_a_crane_mix_without_a_video_holds_one_physics_at_a_time(monkeypatch: py
     from hiab_sim.env import validation
 
     models = _Models()
-    monkeypatch.setattr(validation, "read_plan", _plan)
     monkeypatch.setattr(validation, "run_closed_loop", models.run)
-    runs, nominal, physics = validation.simulate_designs(
-        "result", ("initial", "optimal"), 0.2, quiet=True, tasks=(0, 1, 2), keep_physics=keep
-    )
+    plans = [_plan("result", design, task) for task in (0, 1, 2) for design in ("initial", "optimal")]
+    runs, nominal, physics = validation.simulate_designs(plans, 0.2, quiet=True, keep_physics=keep)  # type: ignore[arg-type]
     assert len(runs) == len(nominal) == 6
     if keep:
         assert models.live == physics and len(physics) == 6

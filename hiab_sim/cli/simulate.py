@@ -127,32 +127,22 @@ def run(args: argparse.Namespace) -> int:
 
     plant = load_plant(args.plant) if args.plant is not None else None
     refuse_mix_effects(args, plant, tasks)
-    for task in tasks:
-        for design in designs:
-            read_plan(args.result_dir, design, task)  # bad input fails before any simulation
+    plans = [read_plan(args.result_dir, design, task) for task in tasks for design in designs]  # bad input first
     out.mkdir(parents=True, exist_ok=True)
     if not args.no_video:
         from hiab_sim.render.backend import ffmpeg_path
 
         ffmpeg_path()
 
-    from hiab_sim.env.plan import read_plan
     from hiab_sim.env.validation import render_video, simulate_designs, simulation_report
 
     runs, nominal, physics = simulate_designs(
-        args.result_dir,
-        designs,
-        error,
-        quiet=args.quiet,
-        plant=plant,
-        cycles=args.cycles,
-        tasks=tasks,
-        keep_physics=not args.no_video,
+        plans, error, quiet=args.quiet, plant=plant, cycles=args.cycles, keep_physics=not args.no_video
     )
-    report = simulation_report(args.result_dir, runs, nominal)
+    report = simulation_report(args.result_dir, runs, nominal, emlas=plans[0].emlas)
     written, effects = write_results(args, report, runs, nominal, plant, designs, out)
     if not args.no_video:
-        plan = read_plan(args.result_dir, runs[0].design, tasks[0])
+        plan = plans[0]
         model_of = {id(run): item for run, item in zip(runs, physics, strict=True)}
         for suffix, of_task in task_runs(runs):
             drawn = [model_of[id(run)] for run in of_task]

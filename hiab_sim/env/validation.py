@@ -32,7 +32,7 @@ from hiab_sim.env.closed_loop_battery import (
     predicted_cycle_battery_energy,
 )
 from hiab_sim.env.physics import CranePhysics
-from hiab_sim.env.plan import mix_tasks, read_plan
+from hiab_sim.env.plan import DesignPlan, mix_tasks, read_plan
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.rollout import ClosedLoopRun, run_closed_loop
 from hiab_sim.results.schema import TaskResult
@@ -46,19 +46,17 @@ VIEWPORT = (480, 480)
 
 
 def simulate_designs(
-    result_dir: str | Path,
-    designs: Sequence[str],
+    plans: Sequence[DesignPlan],
     payload_error: float,
     quiet: bool = False,
     plant: Plant | None = None,
     cycles: int = 1,
-    tasks: Sequence[int | None] = (None,),
     keep_physics: bool = True,
 ) -> tuple[list[ClosedLoopRun], list[ClosedLoopRun], list[CranePhysics]]:
-    """Run every design at ``payload_error`` (and, when it is not 0, nominally too) on ``plant`` for ``cycles``.
+    """Run every plan at ``payload_error`` (and, when it is not 0, nominally too) on ``plant`` for ``cycles``.
 
-    ``tasks``: the duty mix's task indices whose plans run (every design of each), or (None,) for a
-    single-task result. ``keep_physics`` False (no video to render): each run's Physics is freed as
+    ``plans``: one per design (:func:`hiab_sim.env.plan.read_plan`), a duty mix's every design of each
+    task in task order. ``keep_physics`` False (no video to render): each run's Physics is freed as
     soon as the run ends, so that one lives at a time however many tasks and designs run.
 
     Returns:
@@ -69,8 +67,8 @@ def simulate_designs(
     runs: list[ClosedLoopRun] = []
     nominal: list[ClosedLoopRun] = []
     physics: list[CranePhysics] = []
-    for task, design in [(task, design) for task in tasks for design in designs]:
-        plan = read_plan(result_dir, design, task)
+    for plan in plans:
+        design = plan.design
         conditions = [payload_error] if payload_error == 0.0 else [0.0, payload_error]
         for error in conditions:
             label = design if error == 0.0 else f"{design} end mass +{100 * error:g} %"
