@@ -67,13 +67,13 @@ class ComparedRun:
         return self.summary.objective
 
 
-def saved_energy(objective: str, run: RunSummary) -> str:
-    """The column of the energy that measures ``objective`` (its ``measured_by``), :data:`NET` where none does.
+def saved_energy(run: RunSummary) -> str:
+    """The column of the energy that measures the run's objective (its ``measured_by``), :data:`NET` where none does.
 
     :data:`NET` also where the objective is not registered in this process or the result lacks that
     energy (a battery energy without the result's battery model).
     """
-    energy = measured_by(objective)
+    energy = measured_by(run.objective)
     column = NET if energy is None else MEASURED[energy]
     has_battery = all(run.designs[name].battery_energy_J is not None for name in DESIGNS)
     return BATTERY if column == BATTERY and has_battery else NET
@@ -113,7 +113,7 @@ def read_runs(folders: Sequence[str | Path]) -> list[ComparedRun]:
     """
     summaries = [summarise(folder) for folder in folders]
     return [
-        ComparedRun(label, summary, saved_energy(summary.objective, summary))
+        ComparedRun(label, summary, saved_energy(summary))
         for label, summary in zip(run_labels(folders), summaries, strict=True)
     ]
 
