@@ -60,8 +60,8 @@ def run_slsqp(
     """Minimise cost(z) by scipy's SLSQP s.t. equalities(z) = 0, inequalities(z) >= 0 and ``bounds``, from z0.
 
     The one call of SLSQP (the study's solve, a Pareto point, the least-criterion solve, the
-    feasibility phase's least largest violation); ``callback``
-    gets each iterate after the start. The caller chooses the BLAS threads.
+    feasibility phase's least largest violation); ``callback`` gets each iterate after the start.
+    The caller chooses the BLAS threads.
     """
     constraints = []
     for kind, (fun, jac) in (("eq", equalities), ("ineq", inequalities)):
