@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -25,6 +24,7 @@ import numpy as np
 from hiab_sim.errors import BackendUnavailableError, InvalidInputError
 from hiab_sim.study.nlp.interface import Array
 from hiab_sim.study.nlp.problem import StudyProblem
+from hiab_sim.study.solvers.outcome import Outcome
 from hiab_sim.study.solvers.sparse_rows import SparseJacobian
 from hiab_sim.study.solvers.threads import register_casadi_blas, single_blas_thread
 
@@ -32,17 +32,6 @@ from hiab_sim.study.solvers.threads import register_casadi_blas, single_blas_thr
 SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 #: Consecutive iterations of cost change < tol (feasible) that end the solve.
 ACCEPTABLE_ITERATIONS = 5
-
-
-@dataclass
-class IpoptOutcome:
-    """What IPOPT returned: the point, success, status text, iterations and the iterates' z."""
-
-    z: Array
-    success: bool
-    message: str
-    iterations: int
-    iterates: list[Array]
 
 
 def _casadi() -> Any:
@@ -148,7 +137,7 @@ def solve_ipopt(
     objective: tuple[Callable[[Array], float], Callable[[Array], Array]] | None = None,
     constraint_tolerance: float = 1e-8,
     history: int = 6,
-) -> IpoptOutcome:
+) -> Outcome:
     """Minimise the problem's scaled cost from z0 with IPOPT (L-BFGS Hessian, sparse Jacobians).
 
     Args:
@@ -218,10 +207,10 @@ def solve_ipopt(
         )
     )
 
-    iterates: list[Array] = []
+    iterates = [0]  # IPOPT's iterations so far (its iteration 0, the start, included)
 
     def record(z: Array) -> tuple[float]:
-        iterates.append(z)
+        iterates[0] += 1
         if on_iterate is not None:
             on_iterate(z)
         return (0.0,)
@@ -281,10 +270,4 @@ def solve_ipopt(
     message = str(stats.get("return_status", ""))
     if failures and not success:
         message += f" ({len(failures)} trial point(s) outside the model's domain; the last: {failures[-1]})"
-    return IpoptOutcome(
-        z=z,
-        success=success,
-        message=message,
-        iterations=int(stats.get("iter_count", len(iterates))),
-        iterates=iterates,
-    )
+    return Outcome(z, success, 0 if success else 1, message, int(stats.get("iter_count", iterates[0])))

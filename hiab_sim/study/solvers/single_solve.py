@@ -11,7 +11,6 @@ bounds in scipy's form from :func:`slsqp_bounds`.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -19,20 +18,10 @@ from scipy.optimize import minimize
 
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.solvers.ipopt import solve_ipopt
+from hiab_sim.study.solvers.outcome import Outcome
 from hiab_sim.study.solvers.threads import single_blas_thread
 
 Array = NDArray[np.float64]
-
-
-@dataclass(frozen=True)
-class Outcome:
-    """What one solve returned: the point (scaled z), success, status (0 success), message and iterations."""
-
-    z: Array
-    success: bool
-    status: int
-    message: str
-    iterations: int
 
 
 #: A constraint function of z and its Jacobian (None: scipy's finite differences).
@@ -90,7 +79,7 @@ def solve_once(
     """Minimise the problem's scaled cost from z0 once, by the study's ``solver.method``; no start check.
 
     ``slsqp``: :func:`run_slsqp` with one BLAS thread; ``ipopt``: :func:`~hiab_sim.study.solvers.ipopt.solve_ipopt`
-    with the study's ``lbfgs_history`` (status 0 on success, else 1). ``callback`` gets each iterate
+    with the study's ``lbfgs_history``. ``callback`` gets each iterate
     after the start; ``use_gradients`` False leaves SLSQP's derivatives to finite differences.
     A trial point outside the model's domain raises :class:`InvalidInputError` under SLSQP; IPOPT cuts
     its step back from it (and a failed solve's message names it, :mod:`hiab_sim.study.solvers.ipopt`).
@@ -104,8 +93,7 @@ def solve_once(
                 callback(x)
             seen.append(1)
 
-        found = solve_ipopt(problem, z0, maxiter, ftol, on_iterate, history=settings.lbfgs_history)
-        return Outcome(found.z, found.success, 0 if found.success else 1, found.message, found.iterations)
+        return solve_ipopt(problem, z0, maxiter, ftol, on_iterate, history=settings.lbfgs_history)
     with single_blas_thread():  # small matrices: pooled BLAS threads only contend (solvers.threads)
         return run_slsqp(
             problem.cost,
