@@ -24,15 +24,13 @@ from xml.etree import ElementTree
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.design import MachineDesign
 from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
 from hiab_sim.machine.kinematics.assembly import reachable_joint_range
-
-Array = NDArray[np.float64]
 
 #: Poses per joint over its working range that the cameras are fitted to (every combination), as the crane's.
 CAMERA_POSES_PER_JOINT = 4

@@ -26,8 +26,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_range
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
@@ -35,8 +35,6 @@ from hiab_sim.machine.dynamics.paths import make_machine_dynamics
 from hiab_sim.machine.kinematics.forward import forward_kinematics
 from hiab_sim.machine_mjcf import working_ranges
 from hiab_sim.validation import Tolerances
-
-Array = NDArray[np.float64]
 
 #: Step of the five-point time stencils [s]: truncation O(s^4) and round-off eps E / s both < 1e-10 of the
 #: peak power for these machines (E ~ 1e4 J, power ~ 1e3 W).

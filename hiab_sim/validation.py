@@ -23,8 +23,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_choice, check_range
 from hiab_sim.crane import kinematics, mechanism
 from hiab_sim.crane.description import ChainLengths, Crane, LinkLengths
@@ -41,7 +41,6 @@ from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import DEFAULT_CASES, Source, locate
 from hiab_sim.yaml_fields import mapping, read_yaml, section, text, vector
 
-Array = NDArray[np.float64]
 IdFunction = Callable[[LinkLengths, JointSamples, Array], ActuatorSamples]
 
 CASE_KINDS = ("random_states", "trajectory", "random_lengths", "static")

@@ -16,10 +16,10 @@ import pytest
 from test_mix import two_tasks
 from test_study_small import small_study
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla import EmlaSet
 from hiab_sim.study.constraints.block_registry import register_block, unregister_block
 from hiab_sim.study.nlp.interface import (
-    Array,
     PerSampleBlock,
     Relaxation,
     SamplePartials,

@@ -10,14 +10,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths, Pose
 from hiab_sim.crane.names import BASE, TELESCOPE, TELESCOPE_CYLINDER, TELESCOPE_ROD, boom_link, cylinder_link, rod_link
 from hiab_sim.machine.kinematics.forward import rotation_z  # the one rotation about z, shared with the generic model
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -31,12 +31,11 @@ samples (any array shape); lengths in [m], angles in [rad], time derivatives per
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import ChainLengths, ClosedChain, Crane, LinkLengths, check_positive_lengths
 from hiab_sim.errors import InvalidInputError
-
-Array = NDArray[np.float64]
 
 #: Slack on stroke bounds [m]: joint ranges computed from x = 0 must not fail by round-off.
 STROKE_TOLERANCE = 1e-12

@@ -51,12 +51,12 @@ from typing import Any
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths
 from hiab_sim.crane.names import CHAIN_NAMES, LIFT, TILT, boom_link
 from hiab_sim.machine.mounting_geometry import (
     DEFAULT_CLEARANCE,
     DEFAULT_SAMPLES,
-    Array,
     Margins,
     Polygon,
     check_clearance_and_samples,

@@ -34,14 +34,13 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.mounting import Margins, MountingSpace, mounting_margins
 from hiab_sim.errors import InvalidInputError
-
-Array = NDArray[np.float64]
 
 #: Default manufacturing tolerance of a link length [m].
 DEFAULT_TOLERANCE = 1e-3

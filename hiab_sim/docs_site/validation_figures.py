@@ -25,13 +25,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.dynamics.analytic_id import analytic_inverse_dynamics
 from hiab_sim.dynamics.samples import ACTUATOR_NAMES
 from hiab_sim.figure_io import new_figure, save_png
 
-Array = NDArray[np.float64]
 #: Drawn in place of an exact 0 on the log axes (below every round-off residual the cases show).
 FLOOR = 1e-18
 FIGURES = ("validation_forces.png", "validation_balance.png")

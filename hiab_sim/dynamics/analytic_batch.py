@@ -24,12 +24,11 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane
 from hiab_sim.crane.names import cylinder_link, rod_link
 from hiab_sim.dynamics.analytic_planar import PlanarInertia, PlanarModel, planar_model, planar_solve
 from hiab_sim.errors import InvalidInputError
-
-Array = NDArray[np.float64]
 
 
 def stacked_model(crane: Crane, xi: Array, samples: int) -> PlanarModel:

@@ -35,8 +35,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane import names
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths
 from hiab_sim.crane.mechanism import check_lengths
@@ -45,8 +46,6 @@ from hiab_sim.dynamics.analytic_planar import planar_inverse_dynamics, planar_mo
 from hiab_sim.dynamics.checks import check_joints, tcp_force_samples
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.dynamics.spatial import newton_euler_wrench, rotate, spatial_inertia, wrench_to_parent
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -29,15 +29,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths
 from hiab_sim.crane.kinematics import rotation_z
 from hiab_sim.crane.names import BASE, LINK_NAMES, TELESCOPE, TELESCOPE_ROD, boom_link, cylinder_link, rod_link
 from hiab_sim.dynamics.spatial import ad, rotate, twist_to_child
-
-Array = NDArray[np.float64]
 
 #: Moving links in base-to-tip order (each link's parent comes before it).
 MOVING_LINKS = LINK_NAMES[1:]  # every link but the fixed base, parents first

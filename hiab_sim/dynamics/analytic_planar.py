@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths
 from hiab_sim.crane.mechanism import check_lengths
 from hiab_sim.crane.names import (
@@ -43,7 +44,6 @@ from hiab_sim.crane.names import (
     TILT_ROD,
 )
 
-Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
 
 

@@ -13,15 +13,14 @@ once per link-length set.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.names import JOINT_NAMES
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import InvalidInputError
-
-Array = NDArray[np.float64]
 
 
 def check_joints(crane: Crane, lengths: LinkLengths, joints: JointSamples) -> None:

@@ -62,16 +62,15 @@ import copy
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import CHAIN_NAMES, Crane, LinkLengths
 from hiab_sim.crane.names import JOINT_NAMES
 from hiab_sim.dynamics.checks import check_joints, tcp_force_samples
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.model.mjcf import SLIDES, build_spec, source_to_world
 from hiab_sim.model.states import mechanical_energies
-
-Array = NDArray[np.float64]
 
 #: Per chain, the frame sensors of pass 1, in this order (3 values each).
 _SENSORS = (

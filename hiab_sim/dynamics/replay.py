@@ -34,16 +34,15 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from scipy.interpolate import CubicSpline
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import CHAIN_NAMES, Crane, LinkLengths
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.model.mjcf import ACTUATORS, JOINTS, source_to_world
-
-Array = NDArray[np.float64]
 
 #: Default integrator step of a replay [s] (RK4), see the module docstring.
 DEFAULT_TIMESTEP = 2.5e-4

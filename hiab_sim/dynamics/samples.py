@@ -18,12 +18,12 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.names import ACTUATOR_NAMES, JOINT_NAMES
 from hiab_sim.errors import InvalidInputError
 
-Array = NDArray[np.float64]
 __all__ = ["ACTUATOR_NAMES", "JOINT_NAMES", "ActuatorSamples", "IdPath", "JointSamples"]
 
 IdPath = Literal["mujoco", "analytic"]

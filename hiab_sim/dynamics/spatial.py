@@ -18,9 +18,9 @@ forming 6x6 matrices, which keeps the per-sample cost low.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
-Array = NDArray[np.float64]
+from hiab_sim.arrays import Array
 
 
 def skew(v: ArrayLike) -> Array:

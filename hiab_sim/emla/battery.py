@@ -45,12 +45,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_efficiency
 from hiab_sim.errors import InvalidInputError
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -19,12 +19,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla.config import EmlaParams
 from hiab_sim.emla.losses import transmission_loss_torque
 
-Array = NDArray[np.float64]
 #: Partial derivatives (d/d f_x, d/d v_x, d/d a_x) of one quantity.
 Partials = tuple[Array, Array, Array]
 

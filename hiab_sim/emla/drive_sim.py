@@ -44,10 +44,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla.config import EmlaParams
 from hiab_sim.errors import InvalidInputError
-
-Array = NDArray[np.float64]
 
 
 def _stack(params: tuple[EmlaParams, ...], getter: str) -> Array:

@@ -34,9 +34,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_choice
 from hiab_sim.emla.config import EmlaParams
-from hiab_sim.emla.drive import Array, broadcast_inputs, drive_state
+from hiab_sim.emla.drive import broadcast_inputs, drive_state
 from hiab_sim.emla.electrothermal import CoupledWinding, coupled_winding_temperature
 from hiab_sim.emla.hold import HOLD_MODES, RestHold, rest_hold
 from hiab_sim.emla.losses import brake_release

@@ -43,8 +43,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_non_negative
-from hiab_sim.emla.thermal import Array, Duty, ThermalParams, cycle_time_grid
+from hiab_sim.emla.thermal import Duty, ThermalParams, cycle_time_grid
 from hiab_sim.errors import InvalidInputError
 
 #: Temperature coefficient of annealed copper's resistance at 20 deg C [1/K] (IEC 60028: 1/254.5).

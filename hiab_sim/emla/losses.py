@@ -45,11 +45,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_efficiency, check_fields
-
-Array = NDArray[np.float64]
 
 #: Motor speeds below this fraction of omega_eps are standstill in the exact transmission loss: there the
 #: smooth form's tanh is below 1e-9, so exact and smooth agree; above round-off of a zero speed (~1e-12 rad/s).

@@ -30,8 +30,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla.config import EmlaParams
-from hiab_sim.emla.drive import Array, DriveState, drive_state
+from hiab_sim.emla.drive import DriveState, drive_state
 from hiab_sim.emla.envelope import margins_from_state
 from hiab_sim.emla.losses import brake_release, inverter_loss
 from hiab_sim.errors import InvalidInputError

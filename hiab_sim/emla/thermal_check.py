@@ -19,8 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla.config import EmlaParams
-from hiab_sim.emla.drive import Array, drive_state
+from hiab_sim.emla.drive import drive_state
 from hiab_sim.emla.losses import brake_release
 from hiab_sim.emla.thermal import Duty, ThermalParams, periodic_winding_temperature, rms_torque
 from hiab_sim.errors import InvalidInputError

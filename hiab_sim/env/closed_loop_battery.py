@@ -18,12 +18,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla.battery import BatteryParams, battery_power
 from hiab_sim.env.rollout import ClosedLoopRun
-
-Array = NDArray[np.float64]
 
 #: What ``simulation.json`` says of its battery energies.
 BATTERY_NOTE = (

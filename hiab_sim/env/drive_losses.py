@@ -41,13 +41,11 @@ from dataclasses import dataclass
 from typing import cast
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla.config import EmlaParams
 from hiab_sim.emla.drive_sim import DriveStep
 from hiab_sim.emla.losses import DriveLosses, brake_release, inverter_loss, transmission_loss_torque
-
-Array = NDArray[np.float64]
 
 #: Newton steps of the transmission's inversion: the loss torque is piecewise almost linear in f_sm
 #: (smooth |f_sm| within f_eps = 10 N), so two steps from the exact form's solution reach round-off.

@@ -24,8 +24,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.control.cascade import DESIGN_RATIO, CascadeGains
 from hiab_sim.env.plan import DesignPlan
 from hiab_sim.env.plant.config import Plant
@@ -38,8 +38,6 @@ from hiab_sim.structure.natural_frequency import (
     natural_frequencies,
 )
 from hiab_sim.structure.summary import has_stiffness
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -47,8 +47,8 @@ import mujoco
 import numpy as np
 from dm_control import mujoco as dm_mujoco
 from dm_control.rl import control
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.control.cascade import CascadeGains
 from hiab_sim.emla.drive_sim import DriveArrays
 from hiab_sim.env import CURRENT_BANDWIDTH_HZ, PHYSICS_TIMESTEP, episode, sub_steps
@@ -74,8 +74,6 @@ from hiab_sim.machine.dynamics.mjcf_build import spec_of_tree
 from hiab_sim.machine.dynamics.mujoco_path import MujocoMachineDynamics
 from hiab_sim.machine.dynamics.tree import MachineActuatorSamples, SimulationExtras, machine_tree
 from hiab_sim.model.mjcf import source_to_world
-
-Array = NDArray[np.float64]
 
 
 def _extras(plan: MachinePlan) -> SimulationExtras:

@@ -24,16 +24,14 @@ As on the crane, the frequencies are those of the planned machine, all the contr
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.control.cascade import CascadeGains
 from hiab_sim.env.loop_design import LoopDesign
 from hiab_sim.env.machine_plan import MachinePlan
 from hiab_sim.machine.dynamics.paths import make_machine_dynamics
 from hiab_sim.structure.machine_modes import machine_natural_frequencies
 from hiab_sim.structure.summary import has_stiffness
-
-Array = NDArray[np.float64]
 
 
 def machine_first_natural_frequency(plan: MachinePlan) -> float | None:

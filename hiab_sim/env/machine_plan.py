@@ -21,8 +21,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla.duty_energy import DutyOptions
 from hiab_sim.env.plan import PlannedDesign, open_design, studied_task
 from hiab_sim.errors import InvalidInputError
@@ -30,8 +30,6 @@ from hiab_sim.machine.description import Machine
 from hiab_sim.machine.design import MachineDesign
 from hiab_sim.results.read import open_run, result_machine
 from hiab_sim.results.schema import Result
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -38,6 +38,7 @@ import numpy as np
 from dm_control import mujoco as dm_mujoco
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.names import LOAD_BODY, TOOL_LINK
 from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator, DriveStep
 from hiab_sim.env.drive_losses import DriveLossModel
@@ -55,9 +56,6 @@ from hiab_sim.env.tcp_load import TcpLoad
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.model.drives import HomePose, SlideDrives
 from hiab_sim.model.mjcf import ACTUATORS, JOINTS, SLIDES, build_spec, source_to_world
-
-Array = NDArray[np.float64]
-
 
 #: Every live CranePhysics, freed before the interpreter stops dm-control's render thread.
 _LIVE: weakref.WeakSet[CranePhysics] = weakref.WeakSet()

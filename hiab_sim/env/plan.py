@@ -25,8 +25,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.emla.config import EmlaSet
 from hiab_sim.emla.duty_energy import DutyOptions
@@ -37,8 +37,6 @@ from hiab_sim.results.schema import DesignSummary, Result, TaskResult
 from hiab_sim.study.spec.study import Study
 from hiab_sim.study.spec.study_file import load_study
 from hiab_sim.study.spec.tasks import Task
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -10,14 +10,12 @@ from __future__ import annotations
 from typing import Protocol
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla.config import EmlaSet
 from hiab_sim.emla.duty_energy import DutyOptions, drive_duty
 from hiab_sim.emla.model import electrical_power
 from hiab_sim.env.reference import PlannedMotion
-
-Array = NDArray[np.float64]
 
 
 class DutyPlan(Protocol):

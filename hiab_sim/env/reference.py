@@ -19,9 +19,9 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
+from hiab_sim.arrays import Array
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.emla.drive import drive_state
@@ -30,8 +30,6 @@ from hiab_sim.env.plan import DesignPlan, PlannedDesign
 from hiab_sim.machine.dynamics.tree import MachineActuatorSamples
 from hiab_sim.model.mjcf import source_to_world
 from hiab_sim.model.states import site_positions
-
-Array = NDArray[np.float64]
 
 
 def quintic_hermite(

@@ -26,8 +26,8 @@ from typing import Protocol
 import dm_env
 import numpy as np
 from dm_control.rl import control
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.control.cascade import CascadeController, CascadeGains
 from hiab_sim.emla.config import ACTUATOR_NAMES
 from hiab_sim.emla.drive_sim import DriveArrays
@@ -39,8 +39,6 @@ from hiab_sim.env.planned_energy import resampled_prediction
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.quadrature import trapezoid
-
-Array = NDArray[np.float64]
 
 
 class PlanLike(Protocol):

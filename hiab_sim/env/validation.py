@@ -17,9 +17,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 from tqdm import tqdm
 
+from hiab_sim.arrays import Array
 from hiab_sim.control.cascade import CascadeGains
 from hiab_sim.crane.description import Crane
 from hiab_sim.emla.battery import BatteryParams
@@ -37,8 +37,6 @@ from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.rollout import ClosedLoopRun, run_closed_loop
 from hiab_sim.results.schema import TaskResult
 from hiab_sim.terminal import progress_wanted
-
-Array = NDArray[np.float64]
 
 #: Video frame rate [1/s] and the size of one design's viewport (width, height) [px].
 FPS = 30.0

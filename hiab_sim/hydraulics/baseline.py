@@ -44,11 +44,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_efficiency
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.hydraulics.cylinders import HydraulicSystem
-
-Array = NDArray[np.float64]
 
 #: The two supply variants, in the order :func:`hydraulic_baseline` returns them.
 VARIANTS: tuple[str, ...] = ("constant_pressure", "load_sensing")

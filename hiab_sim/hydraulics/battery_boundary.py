@@ -42,10 +42,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_efficiency, check_non_negative, check_positive
 from hiab_sim.emla.battery import BatteryParams, battery_power, trapezoid_weights
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.hydraulics.baseline import Array
 from hiab_sim.hydraulics.cylinders import HydraulicSystem
 
 #: The variants at the battery, in the order :func:`battery_boundary_baselines` returns them.

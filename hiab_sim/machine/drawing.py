@@ -13,14 +13,12 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.figure_io import new_figure, save_png
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.kinematics.assembly import joint_grid
 from hiab_sim.machine.kinematics.forward import Frames, forward_kinematics, pin_positions
-
-Array = NDArray[np.float64]
 
 #: Grid samples per joint for the workspace, by number of joints (about 60 000 poses at most).
 _PER_JOINT = {1: 400, 2: 250, 3: 40, 4: 16, 5: 9}

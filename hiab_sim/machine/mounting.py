@@ -52,6 +52,7 @@ from typing import Any
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.machine import mounting_geometry as geometry
 from hiab_sim.machine.chains import Chain
@@ -59,7 +60,7 @@ from hiab_sim.machine.description import Machine
 from hiab_sim.machine.design import designed_chain
 from hiab_sim.machine.kinematics.closure import chain_geometry
 from hiab_sim.machine.kinematics.design_partials import pivot_direction
-from hiab_sim.machine.mounting_geometry import Array, Margins, Polygon
+from hiab_sim.machine.mounting_geometry import Margins, Polygon
 from hiab_sim.yaml_fields import mapping, positive
 
 #: Kinds of decision variable that move a pivot.

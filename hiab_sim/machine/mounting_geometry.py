@@ -22,12 +22,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.yaml_fields import number
 
-Array = NDArray[np.float64]
 Polygon = tuple[tuple[float, float], ...]
 
 #: Default centre-to-centre clearance of two pins [m]: two 25 mm pin eyes (our assumption).

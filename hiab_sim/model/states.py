@@ -12,9 +12,8 @@ from __future__ import annotations
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
-Array = NDArray[np.float64]
+from hiab_sim.arrays import Array
 
 
 def site_positions(model: mujoco.MjModel, qpos: Array, site: str) -> Array:

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
-Array = NDArray[np.float64]
+from hiab_sim.arrays import Array
 
 #: Camera direction [deg]: looking along +y onto the x-z plane of motion, slightly from above.
 AZIMUTH = 90.0

@@ -13,10 +13,9 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.render.camera import camera_axes
 from hiab_sim.style import rgba
-
-Array = NDArray[np.float64]
 
 #: Design colours (RGBA) of :mod:`hiab_sim.style`: initial blue, optimal bluish green; the reference curve grey.
 INITIAL_RGBA = rgba("initial")

@@ -33,11 +33,9 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane
-
-Array = NDArray[np.float64]
 
 #: Square boom section of the crane file [m]: the data has no boom widths; 120 mm is the order of a
 #: 3 t m crane's inner boom (a choice, drawn only: the dynamics use the data's masses and inertias).

@@ -37,8 +37,8 @@ import itertools
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.machine.description import Chain, Machine
 from hiab_sim.machine.dynamics.tree import MachineTree, machine_tree
 from hiab_sim.render.dress import (
@@ -55,8 +55,6 @@ from hiab_sim.render.dress import (
     model_pins,
     name_of,
 )
-
-Array = NDArray[np.float64]
 
 #: Depth over wall thickness of the drawn box sections: a choice, the order of welded boom plates (h/t 15-30).
 SLENDERNESS = 20.0

@@ -23,6 +23,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.render import decor
 from hiab_sim.render.backend import open_renderer
@@ -30,7 +31,6 @@ from hiab_sim.render.camera import camera_axes, fit_camera, geom_corners
 from hiab_sim.render.dress import PLANE_NORMAL, MachineDress, dress_points, dress_scene
 from hiab_sim.render.labels import caption_bitmap, stamp
 
-Array = NDArray[np.float64]
 Image = NDArray[np.uint8]
 Layout = Literal["side-by-side", "stacked", "overlay"]
 LAYOUTS: tuple[str, ...] = ("side-by-side", "stacked", "overlay")

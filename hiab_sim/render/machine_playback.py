@@ -25,8 +25,8 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import ConfigError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.design import MachineDesign
@@ -36,7 +36,6 @@ from hiab_sim.model.mjcf import source_to_world
 from hiab_sim.results.read import RESULT_FILE, read_result, result_machine
 from hiab_sim.results.trajectory_file import battery_powers, read_trajectory
 
-Array = NDArray[np.float64]
 DESIGNS = ("initial", "optimal")
 
 

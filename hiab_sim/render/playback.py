@@ -26,8 +26,8 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.errors import ConfigError, InvalidInputError
@@ -35,7 +35,6 @@ from hiab_sim.results.playback_view import PlaybackView
 from hiab_sim.results.read import open_run, result_crane
 from hiab_sim.results.trajectory_file import Trajectory, battery_powers
 
-Array = NDArray[np.float64]
 Mode = Literal["kinematic", "simulate"]
 MODES: tuple[str, ...] = ("kinematic", "simulate")
 DESIGNS = ("initial", "optimal")

@@ -20,8 +20,8 @@ from pathlib import Path
 from typing import Protocol
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.model.mjcf import build_model, source_to_world
 from hiab_sim.render.backend import check_output_path, ffmpeg_path, still_time, write_image, write_video
@@ -39,8 +39,6 @@ from hiab_sim.render.playback import (
     simulated_qpos,
 )
 from hiab_sim.results.trajectory_file import read_trajectory
-
-Array = NDArray[np.float64]
 
 #: Default file name of the playback video inside a result folder.
 VIDEO_NAME = "playback.mp4"

@@ -22,10 +22,9 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.errors import ConfigError
-
-Array = NDArray[np.float64]
 
 TRAJECTORY_FILE = "trajectory.npz"
 #: Version of the array schema below; bump it when a key changes meaning or shape.

@@ -20,14 +20,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import ClosedChain, Crane, LinkLengths
 from hiab_sim.crane.names import ACTUATOR_NAMES
 from hiab_sim.errors import InvalidInputError
-
-Array = NDArray[np.float64]
 
 #: Decision variables per chain in Xi: (L, Lc0, Lc).
 PER_CHAIN = 3

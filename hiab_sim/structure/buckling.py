@@ -30,14 +30,13 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_range
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.emla.config import EmlaParams, EmlaSet, ScrewColumn
 from hiab_sim.structure.actuators import Actuator, actuators, column_length, n_xi
-
-Array = NDArray[np.float64]
 
 #: Default safety factor on the buckling load [-]: THK (eq. (5)) and NSK multiply P_cr by 0.5.
 DEFAULT_SAFETY_FACTOR = 2.0

@@ -22,8 +22,9 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.names import JOINT_NAMES
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
@@ -32,8 +33,6 @@ from hiab_sim.emla.config import EmlaSet
 from hiab_sim.model.mjcf import build_spec
 from hiab_sim.structure.natural_frequency import natural_frequencies, static_forces
 from hiab_sim.structure.natural_frequency_mujoco import loop_projection, mujoco_mass_matrix
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -26,8 +26,9 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_range
 from hiab_sim.emla.drive_stiffness import axial_stiffness
 from hiab_sim.emla.emla_set import EmlaSet
@@ -36,8 +37,6 @@ from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.paths import MachineInverseDynamics
 from hiab_sim.machine.kinematics.tracked import TrackedKinematics
 from hiab_sim.structure.natural_frequency import GEOMETRIC_STEP, Modes, differenced_stiffness, generalized_eigh
-
-Array = NDArray[np.float64]
 
 #: Inset of the working-range grid from the ranges' ends [rad or m]: ten central-difference steps.
 GRID_INSET = 10.0 * GEOMETRIC_STEP

@@ -21,8 +21,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla.emla_set import EmlaSet
 from hiab_sim.machine.description import Machine
@@ -33,8 +34,6 @@ from hiab_sim.structure.buckling import DEFAULT_SAFETY_FACTOR, BucklingSamples, 
 from hiab_sim.structure.machine_modes import machine_natural_frequencies, machine_working_range_poses
 from hiab_sim.structure.pin_loads import Pin, PinLoads
 from hiab_sim.structure.summary import DesignStructure, has_stiffness, largest, summarise
-
-Array = NDArray[np.float64]
 
 #: Values per joint of the working-range grid for the frequencies (7^3 = 343 poses on a 3-joint machine).
 WORKING_GRID_PER_JOINT = 7

@@ -40,8 +40,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_range
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
@@ -51,8 +52,6 @@ from hiab_sim.emla.config import EmlaSet
 from hiab_sim.emla.drive_stiffness import axial_stiffness
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.structure.actuators import actuators
-
-Array = NDArray[np.float64]
 
 #: Central-difference step of the geometric stiffness [rad or m].
 GEOMETRIC_STEP = 1e-6

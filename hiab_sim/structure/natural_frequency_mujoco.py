@@ -11,14 +11,13 @@ from __future__ import annotations
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.names import JOINT_NAMES
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
-
-Array = NDArray[np.float64]
 
 
 def loop_projection(model: mujoco.MjModel, data: mujoco.MjData, chains: list[str]) -> Array:

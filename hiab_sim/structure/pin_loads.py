@@ -39,8 +39,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.dynamics.analytic_id import check_analytic_inputs, link_wrenches
 from hiab_sim.dynamics.analytic_kinematics import crane_motion
@@ -49,8 +50,6 @@ from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.dynamics.spatial import rotate, rotate_back
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.structure.actuators import actuators
-
-Array = NDArray[np.float64]
 
 #: The pins of one chain, in order (see the module docstring).
 CHAIN_PINS = ("base_pivot", "boom_hinge", "rod_end")

@@ -24,16 +24,15 @@ import copy
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.dynamics.checks import tcp_force_samples
 from hiab_sim.dynamics.mujoco_id import MujocoInverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.model.mjcf import SOURCE_TO_WORLD, source_to_world
 from hiab_sim.structure.pin_loads import CHAIN_PINS, PinLoads, chain_links, pins
-
-Array = NDArray[np.float64]
 
 
 class MujocoPinLoads:

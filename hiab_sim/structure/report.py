@@ -17,8 +17,8 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane
 from hiab_sim.emla.config import EmlaSet
 from hiab_sim.figure_io import new_figure, save_png
@@ -26,7 +26,6 @@ from hiab_sim.results.schema import Result
 from hiab_sim.structure.natural_frequency import bandwidth_margin, natural_frequencies
 from hiab_sim.structure.summary import DesignStructure, StructureSummary
 
-Array = NDArray[np.float64]
 DESIGNS = ("initial", "optimal")
 
 

@@ -23,8 +23,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla.config import EmlaSet
@@ -33,8 +34,6 @@ from hiab_sim.results.codec import optional
 from hiab_sim.structure.buckling import DEFAULT_SAFETY_FACTOR, BucklingSamples, buckling_samples
 from hiab_sim.structure.natural_frequency import natural_frequencies, working_range_poses
 from hiab_sim.structure.pin_loads import PinLoads, analytic_pin_loads
-
-Array = NDArray[np.float64]
 
 #: Grid of the working range for the frequency map: per chain joint, then the direct joint.
 WORKING_GRID = (9, 9, 3)

@@ -25,13 +25,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.results.read import open_run, read_result
 from hiab_sim.results.schema import Result
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.sweep.map_values import FEASIBILITY_TOLERANCE, DesignEvaluator, DesignValues
-
-Array = NDArray[np.float64]
 
 __all__ = [
     "FEASIBILITY_TOLERANCE",

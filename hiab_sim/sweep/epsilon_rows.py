@@ -22,12 +22,12 @@ from typing import Any
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla import EmlaSet
 from hiab_sim.emla.drive import drive_state
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.constraints.blocks import opposite_rows
 from hiab_sim.study.nlp.interface import (
-    Array,
     ConstraintBlock,
     DenseRows,
     PerSampleBlock,

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla import battery_energy, electrical_power, energy_summary
 from hiab_sim.emla.battery import rest_battery_energy
@@ -52,8 +53,6 @@ from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import TaskProblem
 from hiab_sim.study.report.design_check import fine_problem
-
-Array = NDArray[np.float64]
 
 #: Scaled margin below which a cell counts as infeasible (SLSQP's optimum violates rows by ~1e-10).
 FEASIBILITY_TOLERANCE = 1e-8

@@ -47,8 +47,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla.drive import drive_state
 from hiab_sim.errors import InvalidInputError, SolverError
@@ -60,7 +61,6 @@ from hiab_sim.study.solvers.threads import single_blas_thread
 from hiab_sim.style import colour
 from hiab_sim.sweep.epsilon_rows import epsilon_problem
 
-Array = NDArray[np.float64]
 CRITERIA = {"peak_force": "N", "rms_torque": "N m"}
 #: Largest scaled violation (study rows and epsilon rows) of an accepted front point.
 FEASIBLE = 1e-6

@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla.config import EmlaSet
 from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator
 from hiab_sim.env.drive_losses import DriveLossModel
@@ -38,8 +38,6 @@ from hiab_sim.env.plant.friction import FrictionMeter
 from hiab_sim.env.plant.sensors import CurrentSensorError
 from hiab_sim.env.plant.thermal import WindingTemperature
 from hiab_sim.env.reference import PlannedMotion
-
-Array = NDArray[np.float64]
 
 
 def active_plant(plant: Plant | None) -> Plant | None:

@@ -28,14 +28,13 @@ import cmath
 import math
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla.drive_sim import DriveArrays, DriveSimulator, DriveStep
 from hiab_sim.env.plant.config import CurrentLoop
 from hiab_sim.env.plant.sensors import CurrentSensorError
 from hiab_sim.errors import InvalidInputError
-
-Array = NDArray[np.float64]
 
 #: A 2x2 matrix, row-major.
 Quad = tuple[float, float, float, float]

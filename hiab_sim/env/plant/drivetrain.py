@@ -43,12 +43,11 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla.config import EmlaSet
 from hiab_sim.emla.drive_stiffness import axial_stiffness
 from hiab_sim.env.plant.config import DriveTrain
 from hiab_sim.errors import InvalidInputError
-
-Array = NDArray[np.float64]
 
 
 def drive_train_stiffness(emlas: EmlaSet, stroke: Array) -> Array:

@@ -29,12 +29,10 @@ from collections.abc import Collection
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.env.plant.config import JointFriction
 from hiab_sim.errors import ConfigError
-
-Array = NDArray[np.float64]
 
 #: |n . axis| below 1 by more than this: the mechanism is not planar (its hinges are not parallel).
 PARALLEL_TOLERANCE = 1e-9

@@ -17,11 +17,9 @@ import collections
 import math
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.env.plant.config import Sensors
-
-Array = NDArray[np.float64]
 
 
 class MotionSensor:

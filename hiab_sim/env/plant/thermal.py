@@ -13,13 +13,11 @@ R_s(T) = R_ref (1 + alpha (T - T_ref)) with R_ref the EMLA file's value at T_ref
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla.config import EmlaParams
 from hiab_sim.env.plant.config import Thermal
 from hiab_sim.errors import InvalidInputError
-
-Array = NDArray[np.float64]
 
 
 class WindingTemperature:

@@ -9,12 +9,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-import numpy as np
-from numpy.typing import NDArray
-
+from hiab_sim.arrays import Array
 from hiab_sim.machine.dynamics.tree import PinForces
-
-Array = NDArray[np.float64]
 
 
 class DeferredPinForces(PinForces):

@@ -32,8 +32,8 @@ from typing import Any
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.mjcf_build import SimulationExtras, spec_of_tree
 from hiab_sim.machine.dynamics.planar import close_loops, planar_bodies
@@ -46,8 +46,6 @@ from hiab_sim.machine.dynamics.tree import (
     tcp_force_array,
 )
 from hiab_sim.model.states import mechanical_energies
-
-Array = NDArray[np.float64]
 
 #: Rows of a MuJoCo world vector that lie in the machine's plane (x, y) = MuJoCo (x, z).
 _PLANE = [0, 2]

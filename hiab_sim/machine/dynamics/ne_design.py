@@ -27,12 +27,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.ne_layout import NeConstants, NeLayout
 from hiab_sim.machine.dynamics.tree import world_z
 
-Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
 
 

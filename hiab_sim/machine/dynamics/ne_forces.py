@@ -15,10 +15,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.machine.dynamics.ne_kernel import cross
 from hiab_sim.machine.dynamics.ne_workspace import Prepared, Workspace
 
-Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
 
 

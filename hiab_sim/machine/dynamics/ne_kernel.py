@@ -29,11 +29,11 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.machine.dynamics.ne_four_bar import four_bars
 from hiab_sim.machine.dynamics.ne_layout import NeLayout
 from hiab_sim.machine.dynamics.ne_workspace import Prepared, Workspace, workspace
 
-Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
 
 

@@ -23,11 +23,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.dynamics.planar import PlanarBody, planar_bodies
 from hiab_sim.machine.dynamics.tree import MachineTree, PinLayout, actuator_lengths, machine_tree, pin_layout
 
-Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
 Index = NDArray[np.intp]
 

@@ -18,9 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.machine.dynamics.ne_layout import NeConstants, NeLayout
 
-Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
 Index = NDArray[np.intp]
 

@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_range
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Machine
@@ -60,8 +61,6 @@ from hiab_sim.machine.dynamics.tree import (
     machine_tree,
     tcp_force_complex,
 )
-
-Array = NDArray[np.float64]
 
 
 class NewtonEulerInverseDynamics:

@@ -30,10 +30,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.dynamics.tree import MachineTree, actuator_lengths
 
-Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
 
 

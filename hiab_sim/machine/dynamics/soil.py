@@ -36,12 +36,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_non_negative, check_positive, check_range
 from hiab_sim.errors import InvalidInputError
-
-Array = NDArray[np.float64]
 
 #: Golden-section refinement steps of the failure-plane angle (each shrinks the bracket by 0.618).
 _GOLDEN_STEPS = 60

@@ -35,13 +35,12 @@ the shallow part of the curl, not the filling of the bucket or the weight of its
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_positive, check_range
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.dynamics.soil import SoilProperties, tool_force_world
-
-Array = NDArray[np.float64]
 
 #: Depth over which the force is blended in [m]: chosen small against the cuts of the excavator's
 #: cycles (30-120 mm) so that it changes the cutting force only in the first 10 mm of entry.

@@ -44,12 +44,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_non_negative
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Chain, Machine
 from hiab_sim.machine.parts import Pose, RigidBody
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Chain, Machine
 from hiab_sim.machine.kinematics.closure import (
@@ -28,8 +29,6 @@ from hiab_sim.machine.kinematics.closure import (
     stroke_to_joint,
 )
 from hiab_sim.machine.kinematics.forward import forward_kinematics
-
-Array = NDArray[np.float64]
 
 #: Slack on stroke bounds [m] against round-off at the ends of a range computed from them.
 STROKE_TOLERANCE = 1e-12

@@ -27,10 +27,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import Chain, Machine
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

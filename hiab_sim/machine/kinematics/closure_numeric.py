@@ -21,12 +21,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.machine.description import Chain, Machine
 from hiab_sim.machine.kinematics.closure import ChainGeometry, Closure, chain_geometry
-
-Array = NDArray[np.float64]
 
 #: Newton stops when every loop residual is below this [m].
 RESIDUAL_TOLERANCE = 1e-13

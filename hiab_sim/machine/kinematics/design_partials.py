@@ -17,12 +17,11 @@ Vectorised over joint samples; m per m (dimensionless).
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.machine.description import Chain, DecisionVariable, Machine
 from hiab_sim.machine.kinematics.closure import ChainGeometry, chain_geometry, length_and_rate
-
-Array = NDArray[np.float64]
 
 
 def pivot_direction(machine: Machine, chain: Chain, variable: DecisionVariable) -> Array:

@@ -41,10 +41,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.description import PLANAR_TOLERANCE, Link, Machine
 
-Array = NDArray[np.float64]
 CArray = NDArray[np.complex128]
 
 #: The tracked coordinate that is the TCP frame's absolute angle in the plane [rad].

@@ -10,13 +10,11 @@ from typing import Any
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.machine.mjcf_import.graph import Mechanism, connect_points, name_of
 from hiab_sim.machine.mjcf_import.pose import plane_axes
 from hiab_sim.machine.parts import rot_z
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

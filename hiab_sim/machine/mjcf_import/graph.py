@@ -25,11 +25,9 @@ from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import HiabSimError
-
-Array = NDArray[np.float64]
 
 #: Parallelism tolerance of joint axes with the plane normal (|sin| of the angle).
 AXIS_TOLERANCE = 1e-6

@@ -26,7 +26,6 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
 from hiab_sim.errors import ConfigError
 from hiab_sim.machine.mjcf_import.chains import chain_roles
@@ -35,8 +34,6 @@ from hiab_sim.machine.mjcf_import.graph import ClosedChain, Mechanism, Unsupport
 from hiab_sim.machine.mjcf_import.graph import read_mechanism as _read
 from hiab_sim.machine.mjcf_import.pose import close, residual_and_jacobian
 from hiab_sim.machine.mjcf_import.tree import write_tree
-
-Array = NDArray[np.float64]
 
 #: A pin's pose residual accepted as closed before Newton [m].
 CLOSED_TOL = 1e-3

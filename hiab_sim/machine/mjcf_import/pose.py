@@ -12,11 +12,9 @@ from collections.abc import Callable, Iterator
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.machine.mjcf_import.graph import Mechanism, connect_points
-
-Array = NDArray[np.float64]
 
 #: Newton iterations and in-plane residual tolerance [m].
 NEWTON_STEPS = 30

@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.tolerance import round_lengths
 from hiab_sim.errors import InvalidInputError
@@ -43,7 +44,6 @@ from hiab_sim.results.design_values import with_values
 from hiab_sim.study.constraints.blocks import STROKE_SCALE, WorkingRange
 from hiab_sim.study.constraints.mounting_rows import MOUNTING_SCALE, MountingRows
 from hiab_sim.study.nlp.interface import (
-    Array,
     ConstraintBlock,
     DenseRows,
     Relaxation,

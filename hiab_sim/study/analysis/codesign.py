@@ -28,10 +28,10 @@ from typing import TextIO
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla import EmlaSet
 from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.results.energy_sections import Codesign, CodesignRow, DesignEnergy, TransmissionChoice
-from hiab_sim.study.nlp.interface import Array
 from hiab_sim.study.nlp.objectives import exact_value
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.report.energy_section import design_energy

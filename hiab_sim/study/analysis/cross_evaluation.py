@@ -20,10 +20,10 @@ from __future__ import annotations
 import copy
 from dataclasses import replace
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.results.analysis_sections import CrossEvaluation
 from hiab_sim.results.design_values import DesignValues
-from hiab_sim.study.nlp.interface import Array
 from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import TaskProblem

@@ -34,11 +34,11 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import nnls
 
+from hiab_sim.arrays import Array
 from hiab_sim.results.analysis_sections import Multiplier, Sensitivity
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import XI_SCALE
 
-Array = np.ndarray
 #: Scaled margin below which a row counts as active.
 ACTIVE_TOLERANCE = 1e-6
 

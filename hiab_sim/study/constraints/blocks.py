@@ -26,11 +26,11 @@ from collections.abc import Hashable, Sequence
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla import ENVELOPE_LIMIT_NAMES, EmlaSet, envelope_margin_partials, envelope_margins
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.machines.protocol import Design, StudyMachine
 from hiab_sim.study.nlp.interface import (
-    Array,
     ConstraintBlock,
     DenseRows,
     Objective,

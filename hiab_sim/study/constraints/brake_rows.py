@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla import EmlaSet
 from hiab_sim.study.nlp.interface import (
-    Array,
     ConstraintBlock,
     DenseRows,
     Relaxation,

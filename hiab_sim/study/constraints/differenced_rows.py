@@ -14,8 +14,9 @@ from typing import Any
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.results.design_values import with_values
-from hiab_sim.study.nlp.interface import Array, PerSampleBlock, SamplePartials, SampleRows, SampleState
+from hiab_sim.study.nlp.interface import PerSampleBlock, SamplePartials, SampleRows, SampleState
 
 
 class DifferencedRows(PerSampleBlock):

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla.emla_set import EmlaSet
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.dynamics.paths import make_machine_dynamics
@@ -35,7 +36,7 @@ from hiab_sim.study.constraints.structure_rows import (
     StructureRowKinds,
 )
 from hiab_sim.study.machines.machine_model import MachineModel
-from hiab_sim.study.nlp.interface import Array, SamplePartials, SampleRows, SampleState
+from hiab_sim.study.nlp.interface import SamplePartials, SampleRows, SampleState
 
 
 def _retracted_partials(model: MachineModel, chain: Any) -> Array:

@@ -14,12 +14,13 @@ from __future__ import annotations
 from collections.abc import Callable, Hashable
 from typing import TYPE_CHECKING, Any
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.mounting import MountingSpace, mounting_margins
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.mounting import MachineMountingSpace, machine_mounting_margins
 from hiab_sim.machine.mounting_geometry import Margins
 from hiab_sim.results.design_values import crane_lengths
-from hiab_sim.study.nlp.interface import Array, ConstraintBlock, DenseRows, Relaxation, SamplePartials, SampleState
+from hiab_sim.study.nlp.interface import ConstraintBlock, DenseRows, Relaxation, SamplePartials, SampleState
 
 if TYPE_CHECKING:
     from hiab_sim.study.spec.study import Study

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane
 from hiab_sim.emla import EmlaSet
 from hiab_sim.results.design_values import crane_lengths
@@ -34,7 +35,7 @@ from hiab_sim.structure.natural_frequency import natural_frequencies
 from hiab_sim.structure.pin_loads import pin_forces, pins
 from hiab_sim.structure.settings import StructureSettings
 from hiab_sim.study.constraints.differenced_rows import DifferencedRows
-from hiab_sim.study.nlp.interface import Array, PerSampleBlock, Relaxation, SamplePartials, SampleRows, SampleState
+from hiab_sim.study.nlp.interface import PerSampleBlock, Relaxation, SamplePartials, SampleRows, SampleState
 
 
 def _per_sample_force(tcp_force: Array | None, samples: int) -> Array | None:

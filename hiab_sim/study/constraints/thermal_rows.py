@@ -19,10 +19,11 @@ import math
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla import EmlaParams, EmlaSet, ThermalCheck, thermal_check
 from hiab_sim.emla.duty_energy import DriveDuty
 from hiab_sim.emla.thermal import Duty
-from hiab_sim.study.nlp.interface import Array, ConstraintBlock, DenseRows, Relaxation, SamplePartials, SampleState
+from hiab_sim.study.nlp.interface import ConstraintBlock, DenseRows, Relaxation, SamplePartials, SampleState
 from hiab_sim.study.spec.energy import DutySettings
 
 #: Winding-temperature margins are divided by this [K] (O(1) rows).

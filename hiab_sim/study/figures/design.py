@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 from matplotlib.axes import Axes
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import CHAIN_NAMES, Crane, LinkLengths
 from hiab_sim.crane.kinematics import forward_kinematics
 from hiab_sim.crane.names import ACTUATOR_NAMES
@@ -27,7 +28,6 @@ from hiab_sim.results.schema import HistoryRow
 from hiab_sim.study.report.summary import limit_in_words
 from hiab_sim.style import colour
 
-Array = np.ndarray
 #: The bars of :func:`energy_bars`: the breakdown's parts, the drive train's (:func:`drive_train_energy`), the total.
 ENERGY_LABELS = (
     "mechanical\nf v",

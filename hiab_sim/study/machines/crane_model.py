@@ -16,13 +16,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.crane.names import ACTUATOR_NAMES, JOINT_NAMES
 from hiab_sim.dynamics.interface import InverseDynamics, make_inverse_dynamics
 from hiab_sim.hydraulics.cylinders import HydraulicSystem
 from hiab_sim.study.machines.crane_reach import REASONS, planar_ik
-from hiab_sim.study.machines.protocol import Array, PointReach
+from hiab_sim.study.machines.protocol import PointReach
 from hiab_sim.study.motion import trajectory as tr
 
 

@@ -21,12 +21,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane
 from hiab_sim.study.motion.trajectory import TcpKinematics
-
-Array = NDArray[np.float64]
 
 #: What each :attr:`PlanarIk.status` code means, for error messages.
 REASONS = (

@@ -26,8 +26,9 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.hydraulics.cylinders import HydraulicSystem
@@ -41,8 +42,6 @@ from hiab_sim.machine.kinematics.tracked import inverse_kinematics as tracked_ik
 from hiab_sim.study.machines.machine_strokes import StrokeRows, chains_with_strokes
 from hiab_sim.study.machines.protocol import PointReach
 from hiab_sim.study.motion import trajectory as tr
-
-Array = NDArray[np.float64]
 
 #: The study's inverse-dynamics path names and the machine's.
 PATHS = {"analytic": "newton_euler", "mujoco": "mujoco"}

@@ -13,15 +13,14 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.machine.chains import Chain
 from hiab_sim.machine.description import Machine
 from hiab_sim.machine.design import designed_chain
 from hiab_sim.machine.kinematics.closure import joint_to_stroke
 from hiab_sim.machine.kinematics.design_partials import stroke_design_partials
 
-Array = NDArray[np.float64]
 #: Entries kept per cache before it is emptied (designs and joint samples of a solve's recent points).
 CACHE_SIZE = 256
 

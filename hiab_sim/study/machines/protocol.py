@@ -20,13 +20,11 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.dynamics.interface import InverseDynamics
 from hiab_sim.results.design_values import DesignValues
-
-Array = NDArray[np.float64]
-
 
 #: A design Xi (the crane's LinkLengths or a machine file's MachineDesign; ``as_array()`` gives its values).
 Design = DesignValues

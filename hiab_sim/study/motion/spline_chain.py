@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-Array = NDArray[np.float64]
+from hiab_sim.arrays import Array
 
 
 def spline_band(B: Array) -> tuple[NDArray[np.intp], Array]:

@@ -19,14 +19,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.interpolate import BSpline
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.kinematics.tracked import TrackedSamples
-
-Array = NDArray[np.float64]
 
 
 class SplineBasis:

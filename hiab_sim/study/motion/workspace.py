@@ -9,8 +9,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.machines.crane_reach import REASONS, PlanarIk, planar_ik
@@ -18,8 +18,6 @@ from hiab_sim.study.motion.trajectory import Reference
 
 if TYPE_CHECKING:
     from hiab_sim.study.machines.protocol import StudyMachine
-
-Array = NDArray[np.float64]
 
 
 def dense_times(duration: float, step: float = 0.01) -> Array:

@@ -9,14 +9,13 @@ h = fd_step * max(1, |value|).
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.dynamics.analytic_batch import batched_inverse_dynamics
 from hiab_sim.dynamics.interface import InverseDynamics, make_inverse_dynamics
 from hiab_sim.dynamics.samples import ActuatorSamples, JointSamples
-
-Array = NDArray[np.float64]
 
 
 def _outputs(act: ActuatorSamples) -> Array:

@@ -46,14 +46,12 @@ from functools import cached_property
 from typing import Any, Protocol
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.dynamics.samples import ActuatorSamples
 from hiab_sim.emla.duty_energy import DriveDuty
 from hiab_sim.study.machines.protocol import Design
 from hiab_sim.study.motion import trajectory as tr
-
-Array = NDArray[np.float64]
 
 #: The XS 031 crane's per-sample joint quantities q9 = (theta 0-2, dtheta 3-5, ddtheta 6-8): the
 #: crane-only blocks (structure, buildable design) use it; every other block reads n from its state

@@ -30,10 +30,11 @@ from typing import ClassVar, Protocol
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla import EmlaSet, battery_energy, electrical_power_partials, operating_point
 from hiab_sim.emla.battery import rest_battery_energy
 from hiab_sim.errors import InvalidInputError
-from hiab_sim.study.nlp.interface import Array, Objective, SamplePartials, SampleState
+from hiab_sim.study.nlp.interface import Objective, SamplePartials, SampleState
 
 
 class EmlaObjective:

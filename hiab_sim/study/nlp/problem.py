@@ -32,10 +32,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla import EmlaSet
 from hiab_sim.study.constraints.block_registry import BlockFactory
 from hiab_sim.study.machines.protocol import Design
-from hiab_sim.study.nlp.interface import Array, ConstraintBlock, ScaledProblem
+from hiab_sim.study.nlp.interface import ConstraintBlock, ScaledProblem
 from hiab_sim.study.nlp.task_problem import Evaluation, TaskProblem
 from hiab_sim.study.spec.study_file import Study
 

@@ -44,6 +44,7 @@ from typing import Any
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.dynamics.interface import InverseDynamics
 from hiab_sim.dynamics.samples import JointSamples
 from hiab_sim.emla import (
@@ -60,7 +61,6 @@ from hiab_sim.study.motion import trajectory as tr
 from hiab_sim.study.motion.spline_chain import SplineChain
 from hiab_sim.study.nlp.id_partials import id_joint_partials
 from hiab_sim.study.nlp.interface import (
-    Array,
     BlockJacobian,
     BlockLayout,
     ConstraintBlock,

@@ -2,15 +2,11 @@
 
 from __future__ import annotations
 
-import numpy as np
-from numpy.typing import NDArray
-
+from hiab_sim.arrays import Array
 from hiab_sim.emla import EmlaSet
 from hiab_sim.emla.duty_energy import DutyOptions
 from hiab_sim.study.machines.protocol import StudyMachine
 from hiab_sim.study.spec.study_file import Study
-
-Array = NDArray[np.float64]
 
 
 def duty_options(study: Study, emlas: EmlaSet, cycle_time: float) -> DutyOptions | None:

@@ -33,8 +33,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane.description import Crane
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study.motion.trajectory import JointTrajectory, Reference, SplineBasis, fit_coefficients
@@ -44,7 +44,6 @@ from hiab_sim.yaml_fields import mapping, number, positive
 if TYPE_CHECKING:
     from hiab_sim.study.machines.protocol import Kinematics, StudyMachine
 
-Array = NDArray[np.float64]
 #: A machine's column names: its tracked coordinates beyond the TCP's x, y, and its joints (from its description).
 ColumnNames = tuple[tuple[str, ...], tuple[str, ...]]
 

@@ -38,7 +38,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.optimize import brentq
 
 from hiab_sim.errors import ConfigError, InvalidInputError
@@ -48,10 +47,10 @@ from hiab_sim.study.motion.workspace import check_workspace, dense_times, initia
 if TYPE_CHECKING:
     from hiab_sim.crane.description import Crane
     from hiab_sim.study.machines.protocol import Kinematics, StudyMachine
+from hiab_sim.arrays import Array
 from hiab_sim.study.references.csv_file import ColumnNames, CsvReference
 from hiab_sim.yaml_fields import mapping, number, positive
 
-Array = NDArray[np.float64]
 KINDS = ("spiral", "pick_and_place", "csv")
 
 

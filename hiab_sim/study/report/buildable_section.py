@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.crane.mounting import MountingSpace
@@ -31,8 +32,6 @@ from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.report.design_check import design_summary, other_path
 from hiab_sim.study.report.weighted import weighted_summary
 from hiab_sim.study.spec.study import Study
-
-Array = np.ndarray
 
 
 def rounded_point(problem: StudyProblem, z: Array) -> tuple[LinkLengths, Array]:

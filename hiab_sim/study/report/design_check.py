@@ -14,8 +14,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.emla import energy_summary, operating_point
 from hiab_sim.errors import HiabSimError
 from hiab_sim.quadrature import trapezoid
@@ -36,8 +36,6 @@ from hiab_sim.study.nlp.objectives import costf2
 from hiab_sim.study.nlp.task_problem import Evaluation, TaskProblem
 from hiab_sim.study.report.energy_section import cycle_battery_power
 from hiab_sim.study.spec.study_file import Study
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

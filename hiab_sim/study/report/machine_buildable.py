@@ -22,6 +22,7 @@ import math
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.machine.design import MachineDesign
 from hiab_sim.results.analysis_sections import Buildable, RoundedCheck
 from hiab_sim.results.schema import DesignSummary
@@ -30,8 +31,6 @@ from hiab_sim.study.constraints.mounting_rows import study_mounting_margins
 from hiab_sim.study.machines.machine_model import MachineModel
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.report.buildable_section import rounded_recheck
-
-Array = np.ndarray
 
 #: Grid points per stroke chain's joint range of the stroke check [-].
 STROKE_GRID = 201

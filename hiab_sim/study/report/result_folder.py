@@ -25,8 +25,8 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.results.multistart import DistinctOptimum, FailedStart, MultiStart, StartRow
 from hiab_sim.results.schema import (
@@ -67,8 +67,6 @@ from hiab_sim.study.report.weighted import (
     weighted_summary,
 )
 from hiab_sim.study.solvers.slsqp import SolveResult
-
-Array = NDArray[np.float64]
 
 
 def collocation_costf2(problem: StudyProblem, z: Array) -> float:

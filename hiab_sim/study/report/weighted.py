@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from hiab_sim.arrays import Array
 from hiab_sim.results.schema import (
     ENERGY_PARTS,
     ActuatorSummary,
@@ -23,7 +24,6 @@ from hiab_sim.results.schema import (
     TrackingError,
     WorstConstraint,
 )
-from hiab_sim.study.nlp.interface import Array
 
 TELESCOPE = "prescribed by the reference (third tracked coordinate xt2)"
 

@@ -31,6 +31,7 @@ import math
 import numpy as np
 from scipy.optimize import minimize
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import InfeasibleStudyError, InvalidInputError
 from hiab_sim.results.analysis_sections import FeasibilityPhase
 from hiab_sim.study.constraints.blocks import STROKE_SCALE
@@ -40,7 +41,6 @@ from hiab_sim.study.solvers.ipopt import solve_ipopt
 from hiab_sim.study.solvers.single_solve import run_slsqp, slsqp_bounds
 from hiab_sim.study.solvers.slsqp import start_points
 
-Array = np.ndarray
 #: Scaled margin the phase aims for on every row.
 TARGET = 1e-4
 #: Violation [scaled] reported for every row at a trial point outside the model's domain.

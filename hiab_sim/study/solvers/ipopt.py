@@ -21,8 +21,8 @@ from typing import Any
 
 import numpy as np
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import BackendUnavailableError, InvalidInputError
-from hiab_sim.study.nlp.interface import Array
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.solvers.outcome import Outcome
 from hiab_sim.study.solvers.sparse_rows import SparseJacobian

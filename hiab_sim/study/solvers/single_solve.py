@@ -13,16 +13,13 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.optimize import minimize
 
+from hiab_sim.arrays import Array
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.solvers.ipopt import solve_ipopt
 from hiab_sim.study.solvers.outcome import Outcome
 from hiab_sim.study.solvers.threads import single_blas_thread
-
-Array = NDArray[np.float64]
-
 
 #: A constraint function of z and its Jacobian (None: scipy's finite differences).
 Rows = tuple[Callable[[Array], Array], Callable[[Array], Array] | None]

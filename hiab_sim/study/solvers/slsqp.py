@@ -21,8 +21,8 @@ from pathlib import Path
 from typing import Any, TextIO
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.atomic_io import write_atomic
 from hiab_sim.crane.description import CHAIN_NAMES, LinkLengths
 from hiab_sim.errors import InvalidInputError, SolverError
@@ -31,7 +31,6 @@ from hiab_sim.results.design_values import DesignValues
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.solvers.single_solve import solve_once
 
-Array = NDArray[np.float64]
 #: Largest violation [scaled units] of a nominal constraint (:meth:`TaskProblem.margins`) a start
 #: may have: round-off only (the built crane's strokes reach exactly 0 at the ends of its joint range).
 START_TOLERANCE = 1e-9

@@ -24,7 +24,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import sparse
 
-from hiab_sim.study.nlp.interface import Array, PerSampleBlock
+from hiab_sim.arrays import Array
+from hiab_sim.study.nlp.interface import PerSampleBlock
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import TaskProblem
 

@@ -26,12 +26,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.yaml_fields import mapping, number
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

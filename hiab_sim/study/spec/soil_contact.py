@@ -22,8 +22,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.checks import check_positive, check_range
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.machine.dynamics.soil import SoilProperties
@@ -31,7 +31,6 @@ from hiab_sim.machine.dynamics.soil_file import load_soil
 from hiab_sim.machine.dynamics.soil_load import soil_force_on_tcp
 from hiab_sim.yaml_fields import mapping, number
 
-Array = NDArray[np.float64]
 #: The tracked coordinate that gives the bucket's attitude.
 ATTITUDE = "tcp_angle"
 

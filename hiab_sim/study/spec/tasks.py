@@ -23,16 +23,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from hiab_sim.arrays import Array
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study.references.csv_file import ColumnNames
 from hiab_sim.study.references.kinds import TaskReference, reference_from_mapping
 from hiab_sim.study.spec.payload import Payload
 from hiab_sim.study.spec.soil_contact import SoilContact
 from hiab_sim.yaml_fields import mapping, number
-
-Array = NDArray[np.float64]
 
 if TYPE_CHECKING:
     from hiab_sim.crane.description import Crane
