@@ -58,7 +58,8 @@ def run(args: argparse.Namespace) -> int:
     check_start(study_problem, study_problem.initial_point(study.initial_lengths))
     with StatusLine(f"optimising {study.name} and {args.points - 1} limits on the {args.against} ..."):
         optimum = solve(study_problem, study.initial_lengths, progress=None)
-        front = pareto_front(study_problem, optimum.z, args.against, args.points)
+        traced = pareto_front(study_problem, optimum.z, args.against, args.points)
+    front = traced.points
     frame = pd.DataFrame([p.as_row() for p in front])
     out.mkdir(parents=True, exist_ok=True)
     write_atomic(out / "pareto.csv", frame.to_csv(index=False))
@@ -73,6 +74,8 @@ def run(args: argparse.Namespace) -> int:
         "tasks": [{"name": t.name, "weight": float(t.weight)} for t in study.tasks],
         "design_variables": list(study.model.design_names),
         "points": frame.to_dict("records"),
+        # the least criterion the study's constraints allow, at the design minimising it alone (not on the front)
+        "least_criterion": traced.least.as_row(),
     }
     write_atomic(out / "pareto.json", json.dumps(summary, indent=2) + "\n")
     write_atomic(out / "pareto.png", front_figure_png(front, args.against, study.name, study_problem.objective.name))
@@ -84,6 +87,6 @@ def run(args: argparse.Namespace) -> int:
             f"({p.iterations} iterations, {status})"
         )
     files = ["pareto.csv", "pareto.json", "pareto.png", ANSWER_FILE]
-    answer = front_answer(front, args.against, study_problem.objective.name, study.name, out, files)
+    answer = front_answer(front, args.against, study_problem.objective.name, study.name, out, files, traced.least)
     publish_answer(answer, out, details)
     return 0

@@ -184,6 +184,8 @@ PARETO_FIELDS: tuple[str, ...] = (
     "criterion",
     "unit",
     *(f"points.*.{k}" for k in ("epsilon", "criterion", "objective", "objective_unit", "accepted", "iterations")),
+    "least_criterion.criterion",
+    "least_criterion.objective",
 )
 #: The fields of a sweep's table (``hiab-sim sweep``: ``sweep.parquet``, one row per point) the pages read;
 #: ``parameters`` holds each point's grid values by column name.

@@ -87,7 +87,7 @@ def pareto(runs: RunData) -> str:
     f = runs.section(PARETO, "pareto")
     points = f("points")
     first = points[0]
-    rows = [
+    rows: list[tuple[object, ...]] = [
         (
             i,
             f"{p['criterion']:.5g} {f('unit')}",
@@ -97,6 +97,16 @@ def pareto(runs: RunData) -> str:
         )
         for i, p in enumerate(points)
     ]
+    least = f("least_criterion")
+    rows.append(
+        (
+            "least",
+            f"{least['criterion']:.5g} {f('unit')}",
+            f"{100 * (least['criterion'] / first['criterion'] - 1):+.2f} %",
+            f"{100 * (least['objective'] / first['objective'] - 1):+.2f} %",
+            "the least-criterion design (criterion minimised alone; not on the front)",
+        )
+    )
     header = ("point", f"{f('criterion')}", "criterion vs optimum", "objective vs optimum", "converged")
     return table(header, rows)
 

@@ -147,9 +147,19 @@ def _change(value: float, reference: float) -> str:
 
 
 def front_answer(
-    front: Sequence[FrontPoint], criterion: str, objective: str, title: str, folder: Path, files: Sequence[str]
+    front: Sequence[FrontPoint],
+    criterion: str,
+    objective: str,
+    title: str,
+    folder: Path,
+    files: Sequence[str],
+    least_design: FrontPoint | None = None,
 ) -> list[str]:
-    """The front's answer: its end points and its knee, the criterion and the objective of each."""
+    """The front's answer: its end points and its knee, the criterion and the objective of each.
+
+    ``least_design``: the least criterion the study's constraints allow and the design reaching it
+    (:class:`hiab_sim.sweep.pareto.Front` ``least``), said beside the front when given.
+    """
     words = CRITERION_WORDS.get(criterion, criterion.replace("_", " "))
     ok = [p for p in front if p.accepted]
     plain = front[0]
@@ -166,6 +176,12 @@ def front_answer(
     least = min(ok, key=lambda p: p.criterion) if ok else None
     if least is not None and least is not plain:
         lines.append(point(f"least {words} reached on the front", least))
+    if least_design is not None:
+        lines.append(
+            point(
+                f"least {words} the study's limits allow (minimised alone; the front ends just above it)", least_design
+            )
+        )
     knee = knee_index(front)
     if knee is None:
         lines.append("- knee: none (fewer than three converged points, or the front is straight)")
