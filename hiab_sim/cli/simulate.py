@@ -31,8 +31,10 @@ on the task's own plan (its motion, payload and duty), compared with the task's 
 cycle (``tasks[k].<design>``), not with the mix's weighted sums; ``simulation.json`` holds ``tasks``
 (per task its ``designs``) and ``mix`` (per design sum_k w_k E_k, closed loop against the result's),
 the table a row per task and design, the figures and videos one set per task (``_task<k>`` before the
-extension). The effect study (a plant with effects on) takes one plan per design and is refused on a
-mix with one line (exit 2).
+extension). The effect study (a plant with effects on) runs per task too, on the task's own plans
+against its own energies: ``tasks[k].plant_effects``, ``effects_task<k>.md`` and
+``closed_loop_plant_effects_task<k>.png``, its table printed per task; a mix's task is not re-planned
+for the true masses (the re-planned prediction is that of a single-task study).
 
 A machine file's result (:mod:`hiab_sim.machine`, e.g. the excavator) runs through
 :mod:`hiab_sim.cli.simulate_machine`: the same report, plant and effect study, each chain's EMLA
@@ -48,7 +50,7 @@ import sys
 from pathlib import Path
 
 from hiab_sim.cli.options import add_out_option
-from hiab_sim.cli.simulate_summary import print_results, refuse_mix_effects, task_indices, task_runs, write_results
+from hiab_sim.cli.simulate_summary import print_results, task_indices, task_runs, write_results
 from hiab_sim.errors import InvalidInputError
 
 #: Closed-loop checks: energy within this fraction of the prediction, TCP error rms and max [mm].
@@ -126,7 +128,6 @@ def run(args: argparse.Namespace) -> int:
     from hiab_sim.env.plant import load_plant
 
     plant = load_plant(args.plant) if args.plant is not None else None
-    refuse_mix_effects(args, plant, tasks)
     plans = [read_plan(args.result_dir, design, task) for task in tasks for design in designs]  # bad input first
     out.mkdir(parents=True, exist_ok=True)
     if not args.no_video:

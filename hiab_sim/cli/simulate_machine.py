@@ -59,7 +59,7 @@ def run_machine(
     (:func:`hiab_sim.env.plant.load.machine_plant`). ``tasks``: a duty mix's task indices, each task's
     designs on the task's own plan, or (None,) for a single-task result.
     """
-    from hiab_sim.cli.simulate_summary import print_results, refuse_mix_effects, task_runs, write_results
+    from hiab_sim.cli.simulate_summary import print_results, task_runs, write_results
     from hiab_sim.design_report.simulation_table import run_groups
     from hiab_sim.env.machine_env import run_machine_closed_loop
     from hiab_sim.env.machine_plan import read_machine_plan
@@ -69,7 +69,6 @@ def run_machine(
     refuse_crane_only(args)
     plans = [read_machine_plan(args.result_dir, design, task) for task in tasks for design in designs]  # fails first
     plant = None if args.plant is None else machine_plant(args.plant, plans[0].machine.realistic_plant)
-    refuse_mix_effects(args, plant, tasks)
     if not args.no_video:
         from hiab_sim.render.backend import ffmpeg_path
 

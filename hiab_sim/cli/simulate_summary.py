@@ -5,10 +5,9 @@ from __future__ import annotations
 import argparse
 import json
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
-
-from hiab_sim.errors import InvalidInputError
 
 if TYPE_CHECKING:
     from hiab_sim.env.plant.config import Plant
@@ -33,21 +32,6 @@ def task_runs(runs: list[ClosedLoopRun]) -> list[tuple[str, list[ClosedLoopRun]]
     return [(task_suffix(k), [run for run in runs if run.task == name]) for k, name in enumerate(names)]
 
 
-def refuse_mix_effects(args: argparse.Namespace, plant: Plant | None, tasks: tuple[int | None, ...]) -> None:
-    """One line (exit 2) where a plant with effects on would run the effect study on a duty mix's result.
-
-    The effect study (:mod:`hiab_sim.env.effects`) compares one plan's variants and re-plans the study
-    for the true masses; a duty mix's plans are its tasks', one per task, which it does not take.
-    """
-    if plant is not None and plant.enabled and tasks != (None,):
-        raise InvalidInputError(
-            "--plant",
-            args.plant,
-            "must have every effect off for a duty mix's result (the effect study takes one plan per design; "
-            "leave --plant out to simulate each task on the ideal plant)",
-        )
-
-
 def write_results(
     args: argparse.Namespace,
     report: dict[str, object],
@@ -56,49 +40,81 @@ def write_results(
     plant: Plant | None,
     designs: tuple[str, ...],
     out: Path,
-) -> tuple[list[str], dict[str, object] | None]:
+) -> tuple[list[str], list[TaskEffects]]:
     """Run the effect study (a plant with effects on); write ``simulation.json``, ``effects.md``, the figures.
 
-    Returns the names of the files written and the effect study (None without one), which ``report`` holds too.
+    A duty mix's effect study runs per task on the task's own plans (``tasks[k].plant_effects``,
+    ``effects_task<k>.md``, ``closed_loop_plant_effects_task<k>.png``); a single task's is
+    ``plant_effects``, ``effects.md`` and ``closed_loop_plant_effects.png``. Returns the names of the
+    files written and the effect studies (none without effects on), which ``report`` holds too.
     """
-    effects: dict[str, object] | None = None
-    if plant is not None and plant.enabled:
-        from hiab_sim.env.effects import effect_study
-
-        effects = effect_study(args.result_dir, plant, args.cycles, designs, quiet=args.quiet)
-        report["plant_effects"] = effects
+    effects = _effect_studies(args, report, plant, designs)
     from hiab_sim.atomic_io import write_atomic
 
     write_atomic(out / "simulation.json", json.dumps(report, indent=2) + "\n")
     written = ["simulation.json"]
-    if effects is not None:
-        from hiab_sim.env.effect_report import write_effect_markdown
+    from hiab_sim.env.effect_report import write_effect_markdown
 
-        written.append(write_effect_markdown(out / "effects.md", effects).name)
+    for entry in effects:
+        written.append(write_effect_markdown(out / f"effects{entry.suffix}.md", entry.study).name)
     if not args.no_figures:
         from hiab_sim.env.figures import write_figures
 
         for suffix, of_task in task_runs(runs):
             of_nominal = [run for run in nominal if run.task == of_task[0].task]
             written += [p.name for p in write_figures(out, of_task, of_nominal, suffix)]
-        if effects is not None:
-            from hiab_sim.env.effect_report import effect_figure
+        from hiab_sim.env.effect_report import effect_figure
 
-            written.append(effect_figure(out / "closed_loop_plant_effects.png", effects).name)
+        for entry in effects:
+            figure = out / f"closed_loop_plant_effects{entry.suffix}.png"
+            written.append(effect_figure(figure, entry.study).name)
     return written, effects
 
 
-def print_results(report: dict[str, object], effects: dict[str, object] | None) -> None:
-    """Print the table, the effect study's table and lines (with one) and the closing lines."""
+@dataclass(frozen=True)
+class TaskEffects:
+    """One effect study: the suffix of its files (``""``, ``_task<k>``), its task (None: a single task), the study."""
+
+    suffix: str
+    task: str | None
+    study: dict[str, object]
+
+
+def _effect_studies(
+    args: argparse.Namespace, report: dict[str, object], plant: Plant | None, designs: tuple[str, ...]
+) -> list[TaskEffects]:
+    """The effect study of every task (a duty mix: each on its own plans), put into ``report``; none without effects."""
+    if plant is None or not plant.enabled:
+        return []
+    from hiab_sim.design_report.simulation_table import task_suffix
+    from hiab_sim.env.effects import effect_study
+
+    groups = report.get("tasks")
+    if not isinstance(groups, list):
+        study = effect_study(args.result_dir, plant, args.cycles, designs, quiet=args.quiet)
+        report["plant_effects"] = study
+        return [TaskEffects(task_suffix(None), None, study)]
+    out = []
+    for k, group in enumerate(groups):  # every task of the result, in its order (simulation_report)
+        study = effect_study(args.result_dir, plant, args.cycles, designs, quiet=args.quiet, task=k)
+        group["plant_effects"] = study
+        out.append(TaskEffects(task_suffix(k), str(group["task"]), study))
+    return out
+
+
+def print_results(report: dict[str, object], effects: Sequence[TaskEffects]) -> None:
+    """Print the table, each effect study's table and lines (a duty mix's: per task) and the closing lines."""
     from hiab_sim.design_report.simulation_table import markdown_table
 
     print(markdown_table(report))
-    if effects is not None:
-        from hiab_sim.env.effect_report import effect_lines, effect_table
+    from hiab_sim.env.effect_report import effect_lines, effect_table
 
+    for of_task in effects:
         print()
-        print(effect_table(effects))
-        for line in effect_lines(effects):
+        if of_task.task is not None:
+            print(f"Plant effects, task {of_task.task} (its own plans and energies):")
+        print(effect_table(of_task.study))
+        for line in effect_lines(of_task.study):
             print(line)
     print()
     for line in closing_lines(report):

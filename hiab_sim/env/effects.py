@@ -65,9 +65,14 @@ def variants(plant: Plant) -> list[Plant]:
     return out
 
 
-def read_any_plan(result_dir: str | Path, design: str) -> DesignPlan | MachinePlan:
-    """One design's plan of a crane file's result (:func:`read_plan`) or a machine file's (``read_machine_plan``)."""
-    return read_machine_plan(result_dir, design) if is_machine_result(result_dir) else read_plan(result_dir, design)
+def read_any_plan(result_dir: str | Path, design: str, task: int | None = None) -> DesignPlan | MachinePlan:
+    """One design's plan of a crane file's result (:func:`read_plan`) or a machine file's (``read_machine_plan``).
+
+    ``task``: the index k of a duty mix's task (its own plan), None for a single-task result.
+    """
+    if is_machine_result(result_dir):
+        return read_machine_plan(result_dir, design, task)
+    return read_plan(result_dir, design, task)
 
 
 def run_plan(plan: DesignPlan | MachinePlan, plant: Plant, cycles: int) -> tuple[ClosedLoopRun, CranePhysics]:
@@ -210,14 +215,17 @@ def effect_study(
     designs: tuple[str, ...] = ("initial", "optimal"),
     quiet: bool = False,
     replan: bool = True,
+    task: int | None = None,
 ) -> dict[str, object]:
     """The ``plant_effects`` section of ``simulation.json`` (module docstring).
 
     ``replan`` False leaves the re-planned prediction out (the study's optimisation again, minutes;
-    :func:`attach_replanned` adds one computed elsewhere).
+    :func:`attach_replanned` adds one computed elsewhere). ``task``: the index k of a duty mix's task,
+    whose own plans run and whose own cycle's energies they are compared with (``result.json``
+    ``tasks[k]``); the re-planned prediction of a mix's task is skipped (:func:`replanned_prediction`).
     """
-    plans = {design: read_any_plan(result_dir, design) for design in designs}
-    battery = predicted_cycle_battery_energy(result_dir)
+    plans = {design: read_any_plan(result_dir, design, task) for design in designs}
+    battery = predicted_cycle_battery_energy(result_dir, task)
     table: dict[str, dict[str, object]] = {}
     runs = [(variant, design) for variant in variants(plant) for design in designs]
     hidden = quiet or not progress_wanted()  # redirected to a file, a bar would dump its updates into the log
