@@ -210,3 +210,45 @@ def test_a_keyframe_whose_pins_do_not_close_is_named_where_the_reference_pose_is
     assert status == 0
     header = [line for line in output.read_text().splitlines() if line.startswith("# reference pose")]
     assert len(header) == 1 and "qpos0" in header[0] and "keyframe 'home' skipped" in header[0]
+
+
+@pytest.mark.e2e
+def test_the_imported_crane_optimises_and_the_printed_mjcf_command_runs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Import, a 4 s TCP move, ``optimize``, then the ``mjcf`` command the summary prints, as printed.
+
+    The summary lists the machine copy that command reads, and the command writes the buildable
+    design's MJCF (the lift rod length ends at its bound).
+    """
+    import yaml
+
+    from hiab_sim.resources import shipped
+
+    assert _import(tmp_path, user_crane())[0] == 0
+    emla = yaml.safe_load(shipped("emla", "xs031").read_text())
+    emla["actuators"] = {"lift": emla["actuators"]["lift"], "fold": emla["actuators"]["tilt"]}
+    (tmp_path / "emla.yaml").write_text(yaml.safe_dump(emla))
+    t = np.linspace(0.0, 4.0, 201)
+    s = t / 4.0
+    blend = 10 * s**3 - 15 * s**4 + 6 * s**5
+    start, end = np.array([2.753984, 0.172474]), np.array([3.340563, 1.916326])  # m, q = (0.3, -0.3), (0.7, 0.1)
+    rows = [f"{a:.6f},{p[0]:.6f},{p[1]:.6f}" for a, p in zip(t, start + np.outer(blend, end - start), strict=True)]
+    (tmp_path / "move.csv").write_text("t,x,y\n" + "\n".join(rows) + "\n")
+    (tmp_path / "study.yaml").write_text(
+        "name: user_move\nmachine: crane.yaml\nemla: emla.yaml\nspline: {control_points: 12, degree: 5}\n"
+        "grid: {duration: 4.0, intervals: 16, fine_factor: 10}\n"
+        "tasks: [{name: move, weight: 1, reference: {kind: csv, file: move.csv}}]\n"
+        "tracking: {position: 2.0e-3, velocity: 1.0e-2, acceleration: 0.1}\n"
+        "bounds: {joint_velocity: [0.6, 0.6], working_range: machine}\nsolver: {id_path: analytic}\n"
+    )
+    capsys.readouterr()
+    run = tmp_path / "run"
+    argv = ["optimize", str(tmp_path / "study.yaml"), "--out", str(run), "--no-video", "--no-figures", "--no-report"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "machine.yaml" in out.split("Files in", 1)[1] and (run / "machine.yaml").is_file()
+    command = out.split("Model of the buildable design: hiab-sim ", 1)[1].splitlines()[0].split()
+    assert "lift.rod_length=0.82" in command
+    assert main([*command, "-o", str(tmp_path / "built.xml")]) == 0
+    assert (tmp_path / "built.xml").is_file()
