@@ -8,6 +8,8 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+from hiab_sim.errors import InvalidInputError
+
 
 @contextlib.contextmanager
 def atomic_path(path: Path) -> Iterator[Path]:
@@ -15,7 +17,13 @@ def atomic_path(path: Path) -> Iterator[Path]:
 
     The suffix is kept so that writers which pick a format from it (matplotlib, ffmpeg) behave as
     for ``path``. On any exception the temporary file is removed and ``path`` is left untouched.
+
+    Raises:
+        InvalidInputError: ``path`` is an existing folder (field ``output path``).
+
     """
+    if path.is_dir():
+        raise InvalidInputError("output path", str(path), "must name a file, not an existing folder")
     handle, name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}", dir=path.parent)
     os.close(handle)
     temporary = Path(name)

@@ -10,6 +10,7 @@ a TCP outside the declared workspace); it exits 2 when anything fails.
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 import numpy as np
@@ -158,6 +159,8 @@ def _locks(items: list[str]) -> dict[str, float]:
             raise InvalidInputError("--lock", item, "must be JOINT=VALUE with VALUE a number (rad or m)") from None
         if not sep or not name.strip():
             raise InvalidInputError("--lock", item, "must be JOINT=VALUE")
+        if not math.isfinite(out[name.strip()]):
+            raise InvalidInputError("--lock", item, "VALUE must be a finite number (rad or m)")
     return out
 
 
@@ -166,11 +169,18 @@ def run_import(args: argparse.Namespace) -> int:
     import sys
 
     from hiab_sim.atomic_io import write_atomic
+    from hiab_sim.errors import InvalidInputError
     from hiab_sim.machine.loader import machine_from_dict
     from hiab_sim.machine.mjcf_import.importer import UnsupportedMJCFError, import_mjcf
     from hiab_sim.machine.mjcf_import.round_trip import fit_ranges, machine_yaml, round_trip
     from hiab_sim.yaml_fields import parse_yaml
 
+    if args.samples < 1:
+        raise InvalidInputError("--samples", args.samples, "must be >= 1 (random states of the round trip)")
+    if not args.output.parent.is_dir():
+        raise InvalidInputError("--output", str(args.output), "its folder must exist")
+    if args.output.is_dir():
+        raise InvalidInputError("--output", str(args.output), "must name a file, not an existing folder")
     try:
         imported = import_mjcf(args.model, tcp=args.tcp, locks=_locks(args.lock), plane=args.plane)
     except UnsupportedMJCFError as error:
@@ -194,10 +204,6 @@ def run_import(args: argparse.Namespace) -> int:
             f"round trip ({args.samples} random loop-consistent states): {path} vs the MJCF, "
             f"max relative force difference {value:.2e}"
         )
-    if not args.output.parent.is_dir():
-        from hiab_sim.errors import InvalidInputError
-
-        raise InvalidInputError("--output", str(args.output), "its folder must exist")
     write_atomic(args.output, text)
     print(f"wrote {args.output}")
     return 0

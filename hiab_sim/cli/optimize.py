@@ -166,6 +166,8 @@ def run(args: argparse.Namespace) -> int:
         for line in [*summary_lines(output.result), *energy_lines(output.result), *codesign]:
             print(line)
     files = ["result.json", "trajectory.npz", SUMMARY_FILE]
+    if (output.folder / output.result.crane).is_file():  # the crane or machine file copied next to the result
+        files.append(output.result.crane)
     if output.figures:
         files.append(f"{len(output.figures)} figures (*.png)")
     if not args.no_video:

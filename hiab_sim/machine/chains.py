@@ -44,7 +44,7 @@ class Actuator:
         stroke: Usable stroke [m] > 0; the stroke x lies in [0, stroke].
         piston_offset: Lc0 [m] > 0: piston frame offset inside the cylinder at x = 0 (None: direct).
         rod_length: Lc [m] > 0: rod length, piston frame to rod-end pivot (None: direct).
-        emla: Name of the EMLA that drives it (in the EMLA file).
+        emla: Name of the EMLA that drives it: its key in the EMLA file, an identifier (letters, digits, _).
         hydraulic_cylinder: Name of the hydraulic cylinder it replaces (in ``hydraulic``), or None.
         cylinder_body: Cylinder (housing) body in the cylinder frame, or None (massless).
         rod_body: Rod body in the rod frame, or None.

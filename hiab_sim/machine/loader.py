@@ -239,6 +239,14 @@ def _optional_length(node: Mapping[str, Any], key: str, where: str) -> float | N
     return number(node[key], f"{where}.{key}") if key in node else None
 
 
+def _emla_name(value: Any, where: str) -> str:
+    """An actuator's EMLA name: an identifier, as the EMLA file's ``actuators`` keys must be."""
+    name = text(value, where)
+    if not name.isidentifier():
+        raise InvalidInputError(where, name, "must be an identifier (letters, digits, _): an EMLA file's actuator key")
+    return name
+
+
 def _chain(name: str, node: Any) -> Chain:
     where = f"chains.{name}"
     chain = mapping(node, where, _CHAIN, {"kind", "joint", "actuator"})
@@ -248,7 +256,7 @@ def _chain(name: str, node: Any) -> Chain:
         stroke=number(act["stroke"], f"{act_where}.stroke"),
         piston_offset=_optional_length(act, "piston_offset", act_where),
         rod_length=_optional_length(act, "rod_length", act_where),
-        emla=text(act["emla"], f"{act_where}.emla"),
+        emla=_emla_name(act["emla"], f"{act_where}.emla"),
         hydraulic_cylinder=text(act["hydraulic_cylinder"], f"{act_where}.hydraulic_cylinder")
         if "hydraulic_cylinder" in act
         else None,

@@ -210,6 +210,12 @@ def read_mechanism(model: mujoco.MjModel, locks: dict[str, float], plane: str = 
             continue
         b1, b2 = _connect_bodies(model, e)
         edges.append(Edge("pin", group[b1], group[b2], e, f"equality '{ename}'"))
+    hinge_names = [e.element.removeprefix("joint ") for e in edges if e.kind == "hinge"]
+    if hinge_names and not any(e.kind == "pin" for e in edges):
+        problems.append(
+            "model: no active connect equality closes a loop, so no cylinder drives the hinges "
+            f"{', '.join(hinge_names)} (pin each cylinder's rod end to its link with <connect>)"
+        )
     if problems:
         raise UnsupportedMJCFError(problems)
     mech = Mechanism(

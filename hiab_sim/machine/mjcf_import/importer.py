@@ -61,6 +61,7 @@ def _reference_pose(mech: Mechanism, dependent: list[int]) -> tuple[mujoco.MjDat
         for k in range(model.nkey)
     ]
     starts.append((model.qpos0, "qpos0 (the joints' ref)"))
+    skipped: list[str] = []  # keyframes whose pins do not close, said in the file's header
     for qpos, label in [*starts, (model.qpos0, "Newton from qpos0")]:
         data.qpos[:] = qpos
         for j, value in mech.locked.items():
@@ -68,9 +69,15 @@ def _reference_pose(mech: Mechanism, dependent: list[int]) -> tuple[mujoco.MjDat
         mujoco.mj_kinematics(model, data)
         mujoco.mj_comPos(model, data)
         residual, _ = residual_and_jacobian(mech, data)
-        if label.startswith("Newton") or (residual.size == 0 or np.max(np.abs(residual)) < CLOSED_TOL):
+        gap = float(np.max(np.abs(residual))) if residual.size else 0.0
+        if label.startswith("Newton") or gap < CLOSED_TOL:
             if close(mech, data, dependent) < 1e-10:
-                return data, label
+                return data, "; ".join([label, *skipped])
+        elif label.startswith("keyframe"):
+            skipped.append(
+                f"{label} skipped: its connect pins are up to {gap:.3g} m apart (MuJoCo places a connect's "
+                "second anchor where the first is at qpos0)"
+            )
     raise UnsupportedMJCFError(["model: no loop-consistent pose found (no keyframe or qpos0 closes the connects)"])
 
 

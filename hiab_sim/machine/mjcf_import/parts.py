@@ -6,6 +6,7 @@ Conventions and units in :mod:`hiab_sim.machine.mjcf_import.importer`; every ent
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import mujoco
@@ -23,6 +24,30 @@ Frame = tuple[np.ndarray, float]  # origin (3,) in machine coordinates [m], angl
 
 def _local(frame: Frame, p: np.ndarray) -> list[float]:
     return [float(v) for v in np.array(rot_z(frame[1])).T @ (np.asarray(p) - frame[0])]
+
+
+def emla_name(name: str) -> str:
+    """The EMLA name of an MJCF actuator: its name with every character that cannot be in an identifier as ``_``.
+
+    An EMLA file keys its actuators by identifiers (:func:`hiab_sim.emla.config.load_emla_set`).
+    """
+    out = re.sub(r"\W", "_", name)
+    return out if out.isidentifier() else f"_{out}"
+
+
+def emla_note(name: str) -> Note:
+    """The ``emla`` entry of an actuator named ``name`` in the MJCF, with its origin."""
+    renamed = "" if emla_name(name) == name else f" '{name}' as an identifier"
+    return Note(emla_name(name), f"the actuator's name{renamed} (edit: the EMLA in your EMLA file)")
+
+
+def proposed_bounds(low: float, high: float, value: float) -> list[float]:
+    """Bounds proposed around ``value`` [m], rounded to 1e-9 m (no float noise) and still holding ``value``.
+
+    A bound like 0.8200000000000001 (a stroke from a slide range) would refuse the 1 mm rounded
+    design 0.82 that ``optimize`` reports for an optimum at that bound.
+    """
+    return [min(round(low, 9), value), max(round(high, 9), value)]
 
 
 def group_name(imported: Imported, g: int) -> str:
@@ -44,6 +69,7 @@ def link_entries(imported: Imported, frames: Frames, roles: list[Role]) -> tuple
     root_bodies = frames.bodies(0, np.zeros(3), 0.0)
     links: dict[str, Any] = {ROOT: {"bodies": root_bodies} if root_bodies else {}}
     problems = []
+    failed: set[int] = set()  # groups already reported: what hangs on them is not reported again
     for g in range(1, mech.n_groups):
         if g in own:
             continue
@@ -51,8 +77,11 @@ def link_entries(imported: Imported, frames: Frames, roles: list[Role]) -> tuple
         edge = mech.edges[k]
         j = edge.index
         if edge.a not in link_frames:
-            problems.append(f"{edge.element}: its body hangs on a chain body (cylinder, rod, rocker or coupler)")
+            if edge.a not in failed:
+                problems.append(f"{edge.element}: its body hangs on a chain body (cylinder, rod, rocker or coupler)")
+            failed.add(g)
             continue
+        failed.add(g)  # until its link is written below
         if edge.kind == "hinge" and k not in driven:
             problems.append(f"{edge.element}: no actuated closed chain drives it")
             continue
@@ -107,6 +136,7 @@ def link_entries(imported: Imported, frames: Frames, roles: list[Role]) -> tuple
         if not bodies:
             problems.append(f"body '{name}': a moving link needs mass")
             continue
+        failed.discard(g)
         links[name] = {
             "parent": Note(group_name(imported, edge.a), "the parent body in the MJCF tree"),
             "joint": Note(jname, edge.element),
@@ -162,11 +192,18 @@ def chain_entry(
     qref = float(imported.qpos_ref[model.jnt_qposadr[j]])
     x0 = s_ref + kappa * ((low if kappa > 0 else high) - qref)
     stroke = high - low
+    if not x0 > stroke:
+        raise UnsupportedMJCFError(
+            [
+                f"{slide.element}: retracted pin-to-pin length x0 = {x0:.6g} m is not longer than the stroke "
+                f"{stroke:.6g} m (range [{low:g}, {high:g}]): a rod of at least the stroke must fit in x0"
+            ]
+        )
     rod_origin = frames.point(frames.data.xpos[mech.bodies(role.rod)[0]])
     lc = float((b - rod_origin)[:2] @ u[:2])
     lc_origin = f"body '{group_name(imported, role.rod)}' origin to the rod-end pin along the actuator"
     if not stroke <= lc < x0:
-        lc = min(max(stroke, 0.5 * x0), x0 - 1e-3)
+        lc = max(stroke, 0.5 * x0)  # < x0, as stroke < x0
         lc_origin = "chosen (the rod body's origin gives no Lc in [stroke, x0)): max(stroke, x0/2)"
     imported.actuators.append((j, kappa))
     cylinder = _one_body(frames.bodies(role.cylinder, a, psi), "cylinder")
@@ -186,7 +223,7 @@ def chain_entry(
         "stroke": Note(stroke, f"{range_text}: max - min"),
         "piston_offset": Note(x0 - lc, "x0 - Lc"),
         "rod_length": Note(lc, lc_origin),
-        "emla": Note(name, "the actuator's name (edit: the EMLA in your EMLA file)"),
+        "emla": emla_note(name),
         "body_scaling": Note("fixed", "chosen: an imported body's shape is unknown, so it does not rescale"),
     }
     if cylinder is not None:
@@ -239,10 +276,17 @@ def chain_entry(
     span = PIVOT_SPAN_M(x0)
     proposed = "proposed: +-10 % of x0 around the imported value; edit"
     entry["variables"] = {
-        "base_x": Note({"kind": "pivot_x", "pivot": "base", "bounds": [base[0] - span, base[0] + span]}, proposed),
-        "base_y": Note({"kind": "pivot_y", "pivot": "base", "bounds": [base[1] - span, base[1] + span]}, proposed),
+        "base_x": Note(
+            {"kind": "pivot_x", "pivot": "base", "bounds": proposed_bounds(base[0] - span, base[0] + span, base[0])},
+            proposed,
+        ),
+        "base_y": Note(
+            {"kind": "pivot_y", "pivot": "base", "bounds": proposed_bounds(base[1] - span, base[1] + span, base[1])},
+            proposed,
+        ),
         "retracted_length": Note(
-            {"kind": "retracted_length", "bounds": [0.9 * x0, 1.1 * x0]}, "proposed: +-10 % of " + x0_origin
+            {"kind": "retracted_length", "bounds": proposed_bounds(0.9 * x0, 1.1 * x0, x0)},
+            "proposed: +-10 % of " + x0_origin,
         ),
     }
     return name, entry
@@ -258,14 +302,19 @@ def _triangle_variables(hinge_distance: float, lc0: float, lc: float, stroke: fl
     out: dict[str, Any] = {}
     if hinge_distance > 1e-6:
         out["hinge_distance"] = Note(
-            {"kind": "hinge_distance", "pivot": "base", "bounds": [0.85 * hinge_distance, 1.15 * hinge_distance]},
+            {
+                "kind": "hinge_distance",
+                "pivot": "base",
+                "bounds": proposed_bounds(0.85 * hinge_distance, 1.15 * hinge_distance, hinge_distance),
+            },
             f"proposed: +-15 % of the base pin's distance from the hinge ({hinge_distance:.6g} m); edit",
         )
     out["piston_offset"] = Note(
-        {"kind": "piston_offset", "bounds": [0.7 * lc0, 1.3 * lc0]}, f"proposed: +-30 % of Lc0; {x0_origin}"
+        {"kind": "piston_offset", "bounds": proposed_bounds(0.7 * lc0, 1.3 * lc0, lc0)},
+        f"proposed: +-30 % of Lc0; {x0_origin}",
     )
     out["rod_length"] = Note(
-        {"kind": "rod_length", "bounds": [max(stroke, 0.7 * lc), 1.3 * lc]},
+        {"kind": "rod_length", "bounds": proposed_bounds(max(stroke, 0.7 * lc), 1.3 * lc, lc)},
         "proposed: +-30 % of Lc, not below the stroke",
     )
     return out

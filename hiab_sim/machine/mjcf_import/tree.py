@@ -11,7 +11,7 @@ import numpy as np
 from hiab_sim.machine.mjcf_import.chains import Role
 from hiab_sim.machine.mjcf_import.frames import Frames, Imported, Note
 from hiab_sim.machine.mjcf_import.graph import actuator_on, name_of
-from hiab_sim.machine.mjcf_import.parts import chain_entry, link_entries, tcp_entry
+from hiab_sim.machine.mjcf_import.parts import chain_entry, emla_note, link_entries, tcp_entry
 
 
 def write_tree(imported: Imported, frames: Frames, roles: list[Role], tcp: str | None, filename: str) -> None:
@@ -34,7 +34,7 @@ def write_tree(imported: Imported, frames: Frames, roles: list[Role], tcp: str |
                 "joint": Note(jname, edge.element),
                 "actuator": {
                     "stroke": Note(float(high - low), f"{edge.element} range [{low:g}, {high:g}]: max - min"),
-                    "emla": Note(act, "the actuator's name (edit: the EMLA in your EMLA file)"),
+                    "emla": emla_note(act),
                 },
             }
     gravity = Note(mech.gravity, f"option gravity {np.round(model.opt.gravity, 9).tolist()}: its in-plane magnitude")
