@@ -252,3 +252,42 @@ def test_the_imported_crane_optimises_and_the_printed_mjcf_command_runs(
     assert "lift.rod_length=0.82" in command
     assert main([*command, "-o", str(tmp_path / "built.xml")]) == 0
     assert (tmp_path / "built.xml").is_file()
+
+
+def test_radian_ranges_in_a_file_read_in_degrees_are_named_with_what_they_became(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Without ``<compiler angle="radian"/>`` MuJoCo reads ``range="-0.2 1.1"`` as degrees: 1.1 deg is 0.0192 rad.
+
+    The import follows MuJoCo (the range it writes is the compiled one) and says so, per hinge, on the
+    console and in the file's header, with the range in radians the numbers would have given. The
+    same crane with the compiler line gives no such warning.
+    """
+    assert _import(tmp_path, user_crane())[0] == 0
+    assert "warning" not in capsys.readouterr().err
+    in_degrees = user_crane().replace('<compiler angle="radian"/>', "").replace('euler="0 1.2 0"', 'euler="0 68.75 0"')
+    in_degrees = in_degrees.replace('euler="0 -0.05710043 0"', 'euler="0 -3.27161 0"')
+    in_degrees = in_degrees.replace('euler="0 -1.12637712 0"', 'euler="0 -64.5366 0"')
+    in_degrees = in_degrees.replace('range="-1.3 1.0"', 'range="-74.48 57.3"')  # q2 written in degrees: no warning
+    status, output = _import(tmp_path, in_degrees)
+    assert status == 0, capsys.readouterr().err
+    warned = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    assert len(warned) == 1 and "joint 'q1'" in warned[0]
+    assert "[-0.003491, 0.0192] rad" in warned[0] and "[-0.2, 1.1] rad" in warned[0]
+    assert f"# warning: {warned[0].split('warning: ', 1)[1]}" in output.read_text().splitlines()
+    low, up = next(link.joint_range for link in load_machine(output).links if link.joint == "q1")
+    assert up - low == pytest.approx(np.radians(1.3), rel=1e-6)  # the compiled range, kept as MuJoCo reads it
+
+
+def test_joint_damping_and_armature_left_aside_are_named_with_their_values(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A joint's damping and armature are not part of the machine format: the import names them, not drops them."""
+    text = user_crane().replace('range="-0.2 1.1"/>', 'range="-0.2 1.1" damping="350" armature="0.4"/>')
+    status, output = _import(tmp_path, text)
+    assert status == 0
+    warned = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    assert len(warned) == 1
+    assert "joint 'q1'" in warned[0] and "damping 350" in warned[0] and "armature 0.4" in warned[0]
+    assert "stiffness" not in warned[0] and "left aside" in warned[0]
+    assert any(line.startswith("# warning: joint 'q1'") for line in output.read_text().splitlines())

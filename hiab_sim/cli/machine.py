@@ -187,6 +187,8 @@ def run_import(args: argparse.Namespace) -> int:
         for line in error.lines:
             print(f"hiab-sim machine import: unsupported: {line}", file=sys.stderr)
         return 2
+    for line in imported.warnings:
+        print(f"hiab-sim machine import: warning: {line}", file=sys.stderr)
     machine = fit_ranges(imported)
     command = " ".join(["hiab-sim machine import", str(args.model), *(f"--lock {x}" for x in args.lock)])
     text = machine_yaml(imported, command + (f" --tcp {args.tcp}" if args.tcp else ""))

@@ -41,6 +41,7 @@ class Imported:
     actuators: list[tuple[int, float]] = field(default_factory=list)
     tcp: tuple[int, Array] = (0, np.zeros(3))
     notes: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)  # what the import leaves aside or suspects (import_warnings)
 
 
 class Frames:

@@ -32,6 +32,7 @@ from hiab_sim.machine.mjcf_import.chains import chain_roles
 from hiab_sim.machine.mjcf_import.frames import Frames, Imported, Note
 from hiab_sim.machine.mjcf_import.graph import ClosedChain, Mechanism, UnsupportedMJCFError, name_of
 from hiab_sim.machine.mjcf_import.graph import read_mechanism as _read
+from hiab_sim.machine.mjcf_import.import_warnings import degree_trap, terms_left_aside
 from hiab_sim.machine.mjcf_import.pose import close, residual_and_jacobian
 from hiab_sim.machine.mjcf_import.tree import write_tree
 
@@ -106,6 +107,7 @@ def import_mjcf(
     frames = Frames(mech, data)
     imported = Imported(mech, {}, data.qpos.copy())
     imported.notes.append(f"reference pose: {pose}")
+    imported.warnings += [*degree_trap(path, mech), *terms_left_aside(mech)]
     write_tree(imported, frames, roles, tcp, Path(path).name)
     return imported
 

@@ -66,6 +66,7 @@ def machine_yaml(imported: Imported, command: str) -> str:
         f"# Plane of motion: machine x = MuJoCo {np.round(axes[:, 0], 9).tolist()}, y (up) = "
         f"{np.round(axes[:, 1], 9).tolist()}, z (normal) = {np.round(axes[:, 2], 9).tolist()}.",
         *(f"# {note}" for note in imported.notes),
+        *(f"# warning: {line}" for line in imported.warnings),
         "",
     ]
     _emit(imported.tree, 0, lines)
