@@ -207,6 +207,9 @@ def test_bounds_that_exclude_the_built_crane_start_inside_them_and_converge(tmp_
     assert phase["start"] == 0 and phase["initial_max_violation"] == pytest.approx(1.2 - 1.132185818, abs=1e-6)
     assert any(line.startswith("tilt.L: 1132.2 -> 1200.0 mm") for line in phase["changes"])
     assert phase["final_max_violation"] <= 1e-9
+    summary = (tmp_path / "run" / "summary.md").read_text(encoding="utf-8")  # the answer says from where it counts
+    assert "the feasibility phase moved it: tilt.L: 1132.2 -> 1200.0 mm" in summary
+    assert "measured from the moved start" in summary
 
 
 def test_an_impossible_payload_exits_3_naming_the_limit(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

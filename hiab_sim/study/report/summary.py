@@ -174,6 +174,22 @@ def _trajectory_line(r: Result) -> str | None:
     )
 
 
+def _moved_start(r: Result) -> str | None:
+    """What the feasibility phase did to the study's own start (start 0, the result's), or None where it was feasible.
+
+    The result's ``initial`` design is the moved start, so the changes above and the saving below are
+    measured from it, not from the study file's ``initial_lengths``: said here, where they are read.
+    """
+    phase = next((f for f in r.feasibility or () if f.start == 0), None)
+    if phase is None:
+        return None
+    return (
+        f"  The study's initial design violated a limit ({limit_in_words(phase.initial_worst, detail=False)}); "
+        f"before optimising, the feasibility phase moved it: {'; '.join(phase.changes)}. The changes above and "
+        "the saving below are measured from the moved start."
+    )
+
+
 def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[str]:
     """The summary as lines of Markdown (also readable as plain console text)."""
     built = r.buildable.lengths if r.buildable is not None else r.optimal.lengths
@@ -182,6 +198,9 @@ def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[st
     lines += _design_lines(built, r.initial.lengths, tolerance)
     if r.buildable is None:
         lines.append("  (the optimum itself: this study has no buildable-design check)")
+    moved = _moved_start(r)
+    if moved is not None:
+        lines.append(moved)
     lines += ["", _energy_line(r)]
     binding: list[str] = []
     for m in () if r.sensitivity is None else r.sensitivity.multipliers:
