@@ -48,8 +48,13 @@ def _shade_workspace(ax: object, points: Array) -> None:
     filled[:, :-1] |= grid[:, 1:]
     image = np.zeros((_RASTER, _RASTER, 4))
     image[filled] = (0.35, 0.55, 0.85, 0.25)
+    half = 0.5 * span / (_RASTER - 1)  # sample i sits at the centre of cell i: the cells reach half a cell beyond
     ax.imshow(  # type: ignore[attr-defined]
-        image, origin="lower", extent=(low[0], high[0], low[1], high[1]), interpolation="nearest", zorder=0
+        image,
+        origin="lower",
+        extent=(low[0] - half[0], high[0] + half[0], low[1] - half[1], high[1] + half[1]),
+        interpolation="nearest",
+        zorder=0,
     )
 
 
@@ -132,6 +137,9 @@ def draw_machine(machine: Machine) -> Figure:
     ax.annotate("TCP", _xy(tcp[:2]), xytext=(6, -4), textcoords="offset points", color="tab:red", fontsize=9)
     ax.plot([], [], "s", color=(0.35, 0.55, 0.85, 0.4), label="TCP workspace over the working ranges")
     ax.legend(loc="best", fontsize=8)
+    ax.use_sticky_edges = False  # the image's extent is not the frame: a margin around the workspace and labels
+    ax.margins(0.05)
+    ax.autoscale_view()
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m] (up)")
