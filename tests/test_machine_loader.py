@@ -58,6 +58,13 @@ BAD_FILES: list[tuple[str, Callable[[dict[str, Any]], None], type[HiabSimError],
     ),
     ("duplicate joint name", _set("links.arm.joint", "alpha"), InvalidInputError, "links.arm.joint"),
     ("two chains on one joint", _set("chains.arm.joint", "alpha"), InvalidInputError, "chains.arm.joint"),
+    # the EMLA names are the study's actuator names (results, EMLA file): two chains cannot share one
+    (
+        "two chains name one EMLA",
+        _set("chains.arm.actuator.emla", "boom"),
+        InvalidInputError,
+        "chains.arm.actuator.emla",
+    ),
     (
         "NaN inertia",
         _set("links.arm.bodies.arm.inertia_zz", float("nan")),

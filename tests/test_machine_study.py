@@ -255,6 +255,33 @@ def test_a_machine_studys_transmission_catalogue_is_keyed_by_its_actuators(tmp_p
         load_study(_excavator_with_catalogue(tmp_path, {"lift": [{"gear_ratio": 4.0, "screw_lead": 0.005}]}))
 
 
+def test_transmission_keys_are_the_emla_names_where_they_differ_from_the_chain_names(tmp_path: Path) -> None:
+    """Chains named apart from their EMLAs: the catalogue takes the EMLA names (the EMLA file's and the result's).
+
+    A chain's name there is one line that lists the EMLA names.
+    """
+    from importlib import resources
+
+    from hiab_sim.machine.loader import load_machine
+
+    presets = resources.files("hiab_sim") / "presets"
+    machine = yaml.safe_load((presets / "exact_excavator.yaml").read_text(encoding="utf-8"))
+    emla = yaml.safe_load((presets / "emla_exact.yaml").read_text(encoding="utf-8"))
+    chains = load_machine("exact").actuator_names
+    for chain in chains:
+        machine["chains"][chain]["actuator"]["emla"] = f"e_{chain}"
+    emla["actuators"] = {f"e_{chain}": emla["actuators"][chain] for chain in chains}
+    (tmp_path / "renamed.yaml").write_text(yaml.safe_dump(machine), encoding="utf-8")
+    (tmp_path / "emla.yaml").write_text(yaml.safe_dump(emla), encoding="utf-8")
+    joint_csv(tmp_path / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [0.5, -1.3, -0.3], 4.0)
+    option = [{"gear_ratio": 4.0, "screw_lead": 0.005}]
+    top = {**EXCAVATOR_STUDY, "machine": "renamed.yaml", "emla": "emla.yaml"}
+    study = _study(tmp_path, {**top, "transmission": {f"e_{chains[0]}": option}})
+    assert [name for name, _ in study.energy.transmission.options] == [f"e_{chains[0]}"]  # type: ignore[attr-defined]
+    with pytest.raises(ConfigError, match=rf"transmission: unknown key\(s\) \['{chains[0]}'\].*'e_{chains[0]}'"):
+        _study(tmp_path, {**top, "transmission": {chains[0]: option}})
+
+
 @pytest.mark.e2e
 def test_codesign_runs_on_a_machine_file_and_keeps_the_lowest_battery_energy(tmp_path: Path) -> None:
     """Mounting optimised per transmission of one excavator EMLA: the file's own first, the best the cheapest."""

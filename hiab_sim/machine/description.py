@@ -248,9 +248,18 @@ class Machine:
         if len(set(names)) != len(names):
             raise InvalidInputError("chains", str(names), "duplicate chain name")
         driven: dict[str, str] = {}
+        emla_of: dict[str, str] = {}  # the EMLA names are the study's actuator names: one per chain
         rotations = self.fixed_rotations()
         for chain in self.chains:
             where = f"chains.{chain.name}"
+            emla = chain.actuator.emla or chain.name
+            if emla in emla_of:
+                raise InvalidInputError(
+                    f"{where}.actuator.emla",
+                    emla,
+                    f"already the EMLA of chain {emla_of[emla]}; the EMLA file lists one per chain",
+                )
+            emla_of[emla] = chain.name
             if chain.joint not in self.joint_names:
                 raise InvalidInputError(f"{where}.joint", chain.joint, f"unknown joint; joints: {self.joint_names}")
             if chain.joint in driven:

@@ -1,7 +1,7 @@
 """One task's design evaluated on a grid: energies, peaks, violations, re-check and the saving's decomposition.
 
-Energies are integrated on the fine grid (10x the collocation grid): the cost of eq. ``costf2``
-is 1/2 Dt sum (sum_i P_i)^2 [W^2 s], a squared-power integral, not an energy, so the net
+Energies are integrated on the fine grid (``grid.fine_factor`` times the collocation grid, 10 by default): the
+cost of eq. ``costf2`` is 1/2 Dt sum (sum_i P_i)^2 [W^2 s], a squared-power integral, not an energy, so the net
 electrical energy (regeneration credited) and the energy drawn without regeneration are
 reported separately, with the loss breakdown of :func:`hiab_sim.emla.operating_point`. Every
 ``cost_W2s`` here is costf2 whatever the study's objective (:func:`hiab_sim.study.nlp.objectives.costf2`).
@@ -170,7 +170,8 @@ def recheck_section(checks: dict[str, DesignCheck], recheck: TaskProblem) -> Rec
     return Recheck(
         id_path=recheck.id_path,
         grid_points=len(recheck.times),
-        note="optimal design re-evaluated on the 10x finer grid with the other ID path and nominal bands",
+        note=f"optimal design re-evaluated on the {recheck.study.grid.fine_factor}x finer grid with the other ID path "
+        "and nominal bands",
         max_violation_scaled=rc.max_violation,
         worst_constraint=rc.worst_constraint,
         tracking_error=rc.tracking_error,

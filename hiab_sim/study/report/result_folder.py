@@ -180,7 +180,7 @@ def build_result(
             decomposition=weighted_decomposition(decompositions, w),
         ),
         solver=solver_summary(problem, main, wall_time),
-        recheck=weighted_recheck([t.recheck for t in task_results], w, names),
+        recheck=weighted_recheck([t.recheck for t in task_results], w, names, study.grid.fine_factor),
         multistart=multistart_summary(
             problem, results, multistart_tolerance, energy=study_energy, objective=study_objective
         ),

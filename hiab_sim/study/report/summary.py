@@ -190,6 +190,34 @@ def _moved_start(r: Result) -> str | None:
     )
 
 
+def _thermal_line(r: Result) -> str | None:
+    """A line when the optimum's motors exceed their thermal limits in a study that does not hold them.
+
+    Without ``duty:`` the study has no thermal rows (:mod:`hiab_sim.study.constraints.thermal_rows`), yet the
+    result reports each motor's RMS torque and winding temperature over back-to-back cycles; "all limits hold"
+    must not read as covering them.
+    """
+    reports = [(f"{t.name}: ", t.energy) for t in r.tasks] if r.tasks else [("", r.energy)]
+    over = []
+    for task, e in reports:
+        if e is None or e.optimal.duty is not None or e.optimal.thermal is None:
+            continue
+        for name, th in e.optimal.thermal.items():
+            if th.torque_margin < 0.0 or th.temperature_margin_K < 0.0:
+                over.append(
+                    f"{task}{name} winding {th.peak_winding_temperature_C:.0f} degC (limit "
+                    f"{th.max_winding_temperature_C:.0f}), RMS torque {th.rms_torque_Nm:.3g} of "
+                    f"{th.continuous_torque_Nm:.3g} N m"
+                )
+    if not over:
+        return None
+    return (
+        "Thermal limits exceeded over back-to-back cycles, and not held by this study (it gives no duty:): "
+        + "; ".join(over)
+        + ". Give the duty (rest, hold) to hold them."
+    )
+
+
 def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[str]:
     """The summary as lines of Markdown (also readable as plain console text)."""
     built = r.buildable.lengths if r.buildable is not None else r.optimal.lengths
@@ -224,9 +252,9 @@ def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[st
             where = "the lowest" if reported == 0.0 else f"{reported:.2g} % above the lowest"
             agree += f" (their {ms.objective} within {spread:.2g} % of the lowest; the result is start 0's, {where})"
         lines.append(f"Starts: {ms.converged_starts} of {len(ms.starts)} converged, to {agree}{failed}.")
-    trajectories = _trajectory_line(r)
-    if trajectories is not None:
-        lines.append(trajectories)
+    for extra in (_trajectory_line(r), _thermal_line(r)):
+        if extra is not None:
+            lines.append(extra)
     violation = r.recheck.max_violation_scaled
     lines.append(
         f"Checked on a {r.recheck.grid_points}-point grid with the other dynamics model: "

@@ -100,15 +100,16 @@ def weighted_summary(summaries: list[DesignSummary], weights: Array, names: list
     )
 
 
-def weighted_recheck(rechecks: list[Recheck], weights: Array, names: list[str]) -> Recheck:
-    """The study's re-check: violations and force differences the worst, energy weighted."""
+def weighted_recheck(rechecks: list[Recheck], weights: Array, names: list[str], fine_factor: int) -> Recheck:
+    """The study's re-check: violations and force differences the worst, energy weighted (``fine_factor``: grid's)."""
     if is_one_task([float(v) for v in weights]):
         return rechecks[0]
     worst = min(range(len(rechecks)), key=lambda k: rechecks[k].worst_constraint.scaled_margin)
     return Recheck(
         id_path=rechecks[0].id_path,
         grid_points=sum(r.grid_points for r in rechecks),
-        note="every task's optimal design re-evaluated on its 10x finer grid with the other ID path and nominal bands",
+        note=f"every task's optimal design re-evaluated on its {fine_factor}x finer grid with the other ID path "
+        "and nominal bands",
         max_violation_scaled=max(r.max_violation_scaled for r in rechecks),
         worst_constraint=WorstConstraint(
             f"{names[worst]}: {rechecks[worst].worst_constraint.name}", rechecks[worst].worst_constraint.scaled_margin

@@ -51,6 +51,8 @@ POLISH = 1e-2
 START_TOLERANCE = 1e-9
 #: Iteration limit of a mix's projection on IPOPT.
 PROJECTION_ITERATIONS = 300
+#: Rows within this [scaled] of the least violation count as violated as much (a least-largest violation ties them).
+TIE = 1e-6
 _REMEDY = {
     "peak_torque": "a larger motor or gear ratio is needed",
     "rated_speed": "a faster motor or a longer screw lead is needed",
@@ -98,6 +100,24 @@ def describe_violation(problem: StudyProblem, index: int, value: float) -> str:
     if per_unit > 0.0:
         return f"{name}{where} violated by {-value / per_unit:.3g} {unit}"
     return f"{name}{where} violated by {-value:.3g} (scaled)"
+
+
+def describe_binding(problem: StudyProblem, g: Array) -> str:
+    """The most violated row in words, then the most violated row of each other block violated as much.
+
+    Minimising the largest violation spreads it over every row that competes for the same design: the
+    limit that cannot be met (a winding temperature) ends tied with those it was traded against (the
+    tracking band), so every tied block is named.
+    """
+    order = np.argsort(g, kind="stable")
+    blocks: dict[str, int] = {}
+    for k in order:
+        if g[k] > g[order[0]] + TIE:
+            break
+        block = problem.constraint_names[k].rpartition(": ")[2].split(".")[0]
+        blocks.setdefault(block, int(k))
+    words = [describe_violation(problem, k, float(g[k])) for k in blocks.values()]
+    return words[0] + "".join(f"; as far out: {w}" for w in words[1:])
 
 
 def _phi(problem: StudyProblem, z: Array) -> tuple[float, Array]:
@@ -253,11 +273,10 @@ def feasible_start(
                 continue
         g = problem.constraints(z)
     if g.min() < -START_TOLERANCE or np.abs(problem.equalities(z)).max() > 1e-9:
-        k = int(np.argmin(g))
         xi = ", ".join(f"{v:.4f}" for v in problem.unpack(z)[0].as_array())
         raise InfeasibleStudyError(
             f"no feasible point within the bounds (feasibility phase from start {start}, least violation at "
-            f"Xi = [{xi}] m): " + describe_violation(problem, k, float(g[k]))
+            f"Xi = [{xi}] m): " + describe_binding(problem, g)
         )
     before, _ = problem.unpack(z0)
     after, _ = problem.unpack(z)

@@ -91,7 +91,7 @@ def machine_study_from_dict(top: dict[str, Any], file: Source) -> Study:
         emlas=emlas,
         initial_lengths=initial,
         bounds=bounds,
-        **shared_sections(top, tuple(machine.actuator_names)),
+        **shared_sections(top, tuple(model.actuator_names)),  # the EMLA names, the keys of emlas and results
         crane_file=machine_file,
         machine=machine,
         tracked=tracked,
