@@ -143,7 +143,7 @@ def _four_bar(
                         "base": {"link": "ground", "position": [0.3, -0.3]},
                         "end": {"link": "stick", "position": [0.5, 0.1]},
                     },
-                    "actuator": {"stroke": 1.0, "piston_offset": 0.05, "rod_length": 0.3, "emla": "e"},
+                    "actuator": {"stroke": 1.0, "piston_offset": 0.05, "rod_length": 0.3, "emla": "e1"},
                 },
                 "c2": {
                     "kind": "linkage",
@@ -154,7 +154,7 @@ def _four_bar(
                         "coupler": {"link": "tool", "position": list(coupler)},
                     },
                     "linkage": {"rocker_length": lengths[0], "coupler_length": lengths[1], "pin_side": side},
-                    "actuator": {"stroke": 2.0, "piston_offset": 0.05, "rod_length": 0.2, "emla": "e"},
+                    "actuator": {"stroke": 2.0, "piston_offset": 0.05, "rod_length": 0.2, "emla": "e2"},
                 },
             },
             "tcp": {"link": "tool", "r": [0.4, 0.0]},
