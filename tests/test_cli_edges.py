@@ -80,3 +80,9 @@ def test_an_all_infeasible_energy_map_says_which_limit_binds_and_what_to_map(
     chain = note.split(" cells break ")[1].split()[0]
     assert f"map {chain}.Lc0 and {chain}.Lc instead" in note
     assert "_" not in note.split(" cells break ")[1].split(" with ")[0]  # the limit in words, not a row name
+    # beside the most frequent limit, the next two with their counts, the rest counted: as energy_map.json has them
+    counts = sorted(summary["infeasible_cells_by_binding_constraint"].values(), reverse=True)
+    named = [int(note.split(" cells break ")[0].rsplit(" ", 1)[1])]
+    named += [int(part.split(" break ")[0]) for part in note.split("(the other cells: ")[1].split("; ")[:2]]
+    assert named == counts[:3]
+    assert f" and {len(counts) - 3} more limit" in note

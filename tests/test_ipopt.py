@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 from test_mix import LOCAL_SPREAD, two_tasks
@@ -155,6 +159,31 @@ def test_the_studys_lbfgs_history_is_the_one_ipopt_keeps(monkeypatch: pytest.Mon
         with pytest.raises(StopError):
             solve(problem, problem.study.initial_lengths, progress=None)
         assert seen[-1]["ipopt.limited_memory_max_history"] == expected
+
+
+def test_an_ipopt_solve_prints_nothing_on_stdout() -> None:
+    """IPOPT's licence banner is off: a solve in a fresh process (the banner comes once per process) writes no stdout.
+
+    The banner is C-level output, so the solve runs in a subprocess whose stdout is read whole.
+    """
+    pytest.importorskip("casadi")
+    script = (
+        "import sys; sys.path.insert(0, 'tests')\n"
+        "from test_mix import two_tasks\n"
+        "from hiab_sim.study.nlp.problem import StudyProblem\n"
+        "from hiab_sim.study.solvers.slsqp import solve\n"
+        "from hiab_sim.study.spec.study_file import study_from_dict\n"
+        "p = StudyProblem(study_from_dict(two_tasks(method='ipopt', maxiter=3), 'two.yaml'))\n"
+        "from hiab_sim.errors import SolverError\n"
+        "try:\n"
+        "    solve(p, p.study.initial_lengths, progress=None)\n"
+        "except SolverError:\n"  # three iterations do not converge: the banner comes at the first
+        "    pass\n"
+    )
+    root = Path(__file__).resolve().parents[1]
+    done = subprocess.run([sys.executable, "-c", script], cwd=root, capture_output=True, text=True, check=False)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout == ""
 
 
 @pytest.mark.parametrize("value", [0, 2.5, "many", 501])

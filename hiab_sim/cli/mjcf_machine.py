@@ -40,11 +40,15 @@ def run_machine(args: argparse.Namespace, result_choice: str | None) -> int:
 
     if args.lengths:
         raise InvalidInputError(
-            "--lengths", args.lengths, "is the crane's; give a machine's design as --design chain.var=value"
+            "--lengths",
+            args.lengths,
+            "must be left out for a machine file (a crane file's lengths): give its design as --design chain.var=value",
         )
     if args.stroke_margin:
         raise InvalidInputError(
-            "--stroke-margin", args.stroke_margin, "is the crane file's; a machine file keeps its ranges"
+            "--stroke-margin",
+            args.stroke_margin,
+            "must be left out for a machine file (a crane file's option): a machine file keeps its working ranges",
         )
     machine, design = machine_and_design(args, result_choice)
     output = Path(args.output)

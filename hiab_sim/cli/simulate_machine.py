@@ -108,9 +108,10 @@ def run_machine(
         for design, entry in group.designs.items():
             if entry.get("battery_energy_difference_percent") is not None:
                 print(
-                    f"{opened}{design}: battery energy {entry['battery_energy_J']:.1f} J "
+                    f"{opened}{design}: battery energy over the cycle {entry['battery_energy_J']:.1f} J "
                     f"closed loop against {entry['predicted_battery_energy_J']:.1f} J planned "
-                    f"({entry['battery_energy_difference_percent']:+.2f} %)."
+                    f"({entry['battery_energy_difference_percent']:+.2f} %; without a duty period's rest, "
+                    "which optimize's battery energy per duty period holds)."
                 )
     print(f"wrote {', '.join(written)} to {out}", file=sys.stderr)
     return 0

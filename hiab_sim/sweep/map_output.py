@@ -147,11 +147,17 @@ def write_map(m: EnergyMap, out: Path, per: str = "cycle") -> list[Path]:
     return paths
 
 
-def infeasible_note(m: EnergyMap) -> str | None:
-    """Why cells are infeasible, in words: the most frequent binding limit and which variables to map instead.
+#: Limits named beside the most frequent one in an infeasible map's note (the rest are counted, listed in the JSON).
+OTHER_LIMITS = 2
 
-    None when most cells are feasible. The hint names the other decision variables of the chain the binding
-    limit belongs to (they move that limit), else the two variables of the map with wider bounds.
+
+def infeasible_note(m: EnergyMap, with_others: bool = True) -> str | None:
+    """Why cells are infeasible, in words: the most frequent binding limit (then the others') and what to map instead.
+
+    None when most cells are feasible. ``with_others``: also the next limits with their counts (the console;
+    the figure's legend colours every limit, so its note leaves them out). The hint names the other decision
+    variables of the chain the binding limit belongs to (they move that limit), else the two variables of the
+    map with wider bounds.
     """
     from hiab_sim.study.report.summary import limit_in_words
 
@@ -172,9 +178,15 @@ def infeasible_note(m: EnergyMap) -> str | None:
     )
     count = int(feasible.sum())
     head = "no feasible cell" if count == 0 else f"only {count} feasible cell{'' if count == 1 else 's'}"
+    rest = sorted(zip(counts.tolist(), names.tolist(), strict=True), key=lambda c: -c[0])[1:]
+    also = "; ".join(f"{n} break {limit_in_words(v.names[int(k)], detail=False)}" for n, k in rest[:OTHER_LIMITS])
+    hidden = len(rest) - OTHER_LIMITS
+    more = f" and {hidden} more limit{'s' if hidden > 1 else ''} (energy_map.json)" if hidden > 0 else ""
     return (
         f"{head} of {feasible.size}: {share} cells break {limit_in_words(top)} "
-        f"with the other decision variables fixed at the {m.base.source.split(' (')[0]};\n{hint}"
+        f"with the other decision variables fixed at the {m.base.source.split(' (')[0]}"
+        + (f" (the other cells: {also}{more})" if rest and with_others else "")
+        + f";\n{hint}"
     )
 
 
@@ -240,7 +252,7 @@ def figure_png(m: EnergyMap, per: str = "cycle") -> bytes:
         ax.set_xlabel(variable_words(m.variables[0]))
         ax.set_ylabel(variable_words(m.variables[1]))
         ax.set_title(title, fontsize=10)
-    note = infeasible_note(m)
+    note = infeasible_note(m, with_others=False)  # the legend names every limit by its colour
     if note is not None:
         wrapped = "\n".join(textwrap.fill(part, 58) for part in note.split("\n"))
         for ax in axes:

@@ -241,6 +241,7 @@ def solve_ipopt(
         "ipopt.acceptable_constr_viol_tol": constraint_tolerance,
         "ipopt.acceptable_compl_inf_tol": 1e-6,
         "ipopt.print_level": int(os.environ.get("HIAB_IPOPT_PRINT", "0")),
+        "ipopt.sb": "yes",  # no licence banner on stdout (it broke --quiet and the answer-first console)
         "ipopt.print_timing_statistics": "yes" if os.environ.get("HIAB_IPOPT_PRINT") else "no",
         "print_time": False,
         "iteration_callback": iteration,
