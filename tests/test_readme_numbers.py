@@ -106,3 +106,18 @@ def test_the_prose_numbers_are_the_recorded_runs() -> None:
         assert f"{before:.{digits}f} → {after:.{digits}f} {unit} (−{e['battery_energy_saved_percent']:.1f} %" in text, (
             run
         )
+
+
+def test_the_duty_mix_plant_sentence_is_the_recorded_per_task_runs() -> None:
+    """The README's per-task effect numbers of exact_duty_mix are the recorded run's, and its claim holds there.
+
+    ``tests/data/plant_effects_exact_duty_mix.json`` holds each task's ``plant_effects`` of ``simulation.json``.
+    """
+    recorded = json.loads((ROOT / "tests" / "data" / "plant_effects_exact_duty_mix.json").read_text())
+    text = _prose()
+    for entry in recorded["tasks"]:
+        every = entry["plant_effects"]["variants"]["all"]
+        initial, optimal = (every[d]["battery_energy_difference_percent"] for d in ("initial", "optimal"))
+        assert f"{initial:+.2f} / {optimal:+.2f} % for {entry['task']}" in text, entry["task"]
+        variants = entry["plant_effects"]["variants"].values()
+        assert all(v["optimal_below_initial_battery"] for v in variants), entry["task"]
