@@ -41,91 +41,47 @@ def _set(path: str, value: Any) -> Callable[[dict[str, Any]], None]:
     return edit
 
 
+def _bad(
+    what: str, path: str, value: Any, field: str | None = None, error: type[HiabSimError] = InvalidInputError
+) -> tuple[str, Callable[[dict[str, Any]], None], type[HiabSimError], str]:
+    """A defect: its label, the edit setting ``path`` to ``value``, the error and the field its message names."""
+    return what, _set(path, value), error, path if field is None else field
+
+
 BAD_FILES: list[tuple[str, Callable[[dict[str, Any]], None], type[HiabSimError], str]] = [
-    ("unknown parent link", _set("links.arm.parent", "stick"), InvalidInputError, "links.arm.parent"),
-    ("chain drives an unknown joint", _set("chains.arm.joint", "theta9"), InvalidInputError, "chains.arm.joint"),
-    (
-        "pivot on a missing link",
-        _set("chains.boom.pivots.base.link", "turret"),
-        InvalidInputError,
-        "chains.boom.pivots.base.link",
-    ),
-    (
-        "pivot on a non-adjacent link",
-        _set("chains.boom.pivots.base.link", "bucket"),
-        InvalidInputError,
-        "chains.boom.pivots.base.link",
-    ),
-    ("duplicate joint name", _set("links.arm.joint", "alpha"), InvalidInputError, "links.arm.joint"),
-    ("two chains on one joint", _set("chains.arm.joint", "alpha"), InvalidInputError, "chains.arm.joint"),
+    _bad("unknown parent link", "links.arm.parent", "stick"),
+    _bad("chain drives an unknown joint", "chains.arm.joint", "theta9"),
+    _bad("pivot on a missing link", "chains.boom.pivots.base.link", "turret"),
+    _bad("pivot on a non-adjacent link", "chains.boom.pivots.base.link", "bucket"),
+    _bad("duplicate joint name", "links.arm.joint", "alpha"),
+    _bad("two chains on one joint", "chains.arm.joint", "alpha"),
     # the EMLA names are the study's actuator names (results, EMLA file): two chains cannot share one
-    (
-        "two chains name one EMLA",
-        _set("chains.arm.actuator.emla", "boom"),
-        InvalidInputError,
-        "chains.arm.actuator.emla",
-    ),
-    (
-        "NaN inertia",
-        _set("links.arm.bodies.arm.inertia_zz", float("nan")),
-        InvalidInputError,
-        "links.arm.bodies.arm.inertia_zz",
-    ),
-    (
-        "negative inertia",
-        _set("links.arm.bodies.arm.inertia_zz", -1.0),
-        InvalidInputError,
-        "links.arm.bodies.arm.inertia_zz",
-    ),
-    ("negative mass", _set("links.boom.bodies.boom.mass", -2.0), InvalidInputError, "links.boom.bodies.boom.mass"),
-    (
+    _bad("two chains name one EMLA", "chains.arm.actuator.emla", "boom"),
+    _bad("NaN inertia", "links.arm.bodies.arm.inertia_zz", float("nan")),
+    _bad("negative inertia", "links.arm.bodies.arm.inertia_zz", -1.0),
+    _bad("negative mass", "links.boom.bodies.boom.mass", -2.0),
+    _bad(
         "non-physical 3D inertia",
-        _set("chains.arm.actuator.cylinder_body.inertia", [[0.01, 0, 0], [0, 0.01, 0], [0, 0, 1.0]]),
-        InvalidInputError,
         "chains.arm.actuator.cylinder_body.inertia",
+        [[0.01, 0, 0], [0, 0.01, 0], [0, 0, 1.0]],
     ),
-    (
-        "stroke shorter than the range needs",
-        _set("chains.arm.actuator.stroke", 0.45),
-        InvalidInputError,
-        "chains.arm.actuator.stroke",
-    ),
-    ("loop that cannot close", _set("chains.bucket.linkage.rocker_length", 0.05), InvalidInputError, "chains.bucket"),
-    (
-        "working range through a toggle",
-        _set("links.boom.joint_range", [-0.4737, 2.9]),
-        InvalidInputError,
-        "links.boom.joint_range",
-    ),
-    ("unknown key", _set("chains.arm.actuator.strok", 0.5), ConfigError, "chains.arm.actuator"),
-    ("a word for a number", _set("gravity", "nine"), ConfigError, "gravity"),
-    ("unknown chain kind", _set("chains.arm.kind", "scissor"), InvalidInputError, "chains.arm.kind"),
-    (
-        "variable bound upside down",
-        _set("chains.arm.variables.L.bounds", [1.5, 1.1]),
-        InvalidInputError,
-        "chains.arm.variables.L.bounds",
-    ),
-    (
-        "variable outside its bounds",
-        _set("chains.arm.variables.L.bounds", [1.4, 1.5]),
-        InvalidInputError,
-        "chains.arm.variables.L",
-    ),
-    (
-        "unknown hydraulic cylinder",
-        _set("chains.arm.actuator.hydraulic_cylinder", "stick"),
-        InvalidInputError,
-        "hydraulic.cylinders",
-    ),
-    (
+    _bad("stroke shorter than the range needs", "chains.arm.actuator.stroke", 0.45),
+    _bad("loop that cannot close", "chains.bucket.linkage.rocker_length", 0.05, field="chains.bucket"),
+    _bad("working range through a toggle", "links.boom.joint_range", [-0.4737, 2.9]),
+    _bad("unknown key", "chains.arm.actuator.strok", 0.5, field="chains.arm.actuator", error=ConfigError),
+    _bad("a word for a number", "gravity", "nine", error=ConfigError),
+    _bad("unknown chain kind", "chains.arm.kind", "scissor"),
+    _bad("variable bound upside down", "chains.arm.variables.L.bounds", [1.5, 1.1]),
+    _bad("variable outside its bounds", "chains.arm.variables.L.bounds", [1.4, 1.5], field="chains.arm.variables.L"),
+    _bad("unknown hydraulic cylinder", "chains.arm.actuator.hydraulic_cylinder", "stick", field="hydraulic.cylinders"),
+    _bad(
         "revolute axis out of the plane",
-        _set("links.arm.joint_frame", {"r": [2.05, 0.0], "R": [[1, 0, 0], [0, 0, -1], [0, 1, 0]]}),
-        InvalidInputError,
-        "links.arm.joint_frame.R",
+        "links.arm.joint_frame",
+        {"r": [2.05, 0.0], "R": [[1, 0, 0], [0, 0, -1], [0, 1, 0]]},
+        field="links.arm.joint_frame.R",
     ),
-    ("realistic plant that does not exist", _set("realistic_plant", "no_such_plant"), ConfigError, "realistic_plant"),
-    ("realistic plant not a name", _set("realistic_plant", {"file": "x"}), ConfigError, "realistic_plant"),
+    _bad("realistic plant that does not exist", "realistic_plant", "no_such_plant", error=ConfigError),
+    _bad("realistic plant not a name", "realistic_plant", {"file": "x"}, error=ConfigError),
 ]
 
 
