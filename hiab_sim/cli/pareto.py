@@ -44,7 +44,8 @@ def run(args: argparse.Namespace) -> int:
     from hiab_sim.study.spec.study_file import DEFAULT_STUDY, load_study
     from hiab_sim.sweep.answers import front_answer
     from hiab_sim.sweep.out_folder import check_out_folder
-    from hiab_sim.sweep.pareto import CRITERIA, front_figure_png, pareto_front
+    from hiab_sim.sweep.pareto import CRITERIA, pareto_front
+    from hiab_sim.sweep.pareto_figure import front_figure_png
     from hiab_sim.terminal import StatusLine
 
     if args.points < 2:
@@ -78,7 +79,10 @@ def run(args: argparse.Namespace) -> int:
         "least_criterion": traced.least.as_row(),
     }
     write_atomic(out / "pareto.json", json.dumps(summary, indent=2) + "\n")
-    write_atomic(out / "pareto.png", front_figure_png(front, args.against, study.name, study_problem.objective.name))
+    write_atomic(
+        out / "pareto.png",
+        front_figure_png(front, args.against, study.name, study_problem.objective.name, traced.least),
+    )
     details = []
     for p in front:
         status = "ok" if p.accepted else f"not converged: {p.message}"
