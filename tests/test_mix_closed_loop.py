@@ -229,5 +229,7 @@ def test_the_effect_study_of_a_mix_runs_per_task_on_its_own_plans(crane_mix: Pat
         assert split["predicted_J"] == pytest.approx(planned["optimal"]["net_electrical_energy_J"], rel=1e-12)
         assert split["predicted_at_true_masses_J"] > split["predicted_J"]
         assert "single-task" in effects["mismatch_replanned"]["skipped"]
-        assert (tmp_path / "real" / f"effects_task{k}.md").is_file()
+        assert effects["task"] == planned["name"]
+        title = (tmp_path / "real" / f"effects_task{k}.md").read_text(encoding="utf-8").splitlines()[0]
+        assert f"task {planned['name']} (its own plans and energies)" in title
     assert not (tmp_path / "real" / "effects.md").exists()

@@ -110,8 +110,9 @@ def compact_effect_table(report: dict[str, object]) -> str:
 def effect_markdown(report: dict[str, object]) -> str:
     """``effects.md``: the compact table (:func:`compact_effect_table`), the full table, the lines in words."""
     cycles = report.get("cycles", 1)
+    task = f", task {report['task']} (its own plans and energies)" if report.get("task") else ""
     parts = [
-        f"# Plant effects: {report['plant']} plant, {cycles} cycle(s) per run (energies of the last)",
+        f"# Plant effects: {report['plant']} plant{task}, {cycles} cycle(s) per run (energies of the last)",
         "",
         compact_effect_table(report),
         "",

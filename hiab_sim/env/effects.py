@@ -252,6 +252,7 @@ def effect_study(
                 entry[_CHEAPER[key]] = energy["optimal"] < energy["initial"]
     report: dict[str, object] = {
         "plant": plant.name,
+        "task": next(iter(plans.values())).task,  # a duty mix's task (its name), None for a single task
         "cycles": cycles,
         "effects_on": list(plant.enabled),
         "variants": table,
