@@ -104,7 +104,7 @@ def draw_machine(machine: Machine) -> Figure:
             ax.annotate(
                 f"{chain.name} actuator (direct), stroke {chain.actuator.stroke:g} m",
                 _xy(slide),
-                xytext=(5, -16),
+                xytext=(8, 10),
                 textcoords="offset points",
                 fontsize=8,
                 color="tab:orange",
