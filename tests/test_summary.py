@@ -10,7 +10,7 @@ from test_study_small import small_study, write_study
 
 from hiab_sim.cli import main
 from hiab_sim.results.read import read_result
-from hiab_sim.study.report.summary import SUMMARY_FILE, limit_in_words
+from hiab_sim.study.report.summary import SUMMARY_FILE, before_after, limit_in_words
 
 #: End-to-end runs of whole commands (optimize, report, Chromium, tutorials): not in the fast tier.
 pytestmark = pytest.mark.e2e
@@ -142,3 +142,12 @@ def test_constraint_rows_read_in_words(row: str, words: str) -> None:
     """Row names of the NLP become words a designer reads (no dots, no underscores, no 'x <= Lc')."""
     assert limit_in_words(row).startswith(words)
     assert limit_in_words(row.replace(" <= band", "")) == limit_in_words(row)
+
+
+@pytest.mark.parametrize(
+    ("before", "after", "change"),
+    [(16300.0, 16045.0, "(-1.56 %)"), (-84.86, -87.38, "(-2.97 %)"), (-87.38, -84.86, "(+2.88 %)")],
+)
+def test_energy_change_is_signed_as_the_energy_moves(before: float, after: float, change: str) -> None:
+    """Less energy after reads as a negative change, also for a regenerating cycle (negative energy)."""
+    assert before_after(before, after).endswith(change)

@@ -34,11 +34,15 @@ def test_tutorial_runs_as_written(page: str, tmp_path: Path) -> None:
     """Titled blocks are written as files, bash and python blocks run in a fresh folder and exit 0."""
     env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
     env.setdefault("MUJOCO_GL", "osmesa")
-    for lang, title, body in blocks(TUTORIALS / page):
+    for number, (lang, title, body) in enumerate(blocks(TUTORIALS / page)):
         if title is not None:
             (tmp_path / title).write_text(body)
         elif lang in ("bash", "python"):
-            command = ["bash", "-euo", "pipefail", "-c", body] if lang == "bash" else [sys.executable, "-c", body]
+            command = ["bash", "-euo", "pipefail", "-c", body]
+            if lang == "python":  # run as the script file a reader saves it to (multiprocessing imports it again)
+                script = tmp_path / f"tutorial_block_{number}.py"
+                script.write_text(body)
+                command = [sys.executable, str(script)]
             done = subprocess.run(command, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
             assert done.returncode == 0, (
                 f"{page}: {lang} block failed:\n{body}\n{done.stdout[-2000:]}{done.stderr[-3000:]}"

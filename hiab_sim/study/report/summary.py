@@ -142,8 +142,12 @@ def _energy_line(r: Result) -> str:
 
 
 def before_after(before: float, after: float, names: tuple[str, str] = ("before", "after")) -> str:
-    """``"15.670 kJ before, 15.230 kJ after (-2.81 %)"`` from two energies [J] (the change relative to ``before``)."""
-    change = f" ({100.0 * (after - before) / before:+.2f} %)" if before != 0.0 else ""
+    """``"15.670 kJ before, 15.230 kJ after (-2.81 %)"`` from two energies [J] (the change relative to ``before``).
+
+    The change is signed as the energy moves (less energy: negative), also when ``before`` is negative
+    (a cycle that regenerates more than it draws).
+    """
+    change = f" ({100.0 * (after - before) / abs(before):+.2f} %)" if before != 0.0 else ""
     return f"{before / 1e3:.3f} kJ {names[0]}, {after / 1e3:.3f} kJ {names[1]}{change}"
 
 
