@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from hiab_sim.arrays import Array
@@ -69,6 +70,11 @@ def _link_points(machine: Machine, frames: Frames, link: str) -> list[Array]:
     return points
 
 
+def _actuator_label(ax: Axes, text: str, at: Array, offset: tuple[float, float]) -> None:
+    """An actuator's label in its colour, ``offset`` points [pt] from ``at`` [m] (a direct one's above its slide)."""
+    ax.annotate(text, _xy(at), xytext=offset, textcoords="offset points", fontsize=8, color="tab:orange", zorder=6)
+
+
 def draw_machine(machine: Machine) -> Figure:
     """The labelled drawing of the machine (see the module docstring)."""
     fig = new_figure((9.0, 7.0))
@@ -101,29 +107,14 @@ def draw_machine(machine: Machine) -> Figure:
             )
             slide = frames.position[link.name]
             ax.plot([start[0], slide[0]], [start[1], slide[1]], color="tab:orange", lw=3, zorder=4)
-            ax.annotate(
-                f"{chain.name} actuator (direct), stroke {chain.actuator.stroke:g} m",
-                _xy(slide),
-                xytext=(8, 10),
-                textcoords="offset points",
-                fontsize=8,
-                color="tab:orange",
-            )
+            _actuator_label(ax, f"{chain.name} actuator (direct), stroke {chain.actuator.stroke:g} m", slide, (8, 10))
             continue
         pins = pin_positions(machine, frames, chain.name)
         end = pins["pin"] if chain.kind == "linkage" else pins["end"]
         base = pins["base"]
         ax.plot([base[0], end[0]], [base[1], end[1]], color="tab:orange", lw=3, zorder=3)
         mid = 0.5 * (base[:2] + end[:2])
-        ax.annotate(
-            f"{chain.name} actuator, stroke {chain.actuator.stroke:g} m",
-            _xy(mid),
-            xytext=(5, 5),
-            textcoords="offset points",
-            fontsize=8,
-            color="tab:orange",
-            zorder=6,
-        )
+        _actuator_label(ax, f"{chain.name} actuator, stroke {chain.actuator.stroke:g} m", mid, (5, 5))
         if chain.kind == "linkage":
             for a, b in (("rocker", "pin"), ("pin", "coupler")):
                 ax.plot([pins[a][0], pins[b][0]], [pins[a][1], pins[b][1]], color="tab:green", lw=2.5, zorder=3)
