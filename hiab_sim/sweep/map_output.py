@@ -167,8 +167,9 @@ def infeasible_note(m: EnergyMap, with_others: bool = True) -> str | None:
         return None
     binding = np.asarray(v.binding)[~feasible]
     names, counts = np.unique(binding, return_counts=True)
-    top = v.names[int(names[np.argmax(counts)])]
-    share = int(counts.max())
+    # most cells first; a tie keeps the row order (np.unique's, ascending), as argmax would
+    (share, first), *rest = sorted(zip(counts.tolist(), names.tolist(), strict=True), key=lambda c: -c[0])
+    top = v.names[int(first)]
     chain = top.split(".")[1] if top.count(".") >= 2 else ""
     others = [x for x in m.design_names if x.startswith(f"{chain}.") and x not in m.variables] if chain else []
     hint = (
@@ -178,7 +179,6 @@ def infeasible_note(m: EnergyMap, with_others: bool = True) -> str | None:
     )
     count = int(feasible.sum())
     head = "no feasible cell" if count == 0 else f"only {count} feasible cell{'' if count == 1 else 's'}"
-    rest = sorted(zip(counts.tolist(), names.tolist(), strict=True), key=lambda c: -c[0])[1:]
     also = "; ".join(f"{n} break {limit_in_words(v.names[int(k)], detail=False)}" for n, k in rest[:OTHER_LIMITS])
     hidden = len(rest) - OTHER_LIMITS
     more = f" and {hidden} more limit{'s' if hidden > 1 else ''} (energy_map.json)" if hidden > 0 else ""
