@@ -50,7 +50,7 @@ import sys
 from pathlib import Path
 
 from hiab_sim.cli.options import add_out_option
-from hiab_sim.cli.simulate_summary import print_results, task_indices, task_runs, write_results
+from hiab_sim.cli.simulate_summary import print_results, task_indices, task_runs_with_models, write_results
 from hiab_sim.errors import InvalidInputError
 
 #: Closed-loop checks: energy within this fraction of the prediction, TCP error rms and max [mm].
@@ -144,9 +144,7 @@ def run(args: argparse.Namespace) -> int:
     written, effects = write_results(args, report, runs, nominal, plant, designs, out)
     if not args.no_video:
         plan = plans[0]
-        model_of = {id(run): item for run, item in zip(runs, physics, strict=True)}
-        for suffix, of_task in task_runs(runs):
-            drawn = [model_of[id(run)] for run in of_task]
+        for suffix, of_task, drawn in task_runs_with_models(runs, physics):
             of_nominal = [run for run in nominal if run.task == of_task[0].task]
             video = render_video(
                 out / f"closed_loop{suffix}.mp4",

@@ -59,7 +59,7 @@ def run_machine(
     (:func:`hiab_sim.env.plant.load.machine_plant`). ``tasks``: a duty mix's task indices, each task's
     designs on the task's own plan, or (None,) for a single-task result.
     """
-    from hiab_sim.cli.simulate_summary import print_results, task_runs, write_results
+    from hiab_sim.cli.simulate_summary import print_results, task_runs_with_models, write_results
     from hiab_sim.design_report.simulation_table import run_groups
     from hiab_sim.env.machine_env import run_machine_closed_loop
     from hiab_sim.env.machine_plan import read_machine_plan
@@ -95,9 +95,7 @@ def run_machine(
                     entry["bandwidth_check"]["note"] = NO_STRUCTURE
         written, effects = write_results(args, report, runs, [], plant, designs, out)
         if not args.no_video:
-            model_of = {id(run): physics for run, physics in zip(runs, models, strict=True)}
-            for suffix, of_task in task_runs(runs):
-                drawn = [model_of[id(run)] for run in of_task]
+            for suffix, of_task, drawn in task_runs_with_models(runs, models):
                 written.append(_video(args, out / f"closed_loop{suffix}.mp4", plans, of_task, drawn).name)
     finally:
         for physics in models:

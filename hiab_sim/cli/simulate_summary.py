@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from hiab_sim.env.physics import CranePhysics
     from hiab_sim.env.plant.config import Plant
     from hiab_sim.env.rollout import ClosedLoopRun
 
@@ -30,6 +31,14 @@ def task_runs(runs: list[ClosedLoopRun]) -> list[tuple[str, list[ClosedLoopRun]]
     if names == [None]:
         return [(task_suffix(None), runs)]
     return [(task_suffix(k), [run for run in runs if run.task == name]) for k, name in enumerate(names)]
+
+
+def task_runs_with_models(
+    runs: list[ClosedLoopRun], models: Sequence[CranePhysics]
+) -> list[tuple[str, list[ClosedLoopRun], list[CranePhysics]]]:
+    """:func:`task_runs` with each run's simulation model beside it (``models`` in the order of ``runs``)."""
+    model_of = {id(run): model for run, model in zip(runs, models, strict=True)}
+    return [(suffix, of_task, [model_of[id(run)] for run in of_task]) for suffix, of_task in task_runs(runs)]
 
 
 def write_results(
