@@ -56,7 +56,9 @@ def test_csv_and_npz_hold_the_same_numbers_as_the_model(tmp_path: Path) -> None:
     p = operating_point(EMLAS.telescope, table[:, 0], table[:, 1], 0.0).electrical_power
     np.testing.assert_allclose(table[:, 3], p, rtol=1e-9)
     with np.load(tmp_path / "m.npz") as data:
-        np.testing.assert_array_equal(data["efficiency"], emap.efficiency)
+        for name, value in vars(emap).items():  # every field that has a value comes back as it was
+            if value is not None:
+                np.testing.assert_array_equal(data[name], value, err_msg=name)
         assert list(data["margin_names"]) == ["peak_torque", "rated_speed", "voltage"]
 
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import textwrap
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
@@ -226,18 +226,10 @@ def save_csv(emap: EfficiencyMap, path: str | Path) -> None:
 
 
 def save_npz(emap: EfficiencyMap, path: str | Path) -> None:
-    """Write the map arrays to a compressed NPZ file (keys as the :class:`EfficiencyMap` fields)."""
-    np.savez_compressed(
-        path,
-        force=emap.force,
-        velocity=emap.velocity,
-        efficiency=emap.efficiency,
-        electrical_power=emap.electrical_power,
-        mechanical_power=emap.mechanical_power,
-        margins=emap.margins,
-        margin_names=np.array(ENVELOPE_LIMIT_NAMES),
-        within_envelope=emap.within_envelope,
-        peak_force=emap.peak_force,
-        top_speed=emap.top_speed,
-        loss_options=np.array(emap.loss_options),
-    )
+    """Write the map to a compressed NPZ file: a key per :class:`EfficiencyMap` field, ``margin_names`` beside.
+
+    A field that is ``None`` (a hydraulic force the actuator has none of) is left out; ``margin_names``
+    names the rows of ``margins`` (:data:`hiab_sim.emla.envelope.ENVELOPE_LIMIT_NAMES`).
+    """
+    arrays = {f.name: np.asarray(getattr(emap, f.name)) for f in fields(emap) if getattr(emap, f.name) is not None}
+    np.savez_compressed(path, margin_names=np.array(ENVELOPE_LIMIT_NAMES), **arrays)  # type: ignore[arg-type]
