@@ -6,6 +6,7 @@ from typing import Any
 
 from hiab_sim.crane.description import CHAIN_NAMES
 from hiab_sim.crane.names import ACTUATOR_NAMES
+from hiab_sim.percent import change_percent
 
 #: The crane's chains in the order the pages list them (the crane file's order), each with its lengths
 #: (xi = [L, Lc0, Lc]).
@@ -42,7 +43,7 @@ def length_headers(legend_once: bool = False) -> tuple[str, ...]:
 
 def percent_change(before: float, after: float, digits: int = 2) -> str:
     """The relative change from ``before`` to ``after`` in %, signed, e.g. ``-3.31 %``."""
-    return f"{100.0 * (after - before) / before:+.{digits}f} %"
+    return f"{change_percent(before, after):+.{digits}f} %"
 
 
 def kilo(value: float, digits: int = 2) -> str:

@@ -13,6 +13,7 @@ from typing import Any
 from hiab_sim.docs_site.markdown import table
 from hiab_sim.docs_site.results_data import RunData
 from hiab_sim.docs_site.results_format import kilo
+from hiab_sim.percent import change_percent, saving_percent
 
 #: The output folders' names (and so their data files') that ``scripts/results_pages.sh`` writes.
 ENERGY_MAP, PARETO = "xs031_spiral_energy_map", "xs031_spiral_pareto_peak_force"
@@ -30,7 +31,7 @@ def energy_map(runs: RunData) -> str:
     return (
         f"Map of `xs031_spiral` over {' x '.join(names)} at the {m('base')}: {m('feasible_cells')} of "
         f"{m('cells')} cells are feasible; the best feasible cell ({', '.join(f'{n} = {xi[n]:.3f} m' for n in names)}) "
-        f"has the objective {100 * (best['objective'] / base['objective'] - 1):+.2f} % from the base design's and "
+        f"has the objective {change_percent(base['objective'], best['objective']):+.2f} % from the base design's and "
         f"the battery energy {kilo(base['battery_energy_J'])} → {kilo(best['battery_energy_J'])} kJ. Infeasible "
         f"cells by their binding constraint: {where}."
     )
@@ -42,8 +43,8 @@ def _rows(runs: RunData, sweep: str) -> list[dict[str, Any]]:
 
 
 def _battery_saved(r: dict[str, Any]) -> str:
-    """The battery energy the optimisation saves at a finished point, 1 - optimum / start [%]."""
-    return f"{100.0 * (1.0 - r['opt_battery_energy_J'] / r['start_battery_energy_J']):.2f} %"
+    """The battery energy the optimisation saves at a finished point, (start - optimum) / |start| [%]."""
+    return f"{saving_percent(r['start_battery_energy_J'], r['opt_battery_energy_J']):.2f} %"
 
 
 def mounting_sweep(runs: RunData) -> str:
@@ -91,8 +92,8 @@ def pareto(runs: RunData) -> str:
         (
             i,
             f"{p['criterion']:.5g} {f('unit')}",
-            f"{100 * (p['criterion'] / first['criterion'] - 1):+.2f} %",
-            f"{100 * (p['objective'] / first['objective'] - 1):+.2f} %",
+            f"{change_percent(first['criterion'], p['criterion']):+.2f} %",
+            f"{change_percent(first['objective'], p['objective']):+.2f} %",
             "yes" if p["accepted"] else "no (not converged)",
         )
         for i, p in enumerate(points)
@@ -102,8 +103,8 @@ def pareto(runs: RunData) -> str:
         (
             "least",
             f"{least['criterion']:.5g} {f('unit')}",
-            f"{100 * (least['criterion'] / first['criterion'] - 1):+.2f} %",
-            f"{100 * (least['objective'] / first['objective'] - 1):+.2f} %",
+            f"{change_percent(first['criterion'], least['criterion']):+.2f} %",
+            f"{change_percent(first['objective'], least['objective']):+.2f} %",
             "the least-criterion design (criterion minimised alone; not on the front)",
         )
     )

@@ -22,6 +22,7 @@ import numpy as np
 from hiab_sim.arrays import Array
 from hiab_sim.emla.battery import BatteryParams, battery_power
 from hiab_sim.env.rollout import ClosedLoopRun
+from hiab_sim.percent import change_percent
 
 #: What ``simulation.json`` says of its battery energies.
 BATTERY_NOTE = (
@@ -63,7 +64,7 @@ def battery_entry(run: ClosedLoopRun, battery: BatteryParams, predicted: float |
     return {
         "battery_energy_J": energy,
         "predicted_battery_energy_J": predicted,
-        "battery_energy_difference_percent": None if predicted is None else 100.0 * (energy / predicted - 1.0),
+        "battery_energy_difference_percent": None if predicted is None else change_percent(predicted, energy),
     }
 
 

@@ -38,6 +38,7 @@ from hiab_sim.env.plan import DesignPlan
 from hiab_sim.env.planned_energy import resampled_prediction
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.errors import InvalidInputError
+from hiab_sim.percent import change_percent
 from hiab_sim.quadrature import trapezoid
 
 
@@ -150,7 +151,7 @@ class ClosedLoopRun:
             "payload_error": self.payload_error,
             "net_electrical_energy_J": self.net_energy,
             "predicted_net_electrical_energy_J": self.predicted_net_energy,
-            "energy_difference_percent": 100.0 * (self.net_energy / self.predicted_net_energy - 1.0),
+            "energy_difference_percent": change_percent(self.predicted_net_energy, self.net_energy),
             "copper_loss_J": float(self.copper_energy.sum()),
             "tcp_error_mm": {"rms": 1000.0 * rms, "max": 1000.0 * float(self.tcp_error.max())},
             "tcp_error_to_plan_mm": {
@@ -176,7 +177,7 @@ class ClosedLoopRun:
             "wall_time_s": self.wall_time,
             "plant": self.plant,
             "dc_bus_energy_J": self.bus_energy,
-            "dc_bus_energy_difference_percent": 100.0 * (self.bus_energy / self.predicted_net_energy - 1.0),
+            "dc_bus_energy_difference_percent": change_percent(self.predicted_net_energy, self.bus_energy),
             "inverter_loss_J": _total(self.inverter_energy),
             "motor_terminal_energy_J": _total(self.terminal_energy),
             "transmission_loss_J": _total(self.transmission_loss),
@@ -193,7 +194,7 @@ class ClosedLoopRun:
             "predicted_net_electrical_energy_5ms_grid_J": self.resampled_prediction,
             "energy_difference_to_5ms_grid_percent": None
             if self.resampled_prediction is None
-            else 100.0 * (self.net_energy / self.resampled_prediction - 1.0),
+            else change_percent(self.resampled_prediction, self.net_energy),
         }
 
 

@@ -35,6 +35,7 @@ from hiab_sim.env.physics import CranePhysics
 from hiab_sim.env.plan import DesignPlan, mix_tasks, read_plan
 from hiab_sim.env.plant.config import Plant
 from hiab_sim.env.rollout import ClosedLoopRun, run_closed_loop
+from hiab_sim.percent import change_percent
 from hiab_sim.results.schema import TaskResult
 from hiab_sim.terminal import progress_wanted
 
@@ -200,7 +201,7 @@ def _mix_entry(result_dir: str | Path, runs: list[ClosedLoopRun], tasks: Sequenc
         mix[design] = {
             "net_electrical_energy_J": closed,
             "predicted_net_electrical_energy_J": planned,
-            "energy_difference_percent": 100.0 * (closed / planned - 1.0),
+            "energy_difference_percent": change_percent(planned, closed),
         }
     return mix
 

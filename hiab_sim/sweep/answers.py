@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from hiab_sim.percent import change_percent, saving_percent
 from hiab_sim.study.report.summary import BATTERY_BOUNDARY, NET_BOUNDARY, before_after, files_line, limit_in_words
 from hiab_sim.sweep.energy_map import EnergyMap
 from hiab_sim.sweep.map_output import infeasible_note, objective_words
@@ -143,7 +144,7 @@ def _objective_text(p: FrontPoint, plain: FrontPoint) -> str:
 
 
 def _change(value: float, reference: float) -> str:
-    return f"{100.0 * (value / reference - 1.0):+.2f} %" if reference != 0.0 else "n/a"
+    return f"{change_percent(reference, value):+.2f} %" if reference != 0.0 else "n/a"
 
 
 def front_answer(
@@ -234,7 +235,7 @@ def sweep_answer(
         + "."
     )
     energy = done[column].astype(float) / 1e3
-    saving = 100.0 * (1.0 - done[column].astype(float) / done[start_column].astype(float))
+    saving = saving_percent(done[start_column].astype(float), done[column].astype(float))
     lines.append(
         f"Spread over the {int(ok.sum())} finished point(s), at the same boundary: energy at the optimum "
         f"{energy.min():.3f} .. {energy.max():.3f} kJ; saved by the optimisation {saving.min():.2f} .. "

@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from hiab_sim.figure_io import new_figure, save_png
+from hiab_sim.percent import saving_percent
 from hiab_sim.study.report.summary import BATTERY_BOUNDARY, LENGTH_WORDS
 from hiab_sim.sweep.answers import energy_columns
 
@@ -83,7 +84,7 @@ def summary_figures(
     battery = boundary == BATTERY_BOUNDARY
     what = "battery energy" if battery else "net electrical energy"
     period = per if battery else "cycle"
-    saved = 100.0 * (1.0 - frame[column].astype(float) / frame[start_column].astype(float))
+    saved = saving_percent(frame[start_column].astype(float), frame[column].astype(float))
     rows = (
         (saved, f"{what} saved by the\noptimisation [%]"),
         (frame[column].astype(float) * 1e-3, f"{what} at the optimum\n[kJ per {period}]"),

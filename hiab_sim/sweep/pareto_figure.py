@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from hiab_sim.arrays import Array
+from hiab_sim.percent import change_percent
 from hiab_sim.style import colour
 from hiab_sim.sweep.pareto import CRITERIA, CRITERION_AXIS, FrontPoint
 
@@ -40,7 +41,7 @@ def front_figure_png(
     ok = [p for p in front if p.accepted]
 
     def change(value: ArrayLike, of: float) -> Array:
-        return 100.0 * (np.asarray(value, dtype=float) / of - 1.0)
+        return change_percent(of, np.asarray(value, dtype=float))
 
     fig = new_figure((6.6, 4.8))
     ax = fig.add_subplot()
@@ -58,10 +59,10 @@ def front_figure_png(
     if base != 0.0:
 
         def to_value(d: ArrayLike) -> ArrayLike:
-            return k * base * (1.0 + np.asarray(d, dtype=float) / 100.0)
+            return k * (base + abs(base) * np.asarray(d, dtype=float) / 100.0)
 
         def from_value(c: ArrayLike) -> ArrayLike:
-            return 100.0 * (np.asarray(c, dtype=float) / (k * base) - 1.0)
+            return change_percent(k * base, np.asarray(c, dtype=float))
 
         ax.secondary_xaxis("top", functions=(to_value, from_value)).set_xlabel(f"{words} [{unit}]")
     ax.set_xlabel(f"{words}: change from the plain optimum [%]")

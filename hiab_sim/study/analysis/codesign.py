@@ -31,6 +31,7 @@ import numpy as np
 from hiab_sim.arrays import Array
 from hiab_sim.emla import EmlaSet
 from hiab_sim.errors import InvalidInputError, SolverError
+from hiab_sim.percent import saving_percent
 from hiab_sim.results.energy_sections import Codesign, CodesignRow, DesignEnergy, TransmissionChoice
 from hiab_sim.study.nlp.objectives import exact_value
 from hiab_sim.study.nlp.problem import StudyProblem
@@ -186,8 +187,8 @@ def run_codesign(
         initial_battery_energy_J=e00,
         mounting_only_battery_energy_J=ref.battery_energy_J,
         codesign_battery_energy_J=top.battery_energy_J,
-        mounting_only_saving_percent=100.0 * (e00 - ref.battery_energy_J) / e00,
-        codesign_saving_percent=100.0 * (e00 - top.battery_energy_J) / e00,
+        mounting_only_saving_percent=saving_percent(e00, ref.battery_energy_J),
+        codesign_saving_percent=saving_percent(e00, top.battery_energy_J),
         extra_saving_J=ref.battery_energy_J - top.battery_energy_J,
     )
     return codesign, with_transmission(study.emlas, combos[best])

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from hiab_sim.atomic_io import write_atomic
+from hiab_sim.percent import saving_percent
 from hiab_sim.results.read import DESIGNS, RunSummary, summarise
 from hiab_sim.study.nlp.objectives import measured_by
 from hiab_sim.style import colour
@@ -155,8 +156,8 @@ def columns(runs: Sequence[ComparedRun]) -> dict[str, tuple[str, str]]:
 
 
 def _saving(value: float | None, initial: float | None) -> float:
-    """1 - value / initial [%]; NaN where the result has no such energy."""
-    return math.nan if value is None or initial is None else 100.0 * (1.0 - value / initial)
+    """(initial - value) / |initial| [%]; NaN where the result has no such energy."""
+    return math.nan if value is None or initial is None else saving_percent(initial, value)
 
 
 def rows(runs: Sequence[ComparedRun]) -> list[Row]:
@@ -246,7 +247,7 @@ def comparison_figure(runs: Sequence[ComparedRun]) -> bytes:
         bars = energy_ax.bar(x + (k - 0.5) * width, values, width, color=colour(name), label=name)
         energy_ax.bar_label(bars, fmt="%.3f", fontsize=8)
     for i, run in enumerate(runs):
-        saving = 100.0 * (1.0 - _energy_J(run, "optimal") / _energy_J(run, "initial"))
+        saving = saving_percent(_energy_J(run, "initial"), _energy_J(run, "optimal"))
         energy_ax.annotate(
             f"{-saving:+.2f} %", (x[i] + 0.5 * width, 0.5 * _energy_J(run, "optimal") / 1e3),
             ha="center", color="white", fontsize=9, weight="bold",

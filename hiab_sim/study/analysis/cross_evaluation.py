@@ -22,6 +22,7 @@ from dataclasses import replace
 
 from hiab_sim.arrays import Array
 from hiab_sim.errors import InvalidInputError, SolverError
+from hiab_sim.percent import change_percent
 from hiab_sim.results.analysis_sections import CrossEvaluation
 from hiab_sim.results.design_values import DesignValues
 from hiab_sim.study.nlp.objectives import costf2
@@ -169,7 +170,7 @@ def cross_evaluation(mix: StudyProblem, z_mix: Array, alone: list[DesignValues] 
     def lost(values: list[float | None], best: float | None, percent: bool) -> list[float | None]:
         if best is None:
             return [None] * len(values)
-        return [None if v is None else (100.0 * (v - best) / abs(best) if percent else v - best) for v in values]
+        return [None if v is None else (change_percent(best, v) if percent else v - best) for v in values]
 
     return CrossEvaluation(
         note=(

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from hiab_sim.figure_io import new_figure, save_png
+from hiab_sim.percent import change_percent
 from hiab_sim.results.analysis_sections import CrossEvaluation
 
 
@@ -22,7 +23,7 @@ def cross_figure(cross: CrossEvaluation, path: Path) -> None:
     ax1.set_ylabel("mix net energy over the mix optimum [J]")
     ax1.set_title("price of a single-task design on the mix (weighted)")
     matrix = np.array([[np.nan if v is None else v for v in row] for row in cross.net_energy_J], dtype=float)
-    relative = 100.0 * (matrix / np.nanmin(matrix, axis=0) - 1.0)
+    relative = change_percent(np.nanmin(matrix, axis=0), matrix)
     image = ax2.imshow(relative, cmap="viridis")
     for (i, j), value in np.ndenumerate(relative):
         ax2.text(j, i, "n/a" if np.isnan(value) else f"+{value:.3f} %", ha="center", va="center", color="w")

@@ -34,6 +34,7 @@ from hiab_sim.emla.model import OperatingPoint
 from hiab_sim.emla.thermal import Duty
 from hiab_sim.hydraulics import SupplyResult, hydraulic_baseline
 from hiab_sim.hydraulics.battery_boundary import battery_boundary_baselines
+from hiab_sim.percent import saving_percent
 from hiab_sim.quadrature import trapezoid
 from hiab_sim.results.energy_sections import (
     ActuatorThermal,
@@ -170,7 +171,7 @@ def energy_report(fine: TaskProblem, initial: SampleState, optimal: SampleState)
         initial=e0,
         optimal=e1,
         battery_energy_saved_J=e0.battery_energy_J - e1.battery_energy_J,
-        battery_energy_saved_percent=100.0 * (e0.battery_energy_J - e1.battery_energy_J) / e0.battery_energy_J,
+        battery_energy_saved_percent=saving_percent(e0.battery_energy_J, e1.battery_energy_J),
     )
 
 
@@ -226,7 +227,7 @@ def weighted_energy_report(
         initial=initial,
         optimal=optimal,
         battery_energy_saved_J=saved,
-        battery_energy_saved_percent=100.0 * saved / initial.battery_energy_J,
+        battery_energy_saved_percent=saving_percent(initial.battery_energy_J, optimal.battery_energy_J),
         hourly_rms_torque_Nm=hourly,
         hourly_work_s=work if hourly is not None else None,
     )
@@ -277,7 +278,7 @@ def hydraulic_report(
                 terms_J=b.terms,
                 max_pilot_pressure_Pa=b.max_pilot_pressure,
                 pressure_shortfall_samples=b.pressure_shortfall_samples,
-                emla_saving_percent=100.0 * (1.0 - emla_cycle / b.battery_energy),
+                emla_saving_percent=saving_percent(b.battery_energy, emla_cycle),
             )
             for b in battery_boundary_baselines(
                 state.joints.time, act.force, act.velocity, cylinders, fine.emlas.battery
@@ -287,8 +288,8 @@ def hydraulic_report(
             constant_pressure=_variant(cp, fine.emlas.names),
             load_sensing=_variant(ls, fine.emlas.names),
             emla_battery_energy_J=e.battery_energy_J,
-            emla_saving_vs_load_sensing_percent=100.0 * (1.0 - e.battery_energy_J / ls.input_energy),
-            emla_saving_vs_constant_pressure_percent=100.0 * (1.0 - e.battery_energy_J / cp.input_energy),
+            emla_saving_vs_load_sensing_percent=saving_percent(ls.input_energy, e.battery_energy_J),
+            emla_saving_vs_constant_pressure_percent=saving_percent(cp.input_energy, e.battery_energy_J),
             at_battery=at_battery,
             emla_cycle_battery_energy_J=emla_cycle,
         )

@@ -28,6 +28,7 @@ import numpy as np
 
 from hiab_sim.arrays import Array
 from hiab_sim.atomic_io import write_atomic
+from hiab_sim.percent import saving_percent
 from hiab_sim.results.multistart import DistinctOptimum, FailedStart, MultiStart, StartRow
 from hiab_sim.results.schema import (
     RESULT_FILE,
@@ -176,7 +177,7 @@ def build_result(
         improvement=Improvement(
             cost_ratio=cost1 / cost0,
             net_energy_saved_J=e0 - e1,
-            net_energy_saved_percent=100.0 * (e0 - e1) / e0,
+            net_energy_saved_percent=saving_percent(e0, e1),
             decomposition=weighted_decomposition(decompositions, w),
         ),
         solver=solver_summary(problem, main, wall_time),

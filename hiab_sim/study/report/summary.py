@@ -18,6 +18,7 @@ from pathlib import Path
 
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.machine.design import MachineDesign
+from hiab_sim.percent import change_percent, saving_percent
 from hiab_sim.results.design_values import DesignValues
 from hiab_sim.results.schema import Result
 
@@ -147,7 +148,7 @@ def before_after(before: float, after: float, names: tuple[str, str] = ("before"
     The change is signed as the energy moves (less energy: negative), also when ``before`` is negative
     (a cycle that regenerates more than it draws).
     """
-    change = f" ({100.0 * (after - before) / abs(before):+.2f} %)" if before != 0.0 else ""
+    change = f" ({change_percent(before, after):+.2f} %)" if before != 0.0 else ""
     return f"{before / 1e3:.3f} kJ {names[0]}, {after / 1e3:.3f} kJ {names[1]}{change}"
 
 
@@ -165,12 +166,14 @@ def _trajectory_line(r: Result) -> str | None:
     trajectories, and so possibly in its design.
     """
     c, s = r.cross_evaluation, r.sensitivity
-    if c is None or s is None or c.mix_objective_value is None or s.objective_value <= 0.0:
+    if c is None or s is None or c.mix_objective_value is None or s.objective_value == 0.0:
         return None
     driven = c.mix_objective_value[-1]
-    if driven is None or (s.objective_value - driven) / s.objective_value <= TRAJECTORY_GAIN_SHOWN:
+    if driven is None:
         return None
-    gain = 100.0 * (s.objective_value - driven) / s.objective_value
+    gain = saving_percent(s.objective_value, driven)
+    if gain <= 100.0 * TRAJECTORY_GAIN_SHOWN:
+        return None
     return (
         f"Local optimum: driven from the inverse-kinematics fit (the cross-evaluation), this design costs {gain:.2g} % "
         f"less ({s.objective}, weighted over the tasks) than with the optimiser's own trajectories, which the "
@@ -250,9 +253,9 @@ def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[st
         failed = f", {len(ms.failed_starts)} failed" if ms.failed_starts else ""
         agree = "the same optimum" if ms.same_optimum else f"{len(ms.distinct_optima)} distinct local optima"
         values = [d.objective_value for d in ms.distinct_optima if d.objective_value is not None]
-        if not ms.same_optimum and len(values) == len(ms.distinct_optima) and min(values) > 0:
-            spread = 100.0 * (max(values) - min(values)) / min(values)
-            reported = 100.0 * (values[0] - min(values)) / min(values)  # the result is start 0's optimum
+        if not ms.same_optimum and len(values) == len(ms.distinct_optima) and min(values) != 0.0:
+            spread = change_percent(min(values), max(values))
+            reported = change_percent(min(values), values[0])  # the result is start 0's optimum
             where = "the lowest" if reported == 0.0 else f"{reported:.2g} % above the lowest"
             agree += f" (their {ms.objective} within {spread:.2g} % of the lowest; the result is start 0's, {where})"
         lines.append(f"Starts: {ms.converged_starts} of {len(ms.starts)} converged, to {agree}{failed}.")

@@ -1,0 +1,42 @@
+"""Relative changes and savings in percent, against the magnitude of the reference value.
+
+An energy over a cycle can be negative: a cycle that lowers a load regenerates more than it draws,
+so its net electrical energy (and, with lossless enough drives, its battery energy) is below zero.
+Divided by the signed reference, a change would read a fall as a rise: -85 J -> -87 J is 2.4 % less
+energy, but (-87 - -85) / -85 = +2.4 %. Every percent change and saving of the tool divides by
+``|reference|``, so its sign is the change's own: a change is positive when the value rises, a saving
+positive when it falls. A zero reference has no relative change: the result is inf or nan
+there (numpy division, with numpy's divide warning); callers that print a change test for zero first.
+"""
+
+from __future__ import annotations
+
+from typing import overload
+
+import numpy as np
+
+from hiab_sim.arrays import Array
+
+
+@overload
+def change_percent(reference: float, value: float) -> float: ...
+@overload
+def change_percent(reference: float | Array, value: Array) -> Array: ...
+@overload
+def change_percent(reference: Array, value: float | Array) -> Array: ...
+def change_percent(reference: float | Array, value: float | Array) -> float | Array:
+    """``100 (value - reference) / |reference|`` [%]: positive when ``value`` is above ``reference``."""
+    rise: float | Array = value - reference
+    return 100.0 * rise / np.abs(reference)
+
+
+@overload
+def saving_percent(reference: float, value: float) -> float: ...
+@overload
+def saving_percent(reference: float | Array, value: Array) -> Array: ...
+@overload
+def saving_percent(reference: Array, value: float | Array) -> Array: ...
+def saving_percent(reference: float | Array, value: float | Array) -> float | Array:
+    """``100 (reference - value) / |reference|`` [%]: positive when ``value`` is below ``reference``."""
+    fall: float | Array = reference - value
+    return 100.0 * fall / np.abs(reference)
