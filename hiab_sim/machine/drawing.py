@@ -12,12 +12,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from hiab_sim.arrays import Array
 from hiab_sim.figure_io import new_figure, save_png
 from hiab_sim.machine.description import Machine
+from hiab_sim.machine.drawing_labels import LabelPlan, place_labels
 from hiab_sim.machine.kinematics.assembly import joint_grid
 from hiab_sim.machine.kinematics.forward import Frames, forward_kinematics, pin_positions
 
@@ -70,11 +70,6 @@ def _link_points(machine: Machine, frames: Frames, link: str) -> list[Array]:
     return points
 
 
-def _actuator_label(ax: Axes, text: str, at: Array, offset: tuple[float, float]) -> None:
-    """An actuator's label in its colour, ``offset`` points [pt] from ``at`` [m] (a direct one's above its slide)."""
-    ax.annotate(text, _xy(at), xytext=offset, textcoords="offset points", fontsize=8, color="tab:orange", zorder=6)
-
-
 def draw_machine(machine: Machine) -> Figure:
     """The labelled drawing of the machine (see the module docstring)."""
     fig = new_figure((9.0, 7.0))
@@ -83,22 +78,22 @@ def draw_machine(machine: Machine) -> Figure:
     frames = forward_kinematics(machine, middle)
     cloud = workspace_points(machine)
     _shade_workspace(ax, cloud)
+    # Labels in order of importance: the first placed get the nearest free places.
+    actuators, links, joints, pivots = LabelPlan(), LabelPlan(), LabelPlan(), LabelPlan()
     for link in machine.links:
         pts = _link_points(machine, frames, link.name)
         if len(pts) > 1:
             origin = pts[0]
             for p in pts[1:]:
                 ax.plot([origin[0], p[0]], [origin[1], p[1]], color="0.35", lw=5, solid_capstyle="round", zorder=2)
-        centre = np.mean(pts, axis=0)
-        ax.annotate(
-            link.name, _xy(centre), xytext=(0, 9), textcoords="offset points", ha="center", fontsize=9, zorder=6
-        )
+                actuators.segment(origin, p)
+        links.label(link.name, np.mean(pts, axis=0), fontsize=9, zorder=6)
         if link.parent is not None:
             o = frames.position[link.name][:2]
             ax.plot(*o, "o", ms=8, mfc="white", mec="black", zorder=5)
-            ax.annotate(
-                f"{link.joint} ({link.joint_kind})", _xy(o), xytext=(6, -12), textcoords="offset points", fontsize=7
-            )
+            actuators.marker(o)
+            joints.label(f"{link.joint} ({link.joint_kind})", o, fontsize=7, zorder=6)
+    orange = {"fontsize": 8, "color": "tab:orange", "zorder": 6}
     for chain in machine.chains:
         if chain.kind == "direct":
             link = machine.joint_link(chain.joint)
@@ -107,25 +102,29 @@ def draw_machine(machine: Machine) -> Figure:
             )
             slide = frames.position[link.name]
             ax.plot([start[0], slide[0]], [start[1], slide[1]], color="tab:orange", lw=3, zorder=4)
-            _actuator_label(ax, f"{chain.name} actuator (direct), stroke {chain.actuator.stroke:g} m", slide, (8, 10))
+            actuators.segment(start, slide)
+            actuators.label(f"{chain.name} actuator (direct), stroke {chain.actuator.stroke:g} m", slide, **orange)
             continue
         pins = pin_positions(machine, frames, chain.name)
         end = pins["pin"] if chain.kind == "linkage" else pins["end"]
         base = pins["base"]
         ax.plot([base[0], end[0]], [base[1], end[1]], color="tab:orange", lw=3, zorder=3)
-        mid = 0.5 * (base[:2] + end[:2])
-        _actuator_label(ax, f"{chain.name} actuator, stroke {chain.actuator.stroke:g} m", mid, (5, 5))
+        actuators.segment(base, end)
+        actuators.label(f"{chain.name} actuator, stroke {chain.actuator.stroke:g} m", 0.5 * (base + end), **orange)
         if chain.kind == "linkage":
             for a, b in (("rocker", "pin"), ("pin", "coupler")):
                 ax.plot([pins[a][0], pins[b][0]], [pins[a][1], pins[b][1]], color="tab:green", lw=2.5, zorder=3)
+                actuators.segment(pins[a], pins[b])
         for role, p in pins.items():
             if role == "hinge":
                 continue
             ax.plot(p[0], p[1], "o", ms=5, color="black", zorder=5)
-            ax.annotate(f"{chain.name}.{role}", _xy(p[:2]), xytext=(4, 4), textcoords="offset points", fontsize=7)
+            actuators.marker(p)
+            pivots.label(f"{chain.name}.{role}", p, fontsize=7, zorder=6)
     tcp = frames.tcp_position
     ax.plot(tcp[0], tcp[1], "*", ms=12, color="tab:red", zorder=6)
-    ax.annotate("TCP", _xy(tcp[:2]), xytext=(6, -4), textcoords="offset points", color="tab:red", fontsize=9)
+    actuators.marker(tcp)
+    actuators.label("TCP", tcp, color="tab:red", fontsize=9, zorder=6)
     ax.plot([], [], "s", color=(0.35, 0.55, 0.85, 0.4), label="TCP workspace over the working ranges")
     ax.legend(loc="best", fontsize=8)
     ax.use_sticky_edges = False  # the image's extent is not the frame: a margin around the workspace and labels
@@ -136,6 +135,10 @@ def draw_machine(machine: Machine) -> Figure:
     ax.set_ylabel("y [m] (up)")
     ax.set_title(f"{machine.name}: joints at the middle of their working ranges")
     ax.grid(True, alpha=0.3)
+    plan = LabelPlan(
+        actuators.labels + links.labels + joints.labels + pivots.labels, actuators.markers, actuators.segments
+    )
+    place_labels(fig, ax, plan)
     return fig
 
 
