@@ -25,7 +25,7 @@ def test_a_saving_is_positive_exactly_when_the_energy_falls(reference: float, va
 
 @given(energies, energies)
 def test_a_change_applied_to_its_reference_gives_the_value_back(reference: float, value: float) -> None:
-    """reference + |reference| change / 100 = value: the inverse the Pareto figure's second axis uses."""
+    """Adding |reference| change / 100 to the reference gives the value: the Pareto figure's second axis."""
     back = reference + abs(reference) * change_percent(reference, value) / 100.0
     assert back == pytest.approx(value, rel=1e-9, abs=1e-9 * abs(reference))
 

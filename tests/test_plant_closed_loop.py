@@ -153,7 +153,7 @@ def test_true_mass_prediction_without_errors_is_the_plans_prediction(crane: Cran
 def test_true_mass_prediction_agrees_with_the_optimiser_on_the_true_crane(tmp_path) -> None:  # type: ignore[no-untyped-def]
     """The same-motion prediction at the true masses equals the optimiser's own energy of that design on the true crane.
 
-    The default study is solved again with the mismatch's crane (:func:`replanned_prediction`'s
+    The default study is solved again with the mismatch's crane (:func:`replanned_predictions`'s
     path): its initial design is the nominal study's initial design, so its reported energy is an
     independent computation (the optimiser's objective) of what ``true_mass_prediction`` computes
     (1e-6); the re-planned optimum is no worse than the nominal optimum at the true masses.

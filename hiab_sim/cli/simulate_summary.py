@@ -96,7 +96,7 @@ def _effect_studies(
     if plant is None or not plant.enabled:
         return []
     from hiab_sim.design_report.simulation_table import task_suffix
-    from hiab_sim.env.effects import effect_study
+    from hiab_sim.env.effects import attach_replanned, effect_study, replanned_predictions
 
     groups = report.get("tasks")
     if not isinstance(groups, list):
@@ -105,9 +105,12 @@ def _effect_studies(
         return [TaskEffects(task_suffix(None), None, study)]
     out = []
     for k, group in enumerate(groups):  # every task of the result, in its order (simulation_report)
-        study = effect_study(args.result_dir, plant, args.cycles, designs, quiet=args.quiet, task=k)
+        study = effect_study(args.result_dir, plant, args.cycles, designs, quiet=args.quiet, replan=False, task=k)
         group["plant_effects"] = study
         out.append(TaskEffects(task_suffix(k), str(group["task"]), study))
+    if plant.mismatch.enabled:  # the mix solved again once at the true masses: each task's share of its optimum
+        for k, replanned in enumerate(replanned_predictions(args.result_dir, plant)):
+            attach_replanned(out[k].study, replanned)
     return out
 
 

@@ -150,9 +150,8 @@ def effect_lines(report: dict[str, object]) -> list[str]:
                 f"{row['predicted_at_true_masses_J']:.1f} J, closed loop {row['closed_loop_J']:.1f} J"
             )
             if "replanned_optimum_predicted_J" in row:
-                text += (
-                    f"; the study re-planned for the true masses predicts {row['replanned_optimum_predicted_J']:.1f} J"
-                )
+                what = "the study" if report.get("task") is None else "the mix, re-planned once for all its tasks,"
+                text += f"; {what} re-planned for the true masses predicts {row['replanned_optimum_predicted_J']:.1f} J"
             text += " (net electrical energy)"
             if "closed_loop_battery_J" in row:
                 text += (
@@ -162,9 +161,6 @@ def effect_lines(report: dict[str, object]) -> list[str]:
                 if "replanned_optimum_predicted_battery_J" in row:
                     text += f", re-planned {row['replanned_optimum_predicted_battery_J']:.1f} J"
             lines.append(text + ".")
-    replanned = report.get("mismatch_replanned")
-    if isinstance(replanned, dict) and "skipped" in replanned:
-        lines.append(f"mismatch: no re-plan ({replanned['skipped']}).")
     return lines
 
 

@@ -13,8 +13,9 @@ masses (MuJoCo inverse dynamics of the true crane, the planner's steady-state EM
 eq. ``costf2``'s P_elec integrated by the trapezoid rule), which splits the mismatch's extra energy
 into the cost of the heavier load (true-mass prediction - prediction) and the cost of tracking
 without knowing it (closed loop - true-mass prediction). Beside them stands the plan re-optimised
-for the true masses (:func:`replanned_prediction`: the study solved again with the true crane), the
-energy a planner that knew the load would have predicted for its own optimum.
+for the true masses (:func:`replanned_predictions`: the study solved again with the true crane), the
+energy a planner that knew the load would have predicted for its own optimum; a duty mix is solved
+again once, and each task's effect study gets that optimum's energy of the task's own cycle.
 
 One code path for a crane file's result and a machine file's (:func:`read_any_plan`,
 :func:`run_plan`): on a machine file the true masses are :func:`~hiab_sim.env.plant.mismatch.true_machine`'s
@@ -114,42 +115,45 @@ def true_mass_prediction(plan: DesignPlan | MachinePlan, plant: Plant) -> float:
 def true_study(study: Study, plant: Plant) -> Study:
     """The study with the mismatch's true masses (the true machine and payload, or the true crane).
 
-    A machine file's study gets :func:`~hiab_sim.env.plant.mismatch.true_machine` and its first
-    task's payload x (1 + e_end); a crane file's :func:`~hiab_sim.env.plant.mismatch.true_crane`.
+    A machine file's study gets :func:`~hiab_sim.env.plant.mismatch.true_machine` and every task's
+    payload x (1 + e_end), as the closed loop of each task's plan carries it; a crane file's
+    :func:`~hiab_sim.env.plant.mismatch.true_crane`.
     """
     if study.machine is not None:
-        task = study.tasks[0]
-        payload = replace(task.payload, mass=task.payload.mass * payload_factor(plant.mismatch))
-        tasks = (replace(task, payload=payload), *study.tasks[1:])
+        factor = payload_factor(plant.mismatch)
+        tasks = tuple(replace(t, payload=replace(t.payload, mass=t.payload.mass * factor)) for t in study.tasks)
         return replace(study, machine=true_machine(study.machine, plant.mismatch), tasks=tasks)
     return replace(study, crane_description=true_crane(study.crane, plant.mismatch))
 
 
-def replanned_summary(result_dir: str | Path) -> dict[str, object]:
+def replanned_summary(result_dir: str | Path, task: int | None = None) -> dict[str, object]:
     """``predicted_J``, ``lengths`` (and ``predicted_battery_J`` with a battery) of a re-planned result folder.
 
     ``predicted_battery_J`` is the re-planned optimum's battery energy of one cycle, the boundary of the
     closed loop's and of the nominal prediction (``predicted_cycle_battery_energy`` of
     :mod:`hiab_sim.env.closed_loop_battery`: with the study's duty model the cycle's share, the rest
-    between cycles left out).
+    between cycles left out). ``task``: the index k of a duty mix's task, whose own cycle's energies
+    (``tasks[k]``) are given, with its name under ``task``; ``lengths`` are the mix's one design.
     """
     result = json.loads((Path(result_dir) / "result.json").read_text(encoding="utf-8"))
-    optimal = result["optimal"]
+    optimal = result["optimal"] if task is None else result["tasks"][task]["optimal"]
     replanned: dict[str, object] = {
         "predicted_J": float(optimal["net_electrical_energy_J"]),
-        "lengths": optimal.get("lengths"),
+        "lengths": result["optimal"].get("lengths"),
     }
-    battery = predicted_cycle_battery_energy(result_dir)
+    if task is not None:
+        replanned["task"] = result["tasks"][task]["name"]
+    battery = predicted_cycle_battery_energy(result_dir, task)
     if "optimal" in battery:
         replanned["predicted_battery_J"] = float(battery["optimal"])
     return replanned
 
 
-def replanned_prediction(result_dir: str | Path, plant: Plant) -> dict[str, object]:
+def replanned_predictions(result_dir: str | Path, plant: Plant) -> list[dict[str, object]]:
     """The result's study optimised again with the mismatch's true masses (:func:`true_study`): its optimum's energy.
 
-    Returns :func:`replanned_summary`'s mapping of the re-optimised design, or one with ``skipped``
-    saying why (the study is a mix of tasks).
+    Returns :func:`replanned_summary`'s mapping of the re-optimised design, one per task: a single
+    task's, or each task's of a duty mix (the mix is solved once, its one design serving every task).
 
     Raises:
         ConfigError: the study file is gone.
@@ -160,13 +164,13 @@ def replanned_prediction(result_dir: str | Path, plant: Plant) -> dict[str, obje
     from hiab_sim.study.spec.study_file import load_study
 
     study = load_study(read_result(result_dir).study)
-    if len(study.tasks) != 1:
-        return {"skipped": f"the study has {len(study.tasks)} tasks; re-planning is done for single-task studies"}
     with tempfile.TemporaryDirectory(prefix="hiab_sim_replan_") as folder:
         out = run_study(
             true_study(study, plant), Path(folder) / "replan", progress=None, figures=False, force=True, cross=False
         )
-        return replanned_summary(out.folder)
+        if len(study.tasks) == 1 and read_result(out.folder).tasks is None:
+            return [replanned_summary(out.folder)]
+        return [replanned_summary(out.folder, k) for k in range(len(study.tasks))]
 
 
 def attach_replanned(report: dict[str, Any], replanned: dict[str, object]) -> None:
@@ -220,9 +224,10 @@ def effect_study(
     """The ``plant_effects`` section of ``simulation.json`` (module docstring).
 
     ``replan`` False leaves the re-planned prediction out (the study's optimisation again, minutes;
-    :func:`attach_replanned` adds one computed elsewhere). ``task``: the index k of a duty mix's task,
-    whose own plans run and whose own cycle's energies they are compared with (``result.json``
-    ``tasks[k]``); the re-planned prediction of a mix's task is skipped (:func:`replanned_prediction`).
+    :func:`attach_replanned` adds one computed elsewhere: a duty mix's caller solves the mix once for
+    all its tasks). ``task``: the index k of a duty mix's task, whose own plans run and whose own
+    cycle's energies they are compared with (``result.json`` ``tasks[k]``, and the re-planned mix's
+    ``tasks[k]``, :func:`replanned_predictions`).
     """
     plans = {design: read_any_plan(result_dir, design, task) for design in designs}
     battery = predicted_cycle_battery_energy(result_dir, task)
@@ -285,7 +290,7 @@ def effect_study(
                 row["predicted_battery_J"] = float(battery[design])
         report["mismatch_split"] = split
         if replan:
-            attach_replanned(report, replanned_prediction(result_dir, plant))
+            attach_replanned(report, replanned_predictions(result_dir, plant)[0 if task is None else task])
     return report
 
 
