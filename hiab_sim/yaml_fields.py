@@ -61,13 +61,26 @@ def mapping(data: Any, where: str, allowed: set[str] | None, required: set[str] 
     return data
 
 
+#: Largest magnitude a number of a file may have [SI units]. The largest physical value the shipped files
+#: hold is a steel's Young's modulus, 2.06e11 Pa; 1e15 leaves four orders of magnitude above it and
+#: refuses a typo such as a 1e300 kg link, which would overflow the energy integrals (P^2 of its
+#: forces) into a traceback instead of a one-line error.
+MAGNITUDE_LIMIT = 1e15
+
+
 def number(value: Any, where: str) -> float:
-    """A finite number (bools and strings are rejected)."""
+    """A finite number of magnitude at most :data:`MAGNITUDE_LIMIT` (bools and strings are rejected)."""
     if isinstance(value, bool) or not isinstance(value, int | float):
         hint = " (YAML reads 1e3 as text: write 1.0e+3 or 1000.0)" if isinstance(value, str) else ""
         raise ConfigError(f"{where}: expected a number, got {value!r}{hint}")
     if not math.isfinite(value):
         raise InvalidInputError(where, float(value), "must be finite")
+    if abs(value) > MAGNITUDE_LIMIT:
+        raise InvalidInputError(
+            where,
+            float(value),
+            f"must be of magnitude <= {MAGNITUDE_LIMIT:g} (SI units; the largest in a shipped file is 2.06e+11)",
+        )
     return float(value)
 
 

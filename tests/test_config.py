@@ -11,6 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from hypothesis import given
+from hypothesis import strategies as st
 
 from hiab_sim.crane import mechanism
 from hiab_sim.crane.description import ChainLengths, Crane, LinkLengths
@@ -190,3 +192,15 @@ def test_cli_reports_missing_osmesa_in_one_line(
     assert main(["mjcf", "-o", "unused.xml"]) == 2
     err = capsys.readouterr().err
     assert "apt-get install libosmesa6" in err and err.count("\n") == 1
+
+
+@given(st.floats(allow_nan=False, allow_infinity=False))
+def test_a_file_number_is_kept_as_written_up_to_the_magnitude_limit(value: float) -> None:
+    """Any finite number within +-1e15 is read as it is; a larger one is refused naming the field."""
+    from hiab_sim.yaml_fields import MAGNITUDE_LIMIT, number
+
+    if abs(value) <= MAGNITUDE_LIMIT:
+        assert number(value, "links.boom.bodies.boom.mass") == value
+    else:
+        with pytest.raises(InvalidInputError, match=r"links\.boom\.bodies\.boom\.mass .* magnitude <= 1e\+15"):
+            number(value, "links.boom.bodies.boom.mass")

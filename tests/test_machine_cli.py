@@ -81,6 +81,7 @@ def test_machine_check_lists_each_failure_and_exits_2(tmp_path: Path, capsys: py
         ("links.arm.joint", "alpha", "links.arm.joint"),
         ("chains.bucket.linkage.pin_side", 2, "chains.bucket.linkage.pin_side"),
         ("chains.bucket.linkage.pin_side", True, "chains.bucket.linkage.pin_side"),
+        ("links.boom.bodies.boom.mass", 1e300, "links.boom.bodies.boom.mass"),  # overflowed the energy integrals
     ],
 )
 def test_bad_machine_file_exits_2_with_one_line_and_writes_nothing(
