@@ -11,11 +11,14 @@ there (numpy division, with numpy's divide warning); callers that print a change
 
 from __future__ import annotations
 
-from typing import overload
+from typing import TypeVar, overload
 
 import numpy as np
 
 from hiab_sim.arrays import Array
+
+#: A float or an array of them (a pandas column passes as one).
+Number = TypeVar("Number", float, Array)
 
 
 @overload
@@ -30,13 +33,11 @@ def change_percent(reference: float | Array, value: float | Array) -> float | Ar
     return 100.0 * rise / np.abs(reference)
 
 
-@overload
-def saving_percent(reference: float, value: float) -> float: ...
-@overload
-def saving_percent(reference: float | Array, value: Array) -> Array: ...
-@overload
-def saving_percent(reference: Array, value: float | Array) -> Array: ...
-def saving_percent(reference: float | Array, value: float | Array) -> float | Array:
-    """``100 (reference - value) / |reference|`` [%]: positive when ``value`` is below ``reference``."""
-    fall: float | Array = reference - value
+def saving_percent(reference: Number, value: Number) -> Number:
+    """``100 (reference - value) / |reference|`` [%]: positive when ``value`` is below ``reference``.
+
+    Both of one kind (two floats, two arrays or two columns): a saving is one quantity's own, start
+    against optimum, where :func:`change_percent` also sets one value against many.
+    """
+    fall = reference - value  # not -change_percent: a zero saving prints as 0.00, not -0.00
     return 100.0 * fall / np.abs(reference)

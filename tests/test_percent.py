@@ -35,6 +35,7 @@ def test_a_regenerating_cycle_that_regenerates_more_reads_as_less_energy() -> No
     assert saving_percent(-85.0, -87.0) == pytest.approx(200.0 / 85.0)
     assert percent_change(-85.0, -87.0) == "-2.35 %"
     assert before_after(-85.0, -87.0).endswith("(-2.35 %)")
+    assert f"{saving_percent(-85.0, -85.0):.2f}" == "0.00"  # no saving prints without a sign
 
 
 def test_arrays_are_taken_element_by_element() -> None:
