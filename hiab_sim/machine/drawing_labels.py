@@ -40,7 +40,7 @@ OUTSIDE = 1000.0
 #: Half-size of the square kept free around a marker point [pt].
 MARKER_PT = 3.5
 #: A label's backing: a light box, so a line it must cross leaves the text readable.
-BACKING = {"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.75}
+BACKING = {"boxstyle": "round,pad=0.15", "fc": (1.0, 1.0, 1.0, 0.75), "ec": "none"}  # white, 75 % opaque
 #: Padding around a label's text box [px] when testing overlaps.
 PAD_PX = 2.0
 
