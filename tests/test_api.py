@@ -130,6 +130,14 @@ def test_optimize_refuses_starts_that_are_not_a_positive_integer(
     assert not (tmp_path / "run").exists()
 
 
+@pytest.mark.parametrize("call", [lambda: hs.load_study(3), lambda: hs.evaluate(3, [1.0] * 6)])  # type: ignore[arg-type]
+def test_a_study_that_is_neither_a_name_nor_a_path_is_named(call: object) -> None:
+    """A number for the study: InvalidInputError naming ``study`` (was a TypeError from inside pathlib)."""
+    with pytest.raises(InvalidInputError) as error:
+        call()  # type: ignore[operator]
+    assert error.value.field == "study"
+
+
 @pytest.fixture(scope="module")
 def machine_study() -> hs.api.Study:
     """The small study on the XS 031's machine file (its own bounds; tracking the telescope's extension)."""
