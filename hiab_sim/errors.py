@@ -27,11 +27,13 @@ class InvalidInputError(HiabSimError, ValueError):
 
 
 def _show(value: object) -> str:
+    """The value on one line: a float to 6 digits, a string quoted, an array as its nested list."""
     if isinstance(value, float):
         return f"{value:.6g}"
     if isinstance(value, str):
         return repr(value)
-    return str(value)
+    tolist = getattr(value, "tolist", None)  # a numpy array prints its rows on separate lines
+    return str(tolist() if callable(tolist) else value).replace("\n", " ")
 
 
 class ConfigError(HiabSimError, ValueError):

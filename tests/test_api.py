@@ -37,8 +37,12 @@ def test_the_readme_python_example_runs_as_written(tmp_path: Path) -> None:
 
 
 def test_importing_hiab_sim_leaves_the_environment_alone() -> None:
-    """``import hiab_sim`` sets no variable (MUJOCO_GL is chosen when rendering starts)."""
-    env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}
+    """``import hiab_sim`` sets no variable (MUJOCO_GL is chosen when rendering starts).
+
+    The child starts without the variables that the package or its dependencies are known to set
+    (threadpoolctl's KMP_DUPLICATE_LIB_OK), which this test process has already set for itself.
+    """
+    env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "KMP_DUPLICATE_LIB_OK")}
     code = (
         "import os; before = dict(os.environ); import hiab_sim; hiab_sim.evaluate; import hiab_sim.study.run; "
         "print(dict(os.environ) == before)"
@@ -103,6 +107,35 @@ def test_bad_evaluate_input_names_the_field(study: hs.api.Study, lengths: object
     with pytest.raises(InvalidInputError) as error:
         hs.evaluate(study, lengths, trajectory=trajectory)  # type: ignore[arg-type]
     assert error.value.field == field
+
+
+def test_a_wrongly_shaped_array_is_named_on_one_line(study: hs.api.Study) -> None:
+    """A (2, 3) array for the six lengths: one line showing its values (numpy prints rows on separate lines)."""
+    with pytest.raises(InvalidInputError) as error:
+        hs.evaluate(study, np.ones((2, 3)))
+    assert "\n" not in str(error.value)
+    assert str(error.value).startswith(
+        "lengths = [[1.0, 1.0, 1.0], [1.0, 1.0, 1.0]] m is out of range: must be 6 values"
+    )
+
+
+@pytest.mark.parametrize("starts", [0, -1, 1.5, "2", True])
+def test_optimize_refuses_starts_that_are_not_a_positive_integer(
+    study: hs.api.Study, tmp_path: Path, starts: object
+) -> None:
+    """``starts`` below 1 or not an integer: InvalidInputError naming ``starts``, before any folder is written."""
+    with pytest.raises(InvalidInputError) as error:
+        hs.optimize(study, out=tmp_path / "run", starts=starts, progress=None, figures=False)  # type: ignore[arg-type]
+    assert error.value.field == "starts"
+    assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("call", [lambda: hs.load_study(3), lambda: hs.evaluate(3, [1.0] * 6)])  # type: ignore[arg-type]
+def test_a_study_that_is_neither_a_name_nor_a_path_is_named(call: object) -> None:
+    """A number for the study: InvalidInputError naming ``study`` (was a TypeError from inside pathlib)."""
+    with pytest.raises(InvalidInputError) as error:
+        call()  # type: ignore[operator]
+    assert error.value.field == "study"
 
 
 @pytest.fixture(scope="module")

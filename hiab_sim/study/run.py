@@ -50,8 +50,8 @@ def run_study(
 ) -> RunOutput:
     """Optimise a study and write its result folder.
 
-    Bad input (study, unreachable reference, infeasible start, with ``resume`` a checkpoint of
-    another study, ID path or start) raises before anything is written. A fresh run (no
+    Bad input (study, ``starts`` not an integer >= 1, unreachable reference, infeasible start, with
+    ``resume`` a checkpoint of another study, ID path or start) raises before anything is written. A fresh run (no
     ``resume``) deletes every output of earlier runs; a folder of another study is refused unless
     ``force`` (:mod:`hiab_sim.study.run_safety`). Every study, of one task or several, is one
     :class:`~hiab_sim.study.nlp.problem.StudyProblem`, reported by
@@ -62,6 +62,7 @@ def run_study(
     on disk; failures of extra starts are reported (``multistart.failed_starts``).
     """
     t0 = time.perf_counter()
+    starts = run_safety.check_starts(starts)
     if not isinstance(study, Study):
         study = load_study(study)
     codesign = None

@@ -22,6 +22,7 @@ Only files matching :data:`OUTPUT_PATTERNS` are ever deleted. Checks (:func:`che
 from __future__ import annotations
 
 import json
+from numbers import Integral
 from pathlib import Path
 from typing import Any
 
@@ -121,6 +122,18 @@ def check_folder(folder: Path, digest: str, resume: bool, force: bool) -> None:
         )
 
 
+def check_starts(starts: object, field: str = "starts") -> int:
+    """``starts`` as a number of feasible starts, else one line naming ``field``.
+
+    Raises:
+        InvalidInputError: not an integer >= 1 (a bool, a float, a string).
+
+    """
+    if isinstance(starts, bool) or not isinstance(starts, Integral) or starts < 1:
+        raise InvalidInputError(field, starts, "must be an integer >= 1")
+    return int(starts)
+
+
 def resolve_starts(folder: Path, starts: int | None, resume: bool) -> int:
     """The number of starts of a run: as given, else with ``resume`` the run's own, else 1.
 
@@ -131,9 +144,7 @@ def resolve_starts(folder: Path, starts: int | None, resume: bool) -> int:
 
     """
     if starts is not None:
-        if isinstance(starts, bool) or not isinstance(starts, int) or starts < 1:
-            raise InvalidInputError("--starts", starts, "must be an integer >= 1")
-        return starts
+        return check_starts(starts, "--starts")
     if not resume:
         return 1
     found = checkpoints(folder)

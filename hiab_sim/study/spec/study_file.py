@@ -27,7 +27,7 @@ from hiab_sim.crane.description import CHAIN_NAMES, ChainLengths, Crane, LinkLen
 from hiab_sim.crane.loader import load_crane
 from hiab_sim.crane.mounting import MountingSpace
 from hiab_sim.emla.config import load_emla_set
-from hiab_sim.errors import ConfigError
+from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.resources import DEFAULT_STUDY, Source, locate
 from hiab_sim.structure.pin_loads import pins
 from hiab_sim.structure.settings import StructureSettings
@@ -77,11 +77,13 @@ def load_study(path: str | Path | Source | None = None) -> Study:
 
     Raises:
         ConfigError: Missing file, malformed YAML, unknown or missing keys, wrong types.
-        InvalidInputError: A value out of range, named by its field.
+        InvalidInputError: A value out of range, named by its field; ``path`` neither a name nor a path.
 
     """
     if isinstance(path, Source):
         found = path
+    elif path is not None and not isinstance(path, (str, Path)):
+        raise InvalidInputError("study", path, "must be a shipped study name, a YAML path or a loaded Study")
     else:
         found = locate(DEFAULT_STUDY if path is None else path, "study")
     return study_from_dict(read_yaml(found), found)
