@@ -10,7 +10,9 @@ The Python API (:mod:`hiab_sim.api`)::
     r = hs.read_result("runs/x")
 
 Importing the package changes nothing in the environment: the OpenGL backend of MuJoCo is chosen
-when rendering starts (:mod:`hiab_sim._gl`).
+when rendering starts (:mod:`hiab_sim._gl`). The first use of the study API loads threadpoolctl,
+which sets ``KMP_DUPLICATE_LIB_OK=True`` where it is unset (its own workaround, kept: a process
+with two OpenMP runtimes aborts without it); hiab-sim sets nothing else.
 """
 
 from __future__ import annotations

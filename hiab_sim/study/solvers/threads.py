@@ -19,17 +19,9 @@ digging study took 168 iterations here and 131 with one thread; the XS 031 duty 
 from __future__ import annotations
 
 import functools
-import os
 from contextlib import AbstractContextManager
 
-_KMP = "KMP_DUPLICATE_LIB_OK"
-_kmp_before = os.environ.get(_KMP)
-from threadpoolctl import OpenBLASController, register, threadpool_limits  # noqa: E402
-
-# threadpoolctl sets KMP_DUPLICATE_LIB_OK=True at import (Intel OpenMP then loads a second copy of itself
-# instead of stopping); hiab-sim needs no such thing, and importing it leaves the user's environment as it was.
-if _kmp_before is None:
-    os.environ.pop(_KMP, None)
+from threadpoolctl import OpenBLASController, register, threadpool_limits
 
 
 def single_blas_thread() -> AbstractContextManager[object]:
