@@ -202,3 +202,51 @@ def test_report_of_a_duty_mix_shows_its_tasks_and_cross_evaluation(
     html = (folder / "report.html").read_text()
     assert "<h2>Duty mix</h2>" in html and "lifting x 20" in html
     assert "1234.5" in html and "24690.0" in html and "+0.125 %" in html and "–" in html  # a missing cell: en dash
+
+
+def _answer_box(html: str) -> str:
+    """The text of the page's answer box (the first ``<div class="answer">``)."""
+    start = html.index('<div class="answer">')
+    return html[start : html.index("</div>", start)]
+
+
+def test_report_names_the_period_its_battery_energy_covers(run_dir: Path, result: Result) -> None:
+    """With a duty the battery energy covers cycle and rest: named so (as summary.md does), the cycle beside it."""
+    html = (run_dir / "report.html").read_text()
+    assert result.energy is not None and result.energy.optimal.duty is not None
+    assert "battery energy per cycle" not in html
+    assert "battery energy per duty period (cycle and rest)" in html
+    assert f"{result.energy.optimal.duty.cycle_battery_energy_J:.1f} J" in html
+
+
+def test_report_answer_states_the_saving_the_binding_limits_and_the_check(run_dir: Path, result: Result) -> None:
+    """The answer box says what the summary's answer says: battery energy before/after, binding limits, re-check."""
+    import html as html_lib
+
+    from hiab_sim.study.report.summary import binding_line, check_line, energy_line
+
+    box = html_lib.unescape(_answer_box((run_dir / "report.html").read_text()))
+    for line in (energy_line(result), binding_line(result), check_line(result)):
+        assert line in box
+    assert line in (run_dir / "summary.md").read_text()
+
+
+def test_binding_limits_name_the_objective_they_are_gains_of(result: Result) -> None:
+    """The multipliers are gains in the study's objective: costf2 is a squared power, not called an energy gain."""
+    from hiab_sim.study.report.summary import binding_line
+
+    assert result.sensitivity is not None and result.sensitivity.multipliers
+    line = binding_line(result)
+    if result.sensitivity.objective == "battery_energy":
+        assert "largest energy gain" in line
+    else:
+        assert "energy gain" not in line and f"gain in {result.sensitivity.objective}" in line
+
+
+def test_report_saving_decomposition_adds_up_to_the_saving(run_dir: Path, result: Result) -> None:
+    """Lengths, trajectory and their interaction add up to the net energy saved, and all three are on the page."""
+    d = result.improvement.decomposition
+    assert d.from_lengths_J is not None and d.from_trajectory_J is not None and d.interaction_J is not None
+    html = (run_dir / "report.html").read_text()
+    assert f"Of the {result.improvement.net_energy_saved_J:.1f} J net energy saved" in html
+    assert f"{d.interaction_J:+.1f} J from their interaction" in html
