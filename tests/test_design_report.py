@@ -250,3 +250,44 @@ def test_report_saving_decomposition_adds_up_to_the_saving(run_dir: Path, result
     html = (run_dir / "report.html").read_text()
     assert f"Of the {result.improvement.net_energy_saved_J:.1f} J net energy saved" in html
     assert f"{d.interaction_J:+.1f} J from their interaction" in html
+
+
+def test_report_compares_hydraulics_at_one_boundary_over_one_period(run_dir: Path, result: Result) -> None:
+    """EMLA and cylinders both at the battery over the cycle; no result.json key names shown to the reader."""
+    h = result.hydraulic_baseline
+    assert h is not None and h.optimal.at_battery and h.optimal.emla_cycle_battery_energy_J is not None
+    html = (run_dir / "report.html").read_text()
+    hydraulic = html[html.index("<h2>Hydraulic comparison</h2>") :]
+    hydraulic = hydraulic[: hydraulic.index("</section>")]
+    assert f"{h.optimal.emla_cycle_battery_energy_J / 1e3:.2f} kJ" in hydraulic
+    for variant in h.optimal.at_battery.values():
+        assert f"{variant.cycle_battery_energy_J / 1e3:.2f} kJ ({variant.emla_saving_percent:.1f} %)" in hydraulic
+    # the duty period's battery energy (rest included) is not set against the cylinders' cycle
+    assert f"{h.optimal.emla_saving_vs_load_sensing_percent:.1f} %" not in hydraulic
+    assert "at_battery" not in hydraulic and "load_sensing" not in hydraulic
+
+
+def test_hydraulic_figure_draws_the_emlas_cycle_energy(
+    run_dir: Path, result: Result, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The figure's EMLA bar, like the cylinders' bars, covers the cycle alone (not the duty period's rest)."""
+    from hiab_sim.study.figures import energy
+
+    drawn: list[float] = []
+
+    def capture(names: object, emla_drawn: object, battery_energy: float, *rest: object) -> None:
+        drawn.append(battery_energy)
+        raise RuntimeError("captured")
+
+    monkeypatch.setattr(energy, "plot_energy_comparison", capture)
+    with pytest.raises(RuntimeError, match="captured"):
+        energy.hydraulic_figure(run_dir / "unused.png", result)
+    assert result.hydraulic_baseline is not None
+    assert drawn == [result.hydraulic_baseline.optimal.emla_cycle_battery_energy_J]
+
+
+def test_report_sensitivity_names_its_grid_and_units_have_one_space(run_dir: Path) -> None:
+    """The objective value of the multipliers is the collocation grid's (not the energies' fine grid); '7.83 Hz'."""
+    html = (run_dir / "report.html").read_text()
+    assert "at the optimum on the optimiser&#x27;s collocation grid" in html
+    assert "  Hz" not in html and " Hz</td>" in html
