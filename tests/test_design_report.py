@@ -291,3 +291,13 @@ def test_report_sensitivity_names_its_grid_and_units_have_one_space(run_dir: Pat
     html = (run_dir / "report.html").read_text()
     assert "at the optimum on the optimiser&#x27;s collocation grid" in html
     assert "  Hz" not in html and " Hz</td>" in html
+
+
+def test_report_says_a_screw_in_tension_throughout_never_pushes(run_dir: Path, result: Result) -> None:
+    """A negative largest n f / P_cr (the screw only pulls) is labelled, not left as a bare negative utilisation."""
+    assert result.structure is not None
+    html = (run_dir / "report.html").read_text()
+    pulled = [b for b in result.structure.optimal.buckling.values() if b.peak_push_N <= 0.0]
+    assert pulled, "the small study's telescope screw only pulls"
+    for b in pulled:
+        assert f"{b.max_utilisation:.3f} (tension only, never pushed)" in html

@@ -12,6 +12,7 @@ from hiab_sim.design_report.page import figure, num, paragraph, section, table
 from hiab_sim.design_report.simulation_table import COLUMNS, NUMERIC, run_groups, table_header, table_rows
 from hiab_sim.results.energy_sections import HydraulicBaseline
 from hiab_sim.results.schema import Result
+from hiab_sim.structure.summary import BucklingSummary
 
 T = TypeVar("T")
 
@@ -260,6 +261,11 @@ def _initial_optimal(
     return [(name, value(initial[name]), value(o), detail(o), *set_by(name)) for name, o in optimal.items()]
 
 
+def _utilisation(b: BucklingSummary) -> str:
+    """Largest n f / P_cr [-]; a screw that never pushes (negative: tension throughout) says so."""
+    return f"{b.max_utilisation:.3f}" + (" (tension only, never pushed)" if b.peak_push_N <= 0.0 else "")
+
+
 def structure(result: Result, folder: Path) -> str:
     """Pin loads, screw buckling and natural frequencies of both designs (the result's ``structure`` section).
 
@@ -288,7 +294,7 @@ def structure(result: Result, folder: Path) -> str:
     screws = _initial_optimal(
         s.initial.buckling,
         s.optimal.buckling,
-        lambda b: f"{b.max_utilisation:.3f}",
+        _utilisation,
         lambda b: f"{b.min_critical_load_N / 1e3:.0f} kN at {b.max_column_length_m:.2f} m",
         lambda name: task(None if e is None else e.buckling_task, name),
     )
