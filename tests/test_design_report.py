@@ -301,3 +301,39 @@ def test_report_says_a_screw_in_tension_throughout_never_pushes(run_dir: Path, r
     assert pulled, "the small study's telescope screw only pulls"
     for b in pulled:
         assert f"{b.max_utilisation:.3f} (tension only, never pushed)" in html
+
+
+def test_report_of_a_duty_mix_names_its_weighted_sums_and_each_tasks_battery_energy(
+    run_dir: Path, result: Result, tmp_path: Path
+) -> None:
+    """A mix's top-level energies are weighted sums (J/h for cycles/h), not per cycle; each task's too."""
+    import shutil
+    from dataclasses import replace
+
+    from hiab_sim.results.schema import TaskResult
+
+    assert result.energy is not None
+    task = TaskResult(
+        name="lifting",
+        weight=20.0,
+        kind="spiral",
+        duration_s=6.25,
+        payload_kg=150.0,
+        telescope="prescribed",
+        spline_control_points=16,
+        collocation_points=13,
+        initial=result.initial,
+        optimal=result.optimal,
+        recheck=result.recheck,
+        energy=result.energy,
+    )
+    folder = tmp_path / "mix"
+    shutil.copytree(run_dir, folder)
+    (folder / "result.json").write_text(json.dumps(replace(result, tasks=(task,)).to_json()))
+    assert main(["report", str(folder)]) == 0
+    html = (folder / "report.html").read_text()
+    assert "battery energy per cycle" not in html and "battery energy per duty period" not in html
+    assert "battery energy, the tasks&#x27; weighted sum" in html and "lifting x 20" in html
+    assert "net energy, the tasks&#x27; weighted sum" in html
+    e = result.energy
+    assert f"{e.initial.battery_energy_J:.1f} → {e.optimal.battery_energy_J:.1f} J (per duty period)" in html

@@ -220,10 +220,20 @@ def duty_mix(result: Result, folder: Path) -> str:
             f"{t.weight:g}",
             f"{t.payload_kg:g} kg",
             f"{t.initial.net_electrical_energy_J:.1f} → {t.optimal.net_electrical_energy_J:.1f} J",
+            "–"
+            if t.energy is None
+            else f"{t.energy.initial.battery_energy_J:.1f} → {t.energy.optimal.battery_energy_J:.1f} J "
+            f"({'per duty period' if t.energy.optimal.duty is not None else 'per cycle'})",
         )
         for t in result.tasks
     ]
-    parts = [table(("task", "weight", "payload", "net energy initial → optimal"), rows, numeric=(1, 2, 3))]
+    parts = [
+        table(
+            ("task", "weight", "payload", "net energy initial → optimal", "battery energy initial → optimal"),
+            rows,
+            numeric=(1, 2, 3, 4),
+        )
+    ]
     c = result.cross_evaluation
     if c is not None:
         cross = [

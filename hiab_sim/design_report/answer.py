@@ -169,9 +169,13 @@ def energies(result: Result, folder: Path) -> str:
         e = result.energy
         di, do = e.initial.duty, e.optimal.duty
         boundary = "at the battery (inverters, shared DC bus, battery efficiencies)"
+        if result.tasks:
+            battery = "battery energy, the tasks' weighted sum"
+        else:
+            battery = "battery energy per cycle" if do is None else "battery energy per duty period (cycle and rest)"
         rows.append(
             (
-                "battery energy per cycle" if do is None else "battery energy per duty period (cycle and rest)",
+                battery,
                 boundary,
                 num(e.initial.battery_energy_J, ".1f", "J"),
                 num(e.optimal.battery_energy_J, ".1f", "J"),
@@ -228,8 +232,18 @@ def energies(result: Result, folder: Path) -> str:
             f"re-shaping the trajectory within the tracking bands{interaction}.",
             "note",
         )
+    mix = ""
+    if result.tasks:
+        weights = ", ".join(f"{t.name} x {t.weight:g}" for t in result.tasks)
+        mix = paragraph(
+            f"A duty mix: every energy on this page but the duty-mix section's is the tasks' weighted sum ({weights}) "
+            "of each task's energy per cycle, or per duty period at the battery where the task has a duty; with the "
+            "weights in cycles per hour, J per hour. Each task's own energies are in the duty-mix section.",
+            "note",
+        )
     return section(
         "Energies and their boundaries",
+        mix,
         table(("quantity", "boundary", "initial", "design", "change"), rows, numeric=(2, 3, 4)),
         note,
         figure(folder / "energy_breakdown.png", "Energy by power flow, initial and optimal"),
@@ -249,8 +263,9 @@ def actuator_table(result: Result) -> str:
         )
         for name, a in result.optimal.actuators.items()
     ]
+    net = "net energy, the tasks' weighted sum" if result.tasks else "net energy"
     return table(
-        ("actuator", "peak force", "peak speed", "peak power", "min envelope margin (>= 0)", "net energy"),
+        ("actuator", "peak force", "peak speed", "peak power", "min envelope margin (>= 0)", net),
         rows,
         numeric=(1, 2, 3, 4, 5),
     )
