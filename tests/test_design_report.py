@@ -202,3 +202,138 @@ def test_report_of_a_duty_mix_shows_its_tasks_and_cross_evaluation(
     html = (folder / "report.html").read_text()
     assert "<h2>Duty mix</h2>" in html and "lifting x 20" in html
     assert "1234.5" in html and "24690.0" in html and "+0.125 %" in html and "–" in html  # a missing cell: en dash
+
+
+def _answer_box(html: str) -> str:
+    """The text of the page's answer box (the first ``<div class="answer">``)."""
+    start = html.index('<div class="answer">')
+    return html[start : html.index("</div>", start)]
+
+
+def test_report_names_the_period_its_battery_energy_covers(run_dir: Path, result: Result) -> None:
+    """With a duty the battery energy covers cycle and rest: named so (as summary.md does), the cycle beside it."""
+    html = (run_dir / "report.html").read_text()
+    assert result.energy is not None and result.energy.optimal.duty is not None
+    assert "battery energy per cycle" not in html
+    assert "battery energy per duty period (cycle and rest)" in html
+    assert f"{result.energy.optimal.duty.cycle_battery_energy_J:.1f} J" in html
+
+
+def test_report_answer_states_the_saving_the_binding_limits_and_the_check(run_dir: Path, result: Result) -> None:
+    """The answer box says what the summary's answer says: battery energy before/after, binding limits, re-check."""
+    import html as html_lib
+
+    from hiab_sim.study.report.summary import binding_line, check_line, energy_line
+
+    box = html_lib.unescape(_answer_box((run_dir / "report.html").read_text()))
+    for line in (energy_line(result), binding_line(result), check_line(result)):
+        assert line in box
+    assert line in (run_dir / "summary.md").read_text()
+
+
+def test_binding_limits_name_the_objective_they_are_gains_of(result: Result) -> None:
+    """The multipliers are gains in the study's objective: costf2 is a squared power, not called an energy gain."""
+    from hiab_sim.study.report.summary import binding_line
+
+    assert result.sensitivity is not None and result.sensitivity.multipliers
+    line = binding_line(result)
+    if result.sensitivity.objective == "battery_energy":
+        assert "largest energy gain" in line
+    else:
+        assert "energy gain" not in line and f"gain in {result.sensitivity.objective}" in line
+
+
+def test_report_saving_decomposition_adds_up_to_the_saving(run_dir: Path, result: Result) -> None:
+    """Lengths, trajectory and their interaction add up to the net energy saved, and all three are on the page."""
+    d = result.improvement.decomposition
+    assert d.from_lengths_J is not None and d.from_trajectory_J is not None and d.interaction_J is not None
+    html = (run_dir / "report.html").read_text()
+    assert f"Of the {result.improvement.net_energy_saved_J:.1f} J net energy saved" in html
+    assert f"{d.interaction_J:+.1f} J from their interaction" in html
+
+
+def test_report_compares_hydraulics_at_one_boundary_over_one_period(run_dir: Path, result: Result) -> None:
+    """EMLA and cylinders both at the battery over the cycle; no result.json key names shown to the reader."""
+    h = result.hydraulic_baseline
+    assert h is not None and h.optimal.at_battery and h.optimal.emla_cycle_battery_energy_J is not None
+    html = (run_dir / "report.html").read_text()
+    hydraulic = html[html.index("<h2>Hydraulic comparison</h2>") :]
+    hydraulic = hydraulic[: hydraulic.index("</section>")]
+    assert f"{h.optimal.emla_cycle_battery_energy_J / 1e3:.2f} kJ" in hydraulic
+    for variant in h.optimal.at_battery.values():
+        assert f"{variant.cycle_battery_energy_J / 1e3:.2f} kJ ({variant.emla_saving_percent:.1f} %)" in hydraulic
+    # the duty period's battery energy (rest included) is not set against the cylinders' cycle
+    assert f"{h.optimal.emla_saving_vs_load_sensing_percent:.1f} %" not in hydraulic
+    assert "at_battery" not in hydraulic and "load_sensing" not in hydraulic
+
+
+def test_hydraulic_figure_draws_the_emlas_cycle_energy(
+    run_dir: Path, result: Result, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The figure's EMLA bar, like the cylinders' bars, covers the cycle alone (not the duty period's rest)."""
+    from hiab_sim.study.figures import energy
+
+    drawn: list[float] = []
+
+    def capture(names: object, emla_drawn: object, battery_energy: float, *rest: object) -> None:
+        drawn.append(battery_energy)
+        raise RuntimeError("captured")
+
+    monkeypatch.setattr(energy, "plot_energy_comparison", capture)
+    with pytest.raises(RuntimeError, match="captured"):
+        energy.hydraulic_figure(run_dir / "unused.png", result)
+    assert result.hydraulic_baseline is not None
+    assert drawn == [result.hydraulic_baseline.optimal.emla_cycle_battery_energy_J]
+
+
+def test_report_sensitivity_names_its_grid_and_units_have_one_space(run_dir: Path) -> None:
+    """The objective value of the multipliers is the collocation grid's (not the energies' fine grid); '7.83 Hz'."""
+    html = (run_dir / "report.html").read_text()
+    assert "at the optimum on the optimiser&#x27;s collocation grid" in html
+    assert "  Hz" not in html and " Hz</td>" in html
+
+
+def test_report_says_a_screw_in_tension_throughout_never_pushes(run_dir: Path, result: Result) -> None:
+    """A negative largest n f / P_cr (the screw only pulls) is labelled, not left as a bare negative utilisation."""
+    assert result.structure is not None
+    html = (run_dir / "report.html").read_text()
+    pulled = [b for b in result.structure.optimal.buckling.values() if b.peak_push_N <= 0.0]
+    assert pulled, "the small study's telescope screw only pulls"
+    for b in pulled:
+        assert f"{b.max_utilisation:.3f} (tension only, never pushed)" in html
+
+
+def test_report_of_a_duty_mix_names_its_weighted_sums_and_each_tasks_battery_energy(
+    run_dir: Path, result: Result, tmp_path: Path
+) -> None:
+    """A mix's top-level energies are weighted sums (J/h for cycles/h), not per cycle; each task's too."""
+    import shutil
+    from dataclasses import replace
+
+    from hiab_sim.results.schema import TaskResult
+
+    assert result.energy is not None
+    task = TaskResult(
+        name="lifting",
+        weight=20.0,
+        kind="spiral",
+        duration_s=6.25,
+        payload_kg=150.0,
+        telescope="prescribed",
+        spline_control_points=16,
+        collocation_points=13,
+        initial=result.initial,
+        optimal=result.optimal,
+        recheck=result.recheck,
+        energy=result.energy,
+    )
+    folder = tmp_path / "mix"
+    shutil.copytree(run_dir, folder)
+    (folder / "result.json").write_text(json.dumps(replace(result, tasks=(task,)).to_json()))
+    assert main(["report", str(folder)]) == 0
+    html = (folder / "report.html").read_text()
+    assert "battery energy per cycle" not in html and "battery energy per duty period" not in html
+    assert "battery energy, the tasks&#x27; weighted sum" in html and "lifting x 20" in html
+    assert "net energy, the tasks&#x27; weighted sum" in html
+    e = result.energy
+    assert f"{e.initial.battery_energy_J:.1f} → {e.optimal.battery_energy_J:.1f} J (per duty period)" in html

@@ -10,7 +10,9 @@ from typing import Any, TypeVar
 from hiab_sim.design_report.answer import actuator_table
 from hiab_sim.design_report.page import figure, num, paragraph, section, table
 from hiab_sim.design_report.simulation_table import COLUMNS, NUMERIC, run_groups, table_header, table_rows
+from hiab_sim.results.energy_sections import HydraulicBaseline
 from hiab_sim.results.schema import Result
+from hiab_sim.structure.summary import BucklingSummary
 
 T = TypeVar("T")
 
@@ -84,7 +86,8 @@ def sensitivities(result: Result, folder: Path) -> str:
     return section(
         "Sensitivities",
         paragraph(
-            f"Decrease of the objective ({s.objective}, {s.objective_value:.6g} {s.objective_unit} at the optimum) "
+            f"Decrease of the objective ({s.objective}, {s.objective_value:.6g} {s.objective_unit} at the optimum on "
+            "the optimiser's collocation grid, not the fine grid of the energies above) "
             f"per unit each active limit is relaxed (KKT residual {s.kkt_residual:.1e}); a slope, "
             "not a promise for large moves.",
             "note",
@@ -94,36 +97,86 @@ def sensitivities(result: Result, folder: Path) -> str:
     )
 
 
+def _at_battery_rows(h: HydraulicBaseline) -> tuple[list[str], list[tuple[str, ...]]] | None:
+    """Variants and rows of the comparison at the battery over the cycle, None where the result has none."""
+    designs = (("initial", h.initial), ("optimal", h.optimal))
+    if any(d.at_battery is None or d.emla_cycle_battery_energy_J is None for _, d in designs):
+        return None
+    variants = list(h.optimal.at_battery or {})
+    rows = []
+    for design, d in designs:
+        at = d.at_battery or {}
+        cells = [
+            f"{at[v].cycle_battery_energy_J / 1e3:.2f} kJ ({at[v].emla_saving_percent:.1f} %)" if v in at else "–"
+            for v in variants
+        ]
+        rows.append((design, num((d.emla_cycle_battery_energy_J or 0.0) / 1e3, ".2f", "kJ"), *cells))
+    return variants, rows
+
+
 def hydraulics(result: Result, folder: Path) -> str:
-    """The valve-controlled cylinders the EMLAs replace, for the same motion and loads."""
+    """The hydraulic cylinders the EMLAs replace, for the same motion and loads.
+
+    Where the result has it, every variant at the battery over the cycle against the EMLAs' battery energy
+    of the same cycle [kJ]: one boundary, one period. Below it, the pump motors' electric input of the
+    valve-controlled supplies [kJ] and their system efficiency.
+    """
     h = result.hydraulic_baseline
     if h is None:
         return ""
+    parts = []
+    battery = _at_battery_rows(h)
+    if battery is not None:
+        variants, rows = battery
+        parts += [
+            paragraph(
+                "At the battery, over the cycle (the rest of a duty period excluded): each hydraulic variant with its "
+                "pump, the pump's motor and inverter, valves and leakage, against the EMLAs' battery energy of the "
+                "same cycle; in brackets the EMLAs' saving against it."
+            ),
+            table(
+                ("design", "EMLA", *(v.replace("_", " ") for v in variants)),
+                rows,
+                numeric=tuple(range(1, len(variants) + 2)),
+            ),
+        ]
     rows = [
         (
             design,
-            num(d.emla_battery_energy_J / 1e3, ".2f", "kJ"),
             f"{d.load_sensing.input_energy_J / 1e3:.1f} kJ ({100 * d.load_sensing.system_efficiency:.1f} %)",
             f"{d.constant_pressure.input_energy_J / 1e3:.1f} kJ ({100 * d.constant_pressure.system_efficiency:.1f} %)",
-            f"{d.emla_saving_vs_load_sensing_percent:.1f} % / {d.emla_saving_vs_constant_pressure_percent:.1f} %",
         )
         for design, d in (("initial", h.initial), ("optimal", h.optimal))
     ]
+    parts += [
+        paragraph(
+            "Valve-controlled supplies at the pump motor's electric input over the cycle (system efficiency in "
+            "brackets: delivered work over that input)."
+        ),
+        table(("design", "load sensing", "constant pressure"), rows, numeric=(1, 2)),
+    ]
+    if battery is None:
+        parts.append(
+            paragraph(
+                "EMLA at the battery per "
+                + ("duty period" if result.energy is not None and result.energy.optimal.duty is not None else "cycle")
+                + ": "
+                + "; ".join(
+                    f"{n} {d.emla_battery_energy_J / 1e3:.2f} kJ"
+                    for n, d in (("initial", h.initial), ("optimal", h.optimal))
+                )
+                + " (not the pump motors' boundary).",
+                "note",
+            )
+        )
     return section(
         "Hydraulic comparison",
-        paragraph(h.note, "note"),
-        table(
-            (
-                "design",
-                "EMLA at the battery",
-                "hydraulic, load sensing (system eff.)",
-                "hydraulic, constant pressure",
-                "EMLA saving vs LS / CP",
-            ),
-            rows,
-            numeric=(1, 2, 3, 4),
+        *parts,
+        figure(
+            folder / "energy_emla_vs_hydraulic.png",
+            "EMLA against hydraulic energy over the cycle: the EMLAs at the battery, the cylinders at the pump "
+            "motor's electric input (left); each actuator at its own supply (right)",
         ),
-        figure(folder / "energy_emla_vs_hydraulic.png", "EMLA against hydraulic energy per actuator"),
     )
 
 
@@ -167,10 +220,20 @@ def duty_mix(result: Result, folder: Path) -> str:
             f"{t.weight:g}",
             f"{t.payload_kg:g} kg",
             f"{t.initial.net_electrical_energy_J:.1f} → {t.optimal.net_electrical_energy_J:.1f} J",
+            "–"
+            if t.energy is None
+            else f"{t.energy.initial.battery_energy_J:.1f} → {t.energy.optimal.battery_energy_J:.1f} J "
+            f"({'per duty period' if t.energy.optimal.duty is not None else 'per cycle'})",
         )
         for t in result.tasks
     ]
-    parts = [table(("task", "weight", "payload", "net energy initial → optimal"), rows, numeric=(1, 2, 3))]
+    parts = [
+        table(
+            ("task", "weight", "payload", "net energy initial → optimal", "battery energy initial → optimal"),
+            rows,
+            numeric=(1, 2, 3, 4),
+        )
+    ]
     c = result.cross_evaluation
     if c is not None:
         cross = [
@@ -208,6 +271,11 @@ def _initial_optimal(
     return [(name, value(initial[name]), value(o), detail(o), *set_by(name)) for name, o in optimal.items()]
 
 
+def _utilisation(b: BucklingSummary) -> str:
+    """Largest n f / P_cr [-]; a screw that never pushes (negative: tension throughout) says so."""
+    return f"{b.max_utilisation:.3f}" + (" (tension only, never pushed)" if b.peak_push_N <= 0.0 else "")
+
+
 def structure(result: Result, folder: Path) -> str:
     """Pin loads, screw buckling and natural frequencies of both designs (the result's ``structure`` section).
 
@@ -236,14 +304,14 @@ def structure(result: Result, folder: Path) -> str:
     screws = _initial_optimal(
         s.initial.buckling,
         s.optimal.buckling,
-        lambda b: f"{b.max_utilisation:.3f}",
+        _utilisation,
         lambda b: f"{b.min_critical_load_N / 1e3:.0f} kN at {b.max_column_length_m:.2f} m",
         lambda name: task(None if e is None else e.buckling_task, name),
     )
     path_task = None if e is None else e.lowest_frequency_trajectory_task
     grid_task = None if e is None else e.lowest_frequency_working_range_task
     freq = [
-        (where, num(getattr(s.initial, key), ".2f", " Hz"), num(getattr(s.optimal, key), ".2f", " Hz"), *task(t))
+        (where, num(getattr(s.initial, key), ".2f", "Hz"), num(getattr(s.optimal, key), ".2f", "Hz"), *task(t))
         for where, key, t in (
             ("along the motion", "lowest_frequency_trajectory_Hz", path_task),
             ("over the working range", "lowest_frequency_working_range_Hz", grid_task),
@@ -284,7 +352,7 @@ def structure(result: Result, folder: Path) -> str:
                     t.name,
                     f"{d.most_loaded_pin}, {d.pins[d.most_loaded_pin].peak_N / 1e3:.1f} kN",
                     num(None if worst is None else worst.max_utilisation, ".3f"),
-                    num(d.lowest_frequency_trajectory_Hz, ".2f", " Hz"),
+                    num(d.lowest_frequency_trajectory_Hz, ".2f", "Hz"),
                 )
             )
         parts.append(

@@ -9,8 +9,10 @@ import numpy as np
 from hiab_sim.crane.description import Crane, LinkLengths
 from hiab_sim.design_report.page import esc, figure, num, paragraph, section, table
 from hiab_sim.machine.description import Machine
+from hiab_sim.percent import change_percent
 from hiab_sim.results.design_values import crane_lengths
 from hiab_sim.results.schema import Result
+from hiab_sim.study.report.summary import binding_line, check_line, energy_line
 
 
 def _lengths_text(lengths: LinkLengths, crane: Crane) -> str:
@@ -91,6 +93,11 @@ def _buildable_text(result: Result) -> str:
     )
 
 
+def _verdict(result: Result) -> str:
+    """The answer's second half, as the summary states it: battery energy saved, binding limits, all limits hold."""
+    return paragraph(" ".join((energy_line(result), binding_line(result), check_line(result))))
+
+
 def machine_design(result: Result, machine: Machine, folder: Path) -> str:
     """A machine file's design to build: each decision variable and each pivot it moves, in the link's frame."""
     chosen = result.optimal.lengths if result.buildable is None else result.buildable.lengths
@@ -116,7 +123,7 @@ def machine_design(result: Result, machine: Machine, folder: Path) -> str:
     )
     return section(
         "The answer: the design to build",
-        f'<div class="answer">{paragraph(text + _buildable_text(result))}</div>',
+        f'<div class="answer">{paragraph(text + _buildable_text(result))}{_verdict(result)}</div>',
         table(("variable", "meaning", "initial → design [m]", "change"), rows),
         table(("pivot", "on link", "move in the link's frame"), moves) if moves else "",
     )
@@ -144,7 +151,7 @@ def design(result: Result, crane: Crane, folder: Path) -> str:
     text = f"Build {_lengths_text(build, crane)}." + _buildable_text(result)
     return section(
         "The answer: the design to build",
-        f'<div class="answer">{paragraph(text)}</div>',
+        f'<div class="answer">{paragraph(text)}{_verdict(result)}</div>',
         table(
             ("chain", "L [m] (base pivot to boom hinge)", "base pivot move", "retracted length x0 [m]", "Lc0 / Lc [m]"),
             rows,
@@ -160,15 +167,31 @@ def energies(result: Result, folder: Path) -> str:
     rows: list[tuple[str, str, str, str, str]] = []
     if result.energy is not None:
         e = result.energy
+        di, do = e.initial.duty, e.optimal.duty
+        boundary = "at the battery (inverters, shared DC bus, battery efficiencies)"
+        if result.tasks:
+            battery = "battery energy, the tasks' weighted sum"
+        else:
+            battery = "battery energy per cycle" if do is None else "battery energy per duty period (cycle and rest)"
         rows.append(
             (
-                "battery energy per cycle",
-                "at the battery (inverters, shared DC bus, battery efficiencies)",
+                battery,
+                boundary,
                 num(e.initial.battery_energy_J, ".1f", "J"),
                 num(e.optimal.battery_energy_J, ".1f", "J"),
                 f"{-e.battery_energy_saved_percent:+.2f} %",
             )
         )
+        if di is not None and do is not None:
+            rows.append(
+                (
+                    "battery energy of the cycle alone (no rest)",
+                    boundary,
+                    num(di.cycle_battery_energy_J, ".1f", "J"),
+                    num(do.cycle_battery_energy_J, ".1f", "J"),
+                    f"{change_percent(di.cycle_battery_energy_J, do.cycle_battery_energy_J):+.2f} %",
+                )
+            )
     rows += [
         (
             "net electrical energy",
@@ -202,14 +225,25 @@ def energies(result: Result, folder: Path) -> str:
     d = result.improvement.decomposition
     note = ""
     if d.from_lengths_J is not None and d.from_trajectory_J is not None:
+        interaction = "" if d.interaction_J is None else f" and {d.interaction_J:+.1f} J from their interaction"
         note = paragraph(
-            f"Of the net energy saved, {d.from_lengths_J:.1f} J come from the lengths alone (optimal lengths on the "
-            f"initial trajectory) and {d.from_trajectory_J:.1f} J from re-shaping the trajectory within the tracking "
-            "bands.",
+            f"Of the {result.improvement.net_energy_saved_J:.1f} J net energy saved, {d.from_lengths_J:.1f} J come "
+            f"from the lengths alone (optimal lengths on the initial trajectory), {d.from_trajectory_J:.1f} J from "
+            f"re-shaping the trajectory within the tracking bands{interaction}.",
+            "note",
+        )
+    mix = ""
+    if result.tasks:
+        weights = ", ".join(f"{t.name} x {t.weight:g}" for t in result.tasks)
+        mix = paragraph(
+            f"A duty mix: every energy on this page but the duty-mix section's is the tasks' weighted sum ({weights}) "
+            "of each task's energy per cycle, or per duty period at the battery where the task has a duty; with the "
+            "weights in cycles per hour, J per hour. Each task's own energies are in the duty-mix section.",
             "note",
         )
     return section(
         "Energies and their boundaries",
+        mix,
         table(("quantity", "boundary", "initial", "design", "change"), rows, numeric=(2, 3, 4)),
         note,
         figure(folder / "energy_breakdown.png", "Energy by power flow, initial and optimal"),
@@ -229,8 +263,9 @@ def actuator_table(result: Result) -> str:
         )
         for name, a in result.optimal.actuators.items()
     ]
+    net = "net energy, the tasks' weighted sum" if result.tasks else "net energy"
     return table(
-        ("actuator", "peak force", "peak speed", "peak power", "min envelope margin (>= 0)", "net energy"),
+        ("actuator", "peak force", "peak speed", "peak power", "min envelope margin (>= 0)", net),
         rows,
         numeric=(1, 2, 3, 4, 5),
     )

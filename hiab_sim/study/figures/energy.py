@@ -32,7 +32,11 @@ def _supply(variant: HydraulicVariant, names: list[str]) -> _Supply:
 
 
 def hydraulic_figure(path: Path, result: Result) -> list[Path]:
-    """Write the EMLA-vs-hydraulic charts of the optimal design to ``path``; [] without both sections."""
+    """Write the EMLA-vs-hydraulic charts of the optimal design to ``path``; [] without both sections.
+
+    The EMLA bar is the battery energy of the cycle alone [J] (the rest of a duty period excluded), the
+    period the hydraulic bars cover.
+    """
     energy, baseline = result.energy, result.hydraulic_baseline
     if energy is None or baseline is None:
         return []
@@ -43,7 +47,9 @@ def hydraulic_figure(path: Path, result: Result) -> list[Path]:
     fig = plot_energy_comparison(
         names,
         drawn,
-        energy.optimal.battery_energy_J,
+        design.emla_cycle_battery_energy_J
+        if design.emla_cycle_battery_energy_J is not None
+        else design.emla_battery_energy_J,
         _supply(design.constant_pressure, names),
         _supply(design.load_sensing, names),
         title,

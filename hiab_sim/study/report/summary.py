@@ -121,7 +121,7 @@ def _design_lines(built: DesignValues, initial: DesignValues, tolerance_mm: floa
     return lines
 
 
-def _energy_line(r: Result) -> str:
+def energy_line(r: Result) -> str:
     """The energy before/after, named with its boundary and the period it covers.
 
     With the study's duty model the battery energy covers a duty period (the cycle and the rest that
@@ -225,6 +225,32 @@ def _thermal_line(r: Result) -> str | None:
     )
 
 
+def binding_line(r: Result) -> str:
+    """The limits that bind at the optimum, in words, largest multiplier first.
+
+    The multipliers are gains in the study's objective (``sensitivity.objective``: the battery energy
+    [J], or the seed's costf2 [W^2 s], a squared power and not an energy), so the line names it.
+    """
+    s = r.sensitivity
+    binding: list[str] = []
+    for m in () if s is None else s.multipliers:
+        words = limit_in_words(m.constraint, detail=False)
+        if words not in binding and len(binding) < BINDING_SHOWN:
+            binding.append(words)
+    if s is None or not binding:
+        return "Binding limits at the optimum: none reported (no sensitivity section)."
+    gain = "energy gain" if s.objective == "battery_energy" else f"gain in {s.objective} [{s.objective_unit}]"
+    return f"Binding limits at the optimum (largest {gain} per unit relaxed first): " + "; ".join(binding) + "."
+
+
+def check_line(r: Result) -> str:
+    """Whether every limit holds on the fine-grid re-check with the other dynamics model (scaled violation)."""
+    violation = r.recheck.max_violation_scaled
+    return f"Checked on a {r.recheck.grid_points}-point grid with the other dynamics model: " + (
+        "all limits hold." if violation <= 1e-6 else f"largest violation {violation:.1e} (scaled)."
+    )
+
+
 def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[str]:
     """The summary as lines of Markdown (also readable as plain console text)."""
     built = r.buildable.lengths if r.buildable is not None else r.optimal.lengths
@@ -236,18 +262,8 @@ def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[st
     moved = _moved_start(r)
     if moved is not None:
         lines.append(moved)
-    lines += ["", _energy_line(r)]
-    binding: list[str] = []
-    for m in () if r.sensitivity is None else r.sensitivity.multipliers:
-        words = limit_in_words(m.constraint, detail=False)
-        if words not in binding and len(binding) < BINDING_SHOWN:
-            binding.append(words)
-    if binding:
-        lines.append(
-            "Binding limits at the optimum (largest energy gain per unit relaxed first): " + "; ".join(binding) + "."
-        )
-    else:
-        lines.append("Binding limits at the optimum: none reported (no sensitivity section).")
+    lines += ["", energy_line(r)]
+    lines.append(binding_line(r))
     ms = r.multistart
     if len(ms.starts) > 1:
         failed = f", {len(ms.failed_starts)} failed" if ms.failed_starts else ""
@@ -262,11 +278,7 @@ def summary_lines(r: Result, folder: Path, files: Sequence[str] = ()) -> list[st
     for extra in (_trajectory_line(r), _thermal_line(r)):
         if extra is not None:
             lines.append(extra)
-    violation = r.recheck.max_violation_scaled
-    lines.append(
-        f"Checked on a {r.recheck.grid_points}-point grid with the other dynamics model: "
-        + ("all limits hold." if violation <= 1e-6 else f"largest violation {violation:.1e} (scaled).")
-    )
+    lines.append(check_line(r))
     if r.buildable is not None:
         lines.append(f"Model of the buildable design: {r.buildable.mjcf_command}")
     lines += ["", files_line(folder, files or ("result.json", "trajectory.npz"))]
