@@ -16,6 +16,7 @@ from browser_helper import References, chromium, load_page, save_artifact
 from test_study_small import small_study, write_study
 
 from hiab_sim.cli import main
+from hiab_sim.design_report.page import esc
 from hiab_sim.results.read import read_result
 from hiab_sim.results.schema import Result
 
@@ -337,3 +338,59 @@ def test_report_of_a_duty_mix_names_its_weighted_sums_and_each_tasks_battery_ene
     assert "net energy, the tasks&#x27; weighted sum" in html
     e = result.energy
     assert f"{e.initial.battery_energy_J:.1f} → {e.optimal.battery_energy_J:.1f} J (per duty period)" in html
+
+
+def test_report_of_a_duty_mix_gives_each_tasks_thermal_state(run_dir: Path, result: Result, tmp_path: Path) -> None:
+    """A mix's thermal state is per task (its own cycle and duty): a row per task and motor, none left out."""
+    import shutil
+    from dataclasses import replace
+
+    from hiab_sim.results.schema import TaskResult
+
+    assert result.energy is not None and result.energy.optimal.thermal is not None
+    tasks = tuple(
+        TaskResult(
+            name=name,
+            weight=weight,
+            kind="spiral",
+            duration_s=6.25,
+            payload_kg=150.0,
+            telescope="prescribed",
+            spline_control_points=16,
+            collocation_points=13,
+            initial=result.initial,
+            optimal=result.optimal,
+            recheck=result.recheck,
+            energy=result.energy,
+        )
+        for name, weight in (("lifting", 20.0), ("lowering", 10.0))
+    )
+    folder = tmp_path / "mix"
+    shutil.copytree(run_dir, folder)
+    mixed = replace(
+        result, tasks=tasks, energy=replace(result.energy, optimal=replace(result.energy.optimal, thermal=None))
+    )
+    (folder / "result.json").write_text(json.dumps(mixed.to_json()))
+    assert main(["report", str(folder)]) == 0
+    html = (folder / "report.html").read_text()
+    assert "<h2>Thermal state</h2>" in html  # the mix's top level has no thermal state: the tasks carry it
+    thermal = html.split("<h2>Thermal state</h2>")[1].split("<h2>")[0]
+    for task in ("lifting", "lowering"):
+        for motor, t in result.energy.optimal.thermal.items():
+            assert f"<td>{task}</td><td>{motor}</td>" in thermal
+            assert f"{t.peak_winding_temperature_C:.1f} / {t.max_winding_temperature_C:.0f} °C" in thermal
+
+
+def test_report_names_each_active_limit_in_words_beside_its_row(run_dir: Path, result: Result) -> None:
+    """Sensitivities and the least margin read as a designer's words, the result.json row name kept beside them."""
+    from hiab_sim.study.report.summary import limit_in_words
+
+    html = (run_dir / "report.html").read_text()
+    sensitivities = html.split("<h2>Sensitivities</h2>")[1].split("<h2>")[0]
+    assert result.sensitivity is not None and result.sensitivity.multipliers
+    for m in result.sensitivity.multipliers:
+        words = limit_in_words(m.constraint)
+        assert words != m.constraint  # every active row of the small study has words
+        assert esc(f"{words} ({m.constraint})") in sensitivities
+    worst = result.optimal.worst_constraint.name
+    assert esc(limit_in_words(worst)) in html.split("least margin at the optimum")[1].split("</tr>")[0]

@@ -13,6 +13,7 @@ from hiab_sim.design_report.simulation_table import COLUMNS, NUMERIC, run_groups
 from hiab_sim.results.energy_sections import HydraulicBaseline
 from hiab_sim.results.schema import Result
 from hiab_sim.structure.summary import BucklingSummary
+from hiab_sim.study.report.summary import limit_in_words
 
 T = TypeVar("T")
 
@@ -28,7 +29,10 @@ def constraints(result: Result) -> str:
             f"largest violation {rc.max_violation_scaled:.2e}; TCP error {1e3 * rc.tracking_error.position_m:.3f} mm; "
             f"force difference between the two paths {rc.force_difference_between_paths_N:.2e} N",
         ),
-        ("least margin at the optimum", f"{o.worst_constraint.name}: {o.worst_constraint.scaled_margin:.3e} (scaled)"),
+        (
+            "least margin at the optimum",
+            f"{_in_words(o.worst_constraint.name)}: {o.worst_constraint.scaled_margin:.3e} (scaled)",
+        ),
     ]
     b = result.buildable
     if b is not None:
@@ -50,27 +54,46 @@ def constraints(result: Result) -> str:
     )
 
 
+def _in_words(row: str) -> str:
+    """A constraint row in a designer's words, its name in ``result.json`` beside it where they differ."""
+    words = limit_in_words(row)
+    return row if words == row else f"{words} ({row})"
+
+
 def thermal(result: Result) -> str:
-    """Each motor's RMS torque and winding temperature over the duty, against its limits."""
-    e = result.energy
-    if e is None or e.optimal.thermal is None:
-        return ""
+    """Each motor's RMS torque and winding temperature over the duty, against its limits (a duty mix: per task)."""
+    tasks = [(t.name, t.energy) for t in result.tasks or () if t.energy is not None]
+    studies = tasks if result.tasks else [("", result.energy)]
     rows = [
         (
+            *((task,) if result.tasks else ()),
             name,
             f"{t.rms_torque_Nm:.2f} / {t.continuous_torque_Nm:.1f} N m",
             f"{t.peak_winding_temperature_C:.1f} / {t.max_winding_temperature_C:.0f} °C",
             f"{100 * t.torque_margin:.0f} %",
         )
+        for task, e in studies
+        if e is not None and e.optimal.thermal is not None
         for name, t in e.optimal.thermal.items()
     ]
+    if not rows:
+        return ""
+    duty = "; ".join(f"{task}: {e.duty}" for task, e in studies if e is not None) if result.tasks else ""
+    duty = duty or (result.energy.duty if result.energy is not None else "")
+    header = ("motor", "RMS torque / continuous", "winding peak / maximum", "torque margin")
+    first = 1 if result.tasks else 0
     return section(
         "Thermal state",
         paragraph(
-            f"Duty: {e.duty}. RMS motor torque against the continuous torque, periodic steady-state winding "
-            "temperature against its maximum."
+            f"Duty: {duty}. RMS motor torque against the continuous torque, periodic steady-state winding "
+            "temperature against its maximum, at the optimum"
+            + (", per task (each task's own cycle and duty)." if result.tasks else ".")
         ),
-        table(("motor", "RMS torque / continuous", "winding peak / maximum", "torque margin"), rows, numeric=(1, 2, 3)),
+        table(
+            (("task",) if result.tasks else ()) + header,
+            rows,
+            numeric=tuple(range(first + 1, first + 4)),
+        ),
     )
 
 
@@ -80,7 +103,12 @@ def sensitivities(result: Result, folder: Path) -> str:
     if s is None or not s.multipliers:
         return ""
     rows = [
-        (m.constraint, m.unit, f"{m.percent_per_unit:.4f} %", f"{m.objective_decrease_per_unit:.4g} {s.objective_unit}")
+        (
+            _in_words(m.constraint),
+            m.unit,
+            f"{m.percent_per_unit:.4f} %",
+            f"{m.objective_decrease_per_unit:.4g} {s.objective_unit}",
+        )
         for m in sorted(s.multipliers, key=lambda m: -m.percent_per_unit)
     ]
     return section(
