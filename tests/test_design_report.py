@@ -374,6 +374,8 @@ def test_report_of_a_duty_mix_gives_each_tasks_thermal_state(run_dir: Path, resu
     assert main(["report", str(folder)]) == 0
     html = (folder / "report.html").read_text()
     assert "<h2>Thermal state</h2>" in html  # the mix's top level has no thermal state: the tasks carry it
+    duty = html.split("<td>duty</td>")[1].split("</tr>")[0]
+    assert f"lifting: {result.energy.duty}; lowering: {result.energy.duty}" in duty.replace("&#x27;", "'")
     thermal = html.split("<h2>Thermal state</h2>")[1].split("<h2>")[0]
     for task in ("lifting", "lowering"):
         for motor, t in result.energy.optimal.thermal.items():

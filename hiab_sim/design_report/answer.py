@@ -69,7 +69,10 @@ def question(result: Result, machine: Crane | Machine) -> str:
         ("objective", objective),
         ("decision variables", _variables_text(machine)),
     ]
-    if result.energy is not None:
+    per_task = [f"{t.name}: {t.energy.duty}" for t in result.tasks or () if t.energy is not None]
+    if per_task:  # a duty mix: each task has its own duty (result.json tasks[k].energy.duty)
+        rows.append(("duty", "; ".join(per_task)))
+    elif result.energy is not None:
         rows.append(("duty", result.energy.duty))
     return section(
         "The question",
