@@ -97,6 +97,25 @@ def test_reoptimised_evaluation_of_the_optimum_recovers_its_energy_and_beats_the
     assert again.tasks[0].summary.cost_W2s <= fixed.tasks[0].summary.cost_W2s
 
 
+def test_a_design_outside_its_bounds_is_named_by_the_bound_it_crosses(
+    study: hs.api.Study, optimum: hs.api.Result
+) -> None:
+    """The optimum with lift.Lc0 10 mm above its upper bound (0.30 m): the least margin is that bound's, -0.01 m.
+
+    Every row holds there (the violation is the bound's alone), so no other limit can be the worst; a
+    satisfied row was named before.
+    """
+    lengths = optimum.optimal.lengths.as_array().copy()
+    assert lengths[1] == pytest.approx(0.3, abs=1e-6)  # the small study's optimum sits on this bound
+    lengths[1] = 0.31  # lift Lc0 [m]
+    task = hs.evaluate(study, lengths, trajectory="fixed").tasks[0]
+    assert not task.feasible
+    worst = task.summary.worst_constraint
+    assert worst.name == "bound lift.Lc0 up = 0.3 m"
+    assert worst.scaled_margin == pytest.approx(-0.01, abs=1e-12)
+    assert task.summary.max_violation == pytest.approx(0.01, abs=1e-12)
+
+
 @pytest.mark.parametrize(
     ("lengths", "trajectory", "field"),
     [

@@ -85,7 +85,7 @@ class ActuatorSummary:
 
 @dataclass(frozen=True)
 class WorstConstraint:
-    """The constraint row with the smallest scaled margin."""
+    """The constraint row or design-variable bound (``bound lift.L up = 1.25 m``) with the smallest scaled margin."""
 
     name: str
     scaled_margin: float

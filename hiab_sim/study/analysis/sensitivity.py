@@ -36,6 +36,7 @@ from scipy.optimize import nnls
 
 from hiab_sim.arrays import Array
 from hiab_sim.results.analysis_sections import Multiplier, Sensitivity
+from hiab_sim.study.nlp.interface import bound_row_name
 from hiab_sim.study.nlp.problem import StudyProblem
 from hiab_sim.study.nlp.task_problem import XI_SCALE
 
@@ -101,7 +102,7 @@ def sensitivity(problem: StudyProblem, z: Array, active_tolerance: float = ACTIV
     for k, name in enumerate(problem.model.design_names):
         for side, nu in (("low", nu_low[k]), ("up", nu_up[k])):
             if nu > 0.0:
-                key = f"bound {name} {side} = {(problem.lower if side == 'low' else problem.upper)[k] * XI_SCALE:g} m"
+                key = bound_row_name(name, side, (problem.lower if side == "low" else problem.upper)[k] * XI_SCALE)
                 entries[key] = [float(nu), float(nu) * 1e-3 / XI_SCALE * scale, 1]
                 units[key] = "mm"
     multipliers = tuple(

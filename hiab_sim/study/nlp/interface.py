@@ -316,3 +316,8 @@ class ScaledProblem(ABC):
         only the working-range clearance, a safety the optimiser adds for its own optimum, is removed.
         """
         return self.evaluate(z).constraints + self.clearance
+
+
+def bound_row_name(variable: str, side: str, value_m: float) -> str:
+    """The name of a design variable's bound as a row (``bound tilt.L up = 1.3 m``): sensitivities, least margin."""
+    return f"bound {variable} {side} = {value_m:g} m"

@@ -32,8 +32,9 @@ from hiab_sim.results.schema import (
     WorstConstraint,
 )
 from hiab_sim.study.motion.workspace import tracked_units
+from hiab_sim.study.nlp.interface import bound_row_name
 from hiab_sim.study.nlp.objectives import costf2
-from hiab_sim.study.nlp.task_problem import Evaluation, TaskProblem
+from hiab_sim.study.nlp.task_problem import XI_SCALE, Evaluation, TaskProblem
 from hiab_sim.study.report.energy_section import cycle_battery_power
 from hiab_sim.study.spec.study_file import Study
 
@@ -119,10 +120,20 @@ def design_summary(problem: TaskProblem, z: Array) -> DesignCheck:
 
 
 def worst_constraint(problem: TaskProblem, z: Array) -> WorstConstraint:
-    """The constraint row of least scaled margin at z."""
+    """The constraint row or design-variable bound of least scaled margin at z (the rows first on a tie).
+
+    The bounds count as :meth:`TaskProblem.max_violation` counts them: a design outside its bounds is
+    named by the bound it crosses, not by a row that holds.
+    """
     margins = problem.margins(z)
+    names = list(problem.constraint_names)
+    xi = np.asarray(z)[: problem.n_xi]
+    for k, variable in enumerate(problem.model.design_names):
+        low, up = problem.lower[k], problem.upper[k]
+        margins = np.append(margins, [xi[k] - low, up - xi[k]])
+        names += [bound_row_name(variable, "low", low * XI_SCALE), bound_row_name(variable, "up", up * XI_SCALE)]
     worst = int(np.argmin(margins))
-    return WorstConstraint(problem.constraint_names[worst], float(margins[worst]))
+    return WorstConstraint(names[worst], float(margins[worst]))
 
 
 def fine_problem(problem: TaskProblem, id_path: str | None = None) -> TaskProblem:
