@@ -18,7 +18,7 @@ from test_study_small import small_study, write_study
 from hiab_sim.cli import main
 from hiab_sim.design_report.page import esc
 from hiab_sim.results.read import read_result
-from hiab_sim.results.schema import Result
+from hiab_sim.results.schema import Result, TaskResult
 
 #: End-to-end runs of whole commands (optimize, report, Chromium, tutorials): not in the fast tier.
 pytestmark = pytest.mark.e2e
@@ -156,19 +156,11 @@ def test_documentation_page_renders_in_chromium(site: str) -> None:
     assert battery.split("|")[2].strip().split(" J")[0] in page.text
 
 
-def test_report_of_a_duty_mix_shows_its_tasks_and_cross_evaluation(
-    run_dir: Path, result: Result, tmp_path: Path
-) -> None:
-    """A result with tasks and a cross-evaluation gets the duty-mix section with each task and each design's cells."""
-    import shutil
-    from dataclasses import replace
-
-    from hiab_sim.results.analysis_sections import CrossEvaluation
-    from hiab_sim.results.schema import TaskResult
-
-    task = TaskResult(
-        name="lifting",
-        weight=20.0,
+def _as_task(result: Result, name: str, weight: float, with_energy: bool = True) -> TaskResult:
+    """The small study's result as one task of a made-up duty mix (its designs, re-check and energies)."""
+    return TaskResult(
+        name=name,
+        weight=weight,
         kind="spiral",
         duration_s=6.25,
         payload_kg=150.0,
@@ -178,7 +170,20 @@ def test_report_of_a_duty_mix_shows_its_tasks_and_cross_evaluation(
         initial=result.initial,
         optimal=result.optimal,
         recheck=result.recheck,
+        energy=result.energy if with_energy else None,
     )
+
+
+def test_report_of_a_duty_mix_shows_its_tasks_and_cross_evaluation(
+    run_dir: Path, result: Result, tmp_path: Path
+) -> None:
+    """A result with tasks and a cross-evaluation gets the duty-mix section with each task and each design's cells."""
+    import shutil
+    from dataclasses import replace
+
+    from hiab_sim.results.analysis_sections import CrossEvaluation
+
+    task = _as_task(result, "lifting", 20.0, with_energy=False)
     cross = CrossEvaluation(
         note="test",
         tasks=("lifting",),
@@ -311,23 +316,8 @@ def test_report_of_a_duty_mix_names_its_weighted_sums_and_each_tasks_battery_ene
     import shutil
     from dataclasses import replace
 
-    from hiab_sim.results.schema import TaskResult
-
     assert result.energy is not None
-    task = TaskResult(
-        name="lifting",
-        weight=20.0,
-        kind="spiral",
-        duration_s=6.25,
-        payload_kg=150.0,
-        telescope="prescribed",
-        spline_control_points=16,
-        collocation_points=13,
-        initial=result.initial,
-        optimal=result.optimal,
-        recheck=result.recheck,
-        energy=result.energy,
-    )
+    task = _as_task(result, "lifting", 20.0)
     folder = tmp_path / "mix"
     shutil.copytree(run_dir, folder)
     (folder / "result.json").write_text(json.dumps(replace(result, tasks=(task,)).to_json()))
@@ -345,26 +335,8 @@ def test_report_of_a_duty_mix_gives_each_tasks_thermal_state(run_dir: Path, resu
     import shutil
     from dataclasses import replace
 
-    from hiab_sim.results.schema import TaskResult
-
     assert result.energy is not None and result.energy.optimal.thermal is not None
-    tasks = tuple(
-        TaskResult(
-            name=name,
-            weight=weight,
-            kind="spiral",
-            duration_s=6.25,
-            payload_kg=150.0,
-            telescope="prescribed",
-            spline_control_points=16,
-            collocation_points=13,
-            initial=result.initial,
-            optimal=result.optimal,
-            recheck=result.recheck,
-            energy=result.energy,
-        )
-        for name, weight in (("lifting", 20.0), ("lowering", 10.0))
-    )
+    tasks = (_as_task(result, "lifting", 20.0), _as_task(result, "lowering", 10.0))
     folder = tmp_path / "mix"
     shutil.copytree(run_dir, folder)
     mixed = replace(
