@@ -236,6 +236,8 @@ def test_the_effect_study_of_a_mix_runs_per_task_on_its_own_plans(crane_mix: Pat
         assert split["replanned_optimum_predicted_J"] == replanned["predicted_J"] > split["predicted_J"]
         weighted["replanned"] += planned["weight"] * replanned["predicted_J"]
         weighted["nominal at true masses"] += planned["weight"] * split["predicted_at_true_masses_J"]
+        words = f"(one solve for all its tasks) predicts {replanned['predicted_J']:.1f} J on this task"
+        assert words in (tmp_path / "real" / f"effects_task{k}.md").read_text(encoding="utf-8")
         title = (tmp_path / "real" / f"effects_task{k}.md").read_text(encoding="utf-8").splitlines()[0]
         assert f"task {planned['name']} (its own plans and energies)" in title
     assert not (tmp_path / "real" / "effects.md").exists()

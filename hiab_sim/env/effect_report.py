@@ -150,8 +150,14 @@ def effect_lines(report: dict[str, object]) -> list[str]:
                 f"{row['predicted_at_true_masses_J']:.1f} J, closed loop {row['closed_loop_J']:.1f} J"
             )
             if "replanned_optimum_predicted_J" in row:
-                what = "the study" if report.get("task") is None else "the mix, re-planned once for all its tasks,"
-                text += f"; {what} re-planned for the true masses predicts {row['replanned_optimum_predicted_J']:.1f} J"
+                replanned = row["replanned_optimum_predicted_J"]
+                if report.get("task") is None:
+                    text += f"; the study re-planned for the true masses predicts {replanned:.1f} J"
+                else:
+                    text += (
+                        "; the mix re-planned for the true masses (one solve for all its tasks) predicts "
+                        f"{replanned:.1f} J on this task"
+                    )
             text += " (net electrical energy)"
             if "closed_loop_battery_J" in row:
                 text += (
