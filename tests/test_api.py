@@ -116,6 +116,17 @@ def test_a_design_outside_its_bounds_is_named_by_the_bound_it_crosses(
     assert task.summary.max_violation == pytest.approx(0.01, abs=1e-12)
 
 
+def test_a_design_out_of_its_chains_reach_names_the_lengths_that_moved(study: hs.api.Study) -> None:
+    """lift.L 10 mm past its bound: the chain cannot serve its working range; the line names the chain's lengths."""
+    lengths = study.initial_lengths.as_array().copy()
+    lengths[0] = 1.26  # lift L [m]
+    with pytest.raises(InvalidInputError) as error:
+        hs.evaluate(study, lengths, trajectory="fixed")
+    message = str(error.value)
+    assert "\n" not in message and message.startswith("lift.")
+    assert f"at lift L / Lc0 / Lc = 1.26 / {lengths[1]:.6g} / {lengths[2]:.6g} m" in message
+
+
 @pytest.mark.parametrize(
     ("lengths", "trajectory", "field"),
     [

@@ -210,11 +210,12 @@ def check_joint_samples(chain: ClosedChain, lengths: ChainLengths, theta: ArrayL
     bad = (q <= -np.pi) | (q >= 0.0) | (x < x_min - STROKE_TOLERANCE) | (x > x_max + STROKE_TOLERANCE)
     if np.any(bad):
         worst = float(theta.reshape(-1)[np.argmax(bad.reshape(-1))])
+        at = f"{chain.name} L / Lc0 / Lc = {lengths.L:.6g} / {lengths.Lc0:.6g} / {lengths.Lc:.6g} m"
         try:
             low, high = reachable_joint_range(chain, lengths)
-            allowed = f"must lie in [{low:.6g}, {high:.6g}] rad, the stroke [{x_min:.6g}, {x_max:.6g}] m"
+            allowed = f"must lie in [{low:.6g}, {high:.6g}] rad, the stroke [{x_min:.6g}, {x_max:.6g}] m at {at}"
         except InvalidInputError:
-            allowed = "no stroke is usable for these lengths"
+            allowed = f"no stroke is usable at {at}"
         raise InvalidInputError(name, worst, allowed, "rad")
 
 
