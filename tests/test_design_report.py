@@ -368,3 +368,12 @@ def test_report_names_each_active_limit_in_words_beside_its_row(run_dir: Path, r
         assert esc(f"{words} ({m.constraint})") in sensitivities
     worst = result.optimal.worst_constraint.name
     assert esc(limit_in_words(worst)) in html.split("least margin at the optimum")[1].split("</tr>")[0]
+
+
+def test_report_says_how_a_tolerance_corner_is_named(run_dir: Path, result: Result) -> None:
+    """'at the corner +-+--- design' is decoded on the page: one sign per decision variable, in their order."""
+    assert result.buildable is not None
+    html = (run_dir / "report.html").read_text()
+    section = html.split("<h2>Constraints and margins at the optimum</h2>")[1].split("<h2>")[0]
+    names = ", ".join(result.buildable.lengths.names)
+    assert f"named by its signs: ±{1e3 * result.buildable.tolerance_m:g} mm on each of {names}, in order" in section

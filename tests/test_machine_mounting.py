@@ -237,6 +237,9 @@ def test_mounting_study_on_the_machine_file_reaches_the_crane_files_optimum(tmp_
     assert machine.buildable.tolerance_check.worst.startswith("mounting.lift base pivot inside edge 3")
     assert crane.buildable.tolerance_check.worst.startswith("mounting.lift base pivot inside edge 3")
     assert machine.buildable.tolerance_check.margin == pytest.approx(crane.buildable.tolerance_check.margin, abs=1e-12)
+    # at the same corner of the box, named the same way: its signs in the decision variables' order
+    assert machine.buildable.tolerance_check.worst == crane.buildable.tolerance_check.worst
+    assert " at the corner " in crane.buildable.tolerance_check.worst
 
 
 #: A 0.1 m square around the excavator's bucket cylinder base pin (arm frame, m): the tutorial's example.

@@ -47,9 +47,12 @@ def constraints(result: Result) -> str:
     ms = result.multistart
     if len(ms.starts) > 1:
         rows.append(("starts", f"{ms.converged_starts} converged; same optimum: {ms.same_optimum}"))
+    order = "" if b is None else f"±{1e3 * b.tolerance_m:g} mm on each of {', '.join(b.lengths.names)}, in order"
+    corners = paragraph(f"A corner of the tolerance box is named by its signs: {order}.", "note") if order else ""
     return section(
         "Constraints and margins at the optimum",
         table(("check", "value"), rows),
+        corners,
         actuator_table(result),
     )
 

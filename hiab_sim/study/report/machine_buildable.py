@@ -73,12 +73,14 @@ def machine_buildable_section(problem: StudyProblem, z: Array, optimum: DesignSu
     ranges = buildable_working_range(study, problem.problems[0].working)
     value, row = stroke_margin(model, rounded, ranges)
     stroke_check = RoundedCheck(value >= 0.0, f"strokes over the buildable working range: {row}", value, "m")
-    signs = itertools.product((-1.0, 1.0), repeat=len(optimal.values))
+    signs = list(itertools.product((-1.0, 1.0), repeat=len(optimal.values)))
     corners = [optimal.as_array() + t * np.asarray(sign) for sign in signs]
+    # a corner named by its signs in the decision variables' order, as the crane file's (crane/tolerance.py)
+    corner_names = ["corner " + "".join("+" if v > 0 else "-" for v in sign) for sign in signs]
     mounting = study_mounting_margins(study)
     worst = (math.inf, "none", "nominal")
     for where, values in [("nominal", optimal.as_array()), ("rounded", rounded.as_array())] + [
-        (f"corner {k}", v) for k, v in enumerate(corners)
+        (name, v) for name, v in zip(corner_names, corners, strict=True)
     ]:
         design = model.design(values)
         m, name = stroke_margin(model, design, ranges)
