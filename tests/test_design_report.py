@@ -377,3 +377,23 @@ def test_report_says_how_a_tolerance_corner_is_named(run_dir: Path, result: Resu
     section = html.split("<h2>Constraints and margins at the optimum</h2>")[1].split("<h2>")[0]
     names = ", ".join(result.buildable.lengths.names)
     assert f"named by its signs: ±{1e3 * result.buildable.tolerance_m:g} mm on each of {names}, in order" in section
+
+
+def test_report_calls_multipliers_rough_when_their_fit_leaves_the_gradient_unexplained(
+    run_dir: Path, result: Result, tmp_path: Path
+) -> None:
+    """A KKT fit residual of 0.15 (a duty mix's, measured) gets a warning; the small study's own fit none."""
+    import shutil
+    from dataclasses import replace
+
+    from hiab_sim.design_report.analysis import ROUGH_FIT
+
+    assert result.sensitivity is not None and result.sensitivity.kkt_residual <= ROUGH_FIT
+    assert "read them as rough" not in (run_dir / "report.html").read_text()
+    folder = tmp_path / "rough"
+    shutil.copytree(run_dir, folder)
+    rough = replace(result, sensitivity=replace(result.sensitivity, kkt_residual=0.15))
+    (folder / "result.json").write_text(json.dumps(rough.to_json()))
+    assert main(["report", str(folder)]) == 0
+    section = (folder / "report.html").read_text().split("<h2>Sensitivities</h2>")[1].split("<h2>")[0]
+    assert "leave 15 % of the objective&#x27;s gradient unexplained" in section and "read them as rough" in section

@@ -55,6 +55,12 @@ _BOUND = re.compile(r"^bound (\w+)\.(\w+) (low|up) = (\S+) m$")
 _TASK_ROW = re.compile(r"^([^:]+): (.+)$")
 
 
+def limit_with_row(name: str) -> str:
+    """A constraint row in a designer's words, its name in ``result.json`` beside it where they differ."""
+    words = limit_in_words(name)
+    return name if words == name else f"{words} ({name})"
+
+
 def limit_in_words(name: str, detail: bool = True) -> str:
     """A constraint row name of the NLP (``envelope.lift.peak_torque``, ``bound tilt.L up = 1.3 m``) in words.
 
