@@ -193,7 +193,7 @@ def hydraulics(result: Result, folder: Path) -> str:
         parts.append(
             paragraph(
                 "EMLA at the battery per "
-                + ("duty period" if result.energy is not None and result.energy.optimal.duty is not None else "cycle")
+                + ("cycle" if result.energy is None else result.energy.period)
                 + ": "
                 + "; ".join(
                     f"{n} {d.emla_battery_energy_J / 1e3:.2f} kJ"
@@ -257,7 +257,7 @@ def duty_mix(result: Result, folder: Path) -> str:
             "–"
             if t.energy is None
             else f"{t.energy.initial.battery_energy_J:.1f} → {t.energy.optimal.battery_energy_J:.1f} J "
-            f"({'per duty period' if t.energy.optimal.duty is not None else 'per cycle'})",
+            f"(per {t.energy.period})",
         )
         for t in result.tasks
     ]

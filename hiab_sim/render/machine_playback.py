@@ -115,7 +115,7 @@ def load_machine_playback(result_dir: str | Path) -> MachinePlayback:
     battery, period = None, "cycle"
     if result.energy is not None:
         battery = {"initial": result.energy.initial.battery_energy_J, "optimal": result.energy.optimal.battery_energy_J}
-        period = "duty period" if result.energy.optimal.duty is not None else "cycle"
+        period = result.energy.period
     return MachinePlayback(
         machine, time, reference, tuple(motions), payload, battery, period, study_ground(result.study),
         battery_powers(trajectory),

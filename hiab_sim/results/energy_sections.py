@@ -111,6 +111,11 @@ class EnergyReport:
     hourly_rms_torque_Nm: dict[str, float] | None = optional()
     hourly_work_s: float | None = optional()
 
+    @property
+    def period(self) -> str:
+        """What ``battery_energy_J`` covers: ``"duty period"`` (cycle and rest) under a duty model, else ``"cycle"``."""
+        return "duty period" if self.optimal.duty is not None else "cycle"
+
 
 @dataclass(frozen=True)
 class HydraulicVariant:
