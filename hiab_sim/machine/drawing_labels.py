@@ -125,13 +125,14 @@ def place_labels(fig: Figure, ax: Axes, plan: LabelPlan) -> None:
         probe.remove()
         size = np.array([extent.width, extent.height])
         anchor = to_px(np.array(at))
+        placed_boxes = np.array(placed).reshape(-1, 4)  # the labels placed so far, once per label
         best: tuple[float, float, float, str, str] | None = None
         for radius in RADII_PT:
             for angle in DIRECTIONS:
                 offset = radius * px_per_pt * np.array([math.cos(angle), math.sin(angle)])
                 ha, va = _alignment(angle)
                 box = _box(anchor, offset, size, ha, va)
-                cost = OVERLAP * (_overlaps(box, np.array(placed).reshape(-1, 4)) + _overlaps(box, marker_boxes))
+                cost = OVERLAP * (_overlaps(box, placed_boxes) + _overlaps(box, marker_boxes))
                 cost += CROSSING * _crossings(box, segments)
                 if radius > RADII_PT[1]:  # its leader line should not cross the labels placed before it
                     line = np.array([[anchor, anchor + offset]])
