@@ -7,7 +7,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any, TypeVar
 
-from hiab_sim.design_report.answer import actuator_table
+from hiab_sim.design_report.answer import actuator_table, duty_words
 from hiab_sim.design_report.page import figure, num, paragraph, section, table
 from hiab_sim.design_report.simulation_table import COLUMNS, NUMERIC, run_groups, table_header, table_rows
 from hiab_sim.results.energy_sections import HydraulicBaseline
@@ -78,8 +78,7 @@ def thermal(result: Result) -> str:
     ]
     if not rows:
         return ""
-    duty = "; ".join(f"{task}: {e.duty}" for task, e in studies if e is not None) if result.tasks else ""
-    duty = duty or (result.energy.duty if result.energy is not None else "")
+    duty = duty_words(result)
     header = ("motor", "RMS torque / continuous", "winding peak / maximum", "torque margin")
     first = 1 if result.tasks else 0
     return section(

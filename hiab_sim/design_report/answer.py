@@ -69,11 +69,9 @@ def question(result: Result, machine: Crane | Machine) -> str:
         ("objective", objective),
         ("decision variables", _variables_text(machine)),
     ]
-    per_task = [f"{t.name}: {t.energy.duty}" for t in result.tasks or () if t.energy is not None]
-    if per_task:  # a duty mix: each task has its own duty (result.json tasks[k].energy.duty)
-        rows.append(("duty", "; ".join(per_task)))
-    elif result.energy is not None:
-        rows.append(("duty", result.energy.duty))
+    duty = duty_words(result)
+    if duty is not None:
+        rows.append(("duty", duty))
     return section(
         "The question",
         paragraph(
@@ -94,6 +92,14 @@ def _buildable_text(result: Result) -> str:
         f"{1e3 * b.tolerance_check.margin:.3f} mm) and its net energy differs from the optimum's by "
         f"{b.net_energy_change_vs_optimum_J + 0.0:+.1f} J. Export: {b.mjcf_command}"
     )
+
+
+def duty_words(result: Result) -> str | None:
+    """The study's duty: a duty mix's per task (``result.json`` ``tasks[k].energy.duty``); None without energies."""
+    per_task = [f"{t.name}: {t.energy.duty}" for t in result.tasks or () if t.energy is not None]
+    if per_task:
+        return "; ".join(per_task)
+    return None if result.energy is None else result.energy.duty
 
 
 def _verdict(result: Result) -> str:
