@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 import http.server
 import json
+import re
 import subprocess
 import sys
 import threading
@@ -65,6 +66,21 @@ def test_report_states_the_design_to_build_and_its_energies(run_dir: Path, resul
     for title in ("The question", "Thermal state", "Sensitivities", "Hydraulic comparison", "Provenance"):
         assert f"<h2>{title}</h2>" in html
     assert "Closed-loop validation" not in html  # no simulation.json yet
+
+
+def test_report_gives_the_rounded_designs_net_energy_in_its_own_row(run_dir: Path, result: Result) -> None:
+    """The answer builds the rounded design: the energy column is headed "optimum", the rounded design has its row."""
+    html = (run_dir / "report.html").read_text()
+    assert result.buildable is not None
+    section = html.split("<h2>Energies and their boundaries</h2>")[1].split("<h2>")[0]
+    cells = [re.findall(r"<t[dh][^>]*>(.*?)</t[dh]>", row) for row in re.findall(r"<tr>(.*?)</tr>", section)]
+    assert cells[0][2:] == ["initial", "optimum", "change"]
+    net = next(row for row in cells if row[0] == "net electrical energy")
+    rounded = next(row for row in cells if row[0] == "net electrical energy of the rounded design to build")
+    assert net[3] == f"{result.optimal.net_electrical_energy_J:.1f} J"
+    assert rounded[3] == f"{result.buildable.net_electrical_energy_J:.1f} J"
+    assert rounded[2] == net[2] == f"{result.initial.net_electrical_energy_J:.1f} J"
+    assert result.buildable.recheck_id_path in rounded[1]
 
 
 def test_report_shows_the_closed_loop_of_simulation_json(run_dir: Path, tmp_path: Path) -> None:

@@ -231,6 +231,18 @@ def energies(result: Result, folder: Path) -> str:
             "",
         ),
     ]
+    if result.buildable is not None:  # the answer builds the rounded design; its energy is not the optimum's
+        b = result.buildable
+        rows.insert(
+            rows.index(next(r for r in rows if r[0] == "net electrical energy")) + 1,
+            (
+                "net electrical energy of the rounded design to build",
+                f"motor terminals, the optimal trajectory at the rounded lengths ({b.recheck_id_path} ID path)",
+                num(i.net_electrical_energy_J, ".1f", "J"),
+                num(b.net_electrical_energy_J, ".1f", "J"),
+                f"{change_percent(i.net_electrical_energy_J, b.net_electrical_energy_J):+.2f} %",
+            ),
+        )
     d = result.improvement.decomposition
     note = ""
     if d.from_lengths_J is not None and d.from_trajectory_J is not None:
@@ -253,7 +265,7 @@ def energies(result: Result, folder: Path) -> str:
     return section(
         "Energies and their boundaries",
         mix,
-        table(("quantity", "boundary", "initial", "design", "change"), rows, numeric=(2, 3, 4)),
+        table(("quantity", "boundary", "initial", "optimum", "change"), rows, numeric=(2, 3, 4)),
         note,
         figure(folder / "energy_breakdown.png", "Energy by power flow, initial and optimal"),
     )
