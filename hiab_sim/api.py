@@ -6,7 +6,7 @@ Four functions cover what the CLI does for a study, with typed values instead of
 
     study = hs.load_study("xs031_spiral")  # a shipped name or a path
     result = hs.optimize(study, out="runs/x")  # typed result, the files the CLI writes
-    e = hs.evaluate(study, lengths, trajectory="fixed")  # or "reoptimize"
+    e = hs.evaluate(study, lengths, trajectory="fixed")  # or "reoptimize", or "optimum" with result="runs/x"
     r = hs.read_result("runs/x")
 
 *Evaluating a design* means one of two things, named by ``trajectory``:
@@ -16,7 +16,11 @@ Four functions cover what the CLI does for a study, with typed values instead of
   motion as planned, without re-planning;
 * ``"reoptimize"``: the trajectory re-optimised for the design with its lengths held fixed (IPOPT
   on the task's NLP over the spline coefficients, the cross-evaluation's rule): how a machine built
-  with those lengths does when driven as well as it can.
+  with those lengths does when driven as well as it can;
+* ``"optimum"``: the trajectory of an optimisation's result folder (``result=``: each task's spline
+  coefficients of the reported optimum, from the folder's ``checkpoint_0.json``) at the design's
+  lengths: how another design (a rounded one, a pivot moved) does on the motion planned for the
+  optimum. At the optimum's own lengths it gives ``result.json``'s optimal design.
 
 Either way every task of the study is evaluated on its fine grid with nominal bands (the
 re-check's grid), so the numbers are those ``result.json`` reports for its designs. Whether a
@@ -46,7 +50,7 @@ from hiab_sim.study.spec.study_file import Study, load_study
 __all__ = ["DesignEvaluation", "TaskEvaluation", "evaluate", "load_study", "optimize", "read_result"]
 
 #: The two meanings of evaluating a design (module docstring).
-TRAJECTORIES = ("fixed", "reoptimize")
+TRAJECTORIES = ("fixed", "reoptimize", "optimum")
 #: Largest scaled constraint violation at which a design serves a task (the solvers' tolerance).
 FEASIBLE = 1e-6
 
@@ -88,7 +92,7 @@ class DesignEvaluation:
 
     Attributes:
         lengths: The design Xi [m] (the study's machine's design type).
-        trajectory: ``"fixed"`` or ``"reoptimize"``.
+        trajectory: ``"fixed"``, ``"reoptimize"`` or ``"optimum"``.
         tasks: One :class:`TaskEvaluation` per task, in the study's order.
         battery_energy_J: The weighted sum over the tasks of the battery energy [J].
         net_electrical_energy_J: The weighted sum of the net electrical energy on the DC bus [J].
@@ -201,29 +205,57 @@ def optimize(
     return output.result
 
 
-def evaluate(study: Study | str | Path, lengths: Lengths, trajectory: str = "fixed") -> DesignEvaluation:
+def _optimum_coefficients(loaded: Study, result: str | Path | None) -> list[np.ndarray]:
+    """Each task's spline coefficients of a result folder's reported optimum (start 0's finished checkpoint)."""
+    from hiab_sim.study.nlp.problem import StudyProblem
+    from hiab_sim.study.solvers.slsqp import load_checkpoint, study_digest
+
+    if result is None or isinstance(result, bool) or not isinstance(result, (str, Path)):
+        raise InvalidInputError("result", result, 'the result folder whose optimum trajectory="optimum" evaluates on')
+    data = load_checkpoint(Path(result), 0)
+    if data is None or data.get("done") is not True:
+        raise InvalidInputError("result", str(result), "a folder of a finished optimisation (checkpoint_0.json, done)")
+    problem = StudyProblem(loaded)
+    if data.get("study_sha256") != study_digest(problem):
+        raise InvalidInputError(
+            "result",
+            str(result),
+            f"a result folder of this study ({loaded.name!r}); its checkpoint belongs to another study or EMLA set",
+        )
+    return problem.unpack(np.asarray(data["z"], dtype=float))[1]
+
+
+def evaluate(
+    study: Study | str | Path, lengths: Lengths, trajectory: str = "fixed", result: str | Path | None = None
+) -> DesignEvaluation:
     """Evaluate a design on every task of a study: energies, margins, violations (module docstring).
 
     Args:
         study: A loaded study, a shipped study name or a study file.
         lengths: The design Xi [m] (:data:`Lengths`).
-        trajectory: ``"fixed"`` (the inverse-kinematics start at these lengths) or ``"reoptimize"``
-            (the trajectory re-optimised with the lengths fixed; needs CasADi).
+        trajectory: ``"fixed"`` (the inverse-kinematics start at these lengths), ``"reoptimize"``
+            (the trajectory re-optimised with the lengths fixed; needs CasADi) or ``"optimum"`` (the
+            trajectory of ``result``'s optimum).
+        result: With ``"optimum"``: the result folder of an optimisation of this study.
 
     Raises:
-        InvalidInputError: An unknown ``trajectory``, lengths of the wrong shape, or a design outside
-            the model's domain (a chain that cannot close), naming the field.
+        InvalidInputError: An unknown ``trajectory``, lengths of the wrong shape, a design outside
+            the model's domain (a chain that cannot close), or with ``"optimum"`` a folder that is not a
+            finished optimisation of this study, naming the field.
         BackendUnavailableError: ``"reoptimize"`` without CasADi.
 
     """
     if trajectory not in TRAJECTORIES:
         raise InvalidInputError("trajectory", trajectory, f"one of {list(TRAJECTORIES)}")
+    if result is not None and trajectory != "optimum":
+        raise InvalidInputError("result", str(result), 'given only with trajectory="optimum"')
     from hiab_sim.study.analysis.cross_evaluation import fixed_lengths_optimum, task_alone
     from hiab_sim.study.report.design_check import design_summary, fine_problem
     from hiab_sim.study.report.energy_section import design_energy
 
     loaded = _as_study(study)
     design = as_design(loaded.model, lengths)
+    planned = _optimum_coefficients(loaded, result) if trajectory == "optimum" else None
     tasks = []
     for k, task in enumerate(loaded.tasks):
         alone = task_alone(loaded, k)  # the task's NLP as a study of its own
@@ -231,6 +263,8 @@ def evaluate(study: Study | str | Path, lengths: Lengths, trajectory: str = "fix
         message = None
         if trajectory == "fixed":
             z = problem.initial_point(design)
+        elif planned is not None:
+            z = problem.initial_point(design, planned[k])
         else:
             z, _, message = fixed_lengths_optimum(alone, design)
         fine = fine_problem(problem)

@@ -63,8 +63,15 @@ def study() -> hs.api.Study:
 
 
 @pytest.fixture(scope="module")
-def optimum(study: hs.api.Study, tmp_path_factory: pytest.TempPathFactory) -> hs.api.Result:
-    return hs.optimize(study, out=tmp_path_factory.mktemp("api") / "run", progress=None, figures=False)
+def run_folder(study: hs.api.Study, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("api") / "run"
+    hs.optimize(study, out=folder, progress=None, figures=False)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def optimum(run_folder: Path) -> hs.api.Result:
+    return hs.read_result(run_folder)
 
 
 def test_fixed_evaluation_of_the_start_reproduces_the_results_initial_design(
@@ -78,6 +85,60 @@ def test_fixed_evaluation_of_the_start_reproduces_the_results_initial_design(
     assert e.max_violation == pytest.approx(optimum.initial.max_violation, rel=1e-9, abs=1e-12)
     assert optimum.energy is not None
     assert e.battery_energy_J == pytest.approx(optimum.energy.initial.battery_energy_J, rel=1e-12)
+
+
+def test_evaluation_on_the_optimums_trajectory_at_its_lengths_reproduces_the_results_optimal_design(
+    study: hs.api.Study, optimum: hs.api.Result, run_folder: Path
+) -> None:
+    """evaluate(..., "optimum", result=folder) at the optimal lengths gives result.json's optimal design."""
+    e = hs.evaluate(study, optimum.optimal.lengths, trajectory="optimum", result=run_folder)
+    assert e.trajectory == "optimum"
+    assert e.net_electrical_energy_J == pytest.approx(optimum.optimal.net_electrical_energy_J, rel=1e-12)
+    assert optimum.energy is not None
+    assert e.battery_energy_J == pytest.approx(optimum.energy.optimal.battery_energy_J, rel=1e-12)
+    assert e.max_violation == pytest.approx(optimum.optimal.max_violation, rel=1e-9, abs=1e-12)
+
+
+def test_another_design_on_the_optimums_trajectory_moves_the_actuators_not_the_tcp(
+    study: hs.api.Study, optimum: hs.api.Result, run_folder: Path
+) -> None:
+    """A base pivot 20 mm nearer its hinge, driven on the optimum's motion: the TCP errors stay the optimum's.
+
+    The crane's TCP kinematics do not depend on Xi; the actuator forces and the energy do. The start's
+    trajectory ("fixed") at the same lengths is another motion, with other TCP errors.
+    """
+    lengths = optimum.optimal.lengths.as_array().copy()
+    lengths[0] -= 0.02  # lift L [m]
+    moved = hs.evaluate(study, lengths, trajectory="optimum", result=run_folder).tasks[0].summary
+    fixed = hs.evaluate(study, lengths, trajectory="fixed").tasks[0].summary
+    at_optimum = optimum.optimal
+    assert moved.tracking_error.position_m == pytest.approx(at_optimum.tracking_error.position_m, rel=1e-12)
+    assert moved.tracking_error.position_m != pytest.approx(fixed.tracking_error.position_m, rel=1e-6)
+    assert abs(moved.net_electrical_energy_J - at_optimum.net_electrical_energy_J) > 1.0  # [J]
+    lift = moved.actuators["lift"]
+    assert lift.peak_force_N != pytest.approx(at_optimum.actuators["lift"].peak_force_N, rel=1e-6)
+
+
+def test_the_optimums_trajectory_needs_a_finished_result_folder_of_the_same_study(
+    study: hs.api.Study, run_folder: Path, tmp_path: Path
+) -> None:
+    """No folder, an unfinished one, another study's, or a folder with "fixed": each one line naming ``result``."""
+    import json
+
+    lengths = study.initial_lengths
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "checkpoint_0.json").write_text(json.dumps({"done": True, "study_sha256": "0" * 64, "z": []}))
+    cases = [
+        ({"trajectory": "optimum"}, "None"),
+        ({"trajectory": "optimum", "result": tmp_path}, "finished optimisation"),
+        ({"trajectory": "optimum", "result": other}, "another study"),
+        ({"trajectory": "fixed", "result": run_folder}, 'only with trajectory="optimum"'),
+    ]
+    for kwargs, words in cases:
+        with pytest.raises(InvalidInputError) as error:
+            hs.evaluate(study, lengths, **kwargs)  # type: ignore[arg-type]
+        assert error.value.field == "result" and words in str(error.value) and "\n" not in str(error.value)
 
 
 def test_reoptimised_evaluation_of_the_optimum_recovers_its_energy_and_beats_the_fixed_trajectory(
