@@ -240,6 +240,17 @@ def test_the_renderer_view_needs_only_the_crane_and_both_designs_lengths() -> No
         PlaybackView.from_json({"crane": "xs031", "initial": {}, "optimal": {}})
 
 
+@pytest.mark.parametrize(("duty", "period"), [(None, "cycle"), ({"cycles_per_hour": 60}, "duty period")])
+def test_the_renderer_view_names_the_period_its_battery_energy_covers(duty: object, period: str) -> None:
+    """A battery energy with a duty model covers the duty period (cycle and rest), one without it the cycle."""
+    data = _minimal_result_json()
+    figure = {"battery_energy_J": 1.0} | ({} if duty is None else {"duty": duty})
+    view = PlaybackView.from_json(
+        {k: data[k] for k in ("crane", "initial", "optimal")} | {"energy": {"initial": figure, "optimal": figure}}
+    )
+    assert view.energy is not None and view.energy.period == period
+
+
 @dataclass(frozen=True)
 class _Section:
     """A section a later version adds."""

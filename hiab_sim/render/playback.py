@@ -94,7 +94,7 @@ def load_playback(result_dir: str | Path) -> PlaybackData:
     battery, period = None, "cycle"
     if view.energy is not None:
         battery = {name: getattr(view.energy, name).battery_energy_J for name in DESIGNS}
-        period = "duty period" if view.energy.optimal.duty is not None else "cycle"
+        period = view.energy.period
     return PlaybackData(crane, time, reference, tuple(designs), payload, battery, period, battery_powers(trajectory))
 
 

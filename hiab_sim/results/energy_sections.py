@@ -21,6 +21,11 @@ from hiab_sim.results.codec import optional
 from hiab_sim.results.design_values import DesignValues
 
 
+def battery_period(duty: object | None) -> str:
+    """What a battery energy covers: ``"duty period"`` (cycle and rest) under a duty model, else ``"cycle"``."""
+    return "duty period" if duty is not None else "cycle"
+
+
 @dataclass(frozen=True)
 class ActuatorThermal:
     """One motor over the duty period (:func:`hiab_sim.emla.thermal_check`, exact switching)."""
@@ -113,8 +118,8 @@ class EnergyReport:
 
     @property
     def period(self) -> str:
-        """What ``battery_energy_J`` covers: ``"duty period"`` (cycle and rest) under a duty model, else ``"cycle"``."""
-        return "duty period" if self.optimal.duty is not None else "cycle"
+        """What ``battery_energy_J`` covers (:func:`battery_period`)."""
+        return battery_period(self.optimal.duty)
 
 
 @dataclass(frozen=True)

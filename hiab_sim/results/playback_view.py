@@ -11,6 +11,7 @@ from typing import Any
 
 from hiab_sim.crane.description import LinkLengths
 from hiab_sim.results.codec import from_json, optional
+from hiab_sim.results.energy_sections import battery_period
 
 
 @dataclass(frozen=True)
@@ -34,6 +35,11 @@ class PlaybackEnergy:
 
     initial: BatteryFigure
     optimal: BatteryFigure
+
+    @property
+    def period(self) -> str:
+        """What ``battery_energy_J`` covers (:func:`~hiab_sim.results.energy_sections.battery_period`)."""
+        return battery_period(self.optimal.duty)
 
 
 @dataclass(frozen=True)
