@@ -10,12 +10,14 @@ Each shipped XS 031 study (``crane: xs031``) is optimised three times, one start
 
 and the table gives, against ``crane``, the largest change of an optimal length [m] and of an
 energy (relative: net electrical, battery, costf2), as ``scripts/shipped_optima.py`` compares them.
-A study whose crane-form sections the machine file does not read (a crane-form ``mounting``
-section) says so in its row.
+A study with a crane-form ``mounting`` section is not compared with the machine file: the machine
+form's mounting rows are other rows (its lift-boom sweep runs through every pin on the boom,
+``tests/test_machine_mounting.py``), so the problem is not the same.
 
-    python scripts/optimum_reproducibility.py OUT [STUDY...]   # default: every shipped crane-file study
+    python scripts/optimum_reproducibility.py OUT [STUDY...] [--record]   # default: every crane-file study
 
 Result folders go to ``OUT/<study>/<variant>``; a folder with a ``result.json`` is reused (resume).
+The numbers go to ``OUT/optimum_reproducibility.json``, with ``--record`` also to :data:`RECORD`.
 """
 
 from __future__ import annotations
@@ -29,15 +31,18 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-from shipped_optima import summary
 
 import hiab_sim.api as hs
-from hiab_sim.errors import HiabSimError
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # its sibling, also when loaded by a test
+from shipped_optima import summary
 
 REPO = Path(__file__).resolve().parents[1]
 STUDIES = REPO / "optimize"
 CRANE_FILE = REPO / "hiab_sim" / "presets" / "hiab_xs031.yaml"
 VARIANTS = ("crane", "ulp", "machine")
+#: The recorded numbers of docs/machine.md's table (``--record``), read back by tests/test_optimum_reproducibility.py.
+RECORD = REPO / "tests" / "data" / "xs031_optimum_reproducibility.json"
 
 
 def _one_ulp_up(crane_text: str) -> str:
@@ -83,32 +88,57 @@ def _optimum(study_path: Path, variant: str, out: Path) -> dict[str, Any]:
     return summary(json.loads((folder / "result" / "result.json").read_text(encoding="utf-8")))
 
 
-def _change(got: dict[str, Any], base: dict[str, Any]) -> str:
+def measure(out: Path, names: list[str]) -> dict[str, dict[str, Any]]:
+    """Per study, the compared numbers of each variant it has (a mounting study has no machine variant)."""
+    data: dict[str, dict[str, Any]] = {}
+    for name in names:
+        path = STUDIES / f"{name}.yaml"
+        mounting = "mounting" in yaml.safe_load(path.read_text(encoding="utf-8"))
+        data[name] = {v: _optimum(path, v, out / name) for v in VARIANTS if not (mounting and v == "machine")}
+    return data
+
+
+def change(got: dict[str, Any], base: dict[str, Any]) -> tuple[float, float]:
     """Largest length change [m] and largest relative energy change of ``got`` against ``base``."""
     dxi = max(abs(a - b) for a, b in zip(got["xi_m"], base["xi_m"], strict=True))
     rel = max(abs(got["energies"][k] - v) / abs(v) for k, v in base["energies"].items())
-    return f"{dxi:.1e} | {rel:.1e}"
+    return dxi, rel
+
+
+def table(data: dict[str, dict[str, Any]]) -> str:
+    """The markdown table of :func:`measure`'s numbers (docs/machine.md holds it)."""
+    lines = [
+        "| study | 1 ulp of g: max abs dXi [m] | energies (rel.) | machine file: max abs dXi [m] | energies (rel.) "
+        "| SLSQP iterations (crane / 1 ulp / machine) |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name, runs in data.items():
+        cells = [f"`{name}`", *(f"{v:.1e}" for v in change(runs["ulp"], runs["crane"]))]
+        if "machine" in runs:
+            cells += [f"{v:.1e}" for v in change(runs["machine"], runs["crane"])]
+        else:
+            cells += ["not compared: the machine form's mounting rows are other rows", "-"]
+        cells.append(" / ".join(str(runs[v]["iterations"]) for v in VARIANTS if v in runs))
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
 
 
 def main(argv: list[str]) -> int:
-    """Optimise each study's variants and print the table (module docstring)."""
+    """Optimise each study's variants, write their numbers and print the table (module docstring)."""
+    record = "--record" in argv
+    argv = [a for a in argv if a != "--record"]
     if not argv:
         raise SystemExit(__doc__)
     out = Path(argv[0])
     names = argv[1:] or sorted(
         p.stem for p in STUDIES.glob("*.yaml") if re.search(r"^crane: xs031\b", p.read_text(), flags=re.M)
     )
-    print("| study | 1 ulp of g: max abs dXi [m] | energies (rel.) | machine file: max abs dXi [m] | energies (rel.) |")
-    print("|---|---|---|---|---|")
-    for name in names:
-        path = STUDIES / f"{name}.yaml"
-        base = _optimum(path, "crane", out / name)
-        ulp = _change(_optimum(path, "ulp", out / name), base)
-        try:
-            machine = _change(_optimum(path, "machine", out / name), base)
-        except HiabSimError as error:  # a crane-form section the machine file does not read: said in the row
-            machine = f"not run: {error} | -"
-        print(f"| `{name}` | {ulp} | {machine} |", flush=True)
+    data = measure(out, names)
+    text = json.dumps(data, indent=1) + "\n"
+    (out / "optimum_reproducibility.json").write_text(text, encoding="utf-8")
+    if record:
+        RECORD.write_text(text, encoding="utf-8")
+    print(table(data))
     return 0
 
 
