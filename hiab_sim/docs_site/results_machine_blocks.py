@@ -13,6 +13,7 @@ from typing import Any
 from hiab_sim.docs_site.markdown import table
 from hiab_sim.docs_site.results_data import RunData
 from hiab_sim.docs_site.results_format import CHAINS, LIFT, before_after, kilo, length_headers, lengths, percent_change
+from hiab_sim.results.energy_sections import battery_period
 
 MIX, DEFAULT = "xs031_duty_mix", "xs031_spiral"
 EXCAVATOR = ("exact_digging", "exact_grading")
@@ -207,14 +208,15 @@ def excavator_studies(runs: RunData) -> str:
                 f"`optimize/{study}.yaml`",
                 before_after(
                     r("energy.initial.battery_energy_J") / 1e3, r("energy.optimal.battery_energy_J") / 1e3, "kJ", 3
-                ),
+                )
+                + f" per {battery_period(r('energy.duty'))}",
                 r("solver.iterations"),
                 f"{r('solver.total_wall_time_s'):.0f} s",
                 f"max violation {r('recheck.max_violation_scaled'):.1e}, paths differ by "
                 f"{r('recheck.force_difference_between_paths_N'):.1e} N",
             )
         )
-    header = ("study", "battery energy per cycle, built → optimal", "iterations", "wall time (recorded)", "re-check")
+    header = ("study", "battery energy, built → optimal", "iterations", "wall time (recorded)", "re-check")
     return table(header, rows)
 
 
