@@ -293,7 +293,11 @@ def excavator_mix_tasks(runs: RunData) -> str:
             ),
         )
     )
-    header = ("task (weight, cycle)", "battery energy per duty period, built → optimal", "net electrical, cycle only")
+    header = (
+        "task (weight, cycle)",
+        "battery energy per duty period, built → optimal",
+        "net electrical at the drives (hot windings), cycle only",
+    )
     rms = ", ".join(f"{m} {v:.2f} N m" for m, v in r("energy.hourly_rms_torque_Nm").items())
     return (
         table(header, rows)

@@ -82,7 +82,13 @@ class DutyEnergy:
 
 @dataclass(frozen=True)
 class DesignEnergy:
-    """One design on the fine grid: battery energy, the paper's cost, per-actuator energies, thermal state."""
+    """One design on the fine grid: battery energy, the paper's cost, per-actuator energies, thermal state.
+
+    ``battery_energy_J`` is exact at the battery, with the duty model's hot windings and rest where the
+    study has one (``duty``). ``drawn_energy_J`` and ``net_energy_J`` are each drive's exact power over
+    the cycle at the reference (cold) winding resistance, at the drive's input: without the hot
+    windings' extra copper loss (``duty.hot_winding_extra_J``) and the rest.
+    """
 
     battery_energy_J: float
     battery_energy_smooth_J: float  # the solver's: smooth battery kinks on the solver's (smooth) drive powers
