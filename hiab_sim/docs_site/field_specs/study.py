@@ -158,11 +158,31 @@ def study_keys() -> list[Key]:
             default="the machine file's values",
         )
     )
+    per_duration = (
+        "N, control points per joint over `grid.duration`; a task of another duration (a `csv` or "
+        "`pick_and_place` reference, or a spiral with its own `duration`) gets N x its duration / `grid.duration`, "
+        "rounded, at least degree + 2, unless it sets `tasks[].control_points` (seed: 22)."
+    )
     rows += [
         section("spline", "Joint-trajectory B-splines (eqs. `matrix_basis`..`matrix_basis_dd`).", "defaults"),
-        *from_class("spline", SplineSettings),
+        *from_class("spline", SplineSettings, control_points={"description": per_duration}),
     ]
-    rows += [section("grid", "Collocation grid.", "defaults"), *from_class("grid", GridSettings)]
+    grid_duration = {
+        "description": "The span [s] that `intervals` and `spline.control_points` are given over: the "
+        "collocation step is `duration / intervals` and the spline has `spline.control_points` per `duration`. "
+        "It is a task's duration only for a `spiral` without its own `duration`; a `csv` task lasts its "
+        "file's time span (first to last row) and a `pick_and_place` task its dwells and move, each on its "
+        "own grid at a step of at most this one. Keep it equal to a single task's duration to get exactly "
+        "`intervals` and `spline.control_points`: a 10 s CSV with `duration: 5` gets twice both."
+    }
+    grid_intervals = {
+        "description": "M, collocation intervals over `duration` (M + 1 points); a task of another duration "
+        "gets ceil(its duration / step) intervals, a step of at most `duration / M`."
+    }
+    rows += [
+        section("grid", "Collocation grid.", "defaults"),
+        *from_class("grid", GridSettings, duration=grid_duration, intervals=grid_intervals),
+    ]
     rows += reference_keys("reference")
     rows += payload_keys("payload")
     rows += [
@@ -244,7 +264,12 @@ def study_keys() -> list[Key]:
         text(
             "bounds.working_range",
             "`crane` or `machine`: the design serves the machine's full joint range (the crane's, or "
-            "each joint's working range in the machine file); `reference`: only the reference's.",
+            "each joint's working range in the machine file); `reference`: only the reference's. With `crane` "
+            "or `machine` the inverse dynamics takes each triangle or linkage chain's joint (the crane's lift and "
+            "tilt) only within that range narrowed by 0.02 rad at both ends (`ID_SLACK` in "
+            "`hiab_sim/study/nlp/task_problem.py`), so that the line search's trial points stay evaluable: a "
+            "reference that brings such a joint within 0.02 rad of its range's end is refused at the start (a "
+            "`direct` chain's joint is not narrowed).",
             default=bounds["working_range"]["default"],
             allowed=bounds["working_range"]["allowed"],
         ),
