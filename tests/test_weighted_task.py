@@ -74,3 +74,9 @@ def test_one_weighted_tasks_energy_line_says_it_is_w_times_a_cycle_and_gives_the
     else:
         cycle = before_after(task.initial.net_electrical_energy_J, task.optimal.net_electrical_energy_J)
     assert line.endswith(f"; per cycle: {cycle}.")
+
+
+def test_a_crane_files_task_result_says_how_its_telescope_is_set(weighted_run: Path) -> None:
+    from hiab_sim.study.report.weighted import TELESCOPE
+
+    assert read_result(weighted_run).tasks[0].telescope == TELESCOPE  # type: ignore[index]
