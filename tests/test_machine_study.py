@@ -211,6 +211,20 @@ def test_a_start_the_inverse_dynamics_refuses_is_called_a_machine_on_a_machine_f
     assert "not an admissible crane: " in str(start_error(error, "initial_lengths", crane))
 
 
+def test_an_out_of_reach_csv_reference_is_named_by_its_task_file_row_and_columns(tmp_path: Path) -> None:
+    """The one line the duty-cycle tutorial promises: the task, the file, the row and the columns, said once."""
+    rows = [f"{t:.1f},50.0,0.5,-1.0" for t in np.linspace(0.0, 4.0, 41)]
+    (tmp_path / "far.csv").write_text("# far away\nt,x,y,tcp_angle\n" + "\n".join(rows) + "\n", encoding="utf-8")
+    task = {"name": "move", "weight": 1, "reference": {"kind": "csv", "file": "far.csv"}}
+    study = _study(tmp_path, {**EXCAVATOR_STUDY, "tasks": [task]})
+    with pytest.raises(InvalidInputError) as caught:
+        StudyProblem(study)  # type: ignore[arg-type]
+    message = str(caught.value)
+    assert message.startswith("tasks[0] (move).reference: ")
+    assert "far.csv row 3 (t = 0 s), columns x, y, tcp_angle = 'TCP (50, 0.5) m with tcp_angle = -1 rad'" in message
+    assert "out of the machine's reach" in message and "out of range: is out of" not in message
+
+
 def test_shipped_digging_study_cuts_soil_at_the_tip() -> None:
     """The digging task's TCP force: the soil's resistance while the tip is below ground, the payload's weight after."""
     study = load_study("exact_digging")

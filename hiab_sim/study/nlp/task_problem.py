@@ -70,8 +70,13 @@ from hiab_sim.study.nlp.interface import (
     ScaledProblem,
 )
 from hiab_sim.study.nlp.objectives import make_objective
-from hiab_sim.study.nlp.task_setup import check_reference_ranges, duty_options, served_ranges, start_error
-from hiab_sim.study.references.kinds import ik_start
+from hiab_sim.study.nlp.task_setup import (
+    check_reference_ranges,
+    duty_options,
+    reference_joints,
+    served_ranges,
+    start_error,
+)
 from hiab_sim.study.spec.study_file import Study
 from hiab_sim.study.spec.tasks import Task
 
@@ -163,7 +168,7 @@ class TaskProblem(ScaledProblem):
         self.q_path = "analytic" if joint == "analytic" else self.id_path
         # initial fit: inverse kinematics on the fine grid, least-squares spline at rest at both ends
         fine_ref = task.reference.sample(self.kin, self.fine_times())
-        ik = model.inverse_kinematics(fine_ref, ik_start(task.reference, model, fine_ref))
+        ik = reference_joints(study, task, fine_ref)
         self.reference_joints = ik
         self.c_ref = tr.fit_coefficients(self.basis, ik)
         # const_h with const_k: the machine's joint range and a triangle's hinge-angle margin (q only)

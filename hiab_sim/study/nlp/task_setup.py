@@ -9,6 +9,9 @@ from hiab_sim.emla import EmlaSet
 from hiab_sim.emla.duty_energy import DutyOptions
 from hiab_sim.errors import InvalidInputError
 from hiab_sim.study.machines.protocol import StudyMachine
+from hiab_sim.study.motion.trajectory import JointTrajectory, Reference
+from hiab_sim.study.motion.workspace import describe_point
+from hiab_sim.study.references.kinds import ik_start
 from hiab_sim.study.spec.study_file import Study
 from hiab_sim.study.spec.tasks import Task
 
@@ -63,12 +66,43 @@ def served_ranges(
     return working_range(model, joints, margin), working_range(model, joints, 0.5 * margin)
 
 
+def task_label(study: Study, task: Task) -> str:
+    """``tasks[0] (name)``: the task as the study file gave it."""
+    k = next((i for i, t in enumerate(study.tasks) if t is task), None)
+    return "the task" if k is None else f"tasks[{k}] ({task.name})"
+
+
 def reference_label(study: Study, task: Task) -> str:
     """``tasks[0] (name).reference (file.csv)``: the task's reference as the study file gave it."""
-    k = next((i for i, t in enumerate(study.tasks) if t is task), None)
     path = getattr(getattr(task.reference, "table", None), "path", None)
-    where = "the task's" if k is None else f"tasks[{k}] ({task.name})"
-    return f"{where}.reference ({path})" if path is not None else f"{where}.reference ({task.reference.kind})"
+    return f"{task_label(study, task)}.reference ({task.reference.kind if path is None else path})"
+
+
+def reference_joints(study: Study, task: Task, fine: Reference) -> JointTrajectory:
+    """The machine's inverse kinematics of the task's reference sampled on its fine grid (``fine``) [rad or m].
+
+    Raises:
+        InvalidInputError: a point out of reach, named by its file, row and columns (a CSV's rows
+            first), else by the time of the reference's fit; a singular pose as the IK names it.
+
+    """
+    model = study.model
+    try:
+        return model.inverse_kinematics(fine, ik_start(task.reference, model, fine))
+    except InvalidInputError as error:
+        row_error = getattr(task.reference, "row_reach_error", lambda _: None)(model)
+        if row_error is not None:
+            where = f"{task_label(study, task)}.reference: {row_error.field}"
+            raise InvalidInputError(where, row_error.value, row_error.allowed, row_error.unit) from None
+        reach = model.reach(fine.position)
+        bad = np.flatnonzero(reach.status == 1)
+        if len(bad):
+            i = int(bad[0])
+            field = f"{reference_label(study, task)}, its fit, at t = {fine.time[i]:.6g} s"
+            raise InvalidInputError(field, describe_point(model, fine.position[i]), reach.reasons[1]) from None
+        raise InvalidInputError(
+            f"{reference_label(study, task)} ({error.field})", error.value, error.allowed, error.unit
+        ) from None
 
 
 def check_reference_ranges(
@@ -119,8 +153,10 @@ __all__ = [
     "ID_SLACK",
     "check_reference_ranges",
     "duty_options",
+    "reference_joints",
     "reference_label",
     "served_ranges",
     "start_error",
+    "task_label",
     "working_range",
 ]
