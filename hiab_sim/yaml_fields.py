@@ -30,6 +30,35 @@ def parse_yaml(text: str, loader: type[yaml.SafeLoader] = SafeLoader) -> Any:
     return yaml.load(text, Loader=loader)  # a safe loader: SafeLoader, its libyaml twin or a subclass
 
 
+def duplicate_key(text: str) -> tuple[int, str, str] | None:
+    """The first key given twice in one mapping of YAML ``text``, or None.
+
+    Returns (its 1-based line, the dotted path of the mapping holding it, the key); keys compared as
+    written (scalars), a sequence's items named ``[i]``.
+    """
+
+    def walk(node: yaml.Node, path: str) -> tuple[int, str, str] | None:
+        if isinstance(node, yaml.MappingNode):
+            seen: set[str] = set()
+            for key_node, value_node in node.value:
+                key = str(key_node.value)
+                if key in seen:
+                    return key_node.start_mark.line + 1, path, key
+                seen.add(key)
+                found = walk(value_node, f"{path}.{key}" if path else key)
+                if found is not None:
+                    return found
+        elif isinstance(node, yaml.SequenceNode):
+            for i, item in enumerate(node.value):
+                found = walk(item, f"{path}[{i}]")
+                if found is not None:
+                    return found
+        return None
+
+    root = yaml.compose(text, Loader=SafeLoader)
+    return None if root is None else walk(root, "")
+
+
 def read_yaml(source: Source) -> Any:
     """Parse a YAML file; a missing file or malformed YAML raises :class:`ConfigError`."""
     text = source.read_text()

@@ -110,6 +110,22 @@ def test_duplicate_link_name_is_refused(tmp_path: Path) -> None:
         load_machine(path)
 
 
+def test_a_duplicate_key_is_named_with_its_file_line_and_mapping(tmp_path: Path) -> None:
+    """The one line names the file, the key's line and the dotted path of the mapping that holds it twice."""
+    text = (resources.files("hiab_sim") / "presets" / "exact_excavator.yaml").read_text(encoding="utf-8")
+    duplicated = text.replace("  arm:\n    parent: boom", "  boom:\n    parent: boom", 1)
+    line = duplicated.splitlines().index("  boom:", duplicated.splitlines().index("  boom:") + 1) + 1
+    path = tmp_path / "dup.yaml"
+    path.write_text(duplicated, encoding="utf-8")
+    with pytest.raises(ConfigError) as caught:
+        load_machine(path)
+    assert str(caught.value) == f"{path}: line {line}: duplicate name 'boom' in links"
+    nested = text.replace("    parent: boom\n", "    parent: boom\n    parent: boom\n", 1)
+    path.write_text(nested, encoding="utf-8")
+    with pytest.raises(ConfigError, match=r"dup\.yaml: line \d+: duplicate name 'parent' in links\.\w+$"):
+        load_machine(path)
+
+
 def test_missing_file_and_unknown_preset_are_config_errors(tmp_path: Path) -> None:
     """A path that does not exist and a name that is not shipped are one-line ConfigErrors."""
     for source in (str(tmp_path / "nope.yaml"), "no_such_machine"):

@@ -17,6 +17,7 @@ from machine_result_helper import EXCAVATOR_STUDY, joint_csv
 
 from hiab_sim.errors import ConfigError, InvalidInputError
 from hiab_sim.study.nlp.problem import StudyProblem
+from hiab_sim.study.nlp.task_setup import start_error
 from hiab_sim.study.spec.study_file import load_study, study_from_dict
 
 REPO = Path(__file__).resolve().parents[1]
@@ -174,6 +175,54 @@ def test_machine_study_refuses_what_it_cannot_take_with_one_line(tmp_path: Path)
         study_from_dict({**base, "tracked": ["theta9"]}, tmp_path / "s.yaml")
     with pytest.raises(ConfigError, match="'tracked' belongs to a machine file"):
         study_from_dict({"crane": "xs031", "tracked": ["xt2"], "bounds": {}}, tmp_path / "s.yaml")
+
+
+def test_a_reference_inside_the_id_slack_is_refused_naming_the_reference_not_the_start(tmp_path: Path) -> None:
+    """working_range: machine: the reference must keep ID_SLACK from the range's ends; the error says so.
+
+    alpha's range is [-0.4737, 1.0923] rad: a move to 1.08 rad lies in it (as the CSV check sees) but
+    within the inverse dynamics' 0.02 rad margin, so the optimiser refuses it, naming the task's file
+    and joint, never ``initial_lengths`` or a crane.
+    """
+    joint_csv(tmp_path / "move.csv", ("alpha", "beta", "gamma"), [0.0, -1.8, -1.0], [1.08, -1.3, -0.3], 4.0)
+    bounds = {"joint_velocity": [0.6, 0.6, 1.0], "working_range": "machine"}
+    study = _study(tmp_path, {**EXCAVATOR_STUDY, "bounds": bounds})
+    with pytest.raises(InvalidInputError) as caught:
+        StudyProblem(study)  # type: ignore[arg-type]
+    message = str(caught.value)
+    assert message.startswith("tasks[0] (move).reference (")
+    assert "move.csv) at t = " in message and "joint alpha = " in message
+    assert "must lie in [-0.4537, 1.0723] rad, the machine's range [-0.4737, 1.0923] rad less 0.02 rad" in message
+    assert "initial_lengths" not in message and "crane" not in message and "\n" not in message
+    # the same move with the margin dropped (working_range: reference) is a valid problem
+    reference = _study(tmp_path, {**EXCAVATOR_STUDY, "bounds": {**bounds, "working_range": "reference"}})
+    assert StudyProblem(reference).n_xi == 9  # type: ignore[arg-type]
+
+
+def test_a_start_the_inverse_dynamics_refuses_is_called_a_machine_on_a_machine_file(excavator: StudyProblem) -> None:
+    error = InvalidInputError("alpha", 1.2, "must lie in [0, 1]", "rad")
+    on_machine = str(start_error(error, "initial_lengths", excavator.model))
+    assert (
+        on_machine
+        == "initial_lengths (alpha) = 1.2 rad is out of range: the start is not an admissible machine: "
+        + ("must lie in [0, 1]")
+    )
+    crane = load_study(REPO / "optimize" / "xs031_spiral.yaml").model
+    assert "not an admissible crane: " in str(start_error(error, "initial_lengths", crane))
+
+
+def test_an_out_of_reach_csv_reference_is_named_by_its_task_file_row_and_columns(tmp_path: Path) -> None:
+    """The one line the duty-cycle tutorial promises: the task, the file, the row and the columns, said once."""
+    rows = [f"{t:.1f},50.0,0.5,-1.0" for t in np.linspace(0.0, 4.0, 41)]
+    (tmp_path / "far.csv").write_text("# far away\nt,x,y,tcp_angle\n" + "\n".join(rows) + "\n", encoding="utf-8")
+    task = {"name": "move", "weight": 1, "reference": {"kind": "csv", "file": "far.csv"}}
+    study = _study(tmp_path, {**EXCAVATOR_STUDY, "tasks": [task]})
+    with pytest.raises(InvalidInputError) as caught:
+        StudyProblem(study)  # type: ignore[arg-type]
+    message = str(caught.value)
+    assert message.startswith("tasks[0] (move).reference: ")
+    assert "far.csv row 3 (t = 0 s), columns x, y, tcp_angle = 'TCP (50, 0.5) m with tcp_angle = -1 rad'" in message
+    assert "out of the machine's reach" in message and "out of range: is out of" not in message
 
 
 def test_shipped_digging_study_cuts_soil_at_the_tip() -> None:

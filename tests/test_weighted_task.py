@@ -56,3 +56,27 @@ def test_closed_loop_of_one_weighted_task_is_compared_with_its_own_cycle(
     entry = report["tasks"][0]["designs"]["optimal"]
     assert entry["predicted_net_electrical_energy_J"] == planned
     assert entry["net_electrical_energy_J"] == pytest.approx(planned, rel=0.01)
+
+
+def test_one_weighted_tasks_energy_line_says_it_is_w_times_a_cycle_and_gives_the_cycle(weighted_run: Path) -> None:
+    """The summary's energy line calls the top-level number weight x the cycle (per hour) and prints the cycle too."""
+    from hiab_sim.study.report.energy_section import energy_lines
+    from hiab_sim.study.report.summary import before_after, energy_line
+
+    result = read_result(weighted_run)
+    task = result.tasks[0]  # type: ignore[index]
+    line = energy_line(result)
+    assert f"weight 20 x the energy per cycle of task '{task.name}'" in line and "per hour" in line
+    assert "the tasks' weighted sum of each task's energy" not in line
+    if result.energy is not None and task.energy is not None:
+        cycle = before_after(task.energy.initial.battery_energy_J, task.energy.optimal.battery_energy_J)
+        assert "the tasks' weighted sum" in energy_lines(result)[1]
+    else:
+        cycle = before_after(task.initial.net_electrical_energy_J, task.optimal.net_electrical_energy_J)
+    assert line.endswith(f"; per cycle: {cycle}.")
+
+
+def test_a_crane_files_task_result_says_how_its_telescope_is_set(weighted_run: Path) -> None:
+    from hiab_sim.study.report.weighted import TELESCOPE
+
+    assert read_result(weighted_run).tasks[0].telescope == TELESCOPE  # type: ignore[index]

@@ -26,7 +26,7 @@ from hiab_sim.machine.description import Link, Machine
 from hiab_sim.machine.kinematics.assembly import check_machine
 from hiab_sim.machine.parts import IDENTITY, Matrix3, Pose, RigidBody, Vector3, rot_z
 from hiab_sim.resources import Source, locate, shipped_names
-from hiab_sim.yaml_fields import SafeLoader, integer, mapping, number, parse_yaml, text, vector
+from hiab_sim.yaml_fields import SafeLoader, duplicate_key, integer, mapping, number, parse_yaml, text, vector
 
 #: Shipped machines' names (files in hiab_sim/presets/, :mod:`hiab_sim.resources` kind ``machine``).
 PRESETS: tuple[str, ...] = tuple(shipped_names("machine"))
@@ -60,11 +60,19 @@ _UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG,
 
 
 def read_machine_yaml(source: Source) -> Any:
-    """Parse a machine file; malformed YAML or a duplicate key raises :class:`ConfigError`."""
+    """Parse a machine file; malformed YAML or a duplicate key raises :class:`ConfigError` naming the file."""
+    text = source.read_text()
     try:
-        return parse_yaml(source.read_text(), _UniqueKeyLoader)
+        return parse_yaml(text, _UniqueKeyLoader)
     except yaml.YAMLError as error:
         raise ConfigError(f"{source.label}: not valid YAML: {' '.join(str(error).split())}") from None
+    except ConfigError as error:  # a duplicate key: name the file and the mapping that holds it
+        found = duplicate_key(text)
+        if found is None:
+            raise ConfigError(f"{source.label}: {error}") from None
+        line, path, key = found
+        where = f" in {path}" if path else " at the top level"
+        raise ConfigError(f"{source.label}: line {line}: duplicate name {key!r}{where}") from None
 
 
 def load_machine(source: str | Path | Source = "xs031", *, check_assembly: bool = True) -> Machine:

@@ -263,7 +263,10 @@ class TaskResult:
 
     Written by :func:`hiab_sim.study.report.result_folder.build_result`.
 
-    ``telescope`` says how the crane's redundancy is set for the task (prescribed by the reference).
+    ``telescope`` says how the crane's redundancy is set for the task (prescribed by the reference); None
+    (absent) for a machine file's study, which has no telescope (its tracked coordinates are the
+    reference's columns; each one's error is in ``tracking_error.tracked``). Files before this rule
+    hold the crane's text for a machine file too.
     """
 
     name: str
@@ -271,12 +274,12 @@ class TaskResult:
     kind: str
     duration_s: float
     payload_kg: float
-    telescope: str
     spline_control_points: int
     collocation_points: int
     initial: DesignSummary
     optimal: DesignSummary
     recheck: Recheck
+    telescope: str | None = optional()  # the crane's telescope: how the reference sets it; None on a machine file
     energy: EnergyReport | None = optional()  # battery energy, costf2, thermal at the study's duty
     structure: StructureSummary | None = optional()  # the task's own pin loads, buckling, natural frequencies
 

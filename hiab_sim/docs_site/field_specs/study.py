@@ -267,9 +267,9 @@ def study_keys() -> list[Key]:
             "each joint's working range in the machine file); `reference`: only the reference's. With `crane` "
             "or `machine` the inverse dynamics takes each triangle or linkage chain's joint (the crane's lift and "
             "tilt) only within that range narrowed by 0.02 rad at both ends (`ID_SLACK` in "
-            "`hiab_sim/study/nlp/task_problem.py`), so that the line search's trial points stay evaluable: a "
-            "reference that brings such a joint within 0.02 rad of its range's end is refused at the start (a "
-            "`direct` chain's joint is not narrowed).",
+            "`hiab_sim/study/nlp/task_setup.py`), so that the line search's trial points stay evaluable: a "
+            "reference that brings such a joint within 0.02 rad of its range's end is refused when the optimiser "
+            "starts, naming the task, its file, the time and the joint (a `direct` chain's joint is not narrowed).",
             default=bounds["working_range"]["default"],
             allowed=bounds["working_range"]["allowed"],
         ),

@@ -319,11 +319,11 @@ def inverse_kinematics(
                 break
             jac = s.d_position[0, :, :n]
             if abs(np.linalg.det(jac)) < SINGULAR_DET:
-                raise InvalidInputError("reference", _point(kin, i, target), "reaches a singular pose")
+                raise InvalidInputError("reference", _point(kin, i, target), "must not be a singular pose")
             current = current - np.clip(np.linalg.solve(jac, residual), -STEP_CLIP, STEP_CLIP)
         else:
             raise InvalidInputError(
-                "reference", _point(kin, i, target), "is out of reach (inverse kinematics did not converge)"
+                "reference", _point(kin, i, target), "must be within reach (the inverse kinematics did not converge)"
             )
         q[i] = current
     zero = np.zeros((n_t, n))
@@ -332,7 +332,7 @@ def inverse_kinematics(
     singular = np.flatnonzero(np.abs(np.linalg.det(jac)) < SINGULAR_DET)
     if singular.size:
         i = int(singular[0])
-        raise InvalidInputError("reference", _point(kin, i, ref[0][i]), "reaches a singular pose")
+        raise InvalidInputError("reference", _point(kin, i, ref[0][i]), "must not be a singular pose")
     dq = np.asarray(np.linalg.solve(jac, ref[1][..., None])[..., 0], dtype=float)
     s1 = kin.samples(q, dq, zero)
     ddq = np.asarray(np.linalg.solve(jac, (ref[2] - s1.acceleration)[..., None])[..., 0], dtype=float)

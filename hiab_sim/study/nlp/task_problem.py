@@ -70,8 +70,13 @@ from hiab_sim.study.nlp.interface import (
     ScaledProblem,
 )
 from hiab_sim.study.nlp.objectives import make_objective
-from hiab_sim.study.nlp.task_setup import duty_options, working_range
-from hiab_sim.study.references.kinds import ik_start
+from hiab_sim.study.nlp.task_setup import (
+    check_reference_ranges,
+    duty_options,
+    reference_joints,
+    served_ranges,
+    start_error,
+)
 from hiab_sim.study.spec.study_file import Study
 from hiab_sim.study.spec.tasks import Task
 
@@ -80,8 +85,6 @@ XI_SCALE = 1.0
 #: Scale of the spline-coefficient variables [rad or m per unit] (chosen for fast SQP convergence).
 C_SCALE = 0.1
 STROKE_SCALE = bl.STROKE_SCALE
-#: The ID's input check uses the working range shrunk by this much at both ends [rad].
-ID_SLACK = 0.02
 #: The optimiser (``tightened``) holds const_j at the ends of the working range with this clearance [m] (its
 #: optimum passes the exact stroke check despite SLSQP's round-off); the solver's rows only: start checks and
 #: reported violations (:meth:`TaskProblem.margins`) use the nominal const_j (the built machine: violation ~0).
@@ -165,25 +168,17 @@ class TaskProblem(ScaledProblem):
         self.q_path = "analytic" if joint == "analytic" else self.id_path
         # initial fit: inverse kinematics on the fine grid, least-squares spline at rest at both ends
         fine_ref = task.reference.sample(self.kin, self.fine_times())
-        ik = model.inverse_kinematics(fine_ref, ik_start(task.reference, model, fine_ref))
+        ik = reference_joints(study, task, fine_ref)
         self.reference_joints = ik
         self.c_ref = tr.fit_coefficients(self.basis, ik)
         # const_h with const_k: the machine's joint range and a triangle's hinge-angle margin (q only)
         self.theta_low, self.theta_up = model.joint_bounds(study.bounds.triangle_margin)
-        # working range the design must serve (const_j at its ends): the crane's full joint range
-        # (so the redesigned crane keeps its workspace, as every ID path's input check demands) or
-        # the reference's range widened by a margin. The ID sees a slightly narrower range, so trial
-        # points of the line search that violate const_j by a second-order amount stay evaluable.
-        wr_margin = study.bounds.working_margin
-        if study.bounds.working_range in ("crane", "machine"):
-            ranges = model.joint_ranges()
-            self.working = tuple(ranges[j] for j in model.stroke_joints)
-            inner = tuple((lo + ID_SLACK, hi - ID_SLACK) for lo, hi in self.working)
-        else:
-            self.working = working_range(model, ik.position, wr_margin)
-            inner = working_range(model, ik.position, 0.5 * wr_margin)
+        # working range the design must serve (const_j at its ends) and the narrower one the ID sees
+        self.working, inner = served_ranges(study, ik.position)
         #: the machine the inverse dynamics and the rows see: its stroke chains' ranges narrowed to ``inner``
         self.model = model.with_stroke_ranges(inner)
+        check_reference_ranges(study, task, self.model, ik.position, ik.time)
+        check_reference_ranges(study, task, self.model, self.B[0] @ self.c_ref.T, self.times, ", its spline fit,")
         self.n_xi = len(model.design_names)
         self.n_c = self.n_joints * self.basis.n
         self.n = self.n_xi + self.n_c
@@ -211,11 +206,7 @@ class TaskProblem(ScaledProblem):
             try:
                 cost_scale = self.evaluate(self.initial_point(study.initial_lengths)).cost
             except InvalidInputError as error:
-                raise InvalidInputError(
-                    f"initial_lengths ({error.field})",
-                    error.value,
-                    f"the start is not an admissible crane: {error.allowed}",
-                ) from None
+                raise start_error(error, "initial_lengths", model) from None
         self.cost_scale = max(abs(float(cost_scale)), 1e-300)  # |f0|: a battery energy may be negative (recovered)
 
     def fine_times(self) -> Array:

@@ -231,14 +231,9 @@ class CsvReference:
         tab, data = self.table, self._data()
         t = tab.values[:, tab.columns.index("t")]
         if self.form == "tcp":
-            reach = model.reach(data)
-            if np.any(reach.status):
-                i = int(np.argmax(reach.status != 0))
-                raise InvalidInputError(
-                    f"{tab.path} row {tab.lines[i]} (t = {t[i]:.6g} s)",
-                    describe_point(model, data[i]),
-                    f"the point {reach.reasons[int(reach.status[i])]}",
-                )
+            error = self.row_reach_error(model, out_of_reach_only=False)
+            if error is not None:
+                raise error
         else:
             ranges = model.joint_ranges()
             units = model.joint_units
@@ -253,6 +248,35 @@ class CsvReference:
                         units[j],
                     )
         check_workspace(model, self.sample(kin, dense_times(self.duration)), where=f"{tab.path} fit")
+
+    def row_reach_error(self, model: StudyMachine, out_of_reach_only: bool = True) -> InvalidInputError | None:
+        """The error naming the file, row, time and columns of the first TCP-form row the machine cannot reach.
+
+        ``out_of_reach_only``: only a row its inverse kinematics cannot reach at all (reason 1 of
+        :meth:`~hiab_sim.study.machines.protocol.StudyMachine.reach`); else also one needing a joint
+        outside its range or a stroke outside [0, stroke]. None when every row passes, or for a joint-form file.
+        """
+        if self.form != "tcp":
+            return None
+        tab, data = self.table, self._data()
+        start, size = 0, 1
+        while True:  # blocks of doubling size: an unreachable row costs a grid of IK starts, so stop at the first
+            if start >= len(data):
+                return None
+            reach = model.reach(data[start : start + size])
+            bad = np.flatnonzero(reach.status == 1 if out_of_reach_only else reach.status != 0)
+            if len(bad):
+                break
+            start, size = start + size, 2 * size
+        i = start + int(bad[0])
+        status = int(reach.status[bad[0]])
+        t = tab.values[i, tab.columns.index("t")]
+        columns = ", ".join(c for c in self._fit_columns() if c in tab.columns)
+        return InvalidInputError(
+            f"{tab.path} row {tab.lines[i]} (t = {t:.6g} s), columns {columns}",
+            describe_point(model, data[i]),
+            f"the point {reach.reasons[status]}",
+        )
 
     @classmethod
     def from_mapping(cls, data: Any, where: str, folder: Path, names: ColumnNames) -> CsvReference:

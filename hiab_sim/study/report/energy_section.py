@@ -310,13 +310,15 @@ def energy_lines(r: Result) -> list[str]:
     e = r.energy
     if e is None:
         return []
+    # a mix's, or one task's of weight != 1: weighted sums (per hour for weights in cycles per hour)
+    summed = "" if not r.tasks else ", the tasks' weighted sum (weights in cycles per hour: per hour)"
     lines = [
         f"objective minimised: {e.objective}",
-        f"battery energy (the battery's, shared DC bus): initial {e.initial.battery_energy_J / 1e3:.4f} kJ, "
+        f"battery energy (the battery's, shared DC bus){summed}: initial {e.initial.battery_energy_J / 1e3:.4f} kJ, "
         f"optimal {e.optimal.battery_energy_J / 1e3:.4f} kJ (-{e.battery_energy_saved_percent:.2f} %); "
         f"costf2 (squared power, not an energy): initial {e.initial.costf2_W2s:.4e}, "
         f"optimal {e.optimal.costf2_W2s:.4e} W^2 s",
-        "drawn energy per actuator (no regeneration) at the optimum: "
+        f"drawn energy per actuator (no regeneration){summed} at the optimum: "
         + ", ".join(f"{k} {v / 1e3:.3f} kJ" for k, v in e.optimal.drawn_energy_J.items()),
     ]
     dd = e.optimal.duty

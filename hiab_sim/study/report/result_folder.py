@@ -118,7 +118,7 @@ def build_result(
                 kind=task.reference.kind,
                 duration_s=task.reference.duration,
                 payload_kg=task.payload.mass,
-                telescope=TELESCOPE,
+                telescope=TELESCOPE if problem.study.crane_description is not None else None,  # a machine: none
                 spline_control_points=p.basis.n,
                 collocation_points=len(p.times),
                 initial=designs["initial"],

@@ -132,7 +132,8 @@ def energy_line(r: Result) -> str:
 
     With the study's duty model the battery energy covers a duty period (the cycle and the rest that
     follows it); a study of several tasks reports the tasks' weighted sum (the study's weights, e.g.
-    cycles per hour: then J per hour).
+    cycles per hour: then J per hour), a study of one task of weight w != 1 w times its energy and the
+    task's own per cycle beside it [kJ in the line].
     """
     reports = [t.energy for t in r.tasks] if r.tasks else [r.energy]
     with_duty = any(e is not None and e.optimal.duty is not None for e in reports)
@@ -144,8 +145,21 @@ def energy_line(r: Result) -> str:
     else:
         before, after = r.initial.net_electrical_energy_J, r.optimal.net_electrical_energy_J
         where = NET_BOUNDARY
-    head = f"Energy, the tasks' weighted sum of each task's energy per {period}" if r.tasks else f"Energy per {period}"
-    return f"{head} {where}: {before_after(before, after)}."
+    if not r.tasks:
+        return f"Energy per {period} {where}: {before_after(before, after)}."
+    if len(r.tasks) > 1:
+        head = f"Energy, the tasks' weighted sum of their energies per {period} (weights in cycles per hour: per hour)"
+        return f"{head} {where}: {before_after(before, after)}."
+    task = r.tasks[0]
+    if task.energy is not None and r.energy is not None:
+        one = (task.energy.initial.battery_energy_J, task.energy.optimal.battery_energy_J)
+    else:
+        one = (task.initial.net_electrical_energy_J, task.optimal.net_electrical_energy_J)
+    head = (
+        f"Energy, weight {task.weight:g} x the energy per {period} of task '{task.name}' "
+        "(the weight in cycles per hour: per hour)"
+    )
+    return f"{head} {where}: {before_after(before, after)}; per {period}: {before_after(*one)}."
 
 
 def before_after(before: float, after: float, names: tuple[str, str] = ("before", "after")) -> str:

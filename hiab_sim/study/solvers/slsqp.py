@@ -29,6 +29,7 @@ from hiab_sim.errors import InvalidInputError, SolverError
 from hiab_sim.machine.design import MachineDesign
 from hiab_sim.results.design_values import DesignValues
 from hiab_sim.study.nlp.problem import StudyProblem
+from hiab_sim.study.nlp.task_setup import start_error
 from hiab_sim.study.solvers.single_solve import solve_once
 
 #: Largest violation [scaled units] of a nominal constraint (:meth:`TaskProblem.margins`) a start
@@ -71,9 +72,7 @@ def check_start(problem: StudyProblem, z: Array, label: str = "initial_lengths")
     try:
         ev = problem.evaluate(z)
     except InvalidInputError as error:
-        raise InvalidInputError(
-            f"{label} ({error.field})", error.value, f"the start is not an admissible crane: {error.allowed}"
-        ) from None
+        raise start_error(error, label, problem.model) from None
     margins = ev.constraints + problem.clearance
     worst = int(np.argmin(margins))
     if margins[worst] < -START_TOLERANCE:
