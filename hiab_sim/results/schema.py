@@ -113,13 +113,12 @@ class DesignSummary:
     ``collocation_cost_W2s`` and ``collocation_max_violation`` are set on the result's initial and
     optimal designs (the optimiser's grid), not on the other fine-grid checks.
 
-    ``net_electrical_energy_J``, the two drawn energies and each actuator's ``net_energy_J`` and
-    ``drawn_energy_J`` integrate the drive powers the optimiser uses, at the drives' inputs on the DC
-    side: the drive losses in their smooth forms and, with the study's duty model, the windings at
-    their periodic fixed-point temperature (hot). ``energy_breakdown_J`` and each actuator's
-    ``energy_J`` are exact at the reference (cold) winding resistance (:class:`EnergyBreakdown`), so
-    their ``electrical`` differs from ``net_electrical_energy_J`` by the hot windings' extra copper
-    loss and the smoothing. The battery's energy is the ``energy`` section's.
+    ``net_electrical_energy_J``, the drawn energies and each actuator's ``net_energy_J`` and ``drawn_energy_J``
+    integrate the optimiser's drive powers at the drives' DC inputs: smooth drive losses and, with the study's
+    duty model, the windings at their periodic fixed-point temperature (hot). ``energy_breakdown_J`` and each
+    actuator's ``energy_J`` are exact at the cold resistance (:class:`EnergyBreakdown`): their ``electrical``
+    differs from ``net_electrical_energy_J`` by the hot windings' copper and the smoothing. The battery's
+    energy is the ``energy`` section's.
     """
 
     lengths: DesignValues
