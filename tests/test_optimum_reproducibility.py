@@ -44,3 +44,12 @@ def test_the_machine_file_moves_an_optimum_no_more_than_three_times_one_ulp_of_g
         assert machine <= 3.0 * max(ulp, 1e-15), name
         if ulp < 1e-12:
             assert machine < 1e-12 and runs["machine"]["iterations"] == runs["crane"]["iterations"], name
+
+
+def test_the_readme_claim_on_the_default_study_through_the_machine_file_holds() -> None:
+    """The README: the default study through the machine file reaches the crane file's optimum within 1e-8 m."""
+    runs = RECORDED["xs031_spiral"]
+    machine, _ = SCRIPT.change(runs["machine"], runs["crane"])
+    assert machine <= 1e-8 and runs["machine"]["iterations"] == runs["crane"]["iterations"]
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    assert f"optimum (lengths within 1e-8 m, the same {runs['crane']['iterations']} iterations)" in readme

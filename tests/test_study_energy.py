@@ -188,10 +188,10 @@ def test_negative_thermal_resistance_in_the_emla_file_exits_2(
 
     text = locate("default", "emla").read_bytes().decode()
     emla = tmp_path / "emla.yaml"
-    emla.write_text(text.replace("value: 0.6865", "value: -0.6865"))
+    emla.write_text(text.replace("value: 0.4665", "value: -0.4665"))
     study = write_study(tmp_path, small_study(emla=str(emla)))
     assert main(["optimize", str(study), "--out", str(tmp_path / "out"), *FLAGS]) == 2
-    assert "thermal.thermal_resistance = -0.6865" in capsys.readouterr().err
+    assert "thermal.thermal_resistance = -0.4665" in capsys.readouterr().err
     with pytest.raises(InvalidInputError, match="thermal_resistance"):
         study_from_dict(small_study(emla=str(emla)), tmp_path / "s.yaml")
 
