@@ -9,7 +9,7 @@ Four functions cover what the CLI does for a study, with typed values instead of
     e = hs.evaluate(study, lengths, trajectory="fixed")  # or "reoptimize", or "optimum" with result="runs/x"
     r = hs.read_result("runs/x")
 
-*Evaluating a design* means one of two things, named by ``trajectory``:
+*Evaluating a design* means one of three things, named by ``trajectory``:
 
 * ``"fixed"``: the study's own start trajectory for that design, the inverse-kinematics fit of the
   reference at the design's lengths (what ``optimize`` starts from): how the design does on the
@@ -22,7 +22,7 @@ Four functions cover what the CLI does for a study, with typed values instead of
   lengths: how another design (a rounded one, a pivot moved) does on the motion planned for the
   optimum. At the optimum's own lengths it gives ``result.json``'s optimal design.
 
-Either way every task of the study is evaluated on its fine grid with nominal bands (the
+Each way every task of the study is evaluated on its fine grid with nominal bands (the
 re-check's grid), so the numbers are those ``result.json`` reports for its designs. Whether a
 design is buildable within the manufacturing tolerance is ``result.buildable`` of an optimisation,
 not an evaluation of a single design.
@@ -49,7 +49,7 @@ from hiab_sim.study.spec.study_file import Study, load_study
 
 __all__ = ["DesignEvaluation", "TaskEvaluation", "evaluate", "load_study", "optimize", "read_result"]
 
-#: The two meanings of evaluating a design (module docstring).
+#: The three meanings of evaluating a design (module docstring).
 TRAJECTORIES = ("fixed", "reoptimize", "optimum")
 #: Largest scaled constraint violation at which a design serves a task (the solvers' tolerance).
 FEASIBLE = 1e-6

@@ -1,4 +1,4 @@
-"""The Python API: the README's example runs as written; evaluate's two meanings; bad input names its field."""
+"""The Python API: the README's example runs as written; evaluate's three meanings; bad input names its field."""
 
 from __future__ import annotations
 
