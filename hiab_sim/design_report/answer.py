@@ -201,14 +201,27 @@ def energies(result: Result, folder: Path) -> str:
                     f"{change_percent(di.cycle_battery_energy_J, do.cycle_battery_energy_J):+.2f} %",
                 )
             )
-    rows += [
+    rows.append(
         (
             "net electrical energy",
             "motor terminals, summed over the drives (regeneration credited)",
             num(i.net_electrical_energy_J, ".1f", "J"),
             num(o.net_electrical_energy_J, ".1f", "J"),
             f"{-saved:+.2f} %",
-        ),
+        )
+    )
+    if result.buildable is not None:  # the answer builds the rounded design; its energy is not the optimum's
+        b = result.buildable
+        rows.append(
+            (
+                "net electrical energy of the rounded design to build",
+                f"motor terminals, the optimal trajectory at the rounded lengths ({b.recheck_id_path} ID path)",
+                num(i.net_electrical_energy_J, ".1f", "J"),
+                num(b.net_electrical_energy_J, ".1f", "J"),
+                f"{change_percent(i.net_electrical_energy_J, b.net_electrical_energy_J):+.2f} %",
+            )
+        )
+    rows += [
         (
             "energy drawn, summed power",
             "motor terminals, positive part of the summed power",
@@ -231,18 +244,6 @@ def energies(result: Result, folder: Path) -> str:
             "",
         ),
     ]
-    if result.buildable is not None:  # the answer builds the rounded design; its energy is not the optimum's
-        b = result.buildable
-        rows.insert(
-            rows.index(next(r for r in rows if r[0] == "net electrical energy")) + 1,
-            (
-                "net electrical energy of the rounded design to build",
-                f"motor terminals, the optimal trajectory at the rounded lengths ({b.recheck_id_path} ID path)",
-                num(i.net_electrical_energy_J, ".1f", "J"),
-                num(b.net_electrical_energy_J, ".1f", "J"),
-                f"{change_percent(i.net_electrical_energy_J, b.net_electrical_energy_J):+.2f} %",
-            ),
-        )
     d = result.improvement.decomposition
     note = ""
     if d.from_lengths_J is not None and d.from_trajectory_J is not None:
